@@ -1,0 +1,496 @@
+//! Objects, composite objects, materials, lights and camera: the validated scene.
+//!
+//! A [`SceneBuilder`] takes raw descriptions in `f64` (from the text parser or from code),
+//! validates each one (finite numbers, invertible transforms, coordinates within the
+//! scalar's range, capacities) and converts it to the tracer's scalar. The resulting
+//! [`Scene`] is what the accelerators and the tracer trust. Object storage is a caller-provided
+//! slice, so the capacity is the caller's choice and running out is an ordinary error.
+
+use crate::math::{Aabb, Affine, Ray, Vec3};
+use crate::scalar::Real;
+use crate::shape::Shape;
+use core::fmt;
+use heapless::Vec;
+
+/// Most materials a scene may define.
+pub const MAX_MATERIALS: usize = 16;
+/// Most lights a scene may define.
+pub const MAX_LIGHTS: usize = 4;
+/// Most composite objects (each gets a sub-lattice).
+pub const MAX_GROUPS: usize = 32;
+/// The group index of an object that belongs to no composite.
+pub const NO_GROUP: u16 = u16::MAX;
+
+/// A gray, wavelength-independent surface in the paper's terms (eq. 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material<R> {
+    /// Ambient coefficient `Ka` (multiplies the scene's `Ia`).
+    pub ka: R,
+    /// Diffuse coefficient `Kd`.
+    pub kd: R,
+    /// Mirror-reflection coefficient `Ks` (weight of `S`).
+    pub ks: R,
+    /// Transmission coefficient `Kt` (weight of `T`).
+    pub kt: R,
+    /// Index of refraction of the inside.
+    pub ior: R,
+}
+
+impl Material<f64> {
+    /// The material objects get when none is named: matte gray.
+    pub const DEFAULT: Self = Material { ka: 0.2, kd: 0.8, ks: 0.0, kt: 0.0, ior: 1.0 };
+}
+
+/// A light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light<R> {
+    /// The paper's planar light at infinite distance.
+    Directional {
+        /// Unit vector from the surface towards the light.
+        to_light: Vec3<R>,
+        /// Intensity `Ip`.
+        intensity: R,
+    },
+    /// A point light.
+    Point {
+        /// Position.
+        pos: Vec3<R>,
+        /// Intensity `Ip`.
+        intensity: R,
+    },
+}
+
+/// The camera as given in a scene (eye, look-at, up, field of view in degrees).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    /// Viewpoint `V`.
+    pub eye: Vec3<f64>,
+    /// Point looked at.
+    pub look: Vec3<f64>,
+    /// Up direction.
+    pub up: Vec3<f64>,
+    /// Horizontal and vertical field of view in degrees (the paper: 40 x 25).
+    pub fov: (f64, f64),
+}
+
+impl Default for CameraDesc {
+    fn default() -> Self {
+        CameraDesc {
+            eye: Vec3::new(0.0, 0.0, -10.0),
+            look: Vec3::zero(),
+            up: Vec3::new(0.0, 1.0, 0.0),
+            fov: (40.0, 25.0),
+        }
+    }
+}
+
+/// The camera reduced to what eye rays need.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera<R> {
+    /// Viewpoint.
+    pub eye: Vec3<R>,
+    /// Unit view direction.
+    pub forward: Vec3<R>,
+    /// Right vector scaled by `tan(fov_x / 2)`.
+    pub right: Vec3<R>,
+    /// Up vector scaled by `tan(fov_y / 2)`.
+    pub up: Vec3<R>,
+}
+
+impl<R: Real> Camera<R> {
+    /// The eye ray through the point `(sx, sy)` of a `w x h` window, in pixel units from the
+    /// top-left corner (pixel centres are at `i + 0.5`).
+    pub fn ray(&self, sx2: i32, sy2: i32, w2: i32, h2: i32) -> Ray<R> {
+        // Arguments are doubled coordinates so that pixel centres stay integers.
+        let u = R::from_i32(2 * sx2 - w2) / R::from_i32(w2);
+        let v = R::from_i32(h2 - 2 * sy2) / R::from_i32(h2);
+        Ray::new(self.eye, self.forward + self.right * u + self.up * v)
+    }
+}
+
+/// One primitive placed in the world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Object<R> {
+    /// The canonical primitive.
+    pub shape: Shape<R>,
+    /// World-to-object transform (the inverse of the placement).
+    pub to_object: Affine<R>,
+    /// Index into the scene's materials.
+    pub material: u8,
+    /// Composite object it belongs to, or [`NO_GROUP`].
+    pub group: u16,
+    /// World-space bounding box, padded for the scalar's rounding.
+    pub bounds: Aabb<R>,
+}
+
+impl<R: Real> Object<R> {
+    /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` and the object-space normal.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
+        self.shape.intersect(&self.to_object.ray(ray), tmin, tmax)
+    }
+    /// Unit world-space normal from an object-space normal (inverse-transpose rule).
+    pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
+        self.to_object.transpose_vector(n_obj).normalize()
+    }
+}
+
+/// A composite object: a contiguous run of objects with a common box (gets a sub-lattice).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Group<R> {
+    /// Index of its first object.
+    pub first: u16,
+    /// Number of objects.
+    pub len: u16,
+    /// Union of its objects' boxes.
+    pub bounds: Aabb<R>,
+}
+
+/// Why a scene was refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SceneError {
+    /// More objects than the storage holds.
+    TooManyObjects {
+        /// Objects the storage holds.
+        capacity: usize,
+    },
+    /// More than [`MAX_MATERIALS`] materials.
+    TooManyMaterials,
+    /// More than [`MAX_LIGHTS`] lights.
+    TooManyLights,
+    /// More than [`MAX_GROUPS`] composite objects.
+    TooManyGroups,
+    /// A composite inside a composite.
+    NestedGroup,
+    /// `end` with no open composite.
+    EndWithoutGroup,
+    /// The file ended inside a composite.
+    UnclosedGroup,
+    /// A composite with no objects.
+    EmptyGroup,
+    /// A transform that flattens space (zero or near-zero scale).
+    SingularTransform,
+    /// A NaN or infinite number.
+    NotFinite,
+    /// A coordinate beyond what the scalar can represent safely.
+    OutOfRange {
+        /// The largest magnitude allowed.
+        limit: f64,
+        /// The scalar's name.
+        scalar: &'static str,
+    },
+    /// A size that must be positive is not (radius, height, box extent).
+    NonPositiveSize,
+    /// A material coefficient below zero, or an index of refraction below 1.
+    BadCoefficient,
+    /// A camera whose view direction is zero or parallel to its up vector.
+    DegenerateCamera,
+    /// A field of view outside `(0, 180)` degrees.
+    BadFieldOfView,
+    /// A light with a zero direction.
+    DegenerateLight,
+    /// The scene has no objects.
+    NoObjects,
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SceneError::TooManyObjects { capacity } => {
+                write!(f, "too many objects: the object storage holds {capacity}")
+            }
+            SceneError::TooManyMaterials => write!(f, "too many materials (at most {MAX_MATERIALS})"),
+            SceneError::TooManyLights => write!(f, "too many lights (at most {MAX_LIGHTS})"),
+            SceneError::TooManyGroups => write!(f, "too many composite objects (at most {MAX_GROUPS})"),
+            SceneError::NestedGroup => write!(f, "a group cannot be opened inside another group"),
+            SceneError::EndWithoutGroup => write!(f, "`end` without an open group"),
+            SceneError::UnclosedGroup => write!(f, "group not closed with `end`"),
+            SceneError::EmptyGroup => write!(f, "group has no objects"),
+            SceneError::SingularTransform => write!(f, "transform is singular (zero or near-zero scale)"),
+            SceneError::NotFinite => write!(f, "number is not finite"),
+            SceneError::OutOfRange { limit, scalar } => {
+                write!(f, "coordinate out of range for {scalar}: magnitude must stay below {limit:e}")
+            }
+            SceneError::NonPositiveSize => write!(f, "size must be positive"),
+            SceneError::BadCoefficient => {
+                write!(f, "coefficients must be >= 0 and the index of refraction >= 1")
+            }
+            SceneError::DegenerateCamera => {
+                write!(f, "camera looks nowhere or straight along its up vector")
+            }
+            SceneError::BadFieldOfView => write!(f, "field of view must be between 0 and 180 degrees"),
+            SceneError::DegenerateLight => write!(f, "light direction is zero"),
+            SceneError::NoObjects => write!(f, "scene has no objects"),
+        }
+    }
+}
+
+impl core::error::Error for SceneError {}
+
+/// A validated scene, ready to trace.
+#[derive(Debug)]
+pub struct Scene<'a, R> {
+    /// All primitives; the objects of a composite are contiguous.
+    pub objects: &'a [Object<R>],
+    /// Composite objects.
+    pub groups: Vec<Group<R>, MAX_GROUPS>,
+    /// Materials.
+    pub materials: Vec<Material<R>, MAX_MATERIALS>,
+    /// Lights.
+    pub lights: Vec<Light<R>, MAX_LIGHTS>,
+    /// Ambient intensity `Ia`.
+    pub ambient: R,
+    /// Gray of rays that hit nothing (0 black .. 1 white).
+    pub background: R,
+    /// Camera.
+    pub camera: Camera<R>,
+    /// Maximum depth of the intersection tree (0: eye rays only).
+    pub max_depth: u8,
+    /// Box holding the viewpoint and every object (the paper's world range).
+    pub world: Aabb<R>,
+}
+
+/// Builds and validates a [`Scene`] into caller-provided object storage.
+#[derive(Debug)]
+pub struct SceneBuilder<'a, R> {
+    storage: &'a mut [Object<R>],
+    len: usize,
+    groups: Vec<Group<R>, MAX_GROUPS>,
+    materials: Vec<Material<R>, MAX_MATERIALS>,
+    lights: Vec<Light<R>, MAX_LIGHTS>,
+    open_group: Option<(usize, Affine<f64>, Aabb<f64>)>,
+    /// Ambient intensity `Ia`.
+    pub ambient: f64,
+    /// Background gray.
+    pub background: f64,
+    /// Camera description.
+    pub camera: CameraDesc,
+    /// Maximum depth of the intersection tree.
+    pub max_depth: u8,
+}
+
+fn check_finite(vals: &[f64]) -> Result<(), SceneError> {
+    if vals.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SceneError::NotFinite)
+    }
+}
+
+fn check_range<R: Real>(v: Vec3<f64>) -> Result<(), SceneError> {
+    check_finite(&[v.x, v.y, v.z])?;
+    if v.max_abs() < R::LIMIT {
+        Ok(())
+    } else {
+        Err(SceneError::OutOfRange { limit: R::LIMIT, scalar: R::NAME })
+    }
+}
+
+impl<'a, R: Real> SceneBuilder<'a, R> {
+    /// A builder storing objects in `storage` (its length is the object capacity).
+    pub fn new(storage: &'a mut [Object<R>]) -> Self {
+        SceneBuilder {
+            storage,
+            len: 0,
+            groups: Vec::new(),
+            materials: Vec::new(),
+            lights: Vec::new(),
+            open_group: None,
+            ambient: 0.2,
+            background: 0.0,
+            camera: CameraDesc::default(),
+            max_depth: 5,
+        }
+    }
+
+    /// Number of objects so far.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether no object was added yet.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Adds a material and returns its index.
+    pub fn add_material(&mut self, m: Material<f64>) -> Result<u8, SceneError> {
+        check_finite(&[m.ka, m.kd, m.ks, m.kt, m.ior])?;
+        if m.ka < 0.0 || m.kd < 0.0 || m.ks < 0.0 || m.kt < 0.0 || m.ior < 1.0 {
+            return Err(SceneError::BadCoefficient);
+        }
+        let f = R::from_f64;
+        let conv = Material { ka: f(m.ka), kd: f(m.kd), ks: f(m.ks), kt: f(m.kt), ior: f(m.ior) };
+        self.materials.push(conv).map_err(|_| SceneError::TooManyMaterials)?;
+        Ok((self.materials.len() - 1) as u8)
+    }
+
+    /// Adds a light. A directional light's `dir` is the direction the light travels.
+    pub fn add_light(&mut self, l: Light<f64>) -> Result<(), SceneError> {
+        let conv = match l {
+            Light::Directional { to_light, intensity } => {
+                check_finite(&[to_light.x, to_light.y, to_light.z, intensity])?;
+                if to_light.max_abs() == 0.0 {
+                    return Err(SceneError::DegenerateLight);
+                }
+                Light::Directional { to_light: to_light.normalize().cast(), intensity: R::from_f64(intensity) }
+            }
+            Light::Point { pos, intensity } => {
+                check_range::<R>(pos)?;
+                check_finite(&[intensity])?;
+                Light::Point { pos: pos.cast(), intensity: R::from_f64(intensity) }
+            }
+        };
+        self.lights.push(conv).map_err(|_| SceneError::TooManyLights)
+    }
+
+    /// Opens a composite object placed by `t`; objects until [`SceneBuilder::end_group`] belong to it.
+    pub fn begin_group(&mut self, t: Affine<f64>) -> Result<(), SceneError> {
+        if self.open_group.is_some() {
+            return Err(SceneError::NestedGroup);
+        }
+        if self.groups.is_full() {
+            return Err(SceneError::TooManyGroups);
+        }
+        self.open_group = Some((self.len, t, Aabb::empty()));
+        Ok(())
+    }
+
+    /// Closes the open composite object.
+    pub fn end_group(&mut self) -> Result<(), SceneError> {
+        let (first, _, bounds) = self.open_group.take().ok_or(SceneError::EndWithoutGroup)?;
+        if self.len == first {
+            return Err(SceneError::EmptyGroup);
+        }
+        let g = Group { first: first as u16, len: (self.len - first) as u16, bounds: bounds.cast_padded() };
+        self.groups.push(g).map_err(|_| SceneError::TooManyGroups)
+    }
+
+    /// Adds a primitive placed by `to_world` (inside an open composite, the composite's
+    /// transform is applied after it).
+    pub fn add_object(&mut self, shape: Shape<f64>, to_world: Affine<f64>, material: u8) -> Result<(), SceneError> {
+        if self.len >= self.storage.len() || self.len >= NO_GROUP as usize {
+            return Err(SceneError::TooManyObjects { capacity: self.storage.len() });
+        }
+        let place = match &self.open_group {
+            Some((_, g, _)) => g.after(&to_world),
+            None => to_world,
+        };
+        for row in &place.m {
+            check_finite(row)?;
+        }
+        let top = match shape {
+            Shape::Cone { top } => top,
+            _ => 0.0,
+        };
+        check_finite(&[top])?;
+        if top < 0.0 {
+            return Err(SceneError::NonPositiveSize);
+        }
+        let inv = place.inverse().ok_or(SceneError::SingularTransform)?;
+        let bounds = world_bounds(&shape, &place);
+        check_range::<R>(bounds.min)?;
+        check_range::<R>(bounds.max)?;
+        let material = material.min(self.materials.len().saturating_sub(1) as u8);
+        if self.materials.is_empty() {
+            self.add_material(Material::DEFAULT)?;
+        }
+        let group = match &mut self.open_group {
+            Some((_, _, gb)) => {
+                *gb = gb.union(&bounds);
+                self.groups.len() as u16
+            }
+            None => NO_GROUP,
+        };
+        let shape = match shape {
+            Shape::Sphere => Shape::Sphere,
+            Shape::Cylinder => Shape::Cylinder,
+            Shape::Cone { top } => Shape::Cone { top: R::from_f64(top) },
+            Shape::Box => Shape::Box,
+        };
+        self.storage[self.len] =
+            Object { shape, to_object: inv.cast(), material, group, bounds: bounds.cast_padded() };
+        self.len += 1;
+        Ok(())
+    }
+
+    /// Validates the whole and returns the scene.
+    pub fn finish(mut self) -> Result<Scene<'a, R>, SceneError> {
+        if self.open_group.is_some() {
+            return Err(SceneError::UnclosedGroup);
+        }
+        if self.len == 0 {
+            return Err(SceneError::NoObjects);
+        }
+        if self.materials.is_empty() {
+            self.add_material(Material::DEFAULT)?;
+        }
+        let c = self.camera;
+        check_range::<R>(c.eye)?;
+        check_range::<R>(c.look)?;
+        check_finite(&[c.up.x, c.up.y, c.up.z, c.fov.0, c.fov.1, self.ambient, self.background])?;
+        if !(c.fov.0 > 0.0 && c.fov.0 < 180.0 && c.fov.1 > 0.0 && c.fov.1 < 180.0) {
+            return Err(SceneError::BadFieldOfView);
+        }
+        let forward = (c.look - c.eye).normalize();
+        let right = forward.cross(c.up);
+        if forward.max_abs() == 0.0 || right.length() < 1e-9 * c.up.length() || c.up.max_abs() == 0.0 {
+            return Err(SceneError::DegenerateCamera);
+        }
+        // Left-handed like POV-Ray: x right, y up, z into the screen, so right = up x forward.
+        let right = -right.normalize();
+        let up = forward.cross(right).normalize();
+        let tx = libm::tan(c.fov.0.to_radians_core() / 2.0);
+        let ty = libm::tan(c.fov.1.to_radians_core() / 2.0);
+        let camera =
+            Camera { eye: c.eye.cast(), forward: forward.cast(), right: (right * tx).cast(), up: (up * ty).cast() };
+        let objects: &'a [Object<R>] = &self.storage[..self.len];
+        let mut world = Aabb { min: camera.eye, max: camera.eye };
+        for o in objects {
+            world = world.union(&o.bounds);
+        }
+        Ok(Scene {
+            objects,
+            groups: self.groups,
+            materials: self.materials,
+            lights: self.lights,
+            ambient: R::from_f64(self.ambient),
+            background: R::from_f64(self.background),
+            camera,
+            max_depth: self.max_depth,
+            world,
+        })
+    }
+}
+
+trait ToRadians {
+    fn to_radians_core(self) -> f64;
+}
+impl ToRadians for f64 {
+    fn to_radians_core(self) -> f64 {
+        self * core::f64::consts::PI / 180.0
+    }
+}
+
+/// World box of a placed primitive: exact for spheres (an ellipsoid's extent along axis `i`
+/// is the length of row `i` of the linear part), the transformed corners otherwise.
+fn world_bounds(shape: &Shape<f64>, place: &Affine<f64>) -> Aabb<f64> {
+    let m = &place.m;
+    if let Shape::Sphere = shape {
+        let c = Vec3::new(m[0][3], m[1][3], m[2][3]);
+        let e = |i: usize| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2]);
+        let h = Vec3::new(e(0), e(1), e(2));
+        return Aabb { min: c - h, max: c + h };
+    }
+    let (lo, hi) = shape.bounds();
+    let mut b = Aabb::empty();
+    for i in 0..8 {
+        let p = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        b.include(place.point(p));
+    }
+    b
+}

@@ -1,0 +1,249 @@
+//! The paper's four primitives in their canonical object space: intersection and normal.
+//!
+//! * sphere: unit sphere at the origin;
+//! * cylinder: radius 1 about the y axis, `0 <= y <= 1`, capped;
+//! * cone: radius 1 at `y = 0`, radius `top` at `y = 1` (`top = 0` is a pointed cone), capped;
+//! * box: the unit cube `[0,1]^3`.
+//!
+//! A scene object places one of these with an affine transform. This module knows nothing of
+//! transforms, materials or lattices: it answers "where does this object-space ray first meet
+//! the surface in `(tmin, tmax]`", with the outward object-space normal.
+
+use crate::math::{Ray, Vec3};
+use crate::scalar::Real;
+
+/// A canonical primitive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape<R> {
+    /// Unit sphere at the origin.
+    Sphere,
+    /// Capped unit cylinder along y from 0 to 1.
+    Cylinder,
+    /// Capped cone (or frustum) along y from radius 1 at y=0 to radius `top` at y=1.
+    Cone {
+        /// Radius at y = 1, relative to the base radius (0 for a pointed cone).
+        top: R,
+    },
+    /// The unit cube `[0,1]^3`.
+    Box,
+}
+
+/// Which primitive a shape is, without parameters (for names and statistics).
+pub const SHAPE_NAMES: [&str; 4] = ["sphere", "cylinder", "cone", "box"];
+
+impl<R: Real> Shape<R> {
+    /// Index into [`SHAPE_NAMES`].
+    pub fn kind(&self) -> usize {
+        match self {
+            Shape::Sphere => 0,
+            Shape::Cylinder => 1,
+            Shape::Cone { .. } => 2,
+            Shape::Box => 3,
+        }
+    }
+
+    /// Nearest intersection with `tmin < t <= tmax`: the parameter and the outward normal
+    /// (not normalised) in object space.
+    pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
+        let mut best = Closest { t: tmax, n: None, tmin };
+        match *self {
+            Shape::Sphere => sphere(r, &mut best),
+            Shape::Cylinder => cone_side_and_caps(r, R::ONE, &mut best),
+            Shape::Cone { top } => cone_side_and_caps(r, top, &mut best),
+            Shape::Box => unit_box(r, &mut best),
+        }
+        best.n.map(|n| (best.t, n))
+    }
+
+    /// Corners of an object-space box that holds the shape.
+    pub fn bounds(&self) -> (Vec3<R>, Vec3<R>) {
+        let (o, z) = (R::ONE, R::ZERO);
+        match self {
+            Shape::Sphere => (Vec3::new(-o, -o, -o), Vec3::new(o, o, o)),
+            Shape::Cylinder | Shape::Cone { .. } => (Vec3::new(-o, z, -o), Vec3::new(o, o, o)),
+            Shape::Box => (Vec3::new(z, z, z), Vec3::new(o, o, o)),
+        }
+    }
+}
+
+/// The running nearest root of one shape test.
+struct Closest<R> {
+    t: R,
+    n: Option<Vec3<R>>,
+    tmin: R,
+}
+
+impl<R: Real> Closest<R> {
+    #[inline]
+    fn offer(&mut self, t: R, n: impl FnOnce() -> Vec3<R>) {
+        if t > self.tmin && t <= self.t {
+            self.t = t;
+            self.n = Some(n());
+        }
+    }
+}
+
+/// Roots of `a t^2 + 2 b t + c = 0` given the discriminant `disc = b^2 - a c >= 0`, in the
+/// cancellation-free form (Press et al.): `q = -(b + sign(b) sqrt(disc))`, roots `q/a`, `c/q`.
+/// A root whose denominator is zero is left out, so `a = 0` gives the one linear root.
+fn roots<R: Real>(a: R, b: R, c: R, disc: R) -> [Option<R>; 2] {
+    let s = disc.sqrt();
+    let q = if b < R::ZERO { s - b } else { -(b + s) };
+    let r1 = if a != R::ZERO { Some(q / a) } else { None };
+    let r2 = if q != R::ZERO { Some(c / q) } else { None };
+    [r1, r2]
+}
+
+fn sphere<R: Real>(r: &Ray<R>, best: &mut Closest<R>) {
+    let (o, d) = (r.origin, r.dir);
+    let a = d.dot(d);
+    if a == R::ZERO {
+        return;
+    }
+    let b = o.dot(d);
+    let c = o.dot(o) - R::ONE;
+    // Hearn-Baker: b^2 - a c = a (1 - |o - d b/a|^2), with the closest-approach vector computed
+    // first, so a far small sphere is not lost to cancellation between b^2 and a c.
+    let v = o - d * (b / a);
+    let disc = a * (R::ONE - v.dot(v));
+    if disc < R::ZERO {
+        return;
+    }
+    for t in roots(a, b, c, disc).into_iter().flatten() {
+        best.offer(t, || r.at(t));
+    }
+}
+
+/// Side of the cone `x^2 + z^2 = (1 + k y)^2` with `k = top - 1` (k = 0 is the cylinder) for
+/// `0 <= y <= 1`, plus the caps. The mirror cone beyond a pointed apex has `y > 1` and is
+/// rejected by the same `y` range test.
+fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
+    let (o, d) = (r.origin, r.dir);
+    let k = top - R::ONE;
+    let w = R::ONE + k * o.y;
+    let e = k * d.y;
+    let a = d.x * d.x + d.z * d.z - e * e;
+    let b = o.x * d.x + o.z * d.z - w * e;
+    let c = o.x * o.x + o.z * o.z - w * w;
+    let disc = if k == R::ZERO && a != R::ZERO {
+        // Cylinder: the same Hearn-Baker form as the sphere, in the xz plane.
+        let (vx, vz) = (o.x - d.x * (b / a), o.z - d.z * (b / a));
+        a * (R::ONE - (vx * vx + vz * vz))
+    } else {
+        b * b - a * c
+    };
+    if disc >= R::ZERO && (a != R::ZERO || b != R::ZERO) {
+        for t in roots(a, b, c, disc).into_iter().flatten() {
+            let p = r.at(t);
+            if p.y >= R::ZERO && p.y <= R::ONE {
+                best.offer(t, || {
+                    let n = Vec3::new(p.x, -k * (R::ONE + k * p.y), p.z);
+                    if n.x == R::ZERO && n.z == R::ZERO && n.y == R::ZERO {
+                        Vec3::new(R::ZERO, R::ONE, R::ZERO) // the apex itself
+                    } else {
+                        n
+                    }
+                });
+            }
+        }
+    }
+    if d.y != R::ZERO {
+        for (y, radius, ny) in [(R::ZERO, R::ONE, -R::ONE), (R::ONE, top, R::ONE)] {
+            if radius <= R::ZERO {
+                continue;
+            }
+            let t = (y - o.y) / d.y;
+            let (px, pz) = (o.x + d.x * t, o.z + d.z * t);
+            if px * px + pz * pz <= radius * radius {
+                best.offer(t, || Vec3::new(R::ZERO, ny, R::ZERO));
+            }
+        }
+    }
+}
+
+fn unit_box<R: Real>(r: &Ray<R>, best: &mut Closest<R>) {
+    let (mut t0, mut t1) = (-R::MAX, R::MAX);
+    let (mut a0, mut a1) = (0usize, 0usize);
+    let (mut s0, mut s1) = (R::ZERO, R::ZERO);
+    for a in 0..3 {
+        let (o, d) = (r.origin.axis(a), r.dir.axis(a));
+        if d == R::ZERO {
+            if o < R::ZERO || o > R::ONE {
+                return;
+            }
+            continue;
+        }
+        let (mut ta, mut tb) = ((R::ZERO - o) / d, (R::ONE - o) / d);
+        // Entering face normal points against the ray, leaving face normal along it.
+        let sign = if d > R::ZERO { R::ONE } else { -R::ONE };
+        if ta > tb {
+            core::mem::swap(&mut ta, &mut tb);
+        }
+        if ta > t0 {
+            t0 = ta;
+            a0 = a;
+            s0 = -sign;
+        }
+        if tb < t1 {
+            t1 = tb;
+            a1 = a;
+            s1 = sign;
+        }
+    }
+    if t0 > t1 {
+        return;
+    }
+    let face = |a: usize, s: R| {
+        let mut n = [R::ZERO; 3];
+        n[a] = s;
+        Vec3::new(n[0], n[1], n[2])
+    };
+    best.offer(t0, || face(a0, s0));
+    best.offer(t1, || face(a1, s1));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ray(o: [f64; 3], d: [f64; 3]) -> Ray<f64> {
+        Ray::new(Vec3::new(o[0], o[1], o[2]), Vec3::new(d[0], d[1], d[2]))
+    }
+
+    #[test]
+    fn sphere_front_hit_and_inside_exit() {
+        let s = Shape::<f64>::Sphere;
+        let (t, n) = s.intersect(&ray([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]), 0.0, 100.0).unwrap();
+        assert_eq!(t, 4.0);
+        assert_eq!(n, Vec3::new(0.0, 0.0, -1.0));
+        let (t, _) = s.intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, 2.0]), 0.0, 100.0).unwrap();
+        assert_eq!(t, 0.5);
+    }
+
+    #[test]
+    fn cylinder_parallel_to_axis_hits_the_cap() {
+        let s = Shape::<f64>::Cylinder;
+        let (t, n) = s.intersect(&ray([0.5, -1.0, 0.0], [0.0, 1.0, 0.0]), 0.0, 100.0).unwrap();
+        assert_eq!((t, n), (1.0, Vec3::new(0.0, -1.0, 0.0)));
+        assert!(s.intersect(&ray([1.5, -1.0, 0.0], [0.0, 1.0, 0.0]), 0.0, 100.0).is_none());
+    }
+
+    #[test]
+    fn cone_mirror_nappe_is_never_hit() {
+        let s = Shape::Cone { top: 0.0 };
+        // A horizontal ray at y = 1.5 crosses the mirror cone above the apex only.
+        assert!(s.intersect(&ray([-5.0, 1.5, 0.0], [1.0, 0.0, 0.0]), 0.0, 100.0).is_none());
+        // At y = 0.5 the radius is 0.5.
+        let (t, _) = s.intersect(&ray([-5.0, 0.5, 0.0], [1.0, 0.0, 0.0]), 0.0, 100.0).unwrap();
+        assert!((t - 4.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn box_entering_and_leaving_faces() {
+        let s = Shape::<f64>::Box;
+        let (t, n) = s.intersect(&ray([0.5, 0.5, -1.0], [0.0, 0.0, 1.0]), 0.0, 100.0).unwrap();
+        assert_eq!((t, n), (1.0, Vec3::new(0.0, 0.0, -1.0)));
+        let (t, n) = s.intersect(&ray([0.5, 0.5, 0.5], [0.0, 0.0, -1.0]), 0.0, 100.0).unwrap();
+        assert_eq!((t, n), (0.5, Vec3::new(0.0, 0.0, -1.0)));
+    }
+}
