@@ -1,0 +1,252 @@
+//! The `Accelerator` trait and the two baselines: brute force and the paper's bounding-box
+//! method with its inside test. The lattice (in `lattice`) implements the same trait, so tests
+//! and benchmarks compare all three on the same rays.
+//!
+//! All accelerators share one rule for the nearest hit, [`offer`]: the smaller `t` wins and, at
+//! equal `t`, the smaller object index. Since every object test is exact for its interval, any
+//! accelerator that tests every object the ray can hit returns the brute-force answer bit for bit.
+
+use crate::math::{Ray, Vec3};
+use crate::scalar::Real;
+use crate::scene::Scene;
+
+/// The nearest intersection found for a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit<R> {
+    /// Ray parameter of the hit.
+    pub t: R,
+    /// Index of the object hit.
+    pub object: u16,
+    /// Outward normal in object space (not normalised).
+    pub normal: Vec3<R>,
+}
+
+/// Kinds of rays counted by [`Stats`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// Eye ray.
+    Primary = 0,
+    /// Shadow ray towards a light.
+    Shadow = 1,
+    /// Mirror-reflection ray.
+    Reflection = 2,
+    /// Refraction (transmission) ray.
+    Refraction = 3,
+}
+
+/// Work counted while rendering.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Rays traced, by [`RayKind`].
+    pub rays: [u64; 4],
+    /// Ray-object intersection tests.
+    pub object_tests: u64,
+    /// Bounding-box inside tests (the paper's baseline).
+    pub inside_tests: u64,
+    /// Lattice cells entered (top level and sub-lattices).
+    pub cells_visited: u64,
+}
+
+impl Stats {
+    /// Adds another set of counts.
+    pub fn add(&mut self, o: &Stats) {
+        for (a, b) in self.rays.iter_mut().zip(o.rays.iter()) {
+            *a += b;
+        }
+        self.object_tests += o.object_tests;
+        self.inside_tests += o.inside_tests;
+        self.cells_visited += o.cells_visited;
+    }
+    /// All rays of every kind.
+    pub fn total_rays(&self) -> u64 {
+        self.rays.iter().sum()
+    }
+}
+
+/// Per-query scratch: statistics and the mailbox (one stamp per object and per composite).
+#[derive(Debug)]
+pub struct Query<'m> {
+    /// Counts so far.
+    pub stats: Stats,
+    mailbox: &'m mut [u32],
+    ray_id: u32,
+}
+
+impl<'m> Query<'m> {
+    /// Scratch with a caller-provided mailbox of [`Query::mailbox_len`] entries. A shorter
+    /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
+    pub fn new(mailbox: &'m mut [u32]) -> Self {
+        mailbox.iter_mut().for_each(|m| *m = 0);
+        Query { stats: Stats::default(), mailbox, ray_id: 0 }
+    }
+    /// Mailbox entries a scene needs: one per object and one per composite.
+    pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
+        scene.objects.len() + scene.groups.len()
+    }
+    /// Starts a new ray: every mailbox entry becomes unvisited.
+    pub fn next_ray(&mut self) {
+        self.ray_id = self.ray_id.wrapping_add(1);
+        if self.ray_id == 0 {
+            self.mailbox.iter_mut().for_each(|m| *m = 0);
+            self.ray_id = 1;
+        }
+    }
+    /// Marks entry `i` visited by the current ray; true if it was not yet.
+    #[inline]
+    pub fn first_visit(&mut self, i: usize) -> bool {
+        match self.mailbox.get_mut(i) {
+            Some(m) if *m == self.ray_id => false,
+            Some(m) => {
+                *m = self.ray_id;
+                true
+            }
+            None => true,
+        }
+    }
+}
+
+/// Tests object `i` against `ray` on `(tmin, best.t or tmax]` and keeps the nearer hit (ties:
+/// the lower object index). Returns whether the object was hit at all in that range.
+#[inline]
+pub fn offer<R: Real>(
+    scene: &Scene<'_, R>,
+    i: usize,
+    ray: &Ray<R>,
+    tmin: R,
+    tmax: R,
+    best: &mut Option<Hit<R>>,
+    stats: &mut Stats,
+) -> bool {
+    stats.object_tests += 1;
+    let limit = best.map_or(tmax, |b| b.t);
+    match scene.objects[i].intersect(ray, tmin, limit) {
+        Some((t, n)) => {
+            let better = match best {
+                Some(b) => t < b.t || (t == b.t && (i as u16) < b.object),
+                None => true,
+            };
+            if better {
+                *best = Some(Hit { t, object: i as u16, normal: n });
+            }
+            true
+        }
+        None => false,
+    }
+}
+
+/// Answers ray queries against a scene.
+pub trait Accelerator<R: Real> {
+    /// Short name for reports.
+    fn name(&self) -> &'static str;
+    /// The nearest hit with `tmin < t <= tmax`.
+    fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>>;
+    /// Whether anything is hit with `tmin < t <= tmax` (shadow rays).
+    fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool;
+}
+
+/// Tests every object for every ray.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BruteForce;
+
+impl<R: Real> Accelerator<R> for BruteForce {
+    fn name(&self) -> &'static str {
+        "brute"
+    }
+    fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>> {
+        let mut best = None;
+        for i in 0..scene.objects.len() {
+            offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats);
+        }
+        best
+    }
+    fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool {
+        let mut best = None;
+        (0..scene.objects.len()).any(|i| offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats))
+    }
+}
+
+/// The paper's baseline: every object's box gets an inside test for every ray, and only the
+/// objects whose box the ray passes are intersected.
+///
+/// The inside test is done the paper's way: a rotation maps the ray onto the +z axis through
+/// the origin, the box corners are mapped by the same matrix, and the ray passes the box only
+/// if the mapped x values straddle 0 and the mapped y values straddle 0 (and the box is not
+/// wholly behind the origin). The paper maps two corners; we map all eight, which makes the
+/// test conservative for any orientation, so it never rejects a box the ray really enters.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BoundingBox;
+
+/// The rotation of the paper's inside test: an orthonormal frame with `w` along the ray.
+struct RayFrame<R> {
+    o: Vec3<R>,
+    u: Vec3<R>,
+    v: Vec3<R>,
+    w: Vec3<R>,
+}
+
+impl<R: Real> RayFrame<R> {
+    fn new(ray: &Ray<R>) -> Self {
+        let w = ray.dir.normalize();
+        // Any vector not parallel to w gives the other two axes.
+        let a = if w.x.abs() < R::from_f64(0.57) {
+            Vec3::new(R::ONE, R::ZERO, R::ZERO)
+        } else {
+            Vec3::new(R::ZERO, R::ONE, R::ZERO)
+        };
+        let u = w.cross(a).normalize();
+        let v = w.cross(u);
+        RayFrame { o: ray.origin, u, v, w }
+    }
+
+    /// The inside test for one box: the mapped corners' x values have opposite signs (or one is
+    /// zero), so do their y values, and some corner lies ahead of the origin.
+    fn passes(&self, b: &crate::math::Aabb<R>) -> bool {
+        let (mut lo, mut hi) = ([R::MAX; 3], [-R::MAX; 3]);
+        for i in 0..8 {
+            let p = Vec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x },
+                if i & 2 == 0 { b.min.y } else { b.max.y },
+                if i & 4 == 0 { b.min.z } else { b.max.z },
+            ) - self.o;
+            for (k, axis) in [self.u, self.v, self.w].into_iter().enumerate() {
+                let c = p.dot(axis);
+                lo[k] = lo[k].min(c);
+                hi[k] = hi[k].max(c);
+            }
+        }
+        lo[0] <= R::ZERO && hi[0] >= R::ZERO && lo[1] <= R::ZERO && hi[1] >= R::ZERO && hi[2] >= R::ZERO
+    }
+}
+
+impl BoundingBox {
+    fn run<R: Real>(
+        scene: &Scene<'_, R>,
+        ray: &Ray<R>,
+        tmin: R,
+        tmax: R,
+        any: bool,
+        q: &mut Query<'_>,
+    ) -> Option<Hit<R>> {
+        let frame = RayFrame::new(ray);
+        let mut best = None;
+        for (i, o) in scene.objects.iter().enumerate() {
+            q.stats.inside_tests += 1;
+            if frame.passes(&o.bounds) && offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats) && any {
+                return best;
+            }
+        }
+        best
+    }
+}
+
+impl<R: Real> Accelerator<R> for BoundingBox {
+    fn name(&self) -> &'static str {
+        "bbox"
+    }
+    fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>> {
+        Self::run(scene, ray, tmin, tmax, false, q)
+    }
+    fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool {
+        Self::run(scene, ray, tmin, tmax, true, q).is_some()
+    }
+}

@@ -1,0 +1,248 @@
+//! Turning gray levels (0..=64, the paper's 65 levels) into 1-bit pixels.
+//!
+//! * [`Dither::Bayer`]: ordered dither with the 8x8 Bayer matrix, one gray per pixel;
+//! * [`Dither::Pattern`]: the paper's bit-map patterning: one traced sample per NxN block,
+//!   shown as the NxN dot pattern of its level (N = 8 gives the paper's 65 levels);
+//! * [`Dither::FloydSteinberg`] and [`Dither::Atkinson`]: error diffusion, run in tile order
+//!   with bounded carry buffers (four rows of the image width and two columns of a tile).
+//!
+//! Error diffusion in tile order: error flowing right or down reaches its pixel exactly as in
+//! raster order, across tile borders too. Error flowing down-left into a tile that is already
+//! drawn is given to the pixel straight below instead, so no error is lost; this is the only
+//! difference from a raster-order pass.
+
+use embedded_graphics_core::pixelcolor::BinaryColor;
+
+/// Highest gray level (white).
+pub const LEVELS: u8 = 64;
+
+/// A dithering mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dither {
+    /// 8x8 Bayer ordered dither, one sample per pixel.
+    Bayer,
+    /// The paper's patterning: one sample per NxN block (N = 2, 4 or 8).
+    Pattern(u8),
+    /// Floyd-Steinberg error diffusion.
+    FloydSteinberg,
+    /// Atkinson error diffusion (diffuses 6/8 of the error).
+    Atkinson,
+}
+
+impl Dither {
+    /// Side of the block that shares one traced sample.
+    pub fn block(&self) -> u8 {
+        match self {
+            Dither::Pattern(n) => *n,
+            _ => 1,
+        }
+    }
+    /// Whether the mode needs carry buffers.
+    pub fn diffuses(&self) -> bool {
+        matches!(self, Dither::FloydSteinberg | Dither::Atkinson)
+    }
+}
+
+/// The 8x8 Bayer index matrix (0..=63).
+pub const BAYER8: [[u8; 8]; 8] = [
+    [0, 32, 8, 40, 2, 34, 10, 42],
+    [48, 16, 56, 24, 50, 18, 58, 26],
+    [12, 44, 4, 36, 14, 46, 6, 38],
+    [60, 28, 52, 20, 62, 30, 54, 22],
+    [3, 35, 11, 43, 1, 33, 9, 41],
+    [51, 19, 59, 27, 49, 17, 57, 25],
+    [15, 47, 7, 39, 13, 45, 5, 37],
+    [63, 31, 55, 23, 61, 29, 53, 21],
+];
+
+/// Ordered dither of one pixel: `level` of 64 against an NxN Bayer pattern (N = 1, 2, 4, 8).
+/// The NxN matrix is the top-left corner of the 8x8 one divided down, which is the Bayer
+/// matrix of that size; the level is first rounded to the N*N + 1 levels it can show.
+pub fn ordered(level: u8, x: u32, y: u32, n: u8) -> BinaryColor {
+    let n = n.clamp(1, 8) as u32;
+    let cells = n * n;
+    let q = (level.min(LEVELS) as u32 * cells + 32) / 64; // 0..=cells
+    let shift = 64 / cells;
+    let t = BAYER8[(y % n) as usize][(x % n) as usize] as u32 / shift;
+    BinaryColor::from(q > t)
+}
+
+/// (dx, dy, weight) of an error-diffusion kernel and its divisor.
+type Kernel = (&'static [(i8, i8, i16)], i16);
+
+const FLOYD_STEINBERG: Kernel = (&[(1, 0, 7), (-1, 1, 3), (0, 1, 5), (1, 1, 1)], 16);
+const ATKINSON: Kernel = (&[(1, 0, 1), (2, 0, 1), (-1, 1, 1), (0, 1, 1), (1, 1, 1), (0, 2, 1)], 8);
+
+/// Largest tile side the renderer supports.
+pub const MAX_TILE: usize = 16;
+/// Error units per gray level.
+const SCALE: i16 = 16;
+
+/// Error-diffusion state carried between tiles: `4 * width` entries of caller storage (two rows
+/// arriving at the current band, two rows leaving it) and two columns per tile row.
+#[derive(Debug)]
+pub struct Carry<'c> {
+    rows: &'c mut [i16],
+    width: usize,
+    right: [[i16; 2]; MAX_TILE],
+    incoming: usize,
+}
+
+impl<'c> Carry<'c> {
+    /// Entries of storage needed for an image `width` pixels wide.
+    pub const fn len(width: usize) -> usize {
+        4 * width
+    }
+    /// Carry state over caller storage of at least [`Carry::len`] entries (it is cleared).
+    pub fn new(rows: &'c mut [i16], width: usize) -> Option<Self> {
+        let rows = rows.get_mut(..Self::len(width))?;
+        rows.iter_mut().for_each(|v| *v = 0);
+        Some(Carry { rows, width, right: [[0; 2]; MAX_TILE], incoming: 0 })
+    }
+    fn row(&mut self, which: usize, k: usize) -> &mut [i16] {
+        let w = self.width;
+        let i = (which * 2 + k) * w;
+        &mut self.rows[i..i + w]
+    }
+    /// Call when a new band of tiles (a new tile row) starts.
+    pub fn next_band(&mut self) {
+        // The rows that left the previous band are the rows arriving at this one.
+        let out = 1 - self.incoming;
+        let inc = self.incoming;
+        for k in 0..2 {
+            let w = self.width;
+            self.rows.copy_within((out * 2 + k) * w..(out * 2 + k + 1) * w, (inc * 2 + k) * w);
+            self.row(out, k).iter_mut().for_each(|v| *v = 0);
+        }
+        self.right = [[0; 2]; MAX_TILE];
+    }
+
+    /// Error-diffuses one tile at `(x0, y0)`, `w x h` levels in row-major order, into `out`.
+    pub fn tile(&mut self, mode: Dither, x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
+        let (kernel, div) = if mode == Dither::Atkinson { ATKINSON } else { FLOYD_STEINBERG };
+        let mut acc = [[0i16; MAX_TILE]; MAX_TILE];
+        // Gather what earlier tiles sent here.
+        let inc = self.incoming;
+        for k in 0..2.min(h) {
+            let row = self.row(inc, k);
+            for (x, a) in acc[k].iter_mut().enumerate().take(w) {
+                *a += row[x0 + x];
+                row[x0 + x] = 0;
+            }
+        }
+        for y in 0..h {
+            acc[y][0] += self.right[y][0];
+            if w > 1 {
+                acc[y][1] += self.right[y][1];
+            }
+        }
+        self.right = [[0; 2]; MAX_TILE];
+        let out_rows = 1 - inc;
+        for y in 0..h {
+            for x in 0..w {
+                let v = levels[y * w + x] as i16 * SCALE + acc[y][x];
+                let on = v >= (LEVELS as i16 / 2) * SCALE;
+                out[y * w + x] = BinaryColor::from(on);
+                let err = v - if on { LEVELS as i16 * SCALE } else { 0 };
+                for &(dx, dy, wgt) in kernel {
+                    let e = err * wgt / div;
+                    let (tx, ty) = (x as isize + dx as isize, y + dy as usize);
+                    let gx = x0 as isize + tx;
+                    if gx < 0 || gx >= self.width as isize {
+                        continue;
+                    }
+                    if ty < h {
+                        if tx < 0 {
+                            acc[ty][0] += e; // already drawn: straight below instead
+                        } else if (tx as usize) < w {
+                            acc[ty][tx as usize] += e;
+                        } else {
+                            self.right[ty][tx as usize - w] += e;
+                        }
+                    } else {
+                        let col = if tx < 0 { x0 } else { gx as usize };
+                        self.row(out_rows, ty - h)[col] += e;
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn art(w: usize, px: &[BinaryColor]) -> std::string::String {
+        px.chunks(w).map(|r| r.iter().map(|c| if c.is_on() { '#' } else { '.' }).collect::<std::string::String>() + "\n").collect()
+    }
+
+    #[test]
+    fn bayer_half_gray_is_a_checkerboard() {
+        let px: std::vec::Vec<_> = (0..16).map(|i| ordered(32, i % 4, i / 4, 8)).collect();
+        assert_eq!(art(4, &px), "#.#.\n.#.#\n#.#.\n.#.#\n");
+    }
+
+    #[test]
+    fn bayer_extremes_are_solid() {
+        for (level, on) in [(0u8, false), (64, true)] {
+            assert!((0..64).all(|i| ordered(level, i % 8, i / 8, 8).is_on() == on));
+        }
+    }
+
+    #[test]
+    fn pattern8_quarter_gray_sets_sixteen_dots() {
+        let px: std::vec::Vec<_> = (0..64).map(|i| ordered(16, i % 8, i / 8, 8)).collect();
+        assert_eq!(
+            art(8, &px),
+            "#.#.#.#.\n\
+             ........\n\
+             #.#.#.#.\n\
+             ........\n\
+             #.#.#.#.\n\
+             ........\n\
+             #.#.#.#.\n\
+             ........\n"
+        );
+    }
+
+    #[test]
+    fn pattern2_has_five_levels() {
+        let count = |l| (0..4).filter(|&i| ordered(l, i % 2, i / 2, 2).is_on()).count();
+        assert_eq!([0, 16, 32, 48, 64].map(count), [0, 1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn floyd_steinberg_half_gray_in_tiles_keeps_half_the_dots() {
+        let (w, h, t) = (16usize, 16usize, 8usize);
+        let mut store = [0i16; 64];
+        let mut carry = Carry::new(&mut store, w).unwrap();
+        let mut img = [BinaryColor::Off; 256];
+        for by in 0..h / t {
+            carry.next_band();
+            for bx in 0..w / t {
+                let mut out = [BinaryColor::Off; 64];
+                carry.tile(Dither::FloydSteinberg, bx * t, t, t, &[32u8; 64], &mut out);
+                for y in 0..t {
+                    for x in 0..t {
+                        img[(by * t + y) * w + bx * t + x] = out[y * t + x];
+                    }
+                }
+            }
+        }
+        let on = img.iter().filter(|c| c.is_on()).count();
+        assert_eq!(on, 128, "\n{}", art(w, &img));
+    }
+
+    #[test]
+    fn atkinson_mid_gray_tile_pattern() {
+        let mut store = [0i16; 16];
+        let mut carry = Carry::new(&mut store, 4).unwrap();
+        carry.next_band();
+        let mut out = [BinaryColor::Off; 16];
+        carry.tile(Dither::Atkinson, 0, 4, 4, &[40u8; 16], &mut out);
+        // Row 0 is all on (errors -48, -54, -60 keep each pixel above 512 of 1024); the
+        // negative error it leaves turns pixels of the next rows off.
+        assert_eq!(art(4, &out), "####\n#..#\n###.\n.##.\n");
+    }
+}

@@ -1,0 +1,552 @@
+//! The lattice: the paper's lattice-structured space subdivision.
+//!
+//! The world range (the viewpoint and every object) is cut into cells by per-axis coordinate
+//! lists `X(), Y(), Z()`; every composite object gets a sub-lattice over its own box. A cell
+//! lists the objects (and sub-lattices) whose padded box overlaps it. A ray walks from cell to
+//! neighbouring cell by index arithmetic (3D-DDA) and tests only what the cells it visits hold.
+//!
+//! Storage is caller-provided ([`LatticeStorage`]); [`Lattice::plan`] says how much a scene
+//! needs, and [`Lattice::build`] fails with a [`LatticeError`] naming the capacity that ran out.
+//!
+//! Traversal, with the paper's steps 1-14 in mind:
+//! * the walk starts where the ray enters the world box and keeps an explicit bounded stack of
+//!   walkers: entering a sub-lattice pushes one (step 8), leaving it pops (step 12);
+//! * crossing parameters are computed from the coordinate list each step
+//!   (`(X(a+1) - o) / d`), never accumulated, so long walks do not drift;
+//! * tie rule: when two or three axes cross at the same `t`, x steps before y before z; the
+//!   cells in between are visited with zero length, so no cell is skipped;
+//! * a direction component of +0.0 or -0.0 never steps on that axis, and the start cell on it
+//!   is found from the origin alone, so both zeros give the same cells;
+//! * mailboxing: each object and sub-lattice is tested at most once per ray;
+//! * the walk stops once the best hit lies strictly before the current cell's exit: all
+//!   untested objects lie in later cells, so their hits are no nearer (boxes are padded for
+//!   rounding), and the answer equals brute force.
+
+use crate::accel::{offer, Accelerator, Hit, Query};
+use crate::math::{Aabb, Ray, Vec3};
+use crate::scalar::Real;
+use crate::scene::{Scene, NO_GROUP};
+use core::fmt;
+
+/// Marks a reference to a sub-lattice (composite) rather than an object.
+const SUB_FLAG: u32 = 1 << 31;
+/// Deepest nesting of lattices: the world and one level of composites.
+pub const MAX_NESTING: usize = 2;
+
+/// How the coordinate lists of a lattice are chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Resolution {
+    /// Cost heuristic: about `density * items` cells in all, shaped like the box
+    /// (cells per axis proportional to the extent times the cube root of the item count).
+    Auto {
+        /// Target cells per item.
+        density: f64,
+    },
+    /// A fixed number of equal cells per axis.
+    Uniform([u16; 3]),
+}
+
+/// Choices for building a lattice.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LatticeConfig {
+    /// Resolution of the world lattice.
+    pub top: Resolution,
+    /// Resolution of each composite's sub-lattice.
+    pub sub: Resolution,
+    /// Upper bound on cells per axis for [`Resolution::Auto`].
+    pub max_per_axis: u16,
+}
+
+impl Default for LatticeConfig {
+    fn default() -> Self {
+        LatticeConfig { top: Resolution::Auto { density: 2.0 }, sub: Resolution::Auto { density: 2.0 }, max_per_axis: 64 }
+    }
+}
+
+/// One lattice (the world's or a composite's sub-lattice) inside the shared storage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid<R> {
+    /// The region the lattice covers.
+    pub bounds: Aabb<R>,
+    /// Cells per axis.
+    pub n: [u16; 3],
+    /// Where each axis' coordinate list (`n + 1` entries) starts in the coordinate storage.
+    pub coord_start: [u32; 3],
+    /// Index of the first cell in the cell storage.
+    pub cell_start: u32,
+}
+
+impl<R: Real> Grid<R> {
+    /// An unused slot (for static storage arrays).
+    pub const EMPTY: Self = Grid {
+        bounds: Aabb {
+            min: Vec3 { x: R::ZERO, y: R::ZERO, z: R::ZERO },
+            max: Vec3 { x: R::ZERO, y: R::ZERO, z: R::ZERO },
+        },
+        n: [0; 3],
+        coord_start: [0; 3],
+        cell_start: 0,
+    };
+    fn cells(&self) -> usize {
+        self.n.iter().map(|&v| v as usize).product()
+    }
+}
+
+/// Caller-provided storage for a lattice.
+#[derive(Debug)]
+pub struct LatticeStorage<'a, R> {
+    /// One entry per lattice (world + one per composite).
+    pub grids: &'a mut [Grid<R>],
+    /// All coordinate lists, concatenated.
+    pub coords: &'a mut [R],
+    /// Per cell, the index of its first reference; one extra entry at the end.
+    pub cells: &'a mut [u32],
+    /// Cell contents: object indices, or `SUB_FLAG | composite index`.
+    pub refs: &'a mut [u32],
+}
+
+/// How much storage a scene's lattice needs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LatticeSizes {
+    /// Lattices (world and sub-lattices).
+    pub grids: usize,
+    /// Coordinate-list entries.
+    pub coords: usize,
+    /// Cell entries (cells + 1).
+    pub cells: usize,
+    /// References.
+    pub refs: usize,
+}
+
+/// A storage slice too small for the lattice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LatticeError {
+    /// Which storage ran out ("grids", "coords", "cells", "refs").
+    pub capacity: &'static str,
+    /// Entries needed.
+    pub needed: usize,
+    /// Entries available.
+    pub available: usize,
+}
+
+impl fmt::Display for LatticeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "lattice capacity `{}` too small: {} entries needed, {} available",
+            self.capacity, self.needed, self.available
+        )
+    }
+}
+
+impl core::error::Error for LatticeError {}
+
+/// A built lattice over a scene.
+#[derive(Debug)]
+pub struct Lattice<'a, R> {
+    grids: &'a [Grid<R>],
+    coords: &'a [R],
+    cells: &'a [u32],
+    refs: &'a [u32],
+    /// Objects in the scene it was built for (mailbox entries of composites follow them).
+    objects: usize,
+}
+
+/// The items one lattice holds: the world holds free objects and composites, a sub-lattice
+/// the objects of its composite.
+fn for_each_item<R: Real>(scene: &Scene<'_, R>, grid: usize, mut f: impl FnMut(u32, &Aabb<R>)) {
+    if grid == 0 {
+        for (i, o) in scene.objects.iter().enumerate() {
+            if o.group == NO_GROUP {
+                f(i as u32, &o.bounds);
+            }
+        }
+        for (g, grp) in scene.groups.iter().enumerate() {
+            f(SUB_FLAG | g as u32, &grp.bounds);
+        }
+    } else {
+        let grp = &scene.groups[grid - 1];
+        for i in grp.first as usize..(grp.first + grp.len) as usize {
+            f(i as u32, &scene.objects[i].bounds);
+        }
+    }
+}
+
+fn grid_bounds<R: Real>(scene: &Scene<'_, R>, grid: usize) -> Aabb<R> {
+    if grid == 0 {
+        scene.world
+    } else {
+        scene.groups[grid - 1].bounds
+    }
+}
+
+fn resolution<R: Real>(b: &Aabb<R>, items: usize, res: Resolution, max_axis: u16) -> [u16; 3] {
+    match res {
+        Resolution::Uniform(n) => n.map(|v| v.max(1)),
+        Resolution::Auto { density } => {
+            let ext = [0, 1, 2].map(|a| (b.max.axis(a) - b.min.axis(a)).to_f64().max(0.0));
+            let longest = ext.iter().cloned().fold(0.0f64, f64::max);
+            if longest <= 0.0 {
+                return [1; 3];
+            }
+            // Cells ~ density * items; axes with a tiny extent are given at least one cell, so
+            // the volume of the others is used (a flat box does not get a huge cell count).
+            let floor = longest / max_axis as f64;
+            let vol: f64 = ext.iter().map(|e| e.max(floor)).product();
+            let k = libm::cbrt(density * items.max(1) as f64 / vol);
+            ext.map(|e| (libm::round(e * k) as u16).clamp(1, max_axis))
+        }
+    }
+}
+
+/// Plane `i` of a uniform coordinate list of `n` cells over `[lo, hi]`, computed from the
+/// index (never accumulated); the last plane is exactly `hi`.
+fn uniform_coord<R: Real>(lo: R, hi: R, n: u16, i: usize) -> R {
+    if i == n as usize {
+        hi
+    } else {
+        lo + (hi - lo) / R::from_i32(n as i32) * R::from_i32(i as i32)
+    }
+}
+
+/// Index of the cell holding `x` in a coordinate list of `n` cells given by `c(i)`, clamped to
+/// `0..n`: the largest `i < n` with `c(i) <= x`, by bisection.
+#[inline]
+fn locate_by<R: Real>(n: usize, x: R, c: impl Fn(usize) -> R) -> usize {
+    let (mut lo, mut hi) = (0usize, n);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if c(mid) <= x {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// [`locate_by`] over a stored coordinate list (`n + 1` entries).
+#[inline]
+fn locate<R: Real>(c: &[R], x: R) -> usize {
+    locate_by(c.len() - 1, x, |i| c[i])
+}
+
+/// Cell index range `[lo, hi]` per axis overlapped by a box.
+fn cell_range<R: Real>(coords: &[R], g: &Grid<R>, b: &Aabb<R>) -> [(usize, usize); 3] {
+    [0, 1, 2].map(|a| {
+        let s = g.coord_start[a] as usize;
+        let c = &coords[s..s + g.n[a] as usize + 1];
+        (locate(c, b.min.axis(a)), locate(c, b.max.axis(a)))
+    })
+}
+
+impl<'a, R: Real> Lattice<'a, R> {
+    /// Storage a scene needs with this configuration.
+    pub fn plan(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> LatticeSizes {
+        let mut s = LatticeSizes { grids: 1 + scene.groups.len(), cells: 1, ..Default::default() };
+        for g in 0..s.grids {
+            let b = grid_bounds(scene, g);
+            let mut items = 0;
+            for_each_item(scene, g, |_, _| items += 1);
+            let n = resolution(&b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis);
+            s.coords += n.iter().map(|&v| v as usize + 1).sum::<usize>();
+            s.cells += n.iter().map(|&v| v as usize).product::<usize>();
+            // Reference count: each item's overlapped cells, located exactly as `build` does.
+            for_each_item(scene, g, |_, ib| {
+                let mut count = 1usize;
+                for a in 0..3 {
+                    let (lo, hi) = (b.min.axis(a), b.max.axis(a));
+                    let c = |x: R| locate_by(n[a] as usize, x, |i| uniform_coord(lo, hi, n[a], i));
+                    count *= c(ib.max.axis(a)) - c(ib.min.axis(a)) + 1;
+                }
+                s.refs += count;
+            });
+        }
+        s
+    }
+
+    /// Builds the lattice into `storage`.
+    pub fn build(scene: &Scene<'_, R>, cfg: &LatticeConfig, storage: LatticeStorage<'a, R>) -> Result<Self, LatticeError> {
+        let LatticeStorage { grids, coords, cells, refs } = storage;
+        let ngrids = 1 + scene.groups.len();
+        if grids.len() < ngrids {
+            return Err(LatticeError { capacity: "grids", needed: ngrids, available: grids.len() });
+        }
+        // Coordinate lists and cell ranges.
+        let (mut nc, mut ncells) = (0usize, 0usize);
+        for (g, slot) in grids.iter_mut().enumerate().take(ngrids) {
+            let b = grid_bounds(scene, g);
+            let mut items = 0;
+            for_each_item(scene, g, |_, _| items += 1);
+            let n = resolution(&b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis);
+            let mut grid = Grid { bounds: b, n, coord_start: [0; 3], cell_start: ncells as u32 };
+            for a in 0..3 {
+                let need = nc + n[a] as usize + 1;
+                if need > coords.len() {
+                    let total = Self::plan(scene, cfg).coords;
+                    return Err(LatticeError { capacity: "coords", needed: total, available: coords.len() });
+                }
+                grid.coord_start[a] = nc as u32;
+                let (lo, hi) = (b.min.axis(a), b.max.axis(a));
+                for i in 0..=n[a] as usize {
+                    coords[nc + i] = uniform_coord(lo, hi, n[a], i);
+                }
+                nc = need;
+            }
+            ncells += grid.cells();
+            *slot = grid;
+        }
+        if ncells + 1 > cells.len() {
+            return Err(LatticeError { capacity: "cells", needed: ncells + 1, available: cells.len() });
+        }
+        let cells = &mut cells[..ncells + 1];
+        cells.iter_mut().for_each(|c| *c = 0);
+        // Pass 1: count references per cell (into cells[i + 1]).
+        let mut nrefs = 0usize;
+        for (g, grid) in grids.iter().enumerate().take(ngrids) {
+            for_each_item(scene, g, |_, ib| {
+                visit_cells(coords, grid, ib, |c| {
+                    cells[c + 1] += 1;
+                    nrefs += 1;
+                });
+            });
+        }
+        if nrefs > refs.len() {
+            return Err(LatticeError { capacity: "refs", needed: nrefs, available: refs.len() });
+        }
+        for i in 1..cells.len() {
+            cells[i] += cells[i - 1];
+        }
+        // Pass 2: fill, using cells[i] as a cursor; afterwards cells[i] is the end of cell i,
+        // so shifting by one restores the starts.
+        for (g, grid) in grids.iter().enumerate().take(ngrids) {
+            for_each_item(scene, g, |item, ib| {
+                visit_cells(coords, grid, ib, |c| {
+                    refs[cells[c] as usize] = item;
+                    cells[c] += 1;
+                });
+            });
+        }
+        for i in (1..cells.len()).rev() {
+            cells[i] = cells[i - 1];
+        }
+        cells[0] = 0;
+        Ok(Lattice {
+            grids: &grids[..ngrids],
+            coords: &coords[..nc],
+            cells,
+            refs: &refs[..nrefs],
+            objects: scene.objects.len(),
+        })
+    }
+
+    /// Bytes the built lattice occupies (grids, coordinate lists, cells, references).
+    pub fn bytes(&self) -> usize {
+        core::mem::size_of_val(self.grids)
+            + core::mem::size_of_val(self.coords)
+            + core::mem::size_of_val(self.cells)
+            + core::mem::size_of_val(self.refs)
+    }
+
+    /// The lattices: index 0 is the world, then one per composite.
+    pub fn grids(&self) -> &[Grid<R>] {
+        self.grids
+    }
+
+    /// Number of cells over all lattices.
+    pub fn cell_count(&self) -> usize {
+        self.cells.len() - 1
+    }
+
+    /// Number of references over all cells.
+    pub fn ref_count(&self) -> usize {
+        self.refs.len()
+    }
+
+    /// The coordinate list of lattice `g` along `axis`.
+    pub fn coordinate_list(&self, g: usize, axis: usize) -> &[R] {
+        let grid = &self.grids[g];
+        let s = grid.coord_start[axis] as usize;
+        &self.coords[s..s + grid.n[axis] as usize + 1]
+    }
+
+    /// Calls `visit(grid, cell_index, t_enter, t_exit)` for every cell of the world lattice the
+    /// ray enters, in order, without testing objects (for tests and statistics).
+    pub fn walk_cells(&self, ray: &Ray<R>, tmin: R, tmax: R, mut visit: impl FnMut([usize; 3], R, R)) {
+        let inv = Inverse::new(ray);
+        let Some((t0, t1)) = self.grids[0].bounds.clip(ray, tmin, tmax) else { return };
+        let mut w = Walker::start(self, 0, ray, &inv, t0, t1);
+        let mut enter = t0;
+        loop {
+            let exit = w.exit();
+            visit(w.idx.map(|v| v as usize), enter, exit.min(t1));
+            enter = exit;
+            if !w.advance(self, ray, &inv) {
+                break;
+            }
+        }
+    }
+
+    fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
+        let Some((t0, t1)) = self.grids[0].bounds.clip(ray, tmin, tmax) else { return None };
+        q.next_ray();
+        let inv = Inverse::new(ray);
+        let mut best: Option<Hit<R>> = None;
+        let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
+        let mut depth = 1;
+        stack[0] = Some(Walker::start(self, 0, ray, &inv, t0, t1));
+        q.stats.cells_visited += 1;
+        while depth > 0 {
+            let Some(w) = stack[depth - 1].as_mut() else { break };
+            if w.ref_i < w.ref_end {
+                let item = self.refs[w.ref_i as usize];
+                w.ref_i += 1;
+                if item & SUB_FLAG == 0 {
+                    let i = item as usize;
+                    if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats) && any {
+                        return best;
+                    }
+                } else {
+                    let g = (item & !SUB_FLAG) as usize + 1;
+                    let limit = best.map_or(tmax, |b| b.t);
+                    if depth < MAX_NESTING && q.first_visit(self.objects + g - 1) {
+                        if let Some((a, b)) = self.grids[g].bounds.clip(ray, tmin, limit) {
+                            stack[depth] = Some(Walker::start(self, g, ray, &inv, a, b));
+                            depth += 1;
+                            q.stats.cells_visited += 1;
+                        }
+                    }
+                }
+                continue;
+            }
+            // The cell is done: stop if the best hit lies before its exit, else step.
+            let done = best.is_some_and(|b| b.t < w.exit());
+            if done || !w.advance(self, ray, &inv) {
+                depth -= 1;
+            } else {
+                q.stats.cells_visited += 1;
+            }
+        }
+        best
+    }
+}
+
+/// Per-ray reciprocals of the direction (zero components marked as not stepping).
+struct Inverse<R> {
+    inv: [R; 3],
+    moves: [bool; 3],
+}
+
+impl<R: Real> Inverse<R> {
+    fn new(ray: &Ray<R>) -> Self {
+        let d = [ray.dir.x, ray.dir.y, ray.dir.z];
+        Inverse { inv: d.map(|v| if v == R::ZERO { R::ZERO } else { R::ONE / v }), moves: d.map(|v| v != R::ZERO) }
+    }
+}
+
+/// The state of a walk through one lattice (one entry of the explicit stack).
+#[derive(Clone, Copy, Debug)]
+struct Walker<R> {
+    grid: u16,
+    idx: [i32; 3],
+    step: [i32; 3],
+    t_next: [R; 3],
+    t_end: R,
+    ref_i: u32,
+    ref_end: u32,
+}
+
+impl<R: Real> Walker<R> {
+    fn start(l: &Lattice<'_, R>, grid: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> Self {
+        let g = &l.grids[grid];
+        let p = ray.at(t0);
+        let mut w = Walker {
+            grid: grid as u16,
+            idx: [0; 3],
+            step: [0; 3],
+            t_next: [R::MAX; 3],
+            t_end: t1,
+            ref_i: 0,
+            ref_end: 0,
+        };
+        for a in 0..3 {
+            let c = l.coordinate_list(grid, a);
+            // With a zero direction component the coordinate is the origin's, exactly.
+            let x = if inv.moves[a] { p.axis(a) } else { ray.origin.axis(a) };
+            let i = locate(c, x);
+            w.idx[a] = i as i32;
+            if inv.moves[a] {
+                let forward = ray.dir.axis(a) > R::ZERO;
+                w.step[a] = if forward { 1 } else { -1 };
+                let plane = if forward { c[i + 1] } else { c[i] };
+                w.t_next[a] = (plane - ray.origin.axis(a)) * inv.inv[a];
+            }
+        }
+        w.load_cell(l, g);
+        w
+    }
+
+    fn load_cell(&mut self, l: &Lattice<'_, R>, g: &Grid<R>) {
+        let (nx, ny) = (g.n[0] as usize, g.n[1] as usize);
+        let c = g.cell_start as usize + self.idx[0] as usize + nx * (self.idx[1] as usize + ny * self.idx[2] as usize);
+        self.ref_i = l.cells[c];
+        self.ref_end = l.cells[c + 1];
+    }
+
+    /// Parameter where the ray leaves the current cell.
+    #[inline]
+    fn exit(&self) -> R {
+        self.t_next[0].min(self.t_next[1]).min(self.t_next[2])
+    }
+
+    /// Steps to the neighbouring cell; false when the ray leaves the lattice or its range.
+    fn advance(&mut self, l: &Lattice<'_, R>, ray: &Ray<R>, inv: &Inverse<R>) -> bool {
+        // Tie rule: x before y before z (strict comparisons keep the earlier axis).
+        let mut a = 0;
+        if self.t_next[1] < self.t_next[a] {
+            a = 1;
+        }
+        if self.t_next[2] < self.t_next[a] {
+            a = 2;
+        }
+        if !inv.moves[a] || self.t_next[a] > self.t_end {
+            return false;
+        }
+        let g = &l.grids[self.grid as usize];
+        let i = self.idx[a] + self.step[a];
+        if i < 0 || i >= g.n[a] as i32 {
+            return false;
+        }
+        self.idx[a] = i;
+        let c = l.coordinate_list(self.grid as usize, a);
+        let plane = if self.step[a] > 0 { c[i as usize + 1] } else { c[i as usize] };
+        self.t_next[a] = (plane - ray.origin.axis(a)) * inv.inv[a];
+        self.load_cell(l, g);
+        true
+    }
+}
+
+/// Calls `f` with the global cell index of every cell of `grid` a box overlaps.
+fn visit_cells<R: Real>(coords: &[R], grid: &Grid<R>, b: &Aabb<R>, mut f: impl FnMut(usize)) {
+    let r = cell_range(coords, grid, b);
+    let (nx, ny) = (grid.n[0] as usize, grid.n[1] as usize);
+    for z in r[2].0..=r[2].1 {
+        for y in r[1].0..=r[1].1 {
+            for x in r[0].0..=r[0].1 {
+                f(grid.cell_start as usize + x + nx * (y + ny * z));
+            }
+        }
+    }
+}
+
+impl<R: Real> Accelerator<R> for Lattice<'_, R> {
+    fn name(&self) -> &'static str {
+        "lattice"
+    }
+    fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>> {
+        self.run(scene, ray, tmin, tmax, false, q)
+    }
+    fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool {
+        self.run(scene, ray, tmin, tmax, true, q).is_some()
+    }
+}

@@ -1,0 +1,152 @@
+//! The intersection tree and the paper's eq. (1):
+//! `I = Ia*Ka + sum over visible lights Ip*Kd*max(0, L.N) + Ks*S + Kt*T`.
+//!
+//! The tree is evaluated without recursion: since `I` is linear in `S` and `T`, a pixel's
+//! brightness is the sum over the tree's nodes of (product of coefficients on the path) times
+//! (the node's local term). Nodes wait on an explicit stack of at most `MAX_DEPTH + 1` entries
+//! (depth-first, each node pushes at most two children).
+//!
+//! Secondary rays start at `p + n * eps` on the side they travel to, with `n` the normal
+//! flipped to face the incoming ray and `eps = offset_eps * (1 + max|p|)`: scale-aware, so the
+//! offset stays above the rounding error of `p` wherever the scene sits.
+
+use crate::accel::{Accelerator, Query, RayKind};
+use crate::math::{Ray, Vec3};
+use crate::scalar::Real;
+use crate::scene::{Light, Scene};
+use heapless::Vec;
+
+/// Deepest intersection tree the tracer supports (eye ray = depth 0).
+pub const MAX_DEPTH: u8 = 8;
+
+/// Which ray kinds a render spawns (the scene's effect set, or a forced one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Effects {
+    /// Shadow rays towards lights.
+    pub shadows: bool,
+    /// Mirror-reflection rays (`Ks > 0`).
+    pub reflection: bool,
+    /// Refraction rays (`Kt > 0`).
+    pub refraction: bool,
+}
+
+impl Effects {
+    /// Every effect on.
+    pub const ALL: Effects = Effects { shadows: true, reflection: true, refraction: true };
+
+    /// The effects a scene calls for: shadows if it has lights, reflection if any material has
+    /// `Ks > 0`, refraction if any has `Kt > 0`.
+    pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
+        let used = |f: fn(&crate::scene::Material<R>) -> R| {
+            scene.objects.iter().any(|o| f(&scene.materials[o.material as usize]) > R::ZERO)
+        };
+        Effects { shadows: !scene.lights.is_empty(), reflection: used(|m| m.ks), refraction: used(|m| m.kt) }
+    }
+}
+
+/// Traces rays through a scene with one accelerator.
+#[derive(Debug)]
+pub struct Tracer<'s, 'a, R, A> {
+    /// The scene.
+    pub scene: &'s Scene<'a, R>,
+    /// The accelerator answering ray queries.
+    pub accel: &'s A,
+    /// Ray kinds to spawn.
+    pub effects: Effects,
+    /// Maximum depth of the intersection tree.
+    pub max_depth: u8,
+    /// Branches whose weight falls below this are not traced (0 traces everything).
+    pub cutoff: R,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Node<R> {
+    ray: Ray<R>,
+    weight: R,
+    depth: u8,
+    kind: RayKind,
+}
+
+impl<'s, 'a, R: Real, A: Accelerator<R>> Tracer<'s, 'a, R, A> {
+    /// A tracer with the scene's own effect set and depth, and no cutoff.
+    pub fn new(scene: &'s Scene<'a, R>, accel: &'s A) -> Self {
+        Tracer { scene, accel, effects: Effects::of(scene), max_depth: scene.max_depth.min(MAX_DEPTH), cutoff: R::ZERO }
+    }
+
+    /// Brightness (0 black .. 1 white, clamped) seen along an eye ray.
+    pub fn radiance(&self, eye: Ray<R>, q: &mut Query<'_>) -> R {
+        let scene = self.scene;
+        let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
+        let _ = stack.push(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary });
+        let mut total = R::ZERO;
+        while let Some(node) = stack.pop() {
+            q.stats.rays[node.kind as usize] += 1;
+            let Some(hit) = self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q) else {
+                total += node.weight * scene.background;
+                continue;
+            };
+            let obj = &scene.objects[hit.object as usize];
+            let m = scene.materials[obj.material as usize];
+            let p = node.ray.at(hit.t);
+            let d = node.ray.dir.normalize();
+            let mut n = obj.world_normal(hit.normal);
+            let cos_i = -d.dot(n);
+            let entering = cos_i >= R::ZERO;
+            if !entering {
+                n = -n;
+            }
+            let cos_i = cos_i.abs();
+            let eps = R::offset_eps() * (R::ONE + p.max_abs());
+            let outside = p + n * eps;
+            let mut local = scene.ambient * m.ka;
+            if m.kd > R::ZERO {
+                for light in scene.lights.iter() {
+                    local += self.direct(light, outside, n, m.kd, q);
+                }
+            }
+            total += node.weight * local;
+            if node.depth >= self.max_depth {
+                continue;
+            }
+            let child = |ray, w: R, kind| Node { ray, weight: node.weight * w, depth: node.depth + 1, kind };
+            let mirror = d + n * (cos_i + cos_i);
+            let mut reflect_w = if self.effects.reflection { m.ks } else { R::ZERO };
+            if self.effects.refraction && m.kt > R::ZERO {
+                let eta = if entering { R::ONE / m.ior } else { m.ior };
+                let k = R::ONE - eta * eta * (R::ONE - cos_i * cos_i);
+                if k < R::ZERO {
+                    // Total internal reflection: the transmitted share is reflected.
+                    reflect_w += m.kt;
+                } else if node.weight * m.kt > self.cutoff {
+                    let dir = d * eta + n * (eta * cos_i - k.sqrt());
+                    let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction));
+                }
+            }
+            if reflect_w > R::ZERO && node.weight * reflect_w > self.cutoff {
+                let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection));
+            }
+        }
+        total.max(R::ZERO).min(R::ONE)
+    }
+
+    /// `Ip * Kd * max(0, L.N)` for one light, or zero if the light is behind the surface or
+    /// (with shadows on) blocked.
+    fn direct(&self, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, q: &mut Query<'_>) -> R {
+        let (to_light, reach, ip) = match *light {
+            Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
+            // Unnormalised direction: the light sits at t = 1.
+            Light::Point { pos, intensity } => (pos - from, R::ONE, intensity),
+        };
+        let cos = to_light.normalize().dot(n);
+        if cos <= R::ZERO {
+            return R::ZERO;
+        }
+        if self.effects.shadows {
+            q.stats.rays[RayKind::Shadow as usize] += 1;
+            if self.accel.occluded(self.scene, &Ray::new(from, to_light), R::ZERO, reach, q) {
+                return R::ZERO;
+            }
+        }
+        ip * kd * cos
+    }
+}
