@@ -24,3 +24,7 @@ pub mod dither;
 pub use dither::Dither;
 pub mod render;
 pub use render::{render, Frame, Hooks, NoHooks};
+pub mod parse;
+pub use parse::{parse, ParseError};
+pub mod bitframe;
+pub use bitframe::BitFrame;

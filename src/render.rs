@@ -100,7 +100,7 @@ pub fn level<R: Real>(v: R) -> u8 {
 /// `mailbox` is the accelerator's per-object scratch ([`Query::mailbox_len`] entries);
 /// `carry` must hold [`Carry::len`]`(width)` entries when the mode diffuses error (else it may
 /// be empty).
-pub fn render<R: Real, A: Accelerator<R>, D: DrawTarget<Color = BinaryColor>>(
+pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>>(
     tracer: &Tracer<'_, '_, R, A>,
     frame: &Frame,
     target: &mut D,

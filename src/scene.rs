@@ -123,6 +123,20 @@ pub struct Object<R> {
     pub bounds: Aabb<R>,
 }
 
+impl<R: Real> Default for Object<R> {
+    /// A placeholder (unit sphere at the origin) for filling storage arrays.
+    fn default() -> Self {
+        let z = Vec3::new(R::ZERO, R::ZERO, R::ZERO);
+        Object {
+            shape: Shape::Sphere,
+            to_object: Affine::identity(),
+            material: 0,
+            group: NO_GROUP,
+            bounds: Aabb { min: z, max: z },
+        }
+    }
+}
+
 impl<R: Real> Object<R> {
     /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` and the object-space normal.
     #[inline]

@@ -46,7 +46,7 @@ impl Effects {
 
 /// Traces rays through a scene with one accelerator.
 #[derive(Debug)]
-pub struct Tracer<'s, 'a, R, A> {
+pub struct Tracer<'s, 'a, R, A: ?Sized> {
     /// The scene.
     pub scene: &'s Scene<'a, R>,
     /// The accelerator answering ray queries.
@@ -67,7 +67,7 @@ struct Node<R> {
     kind: RayKind,
 }
 
-impl<'s, 'a, R: Real, A: Accelerator<R>> Tracer<'s, 'a, R, A> {
+impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
     /// A tracer with the scene's own effect set and depth, and no cutoff.
     pub fn new(scene: &'s Scene<'a, R>, accel: &'s A) -> Self {
         Tracer { scene, accel, effects: Effects::of(scene), max_depth: scene.max_depth.min(MAX_DEPTH), cutoff: R::ZERO }

@@ -1,1 +1,184 @@
-fn main(){}
+//! host-sim: the desktop driver of the lattice-rt core. Renders scenes to PNG/PBM/PGM, prints
+//! statistics, and (with no arguments) renders the paper's four scenes into `out/`.
+
+mod load;
+mod output;
+mod run;
+
+use anyhow::{bail, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+use lattice_rt::Dither;
+use std::path::PathBuf;
+
+/// Desktop driver for the lattice-rt ray tracer.
+///
+/// With no command it renders the paper's four scenes (chair, desk, polyhedron, spheres) at
+/// 160x100 and 128x64 into `out/` and prints their statistics.
+#[derive(Parser, Debug)]
+#[command(version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Output folder of the default job.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render one scene to a 1-bit PNG (and optionally PBM and gray PGM).
+    Render(RenderArgs),
+    /// Lattice shape, memory and per-accelerator work for a scene.
+    Stats(StatsArgs),
+    /// Render the paper's four scenes at 160x100 and 128x64 into a folder.
+    Gallery {
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Folder holding the scene files.
+        #[arg(long, default_value = "scenes")]
+        scenes: PathBuf,
+    },
+}
+
+/// Numeric type the tracer runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Scalar {
+    /// 64-bit float (the reference).
+    F64,
+    /// 32-bit float with libm.
+    F32,
+}
+
+/// Ray-query method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Accel {
+    /// The lattice (space subdivision with sub-lattices).
+    Lattice,
+    /// The paper's baseline: a bounding-box inside test per object per ray.
+    Bbox,
+    /// Every object for every ray.
+    Brute,
+}
+
+/// Dithering mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum DitherArg {
+    /// 8x8 Bayer ordered dither, one ray per pixel.
+    Bayer,
+    /// The paper's 8x8 patterning: one ray per 8x8 block (65 levels).
+    Pattern8,
+    /// 4x4 patterning: one ray per 4x4 block (17 levels).
+    Pattern4,
+    /// 2x2 patterning: one ray per 2x2 block (5 levels).
+    Pattern2,
+    /// Floyd-Steinberg error diffusion.
+    Fs,
+    /// Atkinson error diffusion.
+    Atkinson,
+}
+
+impl DitherArg {
+    /// The core's dithering mode.
+    pub fn mode(self) -> Dither {
+        match self {
+            DitherArg::Bayer => Dither::Bayer,
+            DitherArg::Pattern8 => Dither::Pattern(8),
+            DitherArg::Pattern4 => Dither::Pattern(4),
+            DitherArg::Pattern2 => Dither::Pattern(2),
+            DitherArg::Fs => Dither::FloydSteinberg,
+            DitherArg::Atkinson => Dither::Atkinson,
+        }
+    }
+}
+
+/// Parses `WxH`.
+fn parse_size(s: &str) -> Result<(u16, u16), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size `{s}` is not WIDTHxHEIGHT"))?;
+    let num = |v: &str| v.trim().parse::<u16>().ok().filter(|&n| n > 0 && n <= 4096);
+    match (num(w), num(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("size `{s}`: width and height must be whole numbers from 1 to 4096")),
+    }
+}
+
+/// Options of `render`.
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file.
+    pub scene: PathBuf,
+    /// PNG to write.
+    #[arg(short, long, default_value = "out/render.png")]
+    pub output: PathBuf,
+    /// Image size.
+    #[arg(long, default_value = "128x64", value_parser = parse_size)]
+    pub size: (u16, u16),
+    /// Dithering mode.
+    #[arg(long, value_enum, default_value_t = DitherArg::Bayer)]
+    pub dither: DitherArg,
+    /// Ray-query method.
+    #[arg(long, value_enum, default_value_t = Accel::Lattice)]
+    pub accel: Accel,
+    /// Numeric type.
+    #[arg(long, value_enum, default_value_t = Scalar::F64)]
+    pub scalar: Scalar,
+    /// Display theme of the PNG.
+    #[arg(long, value_enum, default_value_t = output::Theme::OledWhite)]
+    pub theme: output::Theme,
+    /// PNG pixel scale.
+    #[arg(long, default_value_t = 4)]
+    pub scale: u32,
+    /// Also write the gray levels (0..=64) as PGM.
+    #[arg(long)]
+    pub gray: Option<PathBuf>,
+    /// Also write the 1-bit frame as PBM.
+    #[arg(long)]
+    pub pbm: Option<PathBuf>,
+    /// Tile side in pixels.
+    #[arg(long, default_value_t = 8)]
+    pub tile: u8,
+}
+
+/// Options of `stats`.
+#[derive(clap::Args, Debug)]
+pub struct StatsArgs {
+    /// Scene file.
+    pub scene: PathBuf,
+    /// Image size used to count work per ray.
+    #[arg(long, default_value = "160x100", value_parser = parse_size)]
+    pub size: (u16, u16),
+    /// Numeric type.
+    #[arg(long, value_enum, default_value_t = Scalar::F64)]
+    pub scalar: Scalar,
+    /// Timed repetitions per accelerator (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub runs: usize,
+}
+
+fn main() {
+    if let Err(e) = real_main() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn real_main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        None => run::gallery(&cli.out, &PathBuf::from("scenes")),
+        Some(Command::Gallery { out, scenes }) => run::gallery(&out, &scenes),
+        Some(Command::Render(a)) => {
+            if a.tile == 0 || a.tile > 16 {
+                bail!("--tile must be from 1 to 16");
+            }
+            match a.scalar {
+                Scalar::F64 => run::render_cmd::<f64>(&a),
+                Scalar::F32 => run::render_cmd::<f32>(&a),
+            }
+        }
+        Some(Command::Stats(a)) => match a.scalar {
+            Scalar::F64 => run::stats_cmd::<f64>(&a),
+            Scalar::F32 => run::stats_cmd::<f32>(&a),
+        },
+    }
+}

@@ -1,0 +1,82 @@
+//! Writing images: PNG through `embedded-graphics-simulator` (with OLED/LCD themes), binary
+//! PBM for 1-bit frames and PGM for gray levels.
+
+use anyhow::{Context, Result};
+use embedded_graphics::geometry::Size;
+use embedded_graphics::pixelcolor::BinaryColor;
+use embedded_graphics::prelude::*;
+use embedded_graphics_simulator::{BinaryColorTheme, OutputSettingsBuilder, SimulatorDisplay};
+use lattice_rt::BitFrame;
+use std::path::Path;
+
+/// Display themes offered on the command line.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Theme {
+    /// Black on white, like the paper's print-out.
+    Paper,
+    /// White OLED pixels on black.
+    OledWhite,
+    /// Blue OLED pixels on black.
+    OledBlue,
+    /// White LCD.
+    LcdWhite,
+}
+
+impl Theme {
+    fn sim(self) -> BinaryColorTheme {
+        match self {
+            Theme::Paper => BinaryColorTheme::Default,
+            Theme::OledWhite => BinaryColorTheme::OledWhite,
+            Theme::OledBlue => BinaryColorTheme::OledBlue,
+            Theme::LcdWhite => BinaryColorTheme::LcdWhite,
+        }
+    }
+}
+
+fn create_parent(path: &Path) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    Ok(())
+}
+
+/// Writes a 1-bit frame as PNG with a display theme and pixel scale.
+pub fn write_png(frame: &BitFrame<'_>, path: &Path, theme: Theme, scale: u32) -> Result<()> {
+    let size = frame.size();
+    let mut display = SimulatorDisplay::<BinaryColor>::new(Size::new(size.width, size.height));
+    for y in 0..size.height {
+        for x in 0..size.width {
+            // Pixels on are lit (white on an OLED); the paper theme inverts to black ink.
+            let c = BinaryColor::from(frame.get(x, y));
+            Pixel(Point::new(x as i32, y as i32), c).draw(&mut display)?;
+        }
+    }
+    let settings = OutputSettingsBuilder::new().theme(theme.sim()).scale(scale.max(1)).build();
+    create_parent(path)?;
+    display
+        .to_rgb_output_image(&settings)
+        .save_png(path)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes a 1-bit frame as binary PBM (`P4`; 1 = black, so lit pixels are written as 0).
+pub fn write_pbm(frame: &BitFrame<'_>, path: &Path) -> Result<()> {
+    create_parent(path)?;
+    std::fs::write(path, pbm_bytes(frame)).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// The bytes of a binary PBM of the frame, with lit pixels white.
+pub fn pbm_bytes(frame: &BitFrame<'_>) -> Vec<u8> {
+    let size = frame.size();
+    let mut out = format!("P4\n{} {}\n", size.width, size.height).into_bytes();
+    out.extend(frame.raster().iter().map(|b| !b));
+    out
+}
+
+/// Writes gray levels 0..=64 as a PGM with maxval 64.
+pub fn write_pgm(width: u32, height: u32, levels: &[u8], path: &Path) -> Result<()> {
+    create_parent(path)?;
+    let mut out = format!("P5\n{width} {height}\n64\n").into_bytes();
+    out.extend_from_slice(levels);
+    std::fs::write(path, out).with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,280 @@
+//! The commands: render, stats and the default gallery job.
+
+use crate::load::{object_storage, parse_scene, read, LatticeBufs};
+use crate::output::{write_pbm, write_pgm, write_png, Theme};
+use crate::{Accel, RenderArgs, StatsArgs};
+use anyhow::{anyhow, Result};
+use lattice_rt::render::{Hooks, RenderError};
+use lattice_rt::trace::Effects;
+use lattice_rt::{
+    render, Accelerator, BitFrame, BoundingBox, BruteForce, Dither, Frame, LatticeConfig, Query, Real, Scene, Stats,
+    Tracer,
+};
+use std::io::Write;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// A finished render on the host.
+pub struct Rendered {
+    /// Packed 1-bit frame (see `BitFrame`).
+    pub bits: Vec<u8>,
+    /// Gray levels 0..=64, row-major.
+    pub gray: Vec<u8>,
+    /// Work counted by the core.
+    pub stats: Stats,
+    /// Wall time of the render.
+    pub elapsed: Duration,
+}
+
+/// Collects gray tiles into a full image and shows progress on long renders.
+struct HostHooks {
+    width: usize,
+    gray: Vec<u8>,
+    start: Instant,
+    progress: bool,
+    shown: bool,
+}
+
+impl Hooks for HostHooks {
+    fn gray_tile(&mut self, x: u16, y: u16, w: u16, h: u16, levels: &[u8]) {
+        for row in 0..h as usize {
+            let dst = (y as usize + row) * self.width + x as usize;
+            self.gray[dst..dst + w as usize].copy_from_slice(&levels[row * w as usize..(row + 1) * w as usize]);
+        }
+    }
+    fn progress(&mut self, done: u32, total: u32) -> bool {
+        if self.progress && (self.shown || self.start.elapsed() > Duration::from_millis(700)) {
+            self.shown = true;
+            eprint!("\r  rendering: {:3}% ({done}/{total} tiles)", done * 100 / total);
+            if done == total {
+                eprintln!();
+            }
+            let _ = std::io::stderr().flush();
+        }
+        true
+    }
+}
+
+/// Renders a frame with one accelerator into host buffers.
+pub fn render_with<R: Real, A: Accelerator<R> + ?Sized>(
+    tracer: &Tracer<'_, '_, R, A>,
+    frame: &Frame,
+    progress: bool,
+) -> Result<Rendered> {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
+    let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
+    let mut mailbox = vec![0u32; Query::mailbox_len(tracer.scene)];
+    let mut carry = vec![0i16; lattice_rt::dither::Carry::len(w)];
+    let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, shown: false };
+    let start = Instant::now();
+    let stats = render(tracer, frame, &mut target, &mut mailbox, &mut carry, &mut hooks).map_err(|e| match e {
+        RenderError::Draw(never) => match never {},
+        other => anyhow!("{other}"),
+    })?;
+    let elapsed = start.elapsed();
+    Ok(Rendered { bits, gray: hooks.gray, stats, elapsed })
+}
+
+/// Renders with the accelerator chosen by `accel` (building the lattice when needed).
+pub fn render_accel<R: Real>(
+    scene: &Scene<'_, R>,
+    accel: Accel,
+    frame: &Frame,
+    tune: impl Fn(&mut Tracer<'_, '_, R, dyn Accelerator<R> + '_>),
+    progress: bool,
+) -> Result<Rendered> {
+    let cfg = LatticeConfig::default();
+    let mut bufs;
+    let lattice;
+    let a: &dyn Accelerator<R> = match accel {
+        Accel::Lattice => {
+            bufs = LatticeBufs::for_scene(scene, &cfg);
+            lattice = bufs.build(scene, &cfg)?;
+            &lattice
+        }
+        Accel::Bbox => &BoundingBox,
+        Accel::Brute => &BruteForce,
+    };
+    let mut tracer = Tracer::new(scene, a);
+    tune(&mut tracer);
+    render_with(&tracer, frame, progress)
+}
+
+fn print_stats(label: &str, s: &Stats, elapsed: Duration) {
+    println!(
+        "{label}: {:.1} ms, rays {} (primary {}, shadow {}, reflection {}, refraction {}), object tests {} ({:.2}/ray), inside tests {}, cells {}",
+        elapsed.as_secs_f64() * 1e3,
+        s.total_rays(),
+        s.rays[0],
+        s.rays[1],
+        s.rays[2],
+        s.rays[3],
+        s.object_tests,
+        s.object_tests as f64 / s.total_rays().max(1) as f64,
+        s.inside_tests,
+        s.cells_visited,
+    );
+}
+
+/// `host-sim render`.
+pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
+    let text = read(&a.scene)?;
+    let mut storage = object_storage::<R>(&text);
+    let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
+    let frame = Frame { width: a.size.0, height: a.size.1, tile: a.tile, dither: a.dither.mode() };
+    let out = render_accel(&scene, a.accel, &frame, |_| {}, true)?;
+    let mut store = vec![0u8; out.bits.len()];
+    let frame_bits = bitframe_from(&mut store, &frame, &out.bits);
+    write_png(&frame_bits, &a.output, a.theme, a.scale)?;
+    println!("wrote {}", a.output.display());
+    if let Some(p) = &a.pbm {
+        write_pbm(&frame_bits, p)?;
+        println!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.gray {
+        write_pgm(frame.width as u32, frame.height as u32, &out.gray, p)?;
+        println!("wrote {}", p.display());
+    }
+    print_stats(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel_name()), &out.stats, out.elapsed);
+    Ok(())
+}
+
+/// A `BitFrame` over `store` holding the packed bits `bits`.
+pub fn bitframe_from<'b>(store: &'b mut [u8], frame: &Frame, bits: &[u8]) -> BitFrame<'b> {
+    let mut f = BitFrame::new(frame.width as u32, frame.height as u32, store).expect("sized by render");
+    use embedded_graphics::prelude::*;
+    let stride = (frame.width as usize).div_ceil(8);
+    let pixels = (0..frame.height as i32).flat_map(|y| {
+        (0..frame.width as i32).map(move |x| {
+            let on = bits[y as usize * stride + x as usize / 8] & (0x80 >> (x % 8)) != 0;
+            Pixel(Point::new(x, y), embedded_graphics::pixelcolor::BinaryColor::from(on))
+        })
+    });
+    let _ = f.draw_iter(pixels);
+    f
+}
+
+impl RenderArgs {
+    fn accel_name(&self) -> &'static str {
+        match self.accel {
+            Accel::Lattice => "lattice",
+            Accel::Bbox => "bbox",
+            Accel::Brute => "brute",
+        }
+    }
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+/// `host-sim stats`.
+pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
+    let text = read(&a.scene)?;
+    let mut storage = object_storage::<R>(&text);
+    let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
+    let cfg = LatticeConfig::default();
+    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+    let t0 = Instant::now();
+    let lattice = bufs.build(&scene, &cfg)?;
+    let build = t0.elapsed();
+    let fx = Effects::of(&scene);
+    println!("scene {} ({})", a.scene.display(), R::NAME);
+    println!(
+        "  objects {}, composites {}, materials {}, lights {}, depth {}",
+        scene.objects.len(),
+        scene.groups.len(),
+        scene.materials.len(),
+        scene.lights.len(),
+        scene.max_depth
+    );
+    println!("  effects: shadows {}, reflection {}, refraction {}", fx.shadows, fx.reflection, fx.refraction);
+    for (i, g) in lattice.grids().iter().enumerate() {
+        let name = if i == 0 { "world lattice".to_string() } else { format!("sub-lattice {}", i - 1) };
+        println!("  {name}: {} x {} x {} cells", g.n[0], g.n[1], g.n[2]);
+    }
+    println!(
+        "  lattice: {} cells, {} references, {} bytes, built in {:.3} ms",
+        lattice.cell_count(),
+        lattice.ref_count(),
+        lattice.bytes(),
+        build.as_secs_f64() * 1e3
+    );
+    let frame = Frame { width: a.size.0, height: a.size.1, tile: 8, dither: Dither::Bayer };
+    let pixels = frame.width as f64 * frame.height as f64;
+    // Primary rays only: the paper's per-ray figures.
+    let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + '_>| {
+        t.max_depth = 0;
+        t.effects = Effects { shadows: false, reflection: false, refraction: false };
+    };
+    println!("  per primary ray at {}x{} (eye rays only):", frame.width, frame.height);
+    let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];
+    for acc in accels {
+        let r = render_accel(&scene, acc, &frame, primary_only, false)?;
+        println!(
+            "    {:8} object tests {:6.3}, inside tests {:6.2}, cells visited {:6.2}",
+            format!("{acc:?}").to_lowercase(),
+            r.stats.object_tests as f64 / pixels,
+            r.stats.inside_tests as f64 / pixels,
+            r.stats.cells_visited as f64 / pixels
+        );
+    }
+    // Full renders, interleaved so drift on a shared machine hits all methods alike.
+    let mut times: Vec<Vec<Duration>> = vec![Vec::new(); accels.len()];
+    let mut last = Vec::new();
+    for _ in 0..a.runs.max(1) {
+        last.clear();
+        for (i, acc) in accels.iter().enumerate() {
+            let r = render_accel(&scene, *acc, &frame, |_| {}, false)?;
+            times[i].push(r.elapsed);
+            last.push(r);
+        }
+    }
+    let med: Vec<Duration> = times.into_iter().map(median).collect();
+    println!("  full render at {}x{}, median of {} interleaved runs:", frame.width, frame.height, a.runs.max(1));
+    for (i, acc) in accels.iter().enumerate() {
+        let s = &last[i].stats;
+        println!(
+            "    {:8} {:9.2} ms  rays {:7}  object tests {:9}  ({:.2}/ray)",
+            format!("{acc:?}").to_lowercase(),
+            med[i].as_secs_f64() * 1e3,
+            s.total_rays(),
+            s.object_tests,
+            s.object_tests as f64 / s.total_rays().max(1) as f64
+        );
+    }
+    let same = last.windows(2).all(|w| w[0].bits == w[1].bits);
+    println!(
+        "  lattice/bbox time ratio {:.3} (lattice {:.2}x faster); images identical across accelerators: {same}",
+        med[2].as_secs_f64() / med[1].as_secs_f64(),
+        med[1].as_secs_f64() / med[2].as_secs_f64()
+    );
+    Ok(())
+}
+
+/// The paper's four scenes.
+pub const PAPER_SCENES: [&str; 4] = ["chair", "desk", "polyhedron", "spheres"];
+
+/// The default job: the paper's scenes at 160x100 and 128x64.
+pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
+    for name in PAPER_SCENES {
+        let path = scenes.join(format!("{name}.scene"));
+        let text = read(&path)?;
+        let mut storage = object_storage::<f64>(&text);
+        let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
+        for (w, h) in [(160u16, 100u16), (128, 64)] {
+            let frame = Frame { width: w, height: h, tile: 8, dither: Dither::Bayer };
+            let r = render_accel(&scene, Accel::Lattice, &frame, |_| {}, true)?;
+            let mut store = vec![0u8; r.bits.len()];
+            let f = bitframe_from(&mut store, &frame, &r.bits);
+            let png = out.join(format!("{name}-{w}x{h}.png"));
+            write_png(&f, &png, Theme::Paper, 3)?;
+            write_pbm(&f, &out.join(format!("{name}-{w}x{h}.pbm")))?;
+            print_stats(&format!("{}", png.display()), &r.stats, r.elapsed);
+        }
+    }
+    println!("wrote the paper's four scenes to {}/", out.display());
+    Ok(())
+}

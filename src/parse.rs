@@ -1,0 +1,358 @@
+//! The plain-text scene format, parsed without allocation (firmware can `include_str!` the same
+//! files the desktop reads). The format is documented in `docs/scene-format.md`.
+//!
+//! One statement per line, `#` starts a comment. Every error names the line and column (1-based,
+//! columns count bytes), the offending token and the reason. Parsing feeds a [`SceneBuilder`],
+//! which validates each object as it arrives, so range errors also point at their line.
+
+use crate::math::{Affine, Vec3};
+use crate::scalar::Real;
+use crate::scene::{Light, Material, Object, Scene, SceneBuilder, SceneError, MAX_MATERIALS};
+use crate::shape::Shape;
+use crate::trace::MAX_DEPTH;
+use core::fmt;
+use heapless::Vec;
+
+/// What is wrong at a position of the scene text.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParseErrorKind {
+    /// The first word of a line is not a statement.
+    UnknownStatement,
+    /// A word that is not an attribute of this statement.
+    UnknownAttribute,
+    /// A number was expected.
+    ExpectedNumber,
+    /// The line ended where a value was expected.
+    MissingValue,
+    /// A material name that was not defined earlier.
+    UnknownMaterial,
+    /// A material name defined twice.
+    DuplicateMaterial,
+    /// An axis other than x, y or z.
+    UnknownAxis,
+    /// A light kind other than `directional` or `point`.
+    UnknownLightKind,
+    /// `depth` must be a whole number from 0 to the tracer's maximum.
+    BadDepth,
+    /// The scene itself is invalid.
+    Scene(SceneError),
+}
+
+/// A scene-text error: where, what token, why.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParseError<'t> {
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column (in bytes).
+    pub col: u32,
+    /// The token at fault (empty at the end of a line or file).
+    pub token: &'t str,
+    /// The reason.
+    pub kind: ParseErrorKind,
+}
+
+impl fmt::Display for ParseErrorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ParseErrorKind::UnknownStatement => write!(
+                f,
+                "unknown statement (expected camera, ambient, background, depth, light, material, \
+                 sphere, cylinder, cone, box, group or end)"
+            ),
+            ParseErrorKind::UnknownAttribute => write!(f, "not an attribute of this statement"),
+            ParseErrorKind::ExpectedNumber => write!(f, "expected a number"),
+            ParseErrorKind::MissingValue => write!(f, "a value is missing at the end of the line"),
+            ParseErrorKind::UnknownMaterial => write!(f, "material not defined before this line"),
+            ParseErrorKind::DuplicateMaterial => write!(f, "material already defined"),
+            ParseErrorKind::UnknownAxis => write!(f, "axis must be x, y or z"),
+            ParseErrorKind::UnknownLightKind => write!(f, "light must be `directional` or `point`"),
+            ParseErrorKind::BadDepth => write!(f, "depth must be a whole number from 0 to {MAX_DEPTH}"),
+            ParseErrorKind::Scene(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl fmt::Display for ParseError<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "line {}, column {}", self.line, self.col)?;
+        if !self.token.is_empty() {
+            write!(f, " at `{}`", self.token)?;
+        }
+        write!(f, ": {}", self.kind)
+    }
+}
+
+impl core::error::Error for ParseError<'_> {}
+
+/// The words of one line with their columns.
+struct Words<'t> {
+    line: &'t str,
+    pos: usize,
+    lineno: u32,
+}
+
+impl<'t> Words<'t> {
+    fn new(line: &'t str, lineno: u32) -> Self {
+        let line = match line.find('#') {
+            Some(i) => &line[..i],
+            None => line,
+        };
+        Words { line, pos: 0, lineno }
+    }
+
+    fn next(&mut self) -> Option<(u32, &'t str)> {
+        let rest = &self.line[self.pos..];
+        let start = self.pos + (rest.len() - rest.trim_start().len());
+        if start >= self.line.len() {
+            self.pos = self.line.len();
+            return None;
+        }
+        let len = self.line[start..].find(|c: char| c.is_whitespace()).unwrap_or(self.line.len() - start);
+        self.pos = start + len;
+        Some((start as u32 + 1, &self.line[start..start + len]))
+    }
+
+    fn err(&self, col: u32, token: &'t str, kind: ParseErrorKind) -> ParseError<'t> {
+        ParseError { line: self.lineno, col, token, kind }
+    }
+
+    fn end_err(&self) -> ParseError<'t> {
+        self.err(self.line.trim_end().len() as u32 + 1, "", ParseErrorKind::MissingValue)
+    }
+
+    fn word(&mut self) -> Result<(u32, &'t str), ParseError<'t>> {
+        self.next().ok_or_else(|| self.end_err())
+    }
+
+    fn number(&mut self) -> Result<f64, ParseError<'t>> {
+        let (col, tok) = self.word()?;
+        let v: f64 = tok.parse().map_err(|_| self.err(col, tok, ParseErrorKind::ExpectedNumber))?;
+        if !v.is_finite() {
+            return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::NotFinite)));
+        }
+        Ok(v)
+    }
+
+    fn positive(&mut self) -> Result<f64, ParseError<'t>> {
+        let save = self.pos;
+        let v = self.number()?;
+        if v <= 0.0 {
+            self.pos = save;
+            let (col, tok) = self.word()?;
+            return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::NonPositiveSize)));
+        }
+        Ok(v)
+    }
+
+    fn vec3(&mut self) -> Result<Vec3<f64>, ParseError<'t>> {
+        Ok(Vec3::new(self.number()?, self.number()?, self.number()?))
+    }
+
+    fn axis(&mut self) -> Result<usize, ParseError<'t>> {
+        let (col, tok) = self.word()?;
+        match tok {
+            "x" => Ok(0),
+            "y" => Ok(1),
+            "z" => Ok(2),
+            _ => Err(self.err(col, tok, ParseErrorKind::UnknownAxis)),
+        }
+    }
+
+    /// Parses a transform attribute if `key` is one, composing it after `t`.
+    fn transform(&mut self, key: &str, t: &mut Affine<f64>) -> Result<bool, ParseError<'t>> {
+        let op = match key {
+            "translate" => Affine::translate(self.vec3()?),
+            "rotate" => {
+                let a = self.axis()?;
+                Affine::rotate(a, self.number()?)
+            }
+            "scale" => {
+                let x = self.number()?;
+                let save = self.pos;
+                match self.next() {
+                    Some((_, tok)) if tok.parse::<f64>().is_ok() => {
+                        self.pos = save;
+                        let (y, z) = (self.number()?, self.number()?);
+                        Affine::scale(Vec3::new(x, y, z))
+                    }
+                    _ => {
+                        self.pos = save;
+                        Affine::scale(Vec3::new(x, x, x))
+                    }
+                }
+            }
+            "shear" => {
+                let (i, j) = (self.axis()?, self.axis()?);
+                Affine::shear(i, j, self.number()?)
+            }
+            _ => return Ok(false),
+        };
+        *t = op.after(t);
+        Ok(true)
+    }
+}
+
+/// Parses scene text into a validated scene whose objects live in `storage`.
+pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Result<Scene<'a, R>, ParseError<'t>> {
+    let mut b = SceneBuilder::<R>::new(storage);
+    let mut names: Vec<(&'t str, u8), MAX_MATERIALS> = Vec::new();
+    let mut camera_at = (0u32, 0u32, "");
+    let mut group_at = (0u32, 0u32, "");
+    let mut last_line = 1u32;
+    for (i, line) in text.lines().enumerate() {
+        let lineno = i as u32 + 1;
+        last_line = lineno;
+        let mut w = Words::new(line, lineno);
+        let Some((kcol, key)) = w.next() else { continue };
+        let scene_err = |e: SceneError| ParseError { line: lineno, col: kcol, token: key, kind: ParseErrorKind::Scene(e) };
+        match key {
+            "camera" => {
+                camera_at = (lineno, kcol, key);
+                while let Some((col, attr)) = w.next() {
+                    match attr {
+                        "eye" => b.camera.eye = w.vec3()?,
+                        "look" => b.camera.look = w.vec3()?,
+                        "up" => b.camera.up = w.vec3()?,
+                        "fov" => b.camera.fov = (w.number()?, w.number()?),
+                        _ => return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute)),
+                    }
+                }
+            }
+            "ambient" => b.ambient = w.number()?,
+            "background" => b.background = w.number()?,
+            "depth" => {
+                let (col, tok) = w.word()?;
+                b.max_depth = match tok.parse::<u8>() {
+                    Ok(d) if d <= MAX_DEPTH => d,
+                    _ => return Err(w.err(col, tok, ParseErrorKind::BadDepth)),
+                };
+            }
+            "light" => {
+                let (col, kind) = w.word()?;
+                let mut v = Vec3::zero();
+                let mut intensity = 1.0;
+                let want = match kind {
+                    "directional" => "dir",
+                    "point" => "pos",
+                    _ => return Err(w.err(col, kind, ParseErrorKind::UnknownLightKind)),
+                };
+                while let Some((col, attr)) = w.next() {
+                    match attr {
+                        a if a == want => v = w.vec3()?,
+                        "intensity" => intensity = w.number()?,
+                        _ => return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute)),
+                    }
+                }
+                let light = if want == "dir" {
+                    Light::Directional { to_light: -v, intensity }
+                } else {
+                    Light::Point { pos: v, intensity }
+                };
+                b.add_light(light).map_err(scene_err)?;
+            }
+            "material" => {
+                let (ncol, name) = w.word()?;
+                if names.iter().any(|(n, _)| *n == name) {
+                    return Err(w.err(ncol, name, ParseErrorKind::DuplicateMaterial));
+                }
+                let mut m = Material::DEFAULT;
+                while let Some((col, attr)) = w.next() {
+                    let slot = match attr {
+                        "ka" => &mut m.ka,
+                        "kd" => &mut m.kd,
+                        "ks" => &mut m.ks,
+                        "kt" => &mut m.kt,
+                        "ior" => &mut m.ior,
+                        _ => return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute)),
+                    };
+                    *slot = w.number()?;
+                }
+                let id = b.add_material(m).map_err(|e| w.err(ncol, name, ParseErrorKind::Scene(e)))?;
+                let _ = names.push((name, id));
+            }
+            "sphere" | "cylinder" | "cone" | "box" => {
+                let (mut pos, mut radius, mut height, mut top) = (Vec3::zero(), 1.0, 1.0, 0.0);
+                let (mut lo, mut hi) = (Vec3::zero(), Vec3::new(1.0, 1.0, 1.0));
+                let mut material = 0u8;
+                let mut t = Affine::identity();
+                while let Some((col, attr)) = w.next() {
+                    match (key, attr) {
+                        ("sphere", "center") | ("cylinder" | "cone", "base") => pos = w.vec3()?,
+                        ("sphere" | "cylinder" | "cone", "radius") => radius = w.positive()?,
+                        ("cylinder" | "cone", "height") => height = w.positive()?,
+                        ("cone", "top") => {
+                            top = w.number()?;
+                            if top < 0.0 {
+                                return Err(w.err(col, attr, ParseErrorKind::Scene(SceneError::NonPositiveSize)));
+                            }
+                        }
+                        ("box", "min") => lo = w.vec3()?,
+                        ("box", "max") => hi = w.vec3()?,
+                        (_, "material") => {
+                            let (mcol, name) = w.word()?;
+                            material = names
+                                .iter()
+                                .find(|(n, _)| *n == name)
+                                .map(|(_, id)| *id)
+                                .ok_or_else(|| w.err(mcol, name, ParseErrorKind::UnknownMaterial))?;
+                        }
+                        _ => {
+                            if !w.transform(attr, &mut t)? {
+                                return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute));
+                            }
+                        }
+                    }
+                }
+                let (shape, placement) = match key {
+                    "sphere" => (Shape::Sphere, Affine::translate(pos).after(&Affine::scale(Vec3::new(radius, radius, radius)))),
+                    "box" => {
+                        let size = hi - lo;
+                        if !(size.x > 0.0 && size.y > 0.0 && size.z > 0.0) {
+                            return Err(scene_err(SceneError::NonPositiveSize));
+                        }
+                        (Shape::Box, Affine::translate(lo).after(&Affine::scale(size)))
+                    }
+                    _ => {
+                        let shape = if key == "cone" { Shape::Cone { top: top / radius } } else { Shape::Cylinder };
+                        (shape, Affine::translate(pos).after(&Affine::scale(Vec3::new(radius, height, radius))))
+                    }
+                };
+                b.add_object(shape, t.after(&placement), material).map_err(scene_err)?;
+            }
+            "group" => {
+                group_at = (lineno, kcol, key);
+                let mut t = Affine::identity();
+                // An optional name comes first; it documents the scene and is not stored.
+                let save = w.pos;
+                if let Some((_, word)) = w.next() {
+                    if matches!(word, "translate" | "rotate" | "scale" | "shear") {
+                        w.pos = save;
+                    }
+                }
+                while let Some((col, attr)) = w.next() {
+                    if !w.transform(attr, &mut t)? {
+                        return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute));
+                    }
+                }
+                b.begin_group(t).map_err(scene_err)?;
+            }
+            "end" => b.end_group().map_err(scene_err)?,
+            _ => return Err(w.err(kcol, key, ParseErrorKind::UnknownStatement)),
+        }
+        if let Some((col, tok)) = w.next() {
+            return Err(w.err(col, tok, ParseErrorKind::UnknownAttribute));
+        }
+    }
+    b.finish().map_err(|e| {
+        let (line, col, token) = match e {
+            SceneError::UnclosedGroup => group_at,
+            SceneError::DegenerateCamera | SceneError::BadFieldOfView | SceneError::OutOfRange { .. }
+                if camera_at.0 > 0 =>
+            {
+                camera_at
+            }
+            _ => (last_line, 1, ""),
+        };
+        ParseError { line, col, token, kind: ParseErrorKind::Scene(e) }
+    })
+}
