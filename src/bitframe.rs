@@ -32,11 +32,50 @@ impl<'b> BitFrame<'b> {
     pub fn raster(&self) -> &[u8] {
         self.bits
     }
+    /// Emits the frame as a binary PBM (`P4`) in pieces, lit pixels white (PBM 0), without
+    /// allocating: the same bytes on the host and over semihosting.
+    pub fn write_pbm(&self, mut sink: impl FnMut(&[u8])) {
+        let mut head = [0u8; 32];
+        let n = pbm_header(self.width, self.height, &mut head);
+        sink(&head[..n]);
+        for chunk in self.bits.chunks(64) {
+            let mut inv = [0u8; 64];
+            for (d, s) in inv.iter_mut().zip(chunk) {
+                *d = !s;
+            }
+            sink(&inv[..chunk.len()]);
+        }
+    }
     /// Whether the pixel at `(x, y)` is on.
     pub fn get(&self, x: u32, y: u32) -> bool {
         let stride = (self.width as usize).div_ceil(8);
         self.bits[y as usize * stride + x as usize / 8] & (0x80 >> (x % 8)) != 0
     }
+}
+
+/// Writes `P4\n<w> <h>\n` into `out` and returns its length.
+fn pbm_header(w: u32, h: u32, out: &mut [u8; 32]) -> usize {
+    let mut n = 0;
+    let mut put = |b: u8| {
+        out[n] = b;
+        n += 1;
+    };
+    b"P4\n".iter().for_each(|&b| put(b));
+    for (v, end) in [(w, b' '), (h, b'\n')] {
+        let mut digits = [0u8; 10];
+        let (mut k, mut v) = (0, v);
+        loop {
+            digits[k] = b'0' + (v % 10) as u8;
+            k += 1;
+            v /= 10;
+            if v == 0 {
+                break;
+            }
+        }
+        digits[..k].iter().rev().for_each(|&d| put(d));
+        put(end);
+    }
+    n
 }
 
 impl OriginDimensions for BitFrame<'_> {

@@ -28,3 +28,4 @@ pub mod parse;
 pub use parse::{parse, ParseError};
 pub mod bitframe;
 pub use bitframe::BitFrame;
+pub mod generate;

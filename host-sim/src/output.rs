@@ -67,9 +67,8 @@ pub fn write_pbm(frame: &BitFrame<'_>, path: &Path) -> Result<()> {
 
 /// The bytes of a binary PBM of the frame, with lit pixels white.
 pub fn pbm_bytes(frame: &BitFrame<'_>) -> Vec<u8> {
-    let size = frame.size();
-    let mut out = format!("P4\n{} {}\n", size.width, size.height).into_bytes();
-    out.extend(frame.raster().iter().map(|b| !b));
+    let mut out = Vec::new();
+    frame.write_pbm(|b| out.extend_from_slice(b));
     out
 }
 

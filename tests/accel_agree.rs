@@ -1,0 +1,114 @@
+//! Lattice, bounding-box and brute force answer every ray identically (object and `t`, bit
+//! for bit), on random scenes and adversarial rays, in every float scalar.
+
+use lattice_rt::generate::{random_scene, RandomScene, Rng};
+use lattice_rt::lattice::{Grid, LatticeSizes};
+use lattice_rt::scene::Object;
+use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, LatticeStorage, Query, Ray, Real, Scene, SceneBuilder, Vec3};
+use proptest::prelude::*;
+
+/// Rays aimed to hurt: random, axis-aligned with +0.0/-0.0 components, starting on lattice
+/// planes, and through lattice corners.
+fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &mut Rng, n: usize) -> Vec<Ray<R>> {
+    let w = scene.world;
+    let pick = |rng: &mut Rng, a: usize| {
+        let c = lat.coordinate_list(0, a);
+        c[rng.below(c.len() as u64) as usize]
+    };
+    let inside = |rng: &mut Rng, a: usize| R::from_f64(rng.range(w.min.axis(a).to_f64(), w.max.axis(a).to_f64()));
+    let mut rays = Vec::with_capacity(n);
+    for i in 0..n {
+        let kind = i % 5;
+        let mut o = Vec3::new(inside(rng, 0), inside(rng, 1), inside(rng, 2));
+        let mut d = Vec3::new(R::from_f64(rng.range(-1.0, 1.0)), R::from_f64(rng.range(-1.0, 1.0)), R::from_f64(rng.range(-1.0, 1.0)));
+        match kind {
+            // Axis-aligned with signed zeros, from a point on cell planes.
+            1 => {
+                let a = rng.below(3) as usize;
+                let s = if rng.below(2) == 0 { R::ONE } else { -R::ONE };
+                let z = |rng: &mut Rng| if rng.below(2) == 0 { R::ZERO } else { -R::ZERO };
+                let mut c = [z(rng), z(rng), z(rng)];
+                c[a] = s;
+                d = Vec3::new(c[0], c[1], c[2]);
+                o = Vec3::new(pick(rng, 0), pick(rng, 1), pick(rng, 2));
+            }
+            // From one lattice point through another (cell corners and edges).
+            2 => {
+                o = Vec3::new(pick(rng, 0), pick(rng, 1), pick(rng, 2));
+                let p = Vec3::new(pick(rng, 0), pick(rng, 1), pick(rng, 2));
+                d = p - o;
+            }
+            // Starting outside the world, aimed at its inside.
+            3 => {
+                let target = o;
+                o = Vec3::new(R::from_f64(-50.0), inside(rng, 1), R::from_f64(-60.0));
+                d = target - o;
+            }
+            // From the camera, as eye rays do.
+            4 => o = scene.camera.eye,
+            _ => {}
+        }
+        if d.max_abs() == R::ZERO {
+            d = Vec3::new(R::ONE, R::ZERO, R::ZERO);
+        }
+        rays.push(Ray::new(o, d));
+    }
+    rays
+}
+
+fn build<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, bufs: &mut (Vec<Grid<R>>, Vec<R>, Vec<u32>, Vec<u32>)) {
+    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(scene, cfg);
+    *bufs = (vec![Grid::EMPTY; grids], vec![R::ZERO; coords], vec![0; cells], vec![0; refs]);
+}
+
+fn check<R: Real>(p: &RandomScene, cfg: &LatticeConfig, nrays: usize) -> Result<(), TestCaseError> {
+    let mut storage = vec![Object::<R>::default(); p.objects];
+    let mut b = SceneBuilder::new(&mut storage);
+    random_scene(&mut b, p).unwrap();
+    let scene = b.finish().unwrap();
+    let mut bufs = Default::default();
+    build(&scene, cfg, &mut bufs);
+    let (g, c, ce, r) = &mut bufs;
+    let lat = Lattice::build(&scene, cfg, LatticeStorage { grids: g, coords: c, cells: ce, refs: r }).unwrap();
+    let mut rng = Rng::new(p.seed ^ 0xABCD);
+    let rays = adversarial_rays(&lat, &scene, &mut rng, nrays);
+    let mut mb = vec![0; Query::mailbox_len(&scene)];
+    let mut q = Query::new(&mut mb);
+    for ray in &rays {
+        let want = BruteForce.nearest(&scene, ray, R::ZERO, R::MAX, &mut q);
+        let got_l = lat.nearest(&scene, ray, R::ZERO, R::MAX, &mut q);
+        let got_b = BoundingBox.nearest(&scene, ray, R::ZERO, R::MAX, &mut q);
+        prop_assert_eq!(want, got_l, "lattice differs from brute force for {:?}", ray);
+        prop_assert_eq!(want, got_b, "bbox differs from brute force for {:?}", ray);
+        let reach = R::from_f64(3.0);
+        let occ = BruteForce.occluded(&scene, ray, R::ZERO, reach, &mut q);
+        prop_assert_eq!(occ, lat.occluded(&scene, ray, R::ZERO, reach, &mut q), "lattice occlusion, {:?}", ray);
+        prop_assert_eq!(occ, BoundingBox.occluded(&scene, ray, R::ZERO, reach, &mut q), "bbox occlusion, {:?}", ray);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn accelerators_agree_ray_by_ray_in_f64(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(3), Just(5)]) {
+        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        check::<f64>(&p, &LatticeConfig::default(), 400)?;
+    }
+
+    #[test]
+    fn accelerators_agree_ray_by_ray_in_f32(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(3), Just(5)]) {
+        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        check::<f32>(&p, &LatticeConfig::default(), 400)?;
+    }
+
+    #[test]
+    fn fine_and_coarse_lattices_agree_too(seed in any::<u64>(), n in 1usize..30, res in 1u16..12) {
+        use lattice_rt::lattice::Resolution;
+        let p = RandomScene { objects: n, group_size: 4, spread: 0.0, seed };
+        let cfg = LatticeConfig { top: Resolution::Uniform([res, res + 1, res.saturating_sub(1).max(1)]), sub: Resolution::Uniform([res; 3]), max_per_axis: 64 };
+        check::<f64>(&p, &cfg, 200)?;
+        check::<f32>(&p, &cfg, 200)?;
+    }
+}

@@ -1,0 +1,102 @@
+//! Helpers shared by the integration tests: parse a scene, build an accelerator, render.
+#![allow(dead_code)]
+
+use lattice_rt::lattice::{Grid, LatticeSizes};
+use lattice_rt::scene::Object;
+use lattice_rt::{
+    parse, render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, Lattice, LatticeConfig, LatticeStorage,
+    NoHooks, Query, Real, Scene, Stats, Tracer,
+};
+
+/// The accelerators under test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Accel {
+    Lattice,
+    Bbox,
+    Brute,
+}
+
+pub const ACCELS: [Accel; 3] = [Accel::Lattice, Accel::Bbox, Accel::Brute];
+
+/// Reads a scene file from `scenes/`.
+pub fn scene_text(name: &str) -> String {
+    let path = format!("{}/scenes/{name}.scene", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// Heap storage for a lattice.
+pub struct Bufs<R> {
+    pub grids: Vec<Grid<R>>,
+    pub coords: Vec<R>,
+    pub cells: Vec<u32>,
+    pub refs: Vec<u32>,
+}
+
+pub fn lattice_bufs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Bufs<R> {
+    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(scene, cfg);
+    Bufs { grids: vec![Grid::EMPTY; grids], coords: vec![R::ZERO; coords], cells: vec![0; cells], refs: vec![0; refs] }
+}
+
+pub fn build_lattice<'a, R: Real>(scene: &Scene<'_, R>, b: &'a mut Bufs<R>) -> Lattice<'a, R> {
+    let st = LatticeStorage { grids: &mut b.grids, coords: &mut b.coords, cells: &mut b.cells, refs: &mut b.refs };
+    Lattice::build(scene, &LatticeConfig::default(), st).expect("lattice fits")
+}
+
+/// Renders with a tracer already set up; returns the PBM bytes and the statistics.
+pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, A>, frame: &Frame) -> (Vec<u8>, Stats) {
+    let mut bits = vec![0u8; BitFrame::bytes(frame.width as u32, frame.height as u32)];
+    let mut target = BitFrame::new(frame.width as u32, frame.height as u32, &mut bits).unwrap();
+    let mut mb = vec![0u32; Query::mailbox_len(t.scene)];
+    let mut carry = vec![0i16; 4 * frame.width as usize];
+    let stats = render(t, frame, &mut target, &mut mb, &mut carry, &mut NoHooks).expect("render");
+    let mut pbm = Vec::new();
+    target.write_pbm(|b| pbm.extend_from_slice(b));
+    (pbm, stats)
+}
+
+/// Parses `text` and renders it with one accelerator and the scene's own settings.
+pub fn render_text<R: Real>(text: &str, accel: Accel, frame: &Frame) -> (Vec<u8>, Stats) {
+    let mut storage = vec![Object::<R>::default(); text.lines().count()];
+    let scene = parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{e}"));
+    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &mut bufs);
+    let a: &dyn Accelerator<R> = match accel {
+        Accel::Lattice => &lat,
+        Accel::Bbox => &BoundingBox,
+        Accel::Brute => &BruteForce,
+    };
+    render_tracer(&Tracer::new(&scene, a), frame)
+}
+
+/// Compares a PBM with the checked-in golden file; on mismatch writes the actual image and an
+/// XOR diff under `target/golden/` and panics with their paths. `UPDATE_GOLDEN=1` rewrites.
+pub fn assert_golden(name: &str, pbm: &[u8]) {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let golden = format!("{root}/tests/golden/{name}.pbm");
+    if std::env::var("UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
+        std::fs::write(&golden, pbm).unwrap();
+        return;
+    }
+    let want = std::fs::read(&golden)
+        .unwrap_or_else(|e| panic!("{golden}: {e}; run with UPDATE_GOLDEN=1 to create it"));
+    if want == pbm {
+        return;
+    }
+    let out = format!("{root}/target/golden");
+    std::fs::create_dir_all(&out).unwrap();
+    let actual = format!("{out}/{name}-actual.pbm");
+    let diff = format!("{out}/{name}-diff.pbm");
+    std::fs::write(&actual, pbm).unwrap();
+    let head_len = pbm.iter().enumerate().filter(|(_, &b)| b == b'\n').nth(1).map_or(0, |(i, _)| i + 1);
+    let mut d = pbm[..head_len].to_vec();
+    let differing: usize = if want.len() == pbm.len() {
+        let body: Vec<u8> = pbm[head_len..].iter().zip(&want[head_len..]).map(|(a, b)| !(a ^ b)).collect();
+        let n = body.iter().map(|b| (!b).count_ones() as usize).sum();
+        d.extend(body);
+        std::fs::write(&diff, &d).unwrap();
+        n
+    } else {
+        usize::MAX
+    };
+    panic!("{name}: image differs from {golden} in {differing} pixels; actual: {actual}, diff (black = differs): {diff}");
+}

@@ -1,0 +1,55 @@
+//! Golden 1-bit images of the paper's scenes and the Whitted showcase in f64 and f32, and the
+//! three accelerators drawing identical frames.
+
+mod common;
+use common::*;
+use lattice_rt::{Dither, Frame, Real};
+
+const SCENES: [&str; 5] = ["chair", "desk", "polyhedron", "spheres", "whitted"];
+
+fn golden_for<R: Real>() {
+    let frame = Frame { width: 128, height: 64, tile: 8, dither: Dither::Bayer };
+    for s in SCENES {
+        let (pbm, _) = render_text::<R>(&scene_text(s), Accel::Lattice, &frame);
+        assert_golden(&format!("{s}-128x64-{}", R::NAME), &pbm);
+    }
+}
+
+#[test]
+fn paper_scenes_match_golden_images_in_f64() {
+    golden_for::<f64>();
+}
+
+#[test]
+fn paper_scenes_match_golden_images_in_f32() {
+    golden_for::<f32>();
+}
+
+fn identical_for<R: Real>(frame: &Frame) {
+    for s in SCENES {
+        let text = scene_text(s);
+        let images: Vec<_> = ACCELS.iter().map(|&a| render_text::<R>(&text, a, frame).0).collect();
+        assert!(images[0] == images[1], "{s} ({}): lattice and bbox images differ", R::NAME);
+        assert!(images[0] == images[2], "{s} ({}): lattice and brute-force images differ", R::NAME);
+    }
+}
+
+#[test]
+fn all_accelerators_draw_identical_frames() {
+    let frame = Frame { width: 160, height: 100, tile: 8, dither: Dither::FloydSteinberg };
+    identical_for::<f64>(&frame);
+    identical_for::<f32>(&frame);
+}
+
+#[test]
+fn error_diffusion_in_tiles_keeps_the_mean_gray() {
+    // Tile-order Floyd-Steinberg keeps the overall brightness of the Bayer rendering.
+    let text = scene_text("spheres");
+    let count = |d| {
+        let f = Frame { width: 160, height: 100, tile: 8, dither: d };
+        let (pbm, _) = render_text::<f64>(&text, Accel::Lattice, &f);
+        pbm[pbm.len() - 2000..].iter().map(|b| b.count_ones()).sum::<u32>() as f64
+    };
+    let (bayer, fs) = (count(Dither::Bayer), count(Dither::FloydSteinberg));
+    assert!((bayer - fs).abs() / bayer < 0.03, "bayer {bayer} vs floyd-steinberg {fs} white pixels");
+}
