@@ -550,3 +550,107 @@ impl<R: Real> Accelerator<R> for Lattice<'_, R> {
         self.run(scene, ray, tmin, tmax, true, q).is_some()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::{random_scene, RandomScene, Rng};
+    use crate::scene::{Object, SceneBuilder};
+    use std::vec;
+    use std::vec::Vec;
+
+    fn scene_storage(n: usize) -> Vec<Object<f64>> {
+        vec![Object::default(); n]
+    }
+
+    fn with_lattice(n: usize, group: usize, cfg: LatticeConfig, f: impl FnOnce(&Scene<'_, f64>, &Lattice<'_, f64>)) {
+        let mut st = scene_storage(n);
+        let mut b = SceneBuilder::new(&mut st);
+        random_scene(&mut b, &RandomScene { objects: n, group_size: group, spread: 0.0, seed: 7 }).unwrap();
+        let scene = b.finish().unwrap();
+        let s = Lattice::plan(&scene, &cfg);
+        let (mut g, mut c, mut ce, mut r) = (vec![Grid::EMPTY; s.grids], vec![0.0; s.coords], vec![0; s.cells], vec![0; s.refs]);
+        let lat = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap();
+        assert_eq!((lat.grids.len(), lat.coords.len(), lat.cells.len(), lat.refs.len()), (s.grids, s.coords, s.cells, s.refs));
+        f(&scene, &lat);
+    }
+
+    #[test]
+    fn plan_gives_exactly_the_storage_build_uses() {
+        with_lattice(50, 0, LatticeConfig::default(), |_, _| {});
+        with_lattice(30, 4, LatticeConfig::default(), |_, _| {});
+    }
+
+    #[test]
+    fn too_little_storage_names_the_capacity_and_the_size_needed() {
+        let mut st = scene_storage(20);
+        let mut b = SceneBuilder::new(&mut st);
+        random_scene(&mut b, &RandomScene { objects: 20, group_size: 5, spread: 0.0, seed: 3 }).unwrap();
+        let scene = b.finish().unwrap();
+        let cfg = LatticeConfig::default();
+        let s = Lattice::plan(&scene, &cfg);
+        let (mut g, mut c, mut ce, mut r) = (vec![Grid::EMPTY; s.grids], vec![0.0; s.coords], vec![0; s.cells], vec![0; s.refs - 1]);
+        let e = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap_err();
+        assert_eq!(e, LatticeError { capacity: "refs", needed: s.refs, available: s.refs - 1 });
+        let mut g2 = vec![Grid::EMPTY; 1];
+        let e = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g2, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap_err();
+        assert_eq!(e.capacity, "grids");
+        assert_eq!(std::format!("{e}"), "lattice capacity `grids` too small: 5 entries needed, 1 available");
+    }
+
+    #[test]
+    fn walk_steps_to_face_neighbours_only_even_through_corners() {
+        let cfg = LatticeConfig { top: Resolution::Uniform([6, 6, 6]), ..LatticeConfig::default() };
+        with_lattice(20, 0, cfg, |scene, lat| {
+            let w = scene.world;
+            let mut rng = Rng::new(11);
+            for i in 0..2000 {
+                // Half the rays run exactly through lattice points (cell corners).
+                let pick = |rng: &mut Rng, a: usize| {
+                    let c = lat.coordinate_list(0, a);
+                    c[rng.below(c.len() as u64) as usize]
+                };
+                let o = Vec3::new(pick(&mut rng, 0), pick(&mut rng, 1), pick(&mut rng, 2));
+                let p = if i % 2 == 0 {
+                    Vec3::new(pick(&mut rng, 0), pick(&mut rng, 1), pick(&mut rng, 2))
+                } else {
+                    Vec3::new(rng.range(w.min.x, w.max.x), rng.range(w.min.y, w.max.y), rng.range(w.min.z, w.max.z))
+                };
+                if p == o {
+                    continue;
+                }
+                let ray = Ray::new(o, p - o);
+                let mut prev: Option<[usize; 3]> = None;
+                let mut last_t = f64::MIN;
+                lat.walk_cells(&ray, 0.0, f64::MAX, |c, t0, _| {
+                    if let Some(q) = prev {
+                        let steps: usize = (0..3).map(|a| c[a].abs_diff(q[a])).sum();
+                        assert_eq!(steps, 1, "skipped from {q:?} to {c:?} on {ray:?}");
+                    }
+                    assert!(t0 >= last_t, "cells out of order");
+                    last_t = t0;
+                    prev = Some(c);
+                });
+            }
+        });
+    }
+
+    #[test]
+    fn plus_and_minus_zero_directions_visit_the_same_cells() {
+        let cfg = LatticeConfig { top: Resolution::Uniform([5, 5, 5]), ..LatticeConfig::default() };
+        with_lattice(10, 0, cfg, |_, lat| {
+            let (x, y) = (lat.coordinate_list(0, 0)[2], lat.coordinate_list(0, 1)[3]);
+            let z0 = lat.coordinate_list(0, 2)[0];
+            let cells = |dx: f64, dy: f64| {
+                let mut v = Vec::new();
+                lat.walk_cells(&Ray::new(Vec3::new(x, y, z0), Vec3::new(dx, dy, 1.0)), 0.0, f64::MAX, |c, _, _| v.push(c));
+                v
+            };
+            let plus = cells(0.0, 0.0);
+            assert_eq!(plus.len(), 5, "one cell per z slab: {plus:?}");
+            assert_eq!(plus, cells(-0.0, 0.0));
+            assert_eq!(plus, cells(0.0, -0.0));
+            assert_eq!(plus, cells(-0.0, -0.0));
+        });
+    }
+}

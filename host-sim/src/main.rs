@@ -15,7 +15,7 @@ use std::path::PathBuf;
 /// With no command it renders the paper's four scenes (chair, desk, polyhedron, spheres) at
 /// 160x100 and 128x64 into `out/` and prints their statistics.
 #[derive(Parser, Debug)]
-#[command(version, about, long_about = None)]
+#[command(version)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,

@@ -79,3 +79,19 @@ pub fn write_pgm(width: u32, height: u32, levels: &[u8], path: &Path) -> Result<
     out.extend_from_slice(levels);
     std::fs::write(path, out).with_context(|| format!("cannot write {}", path.display()))
 }
+
+/// Writes gray levels 0..=64 as a gray PNG (through the simulator's Gray8 display).
+pub fn write_gray_png(width: u32, height: u32, levels: &[u8], path: &Path, scale: u32) -> Result<()> {
+    use embedded_graphics::pixelcolor::Gray8;
+    let mut display = SimulatorDisplay::<Gray8>::new(Size::new(width, height));
+    for (i, &l) in levels.iter().enumerate() {
+        let v = (l as u32 * 255 / 64) as u8;
+        Pixel(Point::new((i as u32 % width) as i32, (i as u32 / width) as i32), Gray8::new(v)).draw(&mut display)?;
+    }
+    create_parent(path)?;
+    let settings = OutputSettingsBuilder::new().scale(scale.max(1)).build();
+    display
+        .to_grayscale_output_image(&settings)
+        .save_png(path)
+        .with_context(|| format!("cannot write {}", path.display()))
+}

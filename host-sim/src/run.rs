@@ -1,7 +1,7 @@
 //! The commands: render, stats and the default gallery job.
 
 use crate::load::{object_storage, parse_scene, read, LatticeBufs};
-use crate::output::{write_pbm, write_pgm, write_png, Theme};
+use crate::output::{write_gray_png, write_pbm, write_pgm, write_png, Theme};
 use crate::{Accel, RenderArgs, StatsArgs};
 use anyhow::{anyhow, Result};
 use lattice_rt::render::{Hooks, RenderError};
@@ -272,6 +272,7 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
             let png = out.join(format!("{name}-{w}x{h}.png"));
             write_png(&f, &png, Theme::Paper, 3)?;
             write_pbm(&f, &out.join(format!("{name}-{w}x{h}.pbm")))?;
+            write_gray_png(w as u32, h as u32, &r.gray, &out.join(format!("{name}-{w}x{h}-gray.png")), 2)?;
             print_stats(&format!("{}", png.display()), &r.stats, r.elapsed);
         }
     }

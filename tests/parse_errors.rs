@@ -1,0 +1,148 @@
+//! Every scene-text error kind, with the message a user sees (line, column, token, reason).
+
+use lattice_rt::scene::Object;
+use lattice_rt::{parse, Real};
+
+fn err<R: Real>(text: &str) -> String {
+    let mut storage = vec![Object::<R>::default(); 8];
+    match parse::<R>(text, &mut storage) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn check(text: &str, want: &str) {
+    assert_eq!(err::<f64>(text), want, "for:\n{text}");
+}
+
+#[test]
+fn unknown_statement() {
+    check("sphere\nteapot size 3", "line 2, column 1 at `teapot`: unknown statement (expected camera, ambient, background, depth, light, material, sphere, cylinder, cone, box, group or end)");
+}
+
+#[test]
+fn unknown_attribute() {
+    check("sphere radius 1 colour red", "line 1, column 17 at `colour`: not an attribute of this statement");
+    check("box radius 1", "line 1, column 5 at `radius`: not an attribute of this statement");
+}
+
+#[test]
+fn expected_number() {
+    check("sphere center 0 one 0", "line 1, column 17 at `one`: expected a number");
+}
+
+#[test]
+fn missing_value() {
+    check("  sphere center 0 1", "line 1, column 20: a value is missing at the end of the line");
+}
+
+#[test]
+fn unknown_material() {
+    check("sphere material gold", "line 1, column 17 at `gold`: material not defined before this line");
+}
+
+#[test]
+fn duplicate_material() {
+    check("material a kd 1\nmaterial a kd 0.5", "line 2, column 10 at `a`: material already defined");
+}
+
+#[test]
+fn unknown_axis() {
+    check("sphere rotate w 30", "line 1, column 15 at `w`: axis must be x, y or z");
+}
+
+#[test]
+fn unknown_light_kind() {
+    check("light spot pos 0 0 0", "line 1, column 7 at `spot`: light must be `directional` or `point`");
+}
+
+#[test]
+fn bad_depth() {
+    check("depth 9", "line 1, column 7 at `9`: depth must be a whole number from 0 to 8");
+    check("depth -1", "line 1, column 7 at `-1`: depth must be a whole number from 0 to 8");
+}
+
+#[test]
+fn nan_and_infinity_in_the_text() {
+    check("sphere center 0 NaN 0", "line 1, column 17 at `NaN`: number is not finite");
+    check("ambient inf", "line 1, column 9 at `inf`: number is not finite");
+}
+
+#[test]
+fn zero_radius_and_degenerate_sizes() {
+    check("sphere radius 0", "line 1, column 15 at `0`: size must be positive");
+    check("cylinder height -2", "line 1, column 17 at `-2`: size must be positive");
+    check("box min 0 0 0 max 1 0 1", "line 1, column 1 at `box`: size must be positive");
+    check("cone top -1", "line 1, column 6 at `top`: size must be positive");
+}
+
+#[test]
+fn zero_scale_is_a_singular_transform() {
+    check("sphere scale 1 0 1", "line 1, column 1 at `sphere`: transform is singular (zero or near-zero scale)");
+}
+
+#[test]
+fn bad_coefficients() {
+    check("material m kd -0.5", "line 1, column 10 at `m`: coefficients must be >= 0 and the index of refraction >= 1");
+    check("material m ior 0.5", "line 1, column 10 at `m`: coefficients must be >= 0 and the index of refraction >= 1");
+}
+
+#[test]
+fn camera_looking_along_its_up_vector() {
+    check("camera eye 0 5 0 look 0 0 0 up 0 1 0\nsphere", "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector");
+    check("camera eye 0 0 0 look 0 0 0\nsphere", "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector");
+}
+
+#[test]
+fn bad_field_of_view() {
+    check("camera fov 180 25\nsphere", "line 1, column 1 at `camera`: field of view must be between 0 and 180 degrees");
+}
+
+#[test]
+fn degenerate_light() {
+    check("light directional dir 0 0 0", "line 1, column 1 at `light`: light direction is zero");
+}
+
+#[test]
+fn groups_must_nest_properly() {
+    check("group a\ngroup b", "line 2, column 1 at `group`: a group cannot be opened inside another group");
+    check("end", "line 1, column 1 at `end`: `end` without an open group");
+    check("sphere\ngroup a translate 1 0 0\nsphere", "line 2, column 1 at `group`: group not closed with `end`");
+    check("group a\nend", "line 2, column 1 at `end`: group has no objects");
+}
+
+#[test]
+fn too_many_objects_names_the_capacity() {
+    let text = "sphere\n".repeat(9);
+    check(&text, "line 9, column 1 at `sphere`: too many objects: the object storage holds 8");
+}
+
+#[test]
+fn too_many_materials_and_lights() {
+    let mats: String = (0..17).map(|i| format!("material m{i}\n")).collect();
+    check(&mats, "line 17, column 10 at `m16`: too many materials (at most 16)");
+    let lights = "light directional dir 0 -1 0\n".repeat(5);
+    check(&lights, "line 5, column 1 at `light`: too many lights (at most 4)");
+}
+
+#[test]
+fn empty_scene() {
+    check("# nothing\n", "line 1, column 1: scene has no objects");
+}
+
+#[test]
+fn out_of_range_for_the_scalar() {
+    assert_eq!(
+        err::<f32>("sphere center 1e16 0 0"),
+        "line 1, column 1 at `sphere`: coordinate out of range for f32: magnitude must stay below 1e15"
+    );
+}
+
+#[test]
+fn comments_blank_lines_and_groups_parse() {
+    let text = "# a chair\n\nmaterial wood kd 0.7 # brown\ngroup chair rotate y 20\n  box min 0 0 0 max 1 1 1 material wood\nend\n";
+    let mut storage = vec![Object::<f64>::default(); 4];
+    let scene = parse::<f64>(text, &mut storage).unwrap();
+    assert_eq!(scene.objects.len(), 1);
+    assert_eq!(scene.groups.len(), 1);
+}
