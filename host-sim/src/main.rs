@@ -102,6 +102,24 @@ fn parse_size(s: &str) -> Result<(u16, u16), String> {
     }
 }
 
+/// Parses `NXxNYxNZ` into a manual lattice resolution.
+fn parse_cells(s: &str) -> Result<[u16; 3], String> {
+    let v: Vec<Option<u16>> = s.split(['x', 'X']).map(|p| p.trim().parse::<u16>().ok().filter(|&n| (1..=1024).contains(&n))).collect();
+    match v.as_slice() {
+        [Some(x), Some(y), Some(z)] => Ok([*x, *y, *z]),
+        _ => Err(format!("cells `{s}`: expected NXxNYxNZ with each from 1 to 1024")),
+    }
+}
+
+/// The lattice configuration chosen on the command line.
+pub fn lattice_config(cells: Option<[u16; 3]>) -> lattice_rt::LatticeConfig {
+    let mut cfg = lattice_rt::LatticeConfig::default();
+    if let Some(n) = cells {
+        cfg.top = lattice_rt::lattice::Resolution::Uniform(n);
+    }
+    cfg
+}
+
 /// Options of `render`.
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
@@ -137,6 +155,9 @@ pub struct RenderArgs {
     /// Tile side in pixels.
     #[arg(long, default_value_t = 8)]
     pub tile: u8,
+    /// World lattice resolution, overriding the automatic choice.
+    #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
+    pub cells: Option<[u16; 3]>,
 }
 
 /// Options of `stats`.
@@ -153,6 +174,9 @@ pub struct StatsArgs {
     /// Timed repetitions per accelerator (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub runs: usize,
+    /// World lattice resolution, overriding the automatic choice.
+    #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
+    pub cells: Option<[u16; 3]>,
 }
 
 fn main() {

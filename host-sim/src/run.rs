@@ -80,17 +80,17 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized>(
 pub fn render_accel<R: Real>(
     scene: &Scene<'_, R>,
     accel: Accel,
+    cfg: &LatticeConfig,
     frame: &Frame,
     tune: impl Fn(&mut Tracer<'_, '_, R, dyn Accelerator<R> + '_>),
     progress: bool,
 ) -> Result<Rendered> {
-    let cfg = LatticeConfig::default();
     let mut bufs;
     let lattice;
     let a: &dyn Accelerator<R> = match accel {
         Accel::Lattice => {
-            bufs = LatticeBufs::for_scene(scene, &cfg);
-            lattice = bufs.build(scene, &cfg)?;
+            bufs = LatticeBufs::for_scene(scene, cfg);
+            lattice = bufs.build(scene, cfg)?;
             &lattice
         }
         Accel::Bbox => &BoundingBox,
@@ -123,7 +123,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let mut storage = object_storage::<R>(&text);
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let frame = Frame { width: a.size.0, height: a.size.1, tile: a.tile, dither: a.dither.mode() };
-    let out = render_accel(&scene, a.accel, &frame, |_| {}, true)?;
+    let out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true)?;
     let mut store = vec![0u8; out.bits.len()];
     let frame_bits = bitframe_from(&mut store, &frame, &out.bits);
     write_png(&frame_bits, &a.output, a.theme, a.scale)?;
@@ -175,7 +175,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let text = read(&a.scene)?;
     let mut storage = object_storage::<R>(&text);
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
-    let cfg = LatticeConfig::default();
+    let cfg = crate::lattice_config(a.cells);
     let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
     let t0 = Instant::now();
     let lattice = bufs.build(&scene, &cfg)?;
@@ -212,7 +212,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     println!("  per primary ray at {}x{} (eye rays only):", frame.width, frame.height);
     let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];
     for acc in accels {
-        let r = render_accel(&scene, acc, &frame, primary_only, false)?;
+        let r = render_accel(&scene, acc, &cfg, &frame, primary_only, false)?;
         println!(
             "    {:8} object tests {:6.3}, inside tests {:6.2}, cells visited {:6.2}",
             format!("{acc:?}").to_lowercase(),
@@ -227,7 +227,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     for _ in 0..a.runs.max(1) {
         last.clear();
         for (i, acc) in accels.iter().enumerate() {
-            let r = render_accel(&scene, *acc, &frame, |_| {}, false)?;
+            let r = render_accel(&scene, *acc, &cfg, &frame, |_| {}, false)?;
             times[i].push(r.elapsed);
             last.push(r);
         }
@@ -266,7 +266,7 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
         let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
         for (w, h) in [(160u16, 100u16), (128, 64)] {
             let frame = Frame { width: w, height: h, tile: 8, dither: Dither::Bayer };
-            let r = render_accel(&scene, Accel::Lattice, &frame, |_| {}, true)?;
+            let r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true)?;
             let mut store = vec![0u8; r.bits.len()];
             let f = bitframe_from(&mut store, &frame, &r.bits);
             let png = out.join(format!("{name}-{w}x{h}.png"));
