@@ -84,6 +84,91 @@ impl fmt::Display for ParseError<'_> {
 
 impl core::error::Error for ParseError<'_> {}
 
+/// Parses a decimal number (`[+-]digits[.digits][(e|E)[+-]digits]`) without core's `f64`
+/// parser, whose 1.7 KB stack frame is more than the whole render needs on a Cortex-M0+.
+/// Up to 19 significant digits are kept; for the numbers scenes use (at most 15 digits,
+/// exponents within +-22) the result is the correctly rounded `f64`. Returns `None` for
+/// anything else; `Some(inf)` or `Some(NaN)` for the words `inf`, `infinity` and `nan`.
+pub fn parse_number(tok: &str) -> Option<f64> {
+    let b = tok.as_bytes();
+    let (neg, mut i) = match b.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let word = &tok[i..];
+    if word.eq_ignore_ascii_case("inf") || word.eq_ignore_ascii_case("infinity") {
+        return Some(if neg { f64::NEG_INFINITY } else { f64::INFINITY });
+    }
+    if word.eq_ignore_ascii_case("nan") {
+        return Some(f64::NAN);
+    }
+    let (mut mant, mut exp10, mut digits, mut kept) = (0u64, 0i32, 0u32, 0u32);
+    let mut seen_point = false;
+    while i < b.len() {
+        match b[i] {
+            c @ b'0'..=b'9' => {
+                digits += 1;
+                if kept < 19 {
+                    if mant != 0 || c != b'0' {
+                        kept += 1;
+                    }
+                    mant = mant * 10 + (c - b'0') as u64;
+                    if seen_point {
+                        exp10 -= 1;
+                    }
+                } else if !seen_point {
+                    exp10 += 1;
+                }
+            }
+            b'.' if !seen_point => seen_point = true,
+            _ => break,
+        }
+        i += 1;
+    }
+    if digits == 0 {
+        return None;
+    }
+    if i < b.len() {
+        if b[i] != b'e' && b[i] != b'E' {
+            return None;
+        }
+        i += 1;
+        let eneg = match b.get(i) {
+            Some(b'-') => {
+                i += 1;
+                true
+            }
+            Some(b'+') => {
+                i += 1;
+                false
+            }
+            _ => false,
+        };
+        let (mut e, mut edigits) = (0i32, 0);
+        while i < b.len() && b[i].is_ascii_digit() {
+            e = (e * 10 + (b[i] - b'0') as i32).min(10_000);
+            edigits += 1;
+            i += 1;
+        }
+        if edigits == 0 || i < b.len() {
+            return None;
+        }
+        exp10 += if eneg { -e } else { e };
+    }
+    // 10^|exp10| by squaring (exact up to 10^22), then one multiplication or division.
+    let (mut p, mut base, mut k) = (1.0f64, 10.0f64, exp10.unsigned_abs());
+    while k > 0 {
+        if k & 1 == 1 {
+            p *= base;
+        }
+        base *= base;
+        k >>= 1;
+    }
+    let v = if exp10 < 0 { mant as f64 / p } else { mant as f64 * p };
+    Some(if neg { -v } else { v })
+}
+
 /// The words of one line with their columns.
 struct Words<'t> {
     line: &'t str,
@@ -126,7 +211,7 @@ impl<'t> Words<'t> {
 
     fn number(&mut self) -> Result<f64, ParseError<'t>> {
         let (col, tok) = self.word()?;
-        let v: f64 = tok.parse().map_err(|_| self.err(col, tok, ParseErrorKind::ExpectedNumber))?;
+        let v = parse_number(tok).ok_or_else(|| self.err(col, tok, ParseErrorKind::ExpectedNumber))?;
         if !v.is_finite() {
             return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::NotFinite)));
         }
@@ -170,7 +255,7 @@ impl<'t> Words<'t> {
                 let x = self.number()?;
                 let save = self.pos;
                 match self.next() {
-                    Some((_, tok)) if tok.parse::<f64>().is_ok() => {
+                    Some((_, tok)) if parse_number(tok).is_some() => {
                         self.pos = save;
                         let (y, z) = (self.number()?, self.number()?);
                         Affine::scale(Vec3::new(x, y, z))
@@ -193,6 +278,10 @@ impl<'t> Words<'t> {
 }
 
 /// Parses scene text into a validated scene whose objects live in `storage`.
+///
+/// Kept out of line so that on a microcontroller the parser's frame is released before the
+/// render that follows it needs the stack.
+#[inline(never)]
 pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Result<Scene<'a, R>, ParseError<'t>> {
     let mut b = SceneBuilder::<R>::new(storage);
     let mut names: Vec<(&'t str, u8), MAX_MATERIALS> = Vec::new();
@@ -355,4 +444,26 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
         };
         ParseError { line, col, token, kind: ParseErrorKind::Scene(e) }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_number;
+
+    #[test]
+    fn numbers_parse_like_core_for_scene_values() {
+        for t in ["0", "1", "-2.5", "0.42", "+3", ".5", "5.", "1e3", "-1.25E-2", "123456.789", "0.1", "2.2", "1e-7", "3.14159"] {
+            assert_eq!(parse_number(t), Some(t.parse::<f64>().unwrap()), "{t}");
+        }
+    }
+
+    #[test]
+    fn non_numbers_are_refused() {
+        for t in ["", "-", ".", "e5", "1e", "1e+", "1.2.3", "one", "1x", "--1"] {
+            assert_eq!(parse_number(t), None, "{t}");
+        }
+        assert!(parse_number("NaN").unwrap().is_nan());
+        assert_eq!(parse_number("-inf"), Some(f64::NEG_INFINITY));
+        assert_eq!(parse_number("1e999"), Some(f64::INFINITY));
+    }
 }

@@ -17,7 +17,7 @@ pub const MAX_MATERIALS: usize = 16;
 /// Most lights a scene may define.
 pub const MAX_LIGHTS: usize = 4;
 /// Most composite objects (each gets a sub-lattice).
-pub const MAX_GROUPS: usize = 32;
+pub const MAX_GROUPS: usize = 16;
 /// The group index of an object that belongs to no composite.
 pub const NO_GROUP: u16 = u16::MAX;
 

@@ -1,0 +1,62 @@
+//! Picks the memory map of the board being built (the Pico's is the repository's root
+//! `memory.x`; the emulated board's is `qemu/memory.x`), the linker scripts, and the scenes
+//! embedded in the firmware.
+//!
+//! Scenes: `FIRMWARE_SCENES` (comma-separated names from `scenes/`, default the paper's four
+//! and the Whitted showcase). Each is parsed here with the core itself, in the firmware's
+//! scalar, so a broken scene fails the build with its line and column, and the storage
+//! capacities are the exact maximum the chosen scenes need (written to `capacities.rs`).
+use lattice_rt::lattice::{Lattice, LatticeConfig};
+use lattice_rt::scene::Object;
+use std::fmt::Write as _;
+use std::{env, fs, path::PathBuf};
+
+const DEFAULT_SCENES: &str = "chair,desk,polyhedron,spheres,whitted";
+
+fn main() {
+    let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
+    let pico = env::var_os("CARGO_FEATURE_PICO").is_some();
+    let src = if pico { "../memory.x" } else { "qemu/memory.x" };
+    fs::copy(src, out.join("memory.x")).expect("memory.x");
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed=../memory.x");
+    println!("cargo:rerun-if-changed=qemu/memory.x");
+    println!("cargo:rerun-if-env-changed=FIRMWARE_SCENES");
+    println!("cargo:rustc-link-arg-bins=-Tlink.x");
+    if pico {
+        println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+    }
+
+    let names = env::var("FIRMWARE_SCENES").unwrap_or_else(|_| DEFAULT_SCENES.to_string());
+    let mut list = String::new();
+    let (mut objects, mut groups, mut grids, mut coords, mut cells, mut refs) = (1, 0, 1, 1, 1, 1);
+    for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let path = PathBuf::from(format!("../scenes/{name}.scene"));
+        println!("cargo:rerun-if-changed={}", path.display());
+        let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
+        let mut storage = vec![Object::<f32>::default(); text.lines().count().max(1)];
+        let scene = lattice_rt::parse::<f32>(&text, &mut storage)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let s = Lattice::plan(&scene, &LatticeConfig::default());
+        objects = objects.max(scene.objects.len());
+        groups = groups.max(scene.groups.len());
+        grids = grids.max(s.grids);
+        coords = coords.max(s.coords);
+        cells = cells.max(s.cells);
+        refs = refs.max(s.refs);
+        let abs = fs::canonicalize(&path).unwrap();
+        writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
+    }
+    let count = list.lines().count();
+    let code = format!(
+        "/// The scenes embedded in this build (`FIRMWARE_SCENES`).\n\
+         pub const SCENES: [(&str, &str); {count}] = [\n{list}];\n\
+         /// Most primitives in an embedded scene.\npub const MAX_OBJECTS: usize = {objects};\n\
+         /// Most composites in an embedded scene.\npub const MAX_COMPOSITES: usize = {groups};\n\
+         /// Most lattices (world + composites).\npub const MAX_GRIDS: usize = {grids};\n\
+         /// Coordinate-list entries.\npub const MAX_COORDS: usize = {coords};\n\
+         /// Cell entries (cells + 1).\npub const MAX_CELLS: usize = {cells};\n\
+         /// Cell references.\npub const MAX_REFS: usize = {refs};\n"
+    );
+    fs::write(out.join("capacities.rs"), code).unwrap();
+}

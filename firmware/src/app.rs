@@ -1,0 +1,105 @@
+//! Scenes, capacities and the render loop.
+
+use core::fmt;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::pixelcolor::BinaryColor;
+use lattice_rt::lattice::{Grid, LatticeError, LatticeStorage};
+use lattice_rt::parse::ParseError;
+use lattice_rt::render::{Hooks, RenderError};
+use lattice_rt::scene::{Object, MAX_GROUPS};
+
+// The composites of every embedded scene fit the core's fixed table (checked at compile time).
+const _: () = assert!(MAX_COMPOSITES <= MAX_GROUPS);
+use lattice_rt::{parse, render, Dither, Frame, Lattice, LatticeConfig, Real, Stats, Tracer};
+
+/// The scalar the firmware traces in (the RP2040 and the Cortex-M3 have no FPU).
+pub type Scalar = f32;
+
+// SCENES and the capacities, computed by build.rs from the scenes chosen for this build.
+include!(concat!(env!("OUT_DIR"), "/capacities.rs"));
+
+/// Display width (SSD1306 128x64).
+pub const WIDTH: u16 = 128;
+/// Display height.
+pub const HEIGHT: u16 = 64;
+
+/// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), Bayer dither.
+pub const FRAME: Frame = Frame { width: WIDTH, height: HEIGHT, tile: 8, dither: Dither::Bayer };
+
+/// All memory a scene needs, owned by the caller (it lives on `main`'s stack).
+pub struct Storage<R> {
+    objects: [Object<R>; MAX_OBJECTS],
+    grids: [Grid<R>; MAX_GRIDS],
+    coords: [R; MAX_COORDS],
+    cells: [u32; MAX_CELLS],
+    refs: [u32; MAX_REFS],
+    mailbox: [u32; MAX_OBJECTS + MAX_COMPOSITES],
+}
+
+impl<R: Real> Storage<R> {
+    /// Empty storage.
+    pub fn new() -> Self {
+        let z = Object::default();
+        Storage {
+            objects: [z; MAX_OBJECTS],
+            grids: [Grid::EMPTY; MAX_GRIDS],
+            coords: [R::ZERO; MAX_COORDS],
+            cells: [0; MAX_CELLS],
+            refs: [0; MAX_REFS],
+            mailbox: [0; MAX_OBJECTS + MAX_COMPOSITES],
+        }
+    }
+}
+
+impl<R: Real> Default for Storage<R> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Why a scene could not be shown.
+#[derive(Debug)]
+pub enum AppError<'t, E> {
+    /// The scene text is invalid or exceeds the object capacity.
+    Parse(ParseError<'t>),
+    /// The lattice exceeds a compiled capacity.
+    Lattice(LatticeError),
+    /// The display failed or the render was cancelled.
+    Render(RenderError<E>),
+}
+
+impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AppError::Parse(e) => write!(f, "scene: {e}"),
+            AppError::Lattice(e) => write!(f, "{e}"),
+            AppError::Render(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// What a finished frame reports.
+#[derive(Clone, Copy, Debug)]
+pub struct Report {
+    /// Work counted by the core.
+    pub stats: Stats,
+    /// Primitives in the scene.
+    pub objects: usize,
+    /// Bytes of the built lattice.
+    pub lattice_bytes: usize,
+}
+
+/// Parses `text`, builds its lattice and renders [`FRAME`] into `target`, tile by tile.
+pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+    text: &'t str,
+    st: &mut Storage<R>,
+    target: &mut D,
+    hooks: &mut impl Hooks,
+) -> Result<Report, AppError<'t, D::Error>> {
+    let scene = parse::<R>(text, &mut st.objects).map_err(AppError::Parse)?;
+    let storage = LatticeStorage { grids: &mut st.grids, coords: &mut st.coords, cells: &mut st.cells, refs: &mut st.refs };
+    let lattice = Lattice::build(&scene, &LatticeConfig::default(), storage).map_err(AppError::Lattice)?;
+    let tracer = Tracer::new(&scene, &lattice);
+    let stats = render(&tracer, &FRAME, target, &mut st.mailbox, &mut [], hooks).map_err(AppError::Render)?;
+    Ok(Report { stats, objects: scene.objects.len(), lattice_bytes: lattice.bytes() })
+}

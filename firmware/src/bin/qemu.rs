@@ -1,0 +1,113 @@
+//! The render loop on QEMU's mps2-an385 (Cortex-M3, runs the thumbv6m build) or mps2-an386
+//! (Cortex-M4F, thumbv7em-none-eabihf). Each frame goes out over semihosting as hex rows with
+//! its statistics; the exit code says whether every scene rendered.
+//!
+//! Run with `-icount shift=0`: every instruction then takes 1 ns of virtual time, and SysTick,
+//! clocked at the board's 25 MHz, ticks once per 40 instructions, so the reported tick counts
+//! are deterministic instruction counts / 40.
+#![no_std]
+#![no_main]
+
+use core::cell::Cell;
+use core::fmt;
+use cortex_m::interrupt::{free, Mutex};
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_semihosting::{debug, hprintln};
+use firmware::app::{render_scene, Scalar, Storage, FRAME, SCENES};
+use firmware::stack;
+use lattice_rt::{BitFrame, NoHooks};
+
+static WRAPS: Mutex<Cell<u32>> = Mutex::new(Cell::new(0));
+const RELOAD: u32 = 0x00FF_FFFF;
+
+#[exception]
+fn SysTick() {
+    free(|cs| WRAPS.borrow(cs).set(WRAPS.borrow(cs).get() + 1));
+}
+
+/// SysTick ticks since start (wraps counted by the exception).
+fn ticks(syst: &cortex_m::peripheral::SYST) -> u64 {
+    loop {
+        let w0 = free(|cs| WRAPS.borrow(cs).get());
+        let cur = cortex_m::peripheral::SYST::get_current();
+        let w1 = free(|cs| WRAPS.borrow(cs).get());
+        if w0 == w1 && !syst.has_wrapped_peek() {
+            return w0 as u64 * (RELOAD as u64 + 1) + (RELOAD - cur) as u64;
+        }
+    }
+}
+
+trait PeekWrap {
+    fn has_wrapped_peek(&self) -> bool;
+}
+impl PeekWrap for cortex_m::peripheral::SYST {
+    /// Whether a wrap is pending whose exception has not run yet (reading COUNTFLAG clears it,
+    /// so this only looks at the pending bit of the exception).
+    fn has_wrapped_peek(&self) -> bool {
+        cortex_m::peripheral::SCB::is_pendst_pending()
+    }
+}
+
+struct Hex<'a>(&'a [u8]);
+impl fmt::Display for Hex<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.0.iter().try_for_each(|b| write!(f, "{b:02x}"))
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let mut cp = cortex_m::Peripherals::take().unwrap();
+    cp.SYST.set_clock_source(SystClkSource::Core);
+    cp.SYST.set_reload(RELOAD);
+    cp.SYST.clear_current();
+    cp.SYST.enable_interrupt();
+    cp.SYST.enable_counter();
+    let board = if cfg!(target_feature = "dsp") { "m4f" } else { "m0" };
+    hprintln!("BOARD {} scalar {} size {}x{}", board, <Scalar as lattice_rt::Real>::NAME, FRAME.width, FRAME.height);
+    let mut st = Storage::<Scalar>::new();
+    let mut bits = [0u8; BitFrame::bytes(FRAME.width as u32, FRAME.height as u32)];
+    let mut failed = false;
+    for (name, text) in SCENES {
+        let mut frame = BitFrame::new(FRAME.width as u32, FRAME.height as u32, &mut bits).unwrap();
+        let t0 = ticks(&cp.SYST);
+        match render_scene(text, &mut st, &mut frame, &mut NoHooks) {
+            Ok(r) => {
+                let t = ticks(&cp.SYST) - t0;
+                let s = r.stats;
+                hprintln!(
+                    "SCENE {} ticks {} rays {} primary {} shadow {} reflection {} refraction {} tests {} cells {} objects {} lattice_bytes {} stack_so_far {}",
+                    name, t, s.total_rays(), s.rays[0], s.rays[1], s.rays[2], s.rays[3], s.object_tests,
+                    s.cells_visited, r.objects, r.lattice_bytes, stack::high_water()
+                );
+                for row in frame.raster().chunks(FRAME.width as usize / 8) {
+                    hprintln!("ROW {}", Hex(row));
+                }
+            }
+            Err(e) => {
+                hprintln!("ERROR {}: {}", name, e);
+                failed = true;
+            }
+        }
+    }
+    hprintln!("RAM stack_high_water {} static {}", stack::high_water(), stack::static_bytes());
+    debug::exit(if failed { debug::EXIT_FAILURE } else { debug::EXIT_SUCCESS });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+#[exception]
+unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
+    hprintln!("HARDFAULT at pc {:#010x}", ef.pc());
+    debug::exit(debug::EXIT_FAILURE);
+    loop {}
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("PANIC {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    loop {}
+}
