@@ -1,6 +1,7 @@
 //! host-sim: the desktop driver of the lattice-rt core. Renders scenes to PNG/PBM/PGM, prints
 //! statistics, and (with no arguments) renders the paper's four scenes into `out/`.
 
+mod firmware;
 mod load;
 mod output;
 mod run;
@@ -38,6 +39,16 @@ enum Command {
         /// Folder holding the scene files.
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
+    },
+    /// Build the firmware, run it in QEMU, check its frames against the host bit for bit,
+    /// and write the flash/RAM/instruction budgets to a report.
+    Firmware {
+        /// Report to write.
+        #[arg(long, default_value = "docs/firmware.md")]
+        out: PathBuf,
+        /// Use the firmware already built instead of building it.
+        #[arg(long)]
+        no_build: bool,
     },
 }
 
@@ -200,6 +211,7 @@ fn real_main() -> Result<()> {
                 Scalar::F32 => run::render_cmd::<f32>(&a),
             }
         }
+        Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),
             Scalar::F32 => run::stats_cmd::<f32>(&a),
