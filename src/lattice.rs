@@ -431,16 +431,20 @@ impl<'a, R: Real> Lattice<'a, R> {
     }
 }
 
-/// Per-ray reciprocals of the direction (zero components marked as not stepping).
+/// Which axes a ray steps along (a zero component, +0.0 or -0.0, never steps).
+///
+/// Crossings are `(plane - o) / d`, one correctly rounded division, rather than a product with
+/// a precomputed reciprocal: the reciprocal of a small component is coarse in fixed point, and
+/// the division keeps every scalar's crossing within one rounding of the exact one.
 struct Inverse<R> {
-    inv: [R; 3],
     moves: [bool; 3],
+    _r: core::marker::PhantomData<R>,
 }
 
 impl<R: Real> Inverse<R> {
     fn new(ray: &Ray<R>) -> Self {
         let d = [ray.dir.x, ray.dir.y, ray.dir.z];
-        Inverse { inv: d.map(|v| if v == R::ZERO { R::ZERO } else { R::ONE / v }), moves: d.map(|v| v != R::ZERO) }
+        Inverse { moves: d.map(|v| v != R::ZERO), _r: core::marker::PhantomData }
     }
 }
 
@@ -479,7 +483,7 @@ impl<R: Real> Walker<R> {
                 let forward = ray.dir.axis(a) > R::ZERO;
                 w.step[a] = if forward { 1 } else { -1 };
                 let plane = if forward { c[i + 1] } else { c[i] };
-                w.t_next[a] = (plane - ray.origin.axis(a)) * inv.inv[a];
+                w.t_next[a] = (plane - ray.origin.axis(a)) / ray.dir.axis(a);
             }
         }
         w.load_cell(l, g);
@@ -520,7 +524,7 @@ impl<R: Real> Walker<R> {
         self.idx[a] = i;
         let c = l.coordinate_list(self.grid as usize, a);
         let plane = if self.step[a] > 0 { c[i as usize + 1] } else { c[i as usize] };
-        self.t_next[a] = (plane - ray.origin.axis(a)) * inv.inv[a];
+        self.t_next[a] = (plane - ray.origin.axis(a)) / ray.dir.axis(a);
         self.load_cell(l, g);
         true
     }

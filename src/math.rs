@@ -53,14 +53,16 @@ impl<R: Real> Vec3<R> {
     pub fn length(self) -> R {
         self.dot(self).sqrt()
     }
-    /// Unit vector in the same direction (the zero vector stays zero).
+    /// Unit vector in the same direction (the zero vector stays zero). The vector is first
+    /// divided by its largest component, so the squares never exceed 3 (no overflow in fixed
+    /// point, no underflow in floats).
     pub fn normalize(self) -> Self {
-        let l = self.length();
-        if l == R::ZERO {
-            self
-        } else {
-            self * (R::ONE / l)
+        let m = self.max_abs();
+        if m == R::ZERO {
+            return self;
         }
+        let v = Vec3::new(self.x / m, self.y / m, self.z / m);
+        v * (R::ONE / v.length())
     }
     /// Largest absolute component.
     pub fn max_abs(self) -> R {

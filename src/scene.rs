@@ -121,6 +121,11 @@ pub struct Object<R> {
     pub group: u16,
     /// World-space bounding box, padded for the scalar's rounding.
     pub bounds: Aabb<R>,
+    /// A power of two (at most 1) that object-space directions are multiplied by, so that
+    /// they stay near unit length however small the object is (exact in floating point).
+    pub dir_scale: R,
+    /// `1 / dir_scale`.
+    pub inv_dir_scale: R,
 }
 
 impl<R: Real> Default for Object<R> {
@@ -133,6 +138,8 @@ impl<R: Real> Default for Object<R> {
             material: 0,
             group: NO_GROUP,
             bounds: Aabb { min: z, max: z },
+            dir_scale: R::ONE,
+            inv_dir_scale: R::ONE,
         }
     }
 }
@@ -141,7 +148,13 @@ impl<R: Real> Object<R> {
     /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` and the object-space normal.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
-        self.shape.intersect(&self.to_object.ray(ray), tmin, tmax)
+        let mut r = self.to_object.ray(ray);
+        r.dir = r.dir * self.dir_scale;
+        // With the direction scaled by k, the object-space parameter is t / k.
+        let far = if tmax == R::MAX { R::MAX } else { tmax * self.inv_dir_scale };
+        self.shape
+            .intersect(&r, tmin * self.inv_dir_scale, far)
+            .map(|(t, n)| (t * self.dir_scale, n))
     }
     /// Unit world-space normal from an object-space normal (inverse-transpose rule).
     pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
@@ -422,8 +435,19 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             Shape::Cone { top } => Shape::Cone { top: R::from_f64(top) },
             Shape::Box => Shape::Box,
         };
-        self.storage[self.len] =
-            Object { shape, to_object: inv.cast(), material, group, bounds: bounds.cast_padded() };
+        // Largest stretch of a direction into object space, rounded up to a power of two.
+        let m = &inv.m;
+        let stretch = (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(1.0, f64::max);
+        let dir_scale = libm::exp2(-libm::ceil(libm::log2(stretch)));
+        self.storage[self.len] = Object {
+            shape,
+            to_object: inv.cast(),
+            material,
+            group,
+            bounds: bounds.cast_padded(),
+            dir_scale: R::from_f64(dir_scale),
+            inv_dir_scale: R::from_f64(1.0 / dir_scale),
+        };
         self.len += 1;
         Ok(())
     }

@@ -9,7 +9,7 @@
 //! transforms, materials or lattices: it answers "where does this object-space ray first meet
 //! the surface in `(tmin, tmax]`", with the outward object-space normal.
 
-use crate::math::{Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3};
 use crate::scalar::Real;
 
 /// A canonical primitive.
@@ -44,15 +44,27 @@ impl<R: Real> Shape<R> {
 
     /// Nearest intersection with `tmin < t <= tmax`: the parameter and the outward normal
     /// (not normalised) in object space.
+    ///
+    /// The ray is first clipped to the shape's object-space box (a slab test needs no squares),
+    /// and the quadratic is solved from the entry point: every square then involves numbers of
+    /// about the shape's own size, however far away the ray started. That keeps fixed point
+    /// from overflowing and floats from cancelling.
     pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
-        let mut best = Closest { t: tmax, n: None, tmin };
-        match *self {
-            Shape::Sphere => sphere(r, &mut best),
-            Shape::Cylinder => cone_side_and_caps(r, R::ONE, &mut best),
-            Shape::Cone { top } => cone_side_and_caps(r, top, &mut best),
-            Shape::Box => unit_box(r, &mut best),
+        let (lo, hi) = self.bounds();
+        let (t0, t1) = Aabb { min: lo, max: hi }.clip(r, tmin, tmax)?;
+        if let Shape::Box = self {
+            // The clip is the whole box test.
+            return unit_box(r, tmin, t0, t1);
         }
-        best.n.map(|n| (best.t, n))
+        let local = Ray::new(r.at(t0), r.dir);
+        let mut best = Closest { t: tmax - t0, n: None, tmin: tmin - t0 };
+        match *self {
+            Shape::Sphere => sphere(&local, &mut best),
+            Shape::Cylinder => cone_side_and_caps(&local, R::ONE, &mut best),
+            Shape::Cone { top } => cone_side_and_caps(&local, top, &mut best),
+            Shape::Box => {}
+        }
+        best.n.map(|n| (best.t + t0, n))
     }
 
     /// Corners of an object-space box that holds the shape.
@@ -161,45 +173,24 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
     }
 }
 
-fn unit_box<R: Real>(r: &Ray<R>, best: &mut Closest<R>) {
-    let (mut t0, mut t1) = (-R::MAX, R::MAX);
-    let (mut a0, mut a1) = (0usize, 0usize);
-    let (mut s0, mut s1) = (R::ZERO, R::ZERO);
+/// The unit cube, given the ray's parameter range inside it `[t0, t1]` from the slab clip:
+/// the first of entry and exit after `tmin`, with the normal of the face it crosses.
+fn unit_box<R: Real>(r: &Ray<R>, tmin: R, t0: R, t1: R) -> Option<(R, Vec3<R>)> {
+    let t = if t0 > tmin { t0 } else if t1 > tmin { t1 } else { return None };
+    // The face is the one the point lies on: the axis whose coordinate is nearest 0 or 1.
+    let p = r.at(t);
+    let (mut axis, mut dist, mut sign) = (0, R::MAX, R::ZERO);
     for a in 0..3 {
-        let (o, d) = (r.origin.axis(a), r.dir.axis(a));
-        if d == R::ZERO {
-            if o < R::ZERO || o > R::ONE {
-                return;
+        let c = p.axis(a);
+        for (d, s) in [(c.abs(), -R::ONE), ((R::ONE - c).abs(), R::ONE)] {
+            if d < dist {
+                (axis, dist, sign) = (a, d, s);
             }
-            continue;
-        }
-        let (mut ta, mut tb) = ((R::ZERO - o) / d, (R::ONE - o) / d);
-        // Entering face normal points against the ray, leaving face normal along it.
-        let sign = if d > R::ZERO { R::ONE } else { -R::ONE };
-        if ta > tb {
-            core::mem::swap(&mut ta, &mut tb);
-        }
-        if ta > t0 {
-            t0 = ta;
-            a0 = a;
-            s0 = -sign;
-        }
-        if tb < t1 {
-            t1 = tb;
-            a1 = a;
-            s1 = sign;
         }
     }
-    if t0 > t1 {
-        return;
-    }
-    let face = |a: usize, s: R| {
-        let mut n = [R::ZERO; 3];
-        n[a] = s;
-        Vec3::new(n[0], n[1], n[2])
-    };
-    best.offer(t0, || face(a0, s0));
-    best.offer(t1, || face(a1, s1));
+    let mut n = [R::ZERO; 3];
+    n[axis] = sign;
+    Some((t, Vec3::new(n[0], n[1], n[2])))
 }
 
 #[cfg(test)]
