@@ -11,7 +11,7 @@ pub mod scene;
 pub mod shape;
 
 pub use math::{Aabb, Affine, Ray, Vec3};
-pub use scalar::Real;
+pub use scalar::{F32Micro, F32MicroNewton, Real};
 pub use scene::{Scene, SceneBuilder, SceneError};
 pub use shape::Shape;
 pub mod accel;
@@ -29,3 +29,5 @@ pub use parse::{parse, ParseError};
 pub mod bitframe;
 pub use bitframe::BitFrame;
 pub mod generate;
+pub mod fixed;
+pub use fixed::Fx;

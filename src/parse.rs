@@ -277,6 +277,23 @@ impl<'t> Words<'t> {
     }
 }
 
+/// Line, column and keyword of the `index`-th object statement (for errors found after parsing).
+fn object_statement(text: &str, index: usize) -> (u32, u32, &str) {
+    let mut seen = 0;
+    for (i, line) in text.lines().enumerate() {
+        let mut w = Words::new(line, i as u32 + 1);
+        if let Some((col, key)) = w.next() {
+            if matches!(key, "sphere" | "cylinder" | "cone" | "box") {
+                if seen == index {
+                    return (i as u32 + 1, col, key);
+                }
+                seen += 1;
+            }
+        }
+    }
+    (1, 1, "")
+}
+
 /// Parses scene text into a validated scene whose objects live in `storage`.
 ///
 /// Kept out of line so that on a microcontroller the parser's frame is released before the
@@ -434,6 +451,7 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
     }
     b.finish().map_err(|e| {
         let (line, col, token) = match e {
+            SceneError::ObjectOutOfRange { object, .. } => object_statement(text, object),
             SceneError::UnclosedGroup => group_at,
             SceneError::DegenerateCamera | SceneError::BadFieldOfView | SceneError::OutOfRange { .. }
                 if camera_at.0 > 0 =>

@@ -80,7 +80,7 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
 
 /// Gray level (0..=64) of a brightness in `[0, 1]`, rounded to nearest.
 pub fn level<R: Real>(v: R) -> u8 {
-    let l = v * R::from_i32(LEVELS as i32) + R::from_f64(0.5);
+    let l = v * R::from_i32(LEVELS as i32) + R::HALF;
     // Bisection over the 65 levels: no float-to-int conversion the scalar may not have.
     let mut lo = 0u8;
     let mut hi = LEVELS + 1;

@@ -28,6 +28,8 @@ pub trait Real:
     const ZERO: Self;
     /// Multiplicative identity.
     const ONE: Self;
+    /// One half.
+    const HALF: Self;
     /// The largest finite value, used as "no hit yet".
     const MAX: Self;
     /// Short name for reports ("f64", "f32", ...).
@@ -81,11 +83,15 @@ pub trait Real:
 impl Real for f64 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
+    const HALF: Self = 0.5;
     const MAX: Self = f64::MAX;
     const NAME: &'static str = "f64";
     const LIMIT: f64 = 1e150;
     fn from_f64(v: f64) -> Self {
         v
+    }
+    fn from_i32(v: i32) -> Self {
+        v as f64
     }
     fn to_f64(self) -> f64 {
         self
@@ -107,10 +113,14 @@ impl Real for f64 {
 impl Real for f32 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
+    const HALF: Self = 0.5;
     const MAX: Self = f32::MAX;
     const NAME: &'static str = "f32";
     const LIMIT: f64 = 1e15;
     fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+    fn from_i32(v: i32) -> Self {
         v as f32
     }
     fn to_f64(self) -> f64 {
@@ -146,5 +156,135 @@ mod tests {
     fn min_max_abs_sqrt_agree_in_every_float() {
         generic_min_max::<f64>();
         generic_min_max::<f32>();
+    }
+}
+
+/// An `f32` newtype whose only difference from `f32` is its square root.
+macro_rules! f32_with_sqrt {
+    ($(#[$doc:meta])* $name:ident, $label:expr, $sqrt:expr) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, PartialOrd)]
+        pub struct $name(pub f32);
+
+        impl Add for $name {
+            type Output = Self;
+            #[inline]
+            fn add(self, o: Self) -> Self {
+                $name(self.0 + o.0)
+            }
+        }
+        impl Sub for $name {
+            type Output = Self;
+            #[inline]
+            fn sub(self, o: Self) -> Self {
+                $name(self.0 - o.0)
+            }
+        }
+        impl Mul for $name {
+            type Output = Self;
+            #[inline]
+            fn mul(self, o: Self) -> Self {
+                $name(self.0 * o.0)
+            }
+        }
+        impl Div for $name {
+            type Output = Self;
+            #[inline]
+            fn div(self, o: Self) -> Self {
+                $name(self.0 / o.0)
+            }
+        }
+        impl Neg for $name {
+            type Output = Self;
+            #[inline]
+            fn neg(self) -> Self {
+                $name(-self.0)
+            }
+        }
+        impl AddAssign for $name {
+            fn add_assign(&mut self, o: Self) {
+                self.0 += o.0;
+            }
+        }
+        impl SubAssign for $name {
+            fn sub_assign(&mut self, o: Self) {
+                self.0 -= o.0;
+            }
+        }
+        impl MulAssign for $name {
+            fn mul_assign(&mut self, o: Self) {
+                self.0 *= o.0;
+            }
+        }
+        impl Real for $name {
+            const ZERO: Self = $name(0.0);
+            const ONE: Self = $name(1.0);
+            const HALF: Self = $name(0.5);
+            const MAX: Self = $name(f32::MAX);
+            const NAME: &'static str = $label;
+            const LIMIT: f64 = <f32 as Real>::LIMIT;
+            fn from_f64(v: f64) -> Self {
+                $name(v as f32)
+            }
+            fn from_i32(v: i32) -> Self {
+                $name(v as f32)
+            }
+            fn to_f64(self) -> f64 {
+                self.0 as f64
+            }
+            fn sqrt(self) -> Self {
+                $name(($sqrt)(self.0))
+            }
+            fn offset_eps() -> Self {
+                $name(<f32 as Real>::offset_eps())
+            }
+            fn pad_eps() -> Self {
+                $name(<f32 as Real>::pad_eps())
+            }
+            fn is_finite(self) -> bool {
+                self.0.is_finite()
+            }
+        }
+    };
+}
+
+f32_with_sqrt!(
+    /// `f32` with micromath's fast square root (an exponent trick, about 5 % off).
+    F32Micro,
+    "f32-micromath",
+    |x: f32| micromath::F32Ext::sqrt(x)
+);
+
+f32_with_sqrt!(
+    /// `f32` with micromath's square root refined by one Newton step (`(y + x / y) / 2`).
+    F32MicroNewton,
+    "f32-micromath-newton",
+    |x: f32| {
+        let y = micromath::F32Ext::sqrt(x);
+        if y > 0.0 {
+            0.5 * (y + x / y)
+        } else {
+            y
+        }
+    }
+);
+
+#[cfg(test)]
+mod micromath_tests {
+    use super::*;
+
+    #[test]
+    fn micromath_sqrt_is_rough_and_one_newton_step_fixes_it() {
+        let (mut worst_fast, mut worst_refined) = (0.0f64, 0.0f64);
+        for i in 1..2000 {
+            let x = i as f64 * 0.37;
+            let exact = libm::sqrt(x);
+            let fast = F32Micro::from_f64(x).sqrt().to_f64();
+            let refined = F32MicroNewton::from_f64(x).sqrt().to_f64();
+            worst_fast = worst_fast.max((fast - exact).abs() / exact);
+            worst_refined = worst_refined.max((refined - exact).abs() / exact);
+        }
+        assert!(worst_fast > 0.01 && worst_fast < 0.07, "fast sqrt error {worst_fast}");
+        assert!(worst_refined < 2e-3, "refined sqrt error {worst_refined}");
     }
 }

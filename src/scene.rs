@@ -218,6 +218,18 @@ pub enum SceneError {
     DegenerateLight,
     /// The scene has no objects.
     NoObjects,
+    /// Inside the world box, an object's own coordinates grow beyond what the scalar holds
+    /// (the object is too small for the size of the scene).
+    ObjectOutOfRange {
+        /// Index of the object (in the order it was added).
+        object: usize,
+        /// The largest object-space coordinate reached.
+        reach: f64,
+        /// The scalar's limit.
+        limit: f64,
+        /// The scalar's name.
+        scalar: &'static str,
+    },
 }
 
 impl fmt::Display for SceneError {
@@ -248,6 +260,11 @@ impl fmt::Display for SceneError {
             SceneError::BadFieldOfView => write!(f, "field of view must be between 0 and 180 degrees"),
             SceneError::DegenerateLight => write!(f, "light direction is zero"),
             SceneError::NoObjects => write!(f, "scene has no objects"),
+            SceneError::ObjectOutOfRange { object, reach, limit, scalar } => write!(
+                f,
+                "object {object} is too small for this scene in {scalar}: its own coordinates reach \
+                 {reach:.0} inside the world box, the limit is {limit:.0} (make it larger or the scene smaller)"
+            ),
         }
     }
 }
@@ -486,6 +503,26 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let mut world = Aabb { min: camera.eye, max: camera.eye };
         for o in objects {
             world = world.union(&o.bounds);
+        }
+        check_range::<R>(world.min.cast())?;
+        check_range::<R>(world.max.cast())?;
+        // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
+        // coordinates never exceed those of the world box's corners in its space.
+        for (i, o) in objects.iter().enumerate() {
+            let inv = o.to_object.cast::<f64>();
+            let reach = (0..8)
+                .map(|c| {
+                    let p = Vec3::new(
+                        if c & 1 == 0 { world.min.x } else { world.max.x },
+                        if c & 2 == 0 { world.min.y } else { world.max.y },
+                        if c & 4 == 0 { world.min.z } else { world.max.z },
+                    );
+                    inv.point(p.cast()).max_abs()
+                })
+                .fold(0.0, f64::max);
+            if reach >= R::LIMIT {
+                return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
+            }
         }
         Ok(Scene {
             objects,

@@ -134,10 +134,14 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
     fn direct(&self, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, q: &mut Query<'_>) -> R {
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
-            // Unnormalised direction: the light sits at t = 1.
-            Light::Point { pos, intensity } => (pos - from, R::ONE, intensity),
+            // Unit direction, so every ray the tracer casts has a direction of length about 1.
+            Light::Point { pos, intensity } => {
+                let v = pos - from;
+                let dir = v.normalize();
+                (dir, v.dot(dir), intensity)
+            }
         };
-        let cos = to_light.normalize().dot(n);
+        let cos = to_light.dot(n);
         if cos <= R::ZERO {
             return R::ZERO;
         }

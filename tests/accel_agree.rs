@@ -104,11 +104,18 @@ proptest! {
     }
 
     #[test]
+    fn accelerators_agree_ray_by_ray_in_fixed_point(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(3), Just(5)]) {
+        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        check::<lattice_rt::Fx>(&p, &LatticeConfig::default(), 400)?;
+    }
+
+    #[test]
     fn fine_and_coarse_lattices_agree_too(seed in any::<u64>(), n in 1usize..30, res in 1u16..12) {
         use lattice_rt::lattice::Resolution;
         let p = RandomScene { objects: n, group_size: 4, spread: 0.0, seed };
         let cfg = LatticeConfig { top: Resolution::Uniform([res, res + 1, res.saturating_sub(1).max(1)]), sub: Resolution::Uniform([res; 3]), max_per_axis: 64 };
         check::<f64>(&p, &cfg, 200)?;
         check::<f32>(&p, &cfg, 200)?;
+        check::<lattice_rt::Fx>(&p, &cfg, 200)?;
     }
 }

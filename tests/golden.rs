@@ -25,6 +25,11 @@ fn paper_scenes_match_golden_images_in_f32() {
     golden_for::<f32>();
 }
 
+#[test]
+fn paper_scenes_match_golden_images_in_fixed_point() {
+    golden_for::<lattice_rt::Fx>();
+}
+
 fn identical_for<R: Real>(frame: &Frame) {
     for s in SCENES {
         let text = scene_text(s);
@@ -39,6 +44,7 @@ fn all_accelerators_draw_identical_frames() {
     let frame = Frame { width: 160, height: 100, tile: 8, dither: Dither::FloydSteinberg };
     identical_for::<f64>(&frame);
     identical_for::<f32>(&frame);
+    identical_for::<lattice_rt::Fx>(&frame);
 }
 
 #[test]

@@ -146,3 +146,23 @@ fn comments_blank_lines_and_groups_parse() {
     assert_eq!(scene.objects.len(), 1);
     assert_eq!(scene.groups.len(), 1);
 }
+
+#[test]
+fn fixed_point_refuses_coordinates_beyond_its_range() {
+    assert_eq!(
+        err::<lattice_rt::Fx>("camera eye 0 0 -9000\nsphere"),
+        "line 1, column 1 at `camera`: coordinate out of range for fixed: magnitude must stay below 8.192e3"
+    );
+}
+
+#[test]
+fn fixed_point_refuses_an_object_too_small_for_the_scene_and_names_its_line() {
+    let text = "camera eye 0 0 -10\nsphere radius 2\nsphere center 1 0 0 radius 0.0005\n";
+    assert_eq!(
+        err::<lattice_rt::Fx>(text),
+        "line 3, column 1 at `sphere`: object 1 is too small for this scene in fixed: its own coordinates reach 20000 inside the world box, the limit is 8192 (make it larger or the scene smaller)"
+    );
+    // The same scene is fine in floating point.
+    let mut storage = vec![Object::<f32>::default(); 4];
+    assert!(parse::<f32>(text, &mut storage).is_ok());
+}

@@ -59,6 +59,8 @@ pub enum Scalar {
     F64,
     /// 32-bit float with libm.
     F32,
+    /// Q16.16 fixed point.
+    Fixed,
 }
 
 /// Ray-query method.
@@ -209,12 +211,14 @@ fn real_main() -> Result<()> {
             match a.scalar {
                 Scalar::F64 => run::render_cmd::<f64>(&a),
                 Scalar::F32 => run::render_cmd::<f32>(&a),
+                Scalar::Fixed => run::render_cmd::<lattice_rt::Fx>(&a),
             }
         }
         Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),
             Scalar::F32 => run::stats_cmd::<f32>(&a),
+            Scalar::Fixed => run::stats_cmd::<lattice_rt::Fx>(&a),
         },
     }
 }
