@@ -6,8 +6,9 @@
 //! and the Whitted showcase). Each is parsed here with the core itself, in the firmware's
 //! scalar, so a broken scene fails the build with its line and column, and the storage
 //! capacities are the exact maximum the chosen scenes need (written to `capacities.rs`).
-use lattice_rt::lattice::{Lattice, LatticeConfig};
+use lattice_rt::lattice::{Lattice, LatticeConfig, LatticeSizes};
 use lattice_rt::scene::Object;
+use lattice_rt::Real;
 use std::fmt::Write as _;
 use std::{env, fs, path::PathBuf};
 
@@ -34,12 +35,18 @@ fn main() {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));
         println!("cargo:rerun-if-changed={}", path.display());
         let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
-        let mut storage = vec![Object::<f32>::default(); text.lines().count().max(1)];
-        let scene = lattice_rt::parse::<f32>(&text, &mut storage)
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let s = Lattice::plan(&scene, &LatticeConfig::default());
-        objects = objects.max(scene.objects.len());
-        groups = groups.max(scene.groups.len());
+        let feature = |f: &str| env::var_os(format!("CARGO_FEATURE_{f}")).is_some();
+        let (n, g, s) = if feature("SCALAR_FIXED") {
+            plan::<lattice_rt::Fx>(&path, &text)
+        } else if feature("SCALAR_MICROMATH") {
+            plan::<lattice_rt::F32Micro>(&path, &text)
+        } else if feature("SCALAR_MICROMATH_NEWTON") {
+            plan::<lattice_rt::F32MicroNewton>(&path, &text)
+        } else {
+            plan::<f32>(&path, &text)
+        };
+        objects = objects.max(n);
+        groups = groups.max(g);
         grids = grids.max(s.grids);
         coords = coords.max(s.coords);
         cells = cells.max(s.cells);
@@ -59,4 +66,11 @@ fn main() {
          /// Cell references.\npub const MAX_REFS: usize = {refs};\n"
     );
     fs::write(out.join("capacities.rs"), code).unwrap();
+}
+
+/// Objects, composites and lattice storage of one scene in the firmware's scalar.
+fn plan<R: Real>(path: &std::path::Path, text: &str) -> (usize, usize, LatticeSizes) {
+    let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
+    let scene = lattice_rt::parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    (scene.objects.len(), scene.groups.len(), Lattice::plan(&scene, &LatticeConfig::default()))
 }

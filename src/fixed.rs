@@ -26,26 +26,46 @@ impl Add for Fx {
     type Output = Fx;
     #[inline]
     fn add(self, o: Fx) -> Fx {
-        sat(self.0 as i64 + o.0 as i64)
+        Fx(self.0.saturating_add(o.0).max(-i32::MAX))
     }
 }
 impl Sub for Fx {
     type Output = Fx;
     #[inline]
     fn sub(self, o: Fx) -> Fx {
-        sat(self.0 as i64 - o.0 as i64)
+        Fx(self.0.saturating_sub(o.0).max(-i32::MAX))
     }
 }
 impl Mul for Fx {
     type Output = Fx;
+    /// `|a| * |b|` from 16-bit halves with 32-bit multiplies only (a Cortex-M0+ has no
+    /// 32x32->64 multiply), rounded half away from zero, then signed; saturates.
     #[inline]
     fn mul(self, o: Fx) -> Fx {
-        let p = self.0 as i64 * o.0 as i64;
-        sat((p + (1 << (FRAC - 1))) >> FRAC)
+        let neg = (self.0 < 0) != (o.0 < 0);
+        let (a, b) = (self.0.unsigned_abs(), o.0.unsigned_abs());
+        let (ah, al, bh, bl) = (a >> 16, a & 0xFFFF, b >> 16, b & 0xFFFF);
+        // (a * b + 2^15) >> 16 = ah*bh << 16 + ah*bl + al*bh + (al*bl + 2^15) >> 16
+        let top = ah * bh;
+        let m = if top >= 1 << 15 {
+            None
+        } else {
+            (top << 16)
+                .checked_add(ah * bl)
+                .and_then(|v| v.checked_add(al * bh))
+                .and_then(|v| v.checked_add((al * bl + 0x8000) >> 16))
+                .filter(|&v| v <= i32::MAX as u32)
+        };
+        let m = m.unwrap_or(i32::MAX as u32) as i32;
+        Fx(if neg { -m } else { m })
     }
 }
 impl Div for Fx {
     type Output = Fx;
+    /// `(a << 16) / b` rounded half away from zero; saturates, and `x / 0` is the largest value
+    /// of the sign of `x`. A Cortex-M0+ has no divide instruction, and a 64-bit division is
+    /// several times dearer than a 32-bit one, so a divisor below 128 (nearly every one the
+    /// tracer uses) is done as long division in base 256 with three 32-bit steps.
     #[inline]
     fn div(self, o: Fx) -> Fx {
         if o.0 == 0 {
@@ -55,12 +75,31 @@ impl Div for Fx {
                 core::cmp::Ordering::Greater => Fx(i32::MAX),
             };
         }
-        let n = (self.0 as i64) << FRAC;
-        let d = o.0 as i64;
-        let (q, r) = (n / d, n % d);
-        // Round half away from zero.
-        let q = if 2 * r.abs() >= d.abs() { q + if (n < 0) == (d < 0) { 1 } else { -1 } } else { q };
-        sat(q)
+        let neg = (self.0 < 0) != (o.0 < 0);
+        let (a, b) = (self.0.unsigned_abs(), o.0.unsigned_abs());
+        let q = if b < 1 << 23 {
+            let (q0, r) = (a / b, a % b);
+            if q0 >= 1 << 15 {
+                i32::MAX as u32
+            } else {
+                let (q1, r) = ((r << 8) / b, (r << 8) % b);
+                let (q2, r) = ((r << 8) / b, (r << 8) % b);
+                let q = (q0 << 16) | (q1 << 8) | q2;
+                // Round half away from zero; q < 2^31 - 1 here, so no overflow.
+                if r >= b - r {
+                    q + 1
+                } else {
+                    q
+                }
+            }
+        } else {
+            let n = (a as u64) << FRAC;
+            let (q, r) = (n / b as u64, n % b as u64);
+            let q = if 2 * r >= b as u64 { q + 1 } else { q };
+            q.min(i32::MAX as u64) as u32
+        };
+        let q = q.min(i32::MAX as u32) as i32;
+        Fx(if neg { -q } else { q })
     }
 }
 impl Neg for Fx {
@@ -156,6 +195,9 @@ mod tests {
     #[test]
     fn arithmetic_rounds_to_nearest() {
         assert_eq!((fx(1.5) * fx(2.25)).to_f64(), 3.375);
+        assert_eq!((fx(-1.5) * fx(2.25)).to_f64(), -3.375);
+        assert_eq!((Fx(3) * Fx(32768)).0, 2); // 1.5 LSB rounds away from zero
+        assert_eq!((Fx(-3) * Fx(32768)).0, -2);
         assert_eq!((fx(1.0) / fx(3.0)).0, 21845); // 0.333328..., nearest to 1/3
         assert_eq!((fx(-1.0) / fx(3.0)).0, -21845);
         assert_eq!((fx(2.0) / fx(3.0)).0, 43691);
@@ -186,10 +228,52 @@ mod tests {
     }
 
     #[test]
+    fn multiply_matches_the_wide_product_everywhere() {
+        let mut x = 0x1234_5678u64;
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let (a, b) = ((x as i32) >> (x % 17) as i32, ((x >> 32) as i32) >> ((x >> 40) % 19) as i32);
+            let (a, b) = (a.max(-i32::MAX), b.max(-i32::MAX));
+            let p = a as i64 * b as i64;
+            let r = (p.abs() + (1 << 15)) >> 16;
+            let want = (if p < 0 { -r } else { r }).clamp(-(i32::MAX as i64), i32::MAX as i64) as i32;
+            assert_eq!((Fx(a) * Fx(b)).0, want, "{a} * {b}");
+        }
+    }
+
+    #[test]
+    fn divide_matches_the_wide_quotient_everywhere() {
+        let mut x = 0x9876_5432u64;
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let (a, b) = ((x as i32) >> (x % 23) as i32, ((x >> 32) as i32) >> ((x >> 40) % 29) as i32);
+            let (a, b) = (a.max(-i32::MAX), b.max(-i32::MAX));
+            if b == 0 {
+                continue;
+            }
+            let (n, d) = ((a as i64).abs() << 16, (b as i64).abs());
+            // Half away from zero (magnitudes here, the sign comes after).
+            let q = if (n % d) * 2 >= d { n / d + 1 } else { n / d };
+            let q = q.min(i32::MAX as i64);
+            let want = if (a < 0) != (b < 0) { -q } else { q } as i32;
+            assert_eq!((Fx(a) / Fx(b)).0, want, "{a} / {b}");
+        }
+    }
+
+    #[test]
     fn isqrt_is_exact_floor() {
         for n in [0u64, 1, 2, 3, 4, 15, 16, 17, 1 << 40, (1 << 47) - 1, u32::MAX as u64 * 7] {
             let r = isqrt(n);
             assert!(r * r <= n && (r + 1) * (r + 1) > n, "{n}");
+        }
+        // sqrt is the nearest Q16.16 value.
+        for raw in (1 << 16) - 300..(1 << 16) + 300 {
+            let want = libm::round(libm::sqrt(raw as f64 / 65536.0) * 65536.0) as i32;
+            assert!((Fx(raw).sqrt().0 - want).abs() <= 1, "{raw}");
         }
     }
 }

@@ -61,7 +61,7 @@ impl<R: Real> Vec3<R> {
         if m == R::ZERO {
             return self;
         }
-        let v = Vec3::new(self.x / m, self.y / m, self.z / m);
+        let v = self * (R::ONE / m);
         v * (R::ONE / v.length())
     }
     /// Largest absolute component.
@@ -169,7 +169,8 @@ impl<R: Real> Aabb<R> {
                 }
                 continue;
             }
-            let (mut ta, mut tb) = ((lo - o) / d, (hi - o) / d);
+            let inv = R::ONE / d;
+            let (mut ta, mut tb) = ((lo - o) * inv, (hi - o) * inv);
             if ta > tb {
                 core::mem::swap(&mut ta, &mut tb);
             }

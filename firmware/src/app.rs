@@ -12,7 +12,17 @@ use lattice_rt::scene::{Object, MAX_GROUPS};
 const _: () = assert!(MAX_COMPOSITES <= MAX_GROUPS);
 use lattice_rt::{parse, render, Dither, Frame, Lattice, LatticeConfig, Real, Stats, Tracer};
 
-/// The scalar the firmware traces in (the RP2040 and the Cortex-M3 have no FPU).
+/// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).
+#[cfg(feature = "scalar-fixed")]
+pub type Scalar = lattice_rt::Fx;
+/// The scalar the firmware traces in.
+#[cfg(feature = "scalar-micromath")]
+pub type Scalar = lattice_rt::F32Micro;
+/// The scalar the firmware traces in.
+#[cfg(feature = "scalar-micromath-newton")]
+pub type Scalar = lattice_rt::F32MicroNewton;
+/// The scalar the firmware traces in.
+#[cfg(not(any(feature = "scalar-fixed", feature = "scalar-micromath", feature = "scalar-micromath-newton")))]
 pub type Scalar = f32;
 
 // SCENES and the capacities, computed by build.rs from the scenes chosen for this build.
