@@ -23,7 +23,7 @@ pub use trace::{Effects, Tracer};
 pub mod dither;
 pub use dither::Dither;
 pub mod render;
-pub use render::{render, Frame, Hooks, NoHooks};
+pub use render::{render, Frame, Hooks, NoHooks, Sampling};
 pub mod parse;
 pub use parse::{parse, ParseError};
 pub mod bitframe;

@@ -5,12 +5,24 @@
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{ordered, Carry, Dither, LEVELS, MAX_TILE};
 use crate::scalar::Real;
-use crate::trace::Tracer;
+use crate::trace::{Tracer, NO_OBJECT};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
+
+/// How many eye rays a pixel gets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampling {
+    /// One ray through the centre of each pixel (or of each pattern block).
+    Center,
+    /// Four rays per pixel on a 2x2 grid, averaged.
+    Grid2x2,
+    /// One ray per pixel, and the 2x2 grid only where a neighbouring pixel's eye ray hit a
+    /// different object: the paper's "area anti-aliasing only at object edges".
+    Edges,
+}
 
 /// What to render.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,12 +35,25 @@ pub struct Frame {
     pub tile: u8,
     /// Dithering mode.
     pub dither: Dither,
+    /// Eye rays per pixel (ignored by the patterning modes, which take one per block).
+    pub sampling: Sampling,
 }
 
 impl Frame {
-    /// A frame with 8x8 tiles and Bayer dithering.
+    /// A frame with 8x8 tiles, Bayer dithering and one ray per pixel.
     pub fn new(width: u16, height: u16) -> Self {
-        Frame { width, height, tile: 8, dither: Dither::Bayer }
+        Frame { width, height, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center }
+    }
+
+    /// Entries of `i16` scratch storage [`render`] needs: error-diffusion carries and the
+    /// object ids of the row above the current band for edge detection.
+    pub fn scratch_len(&self) -> usize {
+        let w = self.width as usize;
+        (if self.dither.diffuses() { Carry::len(w) } else { 0 }) + if self.edges() { w } else { 0 }
+    }
+
+    fn edges(&self) -> bool {
+        self.sampling == Sampling::Edges && self.dither.block() == 1
     }
 }
 
@@ -56,8 +81,8 @@ pub enum RenderError<E> {
     Cancelled,
     /// The tile size is 0, above [`MAX_TILE`], or not a multiple of the pattern block.
     BadTile,
-    /// Error diffusion needs carry storage of `needed` entries.
-    CarryTooSmall {
+    /// The scratch storage is smaller than [`Frame::scratch_len`].
+    ScratchTooSmall {
         /// Entries needed.
         needed: usize,
     },
@@ -71,8 +96,8 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
             RenderError::BadTile => {
                 write!(f, "tile side must be 1..={MAX_TILE} and a multiple of the pattern block")
             }
-            RenderError::CarryTooSmall { needed } => {
-                write!(f, "error-diffusion carry storage too small: {needed} entries needed")
+            RenderError::ScratchTooSmall { needed } => {
+                write!(f, "render scratch storage too small: {needed} entries needed")
             }
         }
     }
@@ -98,14 +123,14 @@ pub fn level<R: Real>(v: R) -> u8 {
 /// Renders a frame tile by tile into `target`, returning the statistics.
 ///
 /// `mailbox` is the accelerator's per-object scratch ([`Query::mailbox_len`] entries);
-/// `carry` must hold [`Carry::len`]`(width)` entries when the mode diffuses error (else it may
-/// be empty).
+/// `scratch` must hold [`Frame::scratch_len`] entries (it may be empty for Bayer or patterning
+/// with one ray per pixel).
 pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>>(
     tracer: &Tracer<'_, '_, R, A>,
     frame: &Frame,
     target: &mut D,
     mailbox: &mut [u32],
-    carry: &mut [i16],
+    scratch: &mut [i16],
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
     let t = frame.tile as usize;
@@ -114,36 +139,70 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
         return Err(RenderError::BadTile);
     }
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let mut carry = if frame.dither.diffuses() {
-        Some(Carry::new(carry, w).ok_or(RenderError::CarryTooSmall { needed: Carry::len(w) })?)
-    } else {
-        None
-    };
+    let scratch = scratch.get_mut(..frame.scratch_len()).ok_or(RenderError::ScratchTooSmall { needed: frame.scratch_len() })?;
+    let (carry_store, above) = scratch.split_at_mut(if frame.dither.diffuses() { Carry::len(w) } else { 0 });
+    let mut carry = if frame.dither.diffuses() { Carry::new(carry_store, w) } else { None };
+    above.iter_mut().for_each(|v| *v = NO_OBJECT as i16);
     let mut q = Query::new(mailbox);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let total = (tiles_x * tiles_y) as u32;
     let cam = &tracer.scene.camera;
-    let (w2, h2) = (2 * w as i32, 2 * h as i32);
+    let (w4, h4) = (4 * w as i32, 4 * h as i32);
+    // An eye ray through the point (sx / 4, sy / 4) in pixels from the top-left corner.
+    let mut shoot = |sx: usize, sy: usize, q: &mut Query<'_>| tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), q);
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
+    let mut ids = [NO_OBJECT; MAX_TILE * MAX_TILE];
+    let mut left;
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     for ty in 0..tiles_y {
         if let Some(c) = carry.as_mut() {
             c.next_band();
         }
+        left = [NO_OBJECT; MAX_TILE];
         for tx in 0..tiles_x {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
-            // One ray per block, through the block's centre (doubled coordinates).
+            // One ray per block through the block's centre; Grid2x2 takes four per pixel.
             for by in (0..th).step_by(block) {
                 for bx in (0..tw).step_by(block) {
-                    let (sx, sy) = (2 * (x0 + bx) + block, 2 * (y0 + by) + block);
-                    let ray = cam.ray(sx as i32, sy as i32, w2, h2);
-                    let l = level(tracer.radiance(ray, &mut q));
+                    let (cx, cy) = (4 * (x0 + bx) + 2 * block, 4 * (y0 + by) + 2 * block);
+                    let (v, id) = if frame.sampling == Sampling::Grid2x2 && block == 1 {
+                        grid2x2(&mut shoot, cx, cy, &mut q)
+                    } else {
+                        shoot(cx, cy, &mut q)
+                    };
+                    let l = level(v);
                     for y in by..(by + block).min(th) {
                         for x in bx..(bx + block).min(tw) {
                             levels[y * tw + x] = l;
+                            ids[y * tw + x] = id;
                         }
                     }
+                }
+            }
+            if frame.edges() {
+                // A pixel is on an edge if its eye ray hit another object than a neighbour's:
+                // left and above come from the tiles already drawn, right and below from this
+                // tile; a pair split by a later tile's border is caught by that later pixel.
+                for y in 0..th {
+                    for x in 0..tw {
+                        let id = ids[y * tw + x];
+                        let l = if x > 0 { ids[y * tw + x - 1] } else { left[y] };
+                        let u = if y > 0 { ids[(y - 1) * tw + x] } else { above[x0 + x] as u16 };
+                        let r = if x + 1 < tw { ids[y * tw + x + 1] } else { id };
+                        let d = if y + 1 < th { ids[(y + 1) * tw + x] } else { id };
+                        let edge = (x0 + x > 0 && l != id) || (y0 + y > 0 && u != id) || r != id || d != id;
+                        if edge {
+                            let (cx, cy) = (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
+                            levels[y * tw + x] = level(grid2x2(&mut shoot, cx, cy, &mut q).0);
+                        }
+                    }
+                }
+                for y in 0..th {
+                    left[y] = ids[y * tw + tw - 1];
+                }
+                for x in 0..tw {
+                    above[x0 + x] = ids[(th - 1) * tw + x] as i16;
                 }
             }
             match carry.as_mut() {
@@ -166,4 +225,19 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
         }
     }
     Ok(q.stats)
+}
+
+/// The mean of four eye rays on a 2x2 grid around the pixel centre `(cx, cy)` (quarter-pixel
+/// units), and the object the first of them hit.
+fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize, &mut Query<'_>) -> (R, u16), cx: usize, cy: usize, q: &mut Query<'_>) -> (R, u16) {
+    let mut sum = R::ZERO;
+    let mut first = NO_OBJECT;
+    for (k, (dx, dy)) in [(0, 0), (2, 0), (0, 2), (2, 2)].into_iter().enumerate() {
+        let (v, id) = shoot(cx - 1 + dx, cy - 1 + dy, q);
+        sum += v;
+        if k == 0 {
+            first = id;
+        }
+    }
+    (sum * R::from_f64(0.25), first)
 }

@@ -16,6 +16,9 @@ use crate::scalar::Real;
 use crate::scene::{Light, Scene};
 use heapless::Vec;
 
+/// The object id reported for an eye ray that hits nothing.
+pub const NO_OBJECT: u16 = u16::MAX;
+
 /// Deepest intersection tree the tracer supports (eye ray = depth 0).
 pub const MAX_DEPTH: u8 = 8;
 
@@ -75,6 +78,12 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
 
     /// Brightness (0 black .. 1 white, clamped) seen along an eye ray.
     pub fn radiance(&self, eye: Ray<R>, q: &mut Query<'_>) -> R {
+        self.radiance_and_object(eye, q).0
+    }
+
+    /// Brightness along an eye ray and the object the eye ray hits ([`NO_OBJECT`] if none).
+    pub fn radiance_and_object(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u16) {
+        let mut first = NO_OBJECT;
         let scene = self.scene;
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
         let _ = stack.push(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary });
@@ -85,6 +94,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
                 total += node.weight * scene.background;
                 continue;
             };
+            if node.depth == 0 {
+                first = hit.object;
+            }
             let obj = &scene.objects[hit.object as usize];
             let m = scene.materials[obj.material as usize];
             let p = node.ray.at(hit.t);
@@ -126,7 +138,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
                 let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection));
             }
         }
-        total.max(R::ZERO).min(R::ONE)
+        (total.max(R::ZERO).min(R::ONE), first)
     }
 
     /// `Ip * Kd * max(0, L.N)` for one light, or zero if the light is behind the surface or

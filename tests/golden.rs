@@ -8,7 +8,7 @@ use lattice_rt::{Dither, Frame, Real};
 const SCENES: [&str; 5] = ["chair", "desk", "polyhedron", "spheres", "whitted"];
 
 fn golden_for<R: Real>() {
-    let frame = Frame { width: 128, height: 64, tile: 8, dither: Dither::Bayer };
+    let frame = Frame::new(128, 64);
     for s in SCENES {
         let (pbm, _) = render_text::<R>(&scene_text(s), Accel::Lattice, &frame);
         assert_golden(&format!("{s}-128x64-{}", R::NAME), &pbm);
@@ -41,7 +41,7 @@ fn identical_for<R: Real>(frame: &Frame) {
 
 #[test]
 fn all_accelerators_draw_identical_frames() {
-    let frame = Frame { width: 160, height: 100, tile: 8, dither: Dither::FloydSteinberg };
+    let frame = Frame { dither: Dither::FloydSteinberg, ..Frame::new(160, 100) };
     identical_for::<f64>(&frame);
     identical_for::<f32>(&frame);
     identical_for::<lattice_rt::Fx>(&frame);
@@ -52,7 +52,7 @@ fn error_diffusion_in_tiles_keeps_the_mean_gray() {
     // Tile-order Floyd-Steinberg keeps the overall brightness of the Bayer rendering.
     let text = scene_text("spheres");
     let count = |d| {
-        let f = Frame { width: 160, height: 100, tile: 8, dither: d };
+        let f = Frame { dither: d, ..Frame::new(160, 100) };
         let (pbm, _) = render_text::<f64>(&text, Accel::Lattice, &f);
         pbm[pbm.len() - 2000..].iter().map(|b| b.count_ones()).sum::<u32>() as f64
     };

@@ -10,6 +10,7 @@ use lattice_rt::scene::{Object, MAX_GROUPS};
 
 // The composites of every embedded scene fit the core's fixed table (checked at compile time).
 const _: () = assert!(MAX_COMPOSITES <= MAX_GROUPS);
+use lattice_rt::render::Sampling;
 use lattice_rt::{parse, render, Dither, Frame, Lattice, LatticeConfig, Real, Stats, Tracer};
 
 /// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).
@@ -34,7 +35,7 @@ pub const WIDTH: u16 = 128;
 pub const HEIGHT: u16 = 64;
 
 /// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), Bayer dither.
-pub const FRAME: Frame = Frame { width: WIDTH, height: HEIGHT, tile: 8, dither: Dither::Bayer };
+pub const FRAME: Frame = Frame { width: WIDTH, height: HEIGHT, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center };
 
 /// All memory a scene needs, owned by the caller (it lives on `main`'s stack).
 pub struct Storage<R> {

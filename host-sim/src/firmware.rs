@@ -5,7 +5,7 @@
 use crate::load::{object_storage, parse_scene, read};
 use crate::run::render_with;
 use anyhow::{bail, Context, Result};
-use lattice_rt::{Dither, Frame, LatticeConfig, Tracer};
+use lattice_rt::{Frame, LatticeConfig, Tracer};
 use object::{Object, ObjectSection, SectionFlags};
 use std::fmt::Write as _;
 use std::io::Read;
@@ -178,7 +178,7 @@ fn host_frame(scenes: &Path, name: &str) -> Result<Vec<u8>> {
     let cfg = LatticeConfig::default();
     let mut bufs = crate::load::LatticeBufs::for_scene(&scene, &cfg);
     let lattice = bufs.build(&scene, &cfg)?;
-    let frame = Frame { width: 128, height: 64, tile: 8, dither: Dither::Bayer };
+    let frame = Frame::new(128, 64);
     Ok(render_with(&Tracer::new(&scene, &lattice), &frame, false)?.bits)
 }
 

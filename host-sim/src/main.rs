@@ -105,6 +105,29 @@ impl DitherArg {
     }
 }
 
+/// Eye rays per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SamplingArg {
+    /// One ray through each pixel centre.
+    One,
+    /// Four rays per pixel (2x2 grid).
+    Four,
+    /// One ray per pixel, four at object edges only.
+    Edges,
+}
+
+impl SamplingArg {
+    /// The core's sampling mode.
+    pub fn mode(self) -> lattice_rt::render::Sampling {
+        use lattice_rt::render::Sampling;
+        match self {
+            SamplingArg::One => Sampling::Center,
+            SamplingArg::Four => Sampling::Grid2x2,
+            SamplingArg::Edges => Sampling::Edges,
+        }
+    }
+}
+
 /// Parses `WxH`.
 fn parse_size(s: &str) -> Result<(u16, u16), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size `{s}` is not WIDTHxHEIGHT"))?;
@@ -147,6 +170,9 @@ pub struct RenderArgs {
     /// Dithering mode.
     #[arg(long, value_enum, default_value_t = DitherArg::Bayer)]
     pub dither: DitherArg,
+    /// Eye rays per pixel.
+    #[arg(long, value_enum, default_value_t = SamplingArg::One)]
+    pub sampling: SamplingArg,
     /// Ray-query method.
     #[arg(long, value_enum, default_value_t = Accel::Lattice)]
     pub accel: Accel,

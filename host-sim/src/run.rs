@@ -7,7 +7,7 @@ use anyhow::{anyhow, Result};
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::Effects;
 use lattice_rt::{
-    render, Accelerator, BitFrame, BoundingBox, BruteForce, Dither, Frame, LatticeConfig, Query, Real, Scene, Stats,
+    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, LatticeConfig, Query, Real, Scene, Stats,
     Tracer,
 };
 use std::io::Write;
@@ -65,7 +65,7 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized>(
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
     let mut mailbox = vec![0u32; Query::mailbox_len(tracer.scene)];
-    let mut carry = vec![0i16; lattice_rt::dither::Carry::len(w)];
+    let mut carry = vec![0i16; frame.scratch_len()];
     let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, shown: false };
     let start = Instant::now();
     let stats = render(tracer, frame, &mut target, &mut mailbox, &mut carry, &mut hooks).map_err(|e| match e {
@@ -122,7 +122,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let text = read(&a.scene)?;
     let mut storage = object_storage::<R>(&text);
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
-    let frame = Frame { width: a.size.0, height: a.size.1, tile: a.tile, dither: a.dither.mode() };
+    let frame = Frame { tile: a.tile, dither: a.dither.mode(), sampling: a.sampling.mode(), ..Frame::new(a.size.0, a.size.1) };
     let out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true)?;
     let mut store = vec![0u8; out.bits.len()];
     let frame_bits = bitframe_from(&mut store, &frame, &out.bits);
@@ -202,7 +202,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
         lattice.bytes(),
         build.as_secs_f64() * 1e3
     );
-    let frame = Frame { width: a.size.0, height: a.size.1, tile: 8, dither: Dither::Bayer };
+    let frame = Frame::new(a.size.0, a.size.1);
     let pixels = frame.width as f64 * frame.height as f64;
     // Primary rays only: the paper's per-ray figures.
     let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + '_>| {
@@ -265,7 +265,7 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
         let mut storage = object_storage::<f64>(&text);
         let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
         for (w, h) in [(160u16, 100u16), (128, 64)] {
-            let frame = Frame { width: w, height: h, tile: 8, dither: Dither::Bayer };
+            let frame = Frame::new(w, h);
             let r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true)?;
             let mut store = vec![0u8; r.bits.len()];
             let f = bitframe_from(&mut store, &frame, &r.bits);

@@ -47,7 +47,7 @@ pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, 
     let mut bits = vec![0u8; BitFrame::bytes(frame.width as u32, frame.height as u32)];
     let mut target = BitFrame::new(frame.width as u32, frame.height as u32, &mut bits).unwrap();
     let mut mb = vec![0u32; Query::mailbox_len(t.scene)];
-    let mut carry = vec![0i16; 4 * frame.width as usize];
+    let mut carry = vec![0i16; frame.scratch_len()];
     let stats = render(t, frame, &mut target, &mut mb, &mut carry, &mut NoHooks).expect("render");
     let mut pbm = Vec::new();
     target.write_pbm(|b| pbm.extend_from_slice(b));
