@@ -18,24 +18,66 @@ const INSTRUCTIONS_PER_TICK: u64 = 40;
 
 /// One firmware build.
 struct Variant {
-    name: &'static str,
+    name: String,
     target: &'static str,
-    features: &'static str,
+    features: String,
     bin: &'static str,
     machine: Option<&'static str>,
     scenes: Option<&'static str>,
-    what: &'static str,
+    scalar: &'static str,
+    what: String,
 }
 
-const VARIANTS: [Variant; 4] = [
-    Variant { name: "qemu-m0", target: "thumbv6m-none-eabi", features: "qemu", bin: "qemu", machine: Some("mps2-an385"), scenes: None, what: "Cortex-M0+ build (runs on QEMU's Cortex-M3 board), all five scenes" },
-    Variant { name: "qemu-m4f", target: "thumbv7em-none-eabihf", features: "qemu", bin: "qemu", machine: Some("mps2-an386"), scenes: None, what: "Cortex-M4F build, all five scenes" },
-    Variant { name: "qemu-m0-chair", target: "thumbv6m-none-eabi", features: "qemu", bin: "qemu", machine: Some("mps2-an385"), scenes: Some("chair"), what: "Cortex-M0+ build with only the chair embedded" },
-    Variant { name: "pico", target: "thumbv6m-none-eabi", features: "pico", bin: "pico", machine: None, scenes: None, what: "Raspberry Pi Pico + SSD1306 image (built with the default linker; `cargo pico` links the same code with flip-link)" },
-];
+/// The firmware scalars: (name in reports, cargo feature).
+pub const SCALARS: [(&str, &str); 4] =
+    [("f32", ""), ("fixed", "scalar-fixed"), ("f32-micromath", "scalar-micromath"), ("f32-micromath-newton", "scalar-micromath-newton")];
+
+fn variants() -> Vec<Variant> {
+    let mut v = Vec::new();
+    for (board, target, machine, core) in [
+        ("m0", "thumbv6m-none-eabi", "mps2-an385", "Cortex-M0+ (thumbv6m, run on QEMU's Cortex-M3 board)"),
+        ("m4f", "thumbv7em-none-eabihf", "mps2-an386", "Cortex-M4F (thumbv7em-none-eabihf)"),
+    ] {
+        for (scalar, feature) in SCALARS {
+            v.push(Variant {
+                name: format!("qemu-{board}-{scalar}"),
+                target,
+                features: ["qemu", feature].iter().filter(|f| !f.is_empty()).cloned().collect::<Vec<_>>().join(","),
+                bin: "qemu",
+                machine: Some(machine),
+                scenes: None,
+                scalar,
+                what: format!("{core}, {scalar}, all five scenes"),
+            });
+        }
+    }
+    for (scalar, feature) in [SCALARS[0], SCALARS[1]] {
+        v.push(Variant {
+            name: format!("qemu-m0-{scalar}-chair"),
+            target: "thumbv6m-none-eabi",
+            features: format!("qemu,{feature}").trim_end_matches(',').to_string(),
+            bin: "qemu",
+            machine: Some("mps2-an385"),
+            scenes: Some("chair"),
+            scalar,
+            what: format!("Cortex-M0+, {scalar}, only the chair embedded"),
+        });
+    }
+    v.push(Variant {
+        name: "pico".into(),
+        target: "thumbv6m-none-eabi",
+        features: "pico".into(),
+        bin: "pico",
+        machine: None,
+        scenes: None,
+        scalar: "fixed",
+        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes (default linker; `cargo pico` links the same code with flip-link)".into(),
+    });
+    v
+}
 
 fn target_dir(root: &Path, v: &Variant) -> PathBuf {
-    root.join("firmware/target/variants").join(v.name)
+    root.join("firmware/target/variants").join(&v.name)
 }
 
 fn elf_path(root: &Path, v: &Variant) -> PathBuf {
@@ -46,7 +88,7 @@ fn build(root: &Path, v: &Variant) -> Result<()> {
     eprintln!("  building {} ({})", v.name, v.target);
     let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cmd.current_dir(root.join("firmware"))
-        .args(["build", "--release", "--features", v.features, "--bin", v.bin, "--target", v.target, "--target-dir"])
+        .args(["build", "--release", "--features", &v.features, "--bin", v.bin, "--target", v.target, "--target-dir"])
         .arg(target_dir(root, v))
         .env_remove("RUSTFLAGS");
     match v.scenes {
@@ -96,7 +138,6 @@ struct SceneRun {
     name: String,
     ticks: u64,
     rays: u64,
-    tests: u64,
     stack_so_far: u64,
     rows: Vec<u8>,
 }
@@ -147,7 +188,6 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
                 name: rest.split_whitespace().next().unwrap_or("").to_string(),
                 ticks: field(line, "ticks"),
                 rays: field(line, "rays"),
-                tests: field(line, "tests"),
                 stack_so_far: field(line, "stack_so_far"),
                 rows: Vec::new(),
             });
@@ -169,27 +209,37 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
     Ok(run)
 }
 
-/// The host's 1-bit frame of a scene in f32 with the firmware's settings.
-fn host_frame(scenes: &Path, name: &str) -> Result<Vec<u8>> {
+/// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R`.
+fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str) -> Result<Vec<u8>> {
     let path = scenes.join(format!("{name}.scene"));
     let text = read(&path)?;
-    let mut storage = object_storage::<f32>(&text);
-    let scene = parse_scene::<f32>(&path, &text, &mut storage)?;
+    let mut storage = object_storage::<R>(&text);
+    let scene = parse_scene::<R>(&path, &text, &mut storage)?;
     let cfg = LatticeConfig::default();
     let mut bufs = crate::load::LatticeBufs::for_scene(&scene, &cfg);
     let lattice = bufs.build(&scene, &cfg)?;
-    let frame = Frame::new(128, 64);
-    Ok(render_with(&Tracer::new(&scene, &lattice), &frame, false)?.bits)
+    Ok(render_with(&Tracer::new(&scene, &lattice), &Frame::new(128, 64), false)?.bits)
+}
+
+/// [`host_frame_in`] for a scalar named as in [`SCALARS`].
+fn host_frame(scenes: &Path, name: &str, scalar: &str) -> Result<Vec<u8>> {
+    match scalar {
+        "fixed" => host_frame_in::<lattice_rt::Fx>(scenes, name),
+        "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(scenes, name),
+        "f32-micromath-newton" => host_frame_in::<lattice_rt::F32MicroNewton>(scenes, name),
+        _ => host_frame_in::<f32>(scenes, name),
+    }
 }
 
 /// The command.
 pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     let (mut passed, mut failed) = (0, 0);
     let mut md = String::new();
-    writeln!(md, "# Firmware budgets\n\nWritten by `cargo run --release -p host-sim -- firmware` (also run by `.ci/run`).\nFrames are 128x64, f32, lattice, Bayer dither, each scene's own effects and depth.\n")?;
+    writeln!(md, "# Firmware budgets\n\nWritten by `cargo run --release -p host-sim -- firmware` (also run by `.ci/run`).\nFrames are 128x64, lattice, Bayer dither, each scene's own effects and depth.\n")?;
     writeln!(md, "## Builds\n\n| variant | what | flash bytes | static RAM | stack high-water | RAM total |\n|---|---|---|---|---|---|")?;
+    let variants = variants();
     let mut runs = Vec::new();
-    for v in &VARIANTS {
+    for v in &variants {
         if !skip_build {
             build(root, v)?;
         }
@@ -211,51 +261,81 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
         }
     }
     writeln!(md, "\nRAM is measured, not estimated: cortex-m-rt paints the stack at reset (`paint-stack`) and the\nfirmware reports the deepest word that lost the paint. All scene storage lives on the stack,\nsized by `firmware/build.rs` to exactly what the embedded scenes need.\n")?;
-    writeln!(md, "## Instructions per frame (QEMU, `-icount shift=0`)\n\nSysTick ticks x {INSTRUCTIONS_PER_TICK} (25 MHz SysTick, 1 ns per instruction): deterministic.\n")?;
-    writeln!(md, "| scene | rays | object tests | M0 instructions | M0 instr/ray | M4F instructions | M4F instr/ray | M0 / M4F | frames bit-identical to host-sim |\n|---|---|---|---|---|---|---|---|---|")?;
     let scenes_dir = root.join("scenes");
-    let find = |name: &str, variant: &str| runs.iter().find(|(v, _)| v.name == variant).and_then(|(_, r)| r.scenes.iter().find(|s| s.name == name));
+    // Every frame must equal the host's render in the same scalar, bit for bit.
+    let mut identical = std::collections::BTreeMap::new();
     for (v, r) in &runs {
         for e in &r.errors {
             eprintln!("FAIL {}: {e}", v.name);
             failed += 1;
         }
         for s in &r.scenes {
-            let want = host_frame(&scenes_dir, &s.name)?;
-            if want == s.rows {
+            let want = host_frame(&scenes_dir, &s.name, v.scalar)?;
+            let same = want == s.rows;
+            if same {
                 passed += 1;
             } else {
                 failed += 1;
                 let differ = want.iter().zip(&s.rows).map(|(a, b)| (a ^ b).count_ones()).sum::<u32>();
                 eprintln!("FAIL {} {}: frame differs from host-sim in {differ} pixels", v.name, s.name);
             }
+            identical.insert((v.name.clone(), s.name.clone()), same);
         }
     }
-    if let Some((_, m0)) = runs.iter().find(|(v, _)| v.name == "qemu-m0") {
-        for s in &m0.scenes {
-            let m4 = find(&s.name, "qemu-m4f");
-            let i0 = s.ticks * INSTRUCTIONS_PER_TICK;
-            let (i4, r4) = m4.map_or((0, 0.0), |m| (m.ticks * INSTRUCTIONS_PER_TICK, (m.ticks * INSTRUCTIONS_PER_TICK) as f64 / m.rays.max(1) as f64));
-            let same = ["qemu-m0", "qemu-m4f", "qemu-m0-chair"]
-                .iter()
-                .filter_map(|v| find(&s.name, v).map(|x| (v, x)))
-                .map(|(v, x)| format!("{v}: {}", if host_frame(&scenes_dir, &s.name).map(|h| h == x.rows).unwrap_or(false) { "yes" } else { "NO" }))
-                .collect::<Vec<_>>()
-                .join(", ");
-            writeln!(
-                md,
-                "| {} | {} | {} | {} | {:.0} | {} | {:.0} | {:.2} | {same} |",
-                s.name, s.rays, s.tests, i0, i0 as f64 / s.rays.max(1) as f64, i4, r4, i0 as f64 / i4.max(1) as f64
-            )?;
+    writeln!(md, "## Instructions per frame (QEMU, `-icount shift=0`)\n\nSysTick ticks x {INSTRUCTIONS_PER_TICK} (25 MHz SysTick, 1 ns per instruction): deterministic, the same on\nany machine. Every frame below was checked bit for bit against host-sim in the same scalar.\n")?;
+    let mut header = String::from("| scene | rays |");
+    let mut rule = String::from("|---|---|");
+    let cols: Vec<&Variant> = variants.iter().filter(|v| v.machine.is_some() && v.scenes.is_none()).collect();
+    for v in &cols {
+        header.push_str(&format!(" {} |", v.name.trim_start_matches("qemu-")));
+        rule.push_str("---|");
+    }
+    writeln!(md, "{header}\n{rule}")?;
+    let mut csv = String::from("scene,scalar,board,instructions,rays\n");
+    let find = |variant: &str, scene: &str| runs.iter().find(|(v, _)| v.name == variant).and_then(|(_, r)| r.scenes.iter().find(|s| s.name == scene));
+    let names: Vec<String> = runs.first().map(|(_, r)| r.scenes.iter().map(|s| s.name.clone()).collect()).unwrap_or_default();
+    for scene in &names {
+        let rays = find(&cols[0].name, scene).map_or(0, |s| s.rays);
+        let mut row = format!("| {scene} | {rays} |");
+        for v in &cols {
+            match find(&v.name, scene) {
+                Some(s) => {
+                    let ins = s.ticks * INSTRUCTIONS_PER_TICK;
+                    let ok = if identical.get(&(v.name.clone(), scene.clone())) == Some(&true) { "" } else { " (frame differs!)" };
+                    row.push_str(&format!(" {:.1} M{ok} |", ins as f64 / 1e6));
+                    let board = if v.target.starts_with("thumbv6m") { "m0" } else { "m4f" };
+                    csv.push_str(&format!("{scene},{},{board},{ins},{}\n", v.scalar, s.rays));
+                }
+                None => row.push_str(" - |"),
+            }
         }
-        if let Some(chair) = find("chair", "qemu-m0-chair") {
-            let statics = runs.iter().find(|(v, _)| v.name == "qemu-m0-chair").map_or(0, |(_, r)| r.statics);
-            writeln!(md, "\nChair at 128x64 on the M0 build with only the chair embedded: static {statics} + stack {} = {} bytes of RAM (budget 16384).", chair.stack_so_far, statics + chair.stack_so_far)?;
+        writeln!(md, "{row}")?;
+    }
+    let ratio = |a: &str, b: &str| -> Option<f64> {
+        let (mut x, mut y) = (0u64, 0u64);
+        for scene in &names {
+            x += find(a, scene)?.ticks;
+            y += find(b, scene)?.ticks;
+        }
+        Some(x as f64 / y.max(1) as f64)
+    };
+    if let Some(r) = ratio("qemu-m0-f32", "qemu-m0-fixed") {
+        writeln!(md, "\nOn the M0 build, f32 soft-float needs {r:.2}x the instructions of fixed point over all scenes (target: 3x).")?;
+    }
+    if let Some(r) = ratio("qemu-m0-f32", "qemu-m4f-f32") {
+        writeln!(md, "The M0 build needs {r:.2}x the instructions of the M4F build in f32 (no FPU against an FPU).")?;
+    }
+    for scalar in ["f32", "fixed"] {
+        let name = format!("qemu-m0-{scalar}-chair");
+        if let (Some(chair), Some((_, r))) = (find(&name, "chair"), runs.iter().find(|(v, _)| v.name == name)) {
+            writeln!(md, "\nChair at 128x64, M0 build with only the chair embedded, {scalar}: static {} + stack {} = {} bytes of RAM (budget 16384).", r.statics, chair.stack_so_far, r.statics + chair.stack_so_far)?;
         }
     }
     std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
     std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
-    println!("wrote {}", out.display());
+    let csv_path = out.with_extension("csv");
+    std::fs::write(&csv_path, csv).with_context(|| format!("cannot write {}", csv_path.display()))?;
+    println!("wrote {} and {}", out.display(), csv_path.display());
     println!("firmware: {passed} passed, {failed} failed");
     if failed > 0 {
         bail!("{failed} firmware checks failed");
