@@ -20,8 +20,13 @@ pub enum Sampling {
     /// Four rays per pixel on a 2x2 grid, averaged.
     Grid2x2,
     /// One ray per pixel, and the 2x2 grid only where a neighbouring pixel's eye ray hit a
-    /// different object: the paper's "area anti-aliasing only at object edges".
-    Edges,
+    /// different object (the paper's "area anti-aliasing only at object edges"), or where the
+    /// one-ray gray levels of neighbours in the tile differ by at least `contrast` (shadow,
+    /// mirror and refraction edges inside one object; above 64 turns this test off).
+    Edges {
+        /// Gray-level jump (of 64) that also counts as an edge.
+        contrast: u8,
+    },
 }
 
 /// What to render.
@@ -53,7 +58,7 @@ impl Frame {
     }
 
     fn edges(&self) -> bool {
-        self.sampling == Sampling::Edges && self.dither.block() == 1
+        matches!(self.sampling, Sampling::Edges { .. }) && self.dither.block() == 1
     }
 }
 
@@ -122,9 +127,13 @@ pub fn level<R: Real>(v: R) -> u8 {
 
 /// Renders a frame tile by tile into `target`, returning the statistics.
 ///
+/// Kept out of line so the firmware report can check that nothing it calls uses floating point
+/// when the scalar is fixed point.
+///
 /// `mailbox` is the accelerator's per-object scratch ([`Query::mailbox_len`] entries);
 /// `scratch` must hold [`Frame::scratch_len`] entries (it may be empty for Bayer or patterning
 /// with one ray per pixel).
+#[inline(never)]
 pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>>(
     tracer: &Tracer<'_, '_, R, A>,
     frame: &Frame,
@@ -184,6 +193,11 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
                 // A pixel is on an edge if its eye ray hit another object than a neighbour's:
                 // left and above come from the tiles already drawn, right and below from this
                 // tile; a pair split by a later tile's border is caught by that later pixel.
+                let centre = levels;
+                let threshold = match frame.sampling {
+                    Sampling::Edges { contrast } => contrast,
+                    _ => u8::MAX,
+                };
                 for y in 0..th {
                     for x in 0..tw {
                         let id = ids[y * tw + x];
@@ -192,7 +206,15 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
                         let r = if x + 1 < tw { ids[y * tw + x + 1] } else { id };
                         let d = if y + 1 < th { ids[(y + 1) * tw + x] } else { id };
                         let edge = (x0 + x > 0 && l != id) || (y0 + y > 0 && u != id) || r != id || d != id;
-                        if edge {
+                        // A shadow, mirror or refraction edge inside one object shows as a jump in
+                        // the one-ray levels of this tile.
+                        let c = centre[y * tw + x];
+                        let jump = |n: u8| c.abs_diff(n) >= threshold;
+                        let contrast = (x > 0 && jump(centre[y * tw + x - 1]))
+                            || (y > 0 && jump(centre[(y - 1) * tw + x]))
+                            || (x + 1 < tw && jump(centre[y * tw + x + 1]))
+                            || (y + 1 < th && jump(centre[(y + 1) * tw + x]));
+                        if edge || contrast {
                             let (cx, cy) = (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
                             levels[y * tw + x] = level(grid2x2(&mut shoot, cx, cy, &mut q).0);
                         }
@@ -239,5 +261,5 @@ fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize, &mut Query<'_>) -> (R, 
             first = id;
         }
     }
-    (sum * R::from_f64(0.25), first)
+    (sum * (R::HALF * R::HALF), first)
 }

@@ -331,6 +331,18 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
             writeln!(md, "\nChair at 128x64, M0 build with only the chair embedded, {scalar}: static {} + stack {} = {} bytes of RAM (budget 16384).", r.statics, chair.stack_so_far, r.statics + chair.stack_so_far)?;
         }
     }
+    // No floating point per ray in the fixed-point build.
+    if let Some(v) = variants.iter().find(|v| v.name == "qemu-m0-fixed") {
+        let (reached, setup) = float_audit(&elf_path(root, v))?;
+        writeln!(md, "\n## Fixed point uses no floating point per ray\n\nChecked on the disassembly of `{}` (call graph from `llvm-objdump`): soft-float routines\nreachable from `lattice_rt::render::render`: {}.", v.name, if reached.is_empty() { "none".to_string() } else { reached.join(", ") })?;
+        writeln!(md, "Functions that do call soft-float routines (scene set-up: parsing, transforms, lattice\nresolution, reports): {}.", setup.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", "))?;
+        if reached.is_empty() {
+            passed += 1;
+        } else {
+            failed += 1;
+            eprintln!("FAIL {}: soft float reachable from the renderer: {}", v.name, reached.join(", "));
+        }
+    }
     std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
     std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
     let csv_path = out.with_extension("csv");
@@ -341,4 +353,78 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
         bail!("{failed} firmware checks failed");
     }
     Ok(())
+}
+
+/// Soft-float routines of the ARM EABI and compiler-builtins (single and double precision).
+fn is_soft_float(name: &str) -> bool {
+    const PREFIXES: [&str; 9] = ["__aeabi_f", "__aeabi_d", "__aeabi_i2f", "__aeabi_i2d", "__aeabi_ui2f", "__aeabi_ui2d", "__aeabi_l2f", "__aeabi_l2d", "__aeabi_ul2"];
+    PREFIXES.iter().any(|p| name.starts_with(p)) || matches!(name, "__addsf3" | "__mulsf3" | "__divsf3" | "__adddf3" | "__muldf3" | "__divdf3" | "sqrtf" | "sqrt")
+}
+
+/// Finds `llvm-objdump` (rustup's `llvm-tools` component) or a system one.
+fn objdump() -> Option<PathBuf> {
+    let sysroot = Command::new("rustc").args(["--print", "sysroot"]).output().ok()?;
+    let root = PathBuf::from(String::from_utf8_lossy(&sysroot.stdout).trim());
+    let found = std::fs::read_dir(root.join("lib/rustlib")).ok()?.flatten().map(|e| e.path().join("bin/llvm-objdump")).find(|p| p.exists());
+    found.or_else(|| Command::new("llvm-objdump").arg("--version").output().ok().map(|_| PathBuf::from("llvm-objdump")))
+}
+
+/// The call graph of an ELF from its disassembly: function -> functions it branches to.
+fn call_graph(elf: &Path) -> Result<std::collections::HashMap<String, std::collections::BTreeSet<String>>> {
+    let tool = objdump().context("llvm-objdump not found: `rustup component add llvm-tools`")?;
+    let out = Command::new(tool).args(["-d", "--no-show-raw-insn"]).arg(elf).output()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut graph: std::collections::HashMap<String, std::collections::BTreeSet<String>> = Default::default();
+    let mut current = String::new();
+    for line in text.lines() {
+        if line.ends_with(">:") {
+            if let (Some(a), Some(b)) = (line.find('<'), line.rfind(">:")) {
+                current = line[a + 1..b].to_string();
+                graph.entry(current.clone()).or_default();
+            }
+        } else if line.contains("\tbl\t") || line.contains("\tb\t") || line.contains("\tblx\t") || line.contains("\tb.w\t") {
+            if let (Some(a), Some(b)) = (line.find('<'), line.rfind('>')) {
+                let target = line[a + 1..b].split('+').next().unwrap_or("").to_string();
+                if target != current {
+                    graph.entry(current.clone()).or_default().insert(target);
+                }
+            }
+        }
+    }
+    Ok(graph)
+}
+
+/// Soft-float routines reachable from the renderer (`lattice_rt::render::render`), with the
+/// path that reaches each, and all soft-float call sites outside it (set-up code).
+pub fn float_audit(elf: &Path) -> Result<(Vec<String>, Vec<String>)> {
+    let graph = call_graph(elf)?;
+    let name = |m: &str| format!("{:#}", rustc_demangle::demangle(m));
+    let roots: Vec<&String> = graph.keys().filter(|k| name(k).starts_with("lattice_rt::render::render")).collect();
+    if roots.is_empty() {
+        bail!("no lattice_rt::render::render in {}", elf.display());
+    }
+    let mut seen: std::collections::HashMap<String, String> = Default::default();
+    let mut queue: std::collections::VecDeque<String> = roots.iter().map(|r| r.to_string()).collect();
+    for r in &roots {
+        seen.insert(r.to_string(), String::new());
+    }
+    let mut reached = Vec::new();
+    while let Some(f) = queue.pop_front() {
+        for g in graph.get(&f).into_iter().flatten() {
+            if seen.contains_key(g) {
+                continue;
+            }
+            seen.insert(g.clone(), f.clone());
+            if is_soft_float(g) {
+                reached.push(format!("{} (called from {})", name(g), name(&f)));
+            } else {
+                queue.push_back(g.clone());
+            }
+        }
+    }
+    let mut setup: Vec<String> =
+        graph.iter().filter(|(f, calls)| !is_soft_float(f) && calls.iter().any(|c| is_soft_float(c))).map(|(f, _)| name(f)).collect();
+    setup.sort();
+    setup.dedup();
+    Ok((reached, setup))
 }

@@ -5,6 +5,7 @@ mod firmware;
 mod load;
 mod output;
 mod run;
+mod tradeoff;
 
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -39,6 +40,27 @@ enum Command {
         /// Folder holding the scene files.
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
+    },
+    /// What accuracy costs in time: error against a 16-ray f64 reference and cost, one knob
+    /// at a time (scalar, tree depth, cutoff, sampling, dithering).
+    Tradeoff {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Image size.
+        #[arg(long, default_value = "128x64", value_parser = parse_size)]
+        size: (u16, u16),
+        /// Timed runs per configuration (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/accuracy.md")]
+        out: PathBuf,
+        /// Plot to write.
+        #[arg(long, default_value = "docs/accuracy.png")]
+        plot: PathBuf,
+        /// Instruction counts written by `host-sim firmware`.
+        #[arg(long, default_value = "docs/firmware.csv")]
+        firmware_csv: PathBuf,
     },
     /// Build the firmware, run it in QEMU, check its frames against the host bit for bit,
     /// and write the flash/RAM/instruction budgets to a report.
@@ -114,6 +136,8 @@ pub enum SamplingArg {
     Four,
     /// One ray per pixel, four at object edges only.
     Edges,
+    /// One ray per pixel, four at object edges and where neighbours differ by 16 of 64 levels.
+    EdgesContrast,
 }
 
 impl SamplingArg {
@@ -123,7 +147,8 @@ impl SamplingArg {
         match self {
             SamplingArg::One => Sampling::Center,
             SamplingArg::Four => Sampling::Grid2x2,
-            SamplingArg::Edges => Sampling::Edges,
+            SamplingArg::Edges => Sampling::Edges { contrast: u8::MAX },
+            SamplingArg::EdgesContrast => Sampling::Edges { contrast: 16 },
         }
     }
 }
@@ -239,6 +264,14 @@ fn real_main() -> Result<()> {
                 Scalar::F32 => run::render_cmd::<f32>(&a),
                 Scalar::Fixed => run::render_cmd::<lattice_rt::Fx>(&a),
             }
+        }
+        Some(Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv }) => {
+            let scenes = if scenes.is_empty() {
+                ["chair", "desk", "polyhedron", "spheres", "whitted"].iter().map(|n| PathBuf::from(format!("scenes/{n}.scene"))).collect()
+            } else {
+                scenes
+            };
+            tradeoff::tradeoff_cmd(&scenes, size, runs, &out, &plot, &firmware_csv)
         }
         Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
         Some(Command::Stats(a)) => match a.scalar {

@@ -1,0 +1,58 @@
+//! Sampling modes: edge-only anti-aliasing spends rays only near edges and leaves every other
+//! pixel exactly as one ray per pixel draws it.
+
+mod common;
+use common::*;
+use lattice_rt::render::Hooks;
+use lattice_rt::scene::Object;
+use lattice_rt::{parse, render, BitFrame, Frame, LatticeConfig, Query, Sampling, Tracer};
+
+struct Gray(Vec<u8>, usize);
+impl Hooks for Gray {
+    fn gray_tile(&mut self, x: u16, y: u16, w: u16, h: u16, levels: &[u8]) {
+        for r in 0..h as usize {
+            for c in 0..w as usize {
+                self.0[(y as usize + r) * self.1 + x as usize + c] = levels[r * w as usize + c];
+            }
+        }
+    }
+}
+
+fn gray(sampling: Sampling) -> (Vec<u8>, u64) {
+    let text = scene_text("spheres");
+    let mut storage = vec![Object::<f64>::default(); 16];
+    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &mut bufs);
+    let frame = Frame { sampling, ..Frame::new(128, 64) };
+    let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
+    let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
+    let mut mb = vec![0u32; Query::mailbox_len(&scene)];
+    let mut scratch = vec![0i16; frame.scratch_len()];
+    let mut hooks = Gray(vec![0; 128 * 64], 128);
+    let stats = render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut mb, &mut scratch, &mut hooks).unwrap();
+    (hooks.0, stats.rays[0])
+}
+
+#[test]
+fn edge_sampling_refines_only_near_edges() {
+    let (one, rays1) = gray(Sampling::Center);
+    let (four, rays4) = gray(Sampling::Grid2x2);
+    let (edges, rays_e) = gray(Sampling::Edges { contrast: u8::MAX });
+    assert_eq!(rays1, 128 * 64);
+    assert_eq!(rays4, 4 * 128 * 64);
+    assert!(rays_e > rays1 && rays_e < rays1 + (rays4 - rays1) / 4, "edge rays {rays_e}");
+    // Every refined pixel took exactly four extra rays and now shows the 4-ray value.
+    let refined = (0..one.len()).filter(|&i| edges[i] != one[i]).count() as u64;
+    assert!(refined <= (rays_e - rays1) / 4);
+    for i in 0..one.len() {
+        assert!(edges[i] == one[i] || edges[i] == four[i], "pixel {i}: {} not {} or {}", edges[i], one[i], four[i]);
+    }
+}
+
+#[test]
+fn contrast_also_refines_shadow_edges() {
+    let (_, plain) = gray(Sampling::Edges { contrast: u8::MAX });
+    let (_, contrast) = gray(Sampling::Edges { contrast: 16 });
+    assert!(contrast > plain, "contrast {contrast} vs object edges {plain}");
+}
