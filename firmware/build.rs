@@ -31,12 +31,13 @@ fn main() {
     let names = env::var("FIRMWARE_SCENES").unwrap_or_else(|_| DEFAULT_SCENES.to_string());
     let mut list = String::new();
     let (mut objects, mut groups, mut grids, mut coords, mut cells, mut refs) = (1, 0, 1, 1, 1, 1);
+    let mut effects = 0u8;
     for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));
         println!("cargo:rerun-if-changed={}", path.display());
         let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
         let feature = |f: &str| env::var_os(format!("CARGO_FEATURE_{f}")).is_some();
-        let (n, g, s) = if feature("SCALAR_FIXED") {
+        let (n, g, s, e) = if feature("SCALAR_FIXED") {
             plan::<lattice_rt::Fx>(&path, &text)
         } else if feature("SCALAR_MICROMATH") {
             plan::<lattice_rt::F32Micro>(&path, &text)
@@ -45,6 +46,7 @@ fn main() {
         } else {
             plan::<f32>(&path, &text)
         };
+        effects |= e;
         objects = objects.max(n);
         groups = groups.max(g);
         grids = grids.max(s.grids);
@@ -55,6 +57,9 @@ fn main() {
         writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
     }
     let count = list.lines().count();
+    if env::var_os("CARGO_FEATURE_EFFECTS_ALL").is_some() {
+        effects = lattice_rt::Effects::ALL;
+    }
     let code = format!(
         "/// The scenes embedded in this build (`FIRMWARE_SCENES`).\n\
          pub const SCENES: [(&str, &str); {count}] = [\n{list}];\n\
@@ -63,14 +68,16 @@ fn main() {
          /// Most lattices (world + composites).\npub const MAX_GRIDS: usize = {grids};\n\
          /// Coordinate-list entries.\npub const MAX_COORDS: usize = {coords};\n\
          /// Cell entries (cells + 1).\npub const MAX_CELLS: usize = {cells};\n\
-         /// Cell references.\npub const MAX_REFS: usize = {refs};\n"
+         /// Cell references.\npub const MAX_REFS: usize = {refs};\n\
+         /// Effects compiled in: those the embedded scenes call for (`Effects` bits).\npub const EFFECTS: u8 = {effects};\n"
     );
     fs::write(out.join("capacities.rs"), code).unwrap();
 }
 
-/// Objects, composites and lattice storage of one scene in the firmware's scalar.
-fn plan<R: Real>(path: &std::path::Path, text: &str) -> (usize, usize, LatticeSizes) {
+/// Objects, composites, lattice storage and effects of one scene in the firmware's scalar.
+fn plan<R: Real>(path: &std::path::Path, text: &str) -> (usize, usize, LatticeSizes, u8) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
     let scene = lattice_rt::parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    (scene.objects.len(), scene.groups.len(), Lattice::plan(&scene, &LatticeConfig::default()))
+    let effects = lattice_rt::Effects::of(&scene).0;
+    (scene.objects.len(), scene.groups.len(), Lattice::plan(&scene, &LatticeConfig::default()), effects)
 }

@@ -5,7 +5,7 @@
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{ordered, Carry, Dither, LEVELS, MAX_TILE};
 use crate::scalar::Real;
-use crate::trace::{Tracer, NO_OBJECT};
+use crate::trace::{Effects, Tracer, NO_OBJECT};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
@@ -86,6 +86,8 @@ pub enum RenderError<E> {
     Cancelled,
     /// The tile size is 0, above [`MAX_TILE`], or not a multiple of the pattern block.
     BadTile,
+    /// The frame asks for an effect the tracer was compiled without.
+    NotCompiled(Effects),
     /// The scratch storage is smaller than [`Frame::scratch_len`].
     ScratchTooSmall {
         /// Entries needed.
@@ -101,6 +103,7 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
             RenderError::BadTile => {
                 write!(f, "tile side must be 1..={MAX_TILE} and a multiple of the pattern block")
             }
+            RenderError::NotCompiled(e) => write!(f, "this build leaves out {e}"),
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
@@ -134,8 +137,8 @@ pub fn level<R: Real>(v: R) -> u8 {
 /// `scratch` must hold [`Frame::scratch_len`] entries (it may be empty for Bayer or patterning
 /// with one ray per pixel).
 #[inline(never)]
-pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>>(
-    tracer: &Tracer<'_, '_, R, A>,
+pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+    tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     target: &mut D,
     mailbox: &mut [u32],
@@ -146,6 +149,9 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     let block = frame.dither.block() as usize;
     if t == 0 || t > MAX_TILE || t % block != 0 {
         return Err(RenderError::BadTile);
+    }
+    if frame.edges() && E & Effects::EDGE_AA == 0 {
+        return Err(RenderError::NotCompiled(Effects(Effects::EDGE_AA)));
     }
     let (w, h) = (frame.width as usize, frame.height as usize);
     let scratch = scratch.get_mut(..frame.scratch_len()).ok_or(RenderError::ScratchTooSmall { needed: frame.scratch_len() })?;
@@ -189,7 +195,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
                     }
                 }
             }
-            if frame.edges() {
+            if E & Effects::EDGE_AA != 0 && frame.edges() {
                 // A pixel is on an edge if its eye ray hit another object than a neighbour's:
                 // left and above come from the tiles already drawn, right and below from this
                 // tile; a pair split by a later tile's border is caught by that later pixel.

@@ -22,39 +22,101 @@ pub const NO_OBJECT: u16 = u16::MAX;
 /// Deepest intersection tree the tracer supports (eye ray = depth 0).
 pub const MAX_DEPTH: u8 = 8;
 
-/// Which ray kinds a render spawns (the scene's effect set, or a forced one).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Effects {
-    /// Shadow rays towards lights.
-    pub shadows: bool,
-    /// Mirror-reflection rays (`Ks > 0`).
-    pub reflection: bool,
-    /// Refraction rays (`Kt > 0`).
-    pub refraction: bool,
-}
+/// The effects a render simulates, as a bit set: the scene's own set ([`Effects::of`]), a
+/// forced one, and at compile time the set a [`Tracer`] is built with (its const parameter).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Effects(pub u8);
 
 impl Effects {
-    /// Every effect on.
-    pub const ALL: Effects = Effects { shadows: true, reflection: true, refraction: true };
+    /// Shadow rays towards lights.
+    pub const SHADOWS: u8 = 1;
+    /// Mirror-reflection rays (`Ks > 0`).
+    pub const REFLECTION: u8 = 2;
+    /// Refraction rays (`Kt > 0`).
+    pub const REFRACTION: u8 = 4;
+    /// Point lights (directional lights are always compiled in).
+    pub const POINT_LIGHTS: u8 = 8;
+    /// Composite objects, walked as sub-lattices.
+    pub const COMPOSITES: u8 = 16;
+    /// Extra eye rays at object edges ([`crate::render::Sampling::Edges`]).
+    pub const EDGE_AA: u8 = 32;
+    /// Every effect.
+    pub const ALL: u8 = 63;
+    /// Names of the bits, lowest first.
+    pub const NAMES: [&'static str; 6] = ["shadows", "reflection", "refraction", "point lights", "composites", "edge anti-aliasing"];
 
-    /// The effects a scene calls for: shadows if it has lights, reflection if any material has
-    /// `Ks > 0`, refraction if any has `Kt > 0`.
+    /// Whether every bit of `bits` is set.
+    pub const fn has(self, bits: u8) -> bool {
+        self.0 & bits == bits
+    }
+
+    /// The effects a scene calls for. Shadows need a light and at least two objects (every
+    /// primitive is convex, so a lone object never shadows itself); reflection needs a
+    /// material with `Ks > 0` on some object, refraction one with `Kt > 0`. Edge
+    /// anti-aliasing is never called for by a scene; a frame asks for it.
     pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
         let used = |f: fn(&crate::scene::Material<R>) -> R| {
             scene.objects.iter().any(|o| f(&scene.materials[o.material as usize]) > R::ZERO)
         };
-        Effects { shadows: !scene.lights.is_empty(), reflection: used(|m| m.ks), refraction: used(|m| m.kt) }
+        let mut e = 0;
+        if !scene.lights.is_empty() && scene.objects.len() > 1 {
+            e |= Self::SHADOWS;
+        }
+        if used(|m| m.ks) {
+            e |= Self::REFLECTION;
+        }
+        if used(|m| m.kt) {
+            e |= Self::REFRACTION;
+        }
+        if scene.lights.iter().any(|l| matches!(l, Light::Point { .. })) {
+            e |= Self::POINT_LIGHTS;
+        }
+        if !scene.groups.is_empty() {
+            e |= Self::COMPOSITES;
+        }
+        Effects(e)
     }
 }
 
+impl core::fmt::Display for Effects {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let mut first = true;
+        for (i, name) in Self::NAMES.iter().enumerate() {
+            if self.0 & (1 << i) != 0 {
+                write!(f, "{}{name}", if first { "" } else { ", " })?;
+                first = false;
+            }
+        }
+        if first {
+            write!(f, "diffuse only")?;
+        }
+        Ok(())
+    }
+}
+
+/// A scene needs effects the tracer was compiled without.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MissingEffects(pub Effects);
+
+impl core::fmt::Display for MissingEffects {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "the scene needs effects this build leaves out: {}", self.0)
+    }
+}
+
+impl core::error::Error for MissingEffects {}
+
 /// Traces rays through a scene with one accelerator.
+///
+/// `E` is the set of effects compiled in (an [`Effects`] bit set): code for the others is
+/// removed by the compiler, so firmware for a matte scene carries no mirror or glass code.
 #[derive(Debug)]
-pub struct Tracer<'s, 'a, R, A: ?Sized> {
+pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL }> {
     /// The scene.
     pub scene: &'s Scene<'a, R>,
     /// The accelerator answering ray queries.
     pub accel: &'s A,
-    /// Ray kinds to spawn.
+    /// Effects simulated at run time (within those compiled in): the scene's own by default.
     pub effects: Effects,
     /// Maximum depth of the intersection tree.
     pub max_depth: u8,
@@ -71,9 +133,28 @@ struct Node<R> {
 }
 
 impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
-    /// A tracer with the scene's own effect set and depth, and no cutoff.
+    /// A tracer with every effect compiled in, the scene's own effect set and depth, and no
+    /// cutoff.
     pub fn new(scene: &'s Scene<'a, R>, accel: &'s A) -> Self {
         Tracer { scene, accel, effects: Effects::of(scene), max_depth: scene.max_depth.min(MAX_DEPTH), cutoff: R::ZERO }
+    }
+}
+
+impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R, A, E> {
+    /// A tracer with only the effects `E` compiled in; fails if the scene needs others.
+    pub fn compiled(scene: &'s Scene<'a, R>, accel: &'s A) -> Result<Self, MissingEffects> {
+        let need = Effects::of(scene);
+        let missing = need.0 & !E;
+        if missing != 0 {
+            return Err(MissingEffects(Effects(missing)));
+        }
+        Ok(Tracer { scene, accel, effects: need, max_depth: scene.max_depth.min(MAX_DEPTH), cutoff: R::ZERO })
+    }
+
+    /// Whether an effect is both compiled in and switched on.
+    #[inline(always)]
+    pub fn simulates(&self, bit: u8) -> bool {
+        E & bit != 0 && self.effects.0 & bit != 0
     }
 
     /// Brightness (0 black .. 1 white, clamped) seen along an eye ray.
@@ -122,8 +203,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
             }
             let child = |ray, w: R, kind| Node { ray, weight: node.weight * w, depth: node.depth + 1, kind };
             let mirror = d + n * (cos_i + cos_i);
-            let mut reflect_w = if self.effects.reflection { m.ks } else { R::ZERO };
-            if self.effects.refraction && m.kt > R::ZERO {
+            let mut reflect_w = if self.simulates(Effects::REFLECTION) { m.ks } else { R::ZERO };
+            if self.simulates(Effects::REFRACTION) && m.kt > R::ZERO {
                 let eta = if entering { R::ONE / m.ior } else { m.ior };
                 let k = R::ONE - eta * eta * (R::ONE - cos_i * cos_i);
                 if k < R::ZERO {
@@ -147,17 +228,19 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
-            Light::Point { pos, intensity } => {
+            Light::Point { pos, intensity } if E & Effects::POINT_LIGHTS != 0 => {
                 let v = pos - from;
                 let dir = v.normalize();
                 (dir, v.dot(dir), intensity)
             }
+            // Not compiled in: `compiled` refused any scene that has one.
+            Light::Point { .. } => return R::ZERO,
         };
         let cos = to_light.dot(n);
         if cos <= R::ZERO {
             return R::ZERO;
         }
-        if self.effects.shadows {
+        if self.simulates(Effects::SHADOWS) {
             q.stats.rays[RayKind::Shadow as usize] += 1;
             if self.accel.occluded(self.scene, &Ray::new(from, to_light), R::ZERO, reach, q) {
                 return R::ZERO;

@@ -11,7 +11,8 @@ use lattice_rt::scene::{Object, MAX_GROUPS};
 // The composites of every embedded scene fit the core's fixed table (checked at compile time).
 const _: () = assert!(MAX_COMPOSITES <= MAX_GROUPS);
 use lattice_rt::render::Sampling;
-use lattice_rt::{parse, render, Dither, Frame, Lattice, LatticeConfig, Real, Stats, Tracer};
+use lattice_rt::trace::MissingEffects;
+use lattice_rt::{parse, render, Dither, Effects, Frame, Lattice, LatticeConfig, Real, Stats, Tracer};
 
 /// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).
 #[cfg(feature = "scalar-fixed")]
@@ -75,6 +76,8 @@ pub enum AppError<'t, E> {
     Parse(ParseError<'t>),
     /// The lattice exceeds a compiled capacity.
     Lattice(LatticeError),
+    /// The scene needs an effect this build leaves out.
+    Effects(MissingEffects),
     /// The display failed or the render was cancelled.
     Render(RenderError<E>),
 }
@@ -84,6 +87,7 @@ impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
         match self {
             AppError::Parse(e) => write!(f, "scene: {e}"),
             AppError::Lattice(e) => write!(f, "{e}"),
+            AppError::Effects(e) => write!(f, "{e}"),
             AppError::Render(e) => write!(f, "{e}"),
         }
     }
@@ -110,7 +114,10 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     let scene = parse::<R>(text, &mut st.objects).map_err(AppError::Parse)?;
     let storage = LatticeStorage { grids: &mut st.grids, coords: &mut st.coords, cells: &mut st.cells, refs: &mut st.refs };
     let lattice = Lattice::build(&scene, &LatticeConfig::default(), storage).map_err(AppError::Lattice)?;
-    let tracer = Tracer::new(&scene, &lattice);
+    let mut tracer = Tracer::<_, _, EFFECTS>::compiled(&scene, &lattice).map_err(AppError::Effects)?;
+    if cfg!(feature = "effects-all") {
+        tracer.effects = Effects(Effects::ALL);
+    }
     let stats = render(&tracer, &FRAME, target, &mut st.mailbox, &mut [], hooks).map_err(AppError::Render)?;
     Ok(Report { stats, objects: scene.objects.len(), lattice_bytes: lattice.bytes() })
 }

@@ -190,7 +190,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
         scene.lights.len(),
         scene.max_depth
     );
-    println!("  effects: shadows {}, reflection {}, refraction {}", fx.shadows, fx.reflection, fx.refraction);
+    println!("  effects: {fx}");
     for (i, g) in lattice.grids().iter().enumerate() {
         let name = if i == 0 { "world lattice".to_string() } else { format!("sub-lattice {}", i - 1) };
         println!("  {name}: {} x {} x {} cells", g.n[0], g.n[1], g.n[2]);
@@ -207,7 +207,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     // Primary rays only: the paper's per-ray figures.
     let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + '_>| {
         t.max_depth = 0;
-        t.effects = Effects { shadows: false, reflection: false, refraction: false };
+        t.effects = Effects(0);
     };
     println!("  per primary ray at {}x{} (eye rays only):", frame.width, frame.height);
     let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];

@@ -1,0 +1,89 @@
+//! The effect set a scene calls for, one test per effect (a scene with it and without it), and
+//! what the tracer does with it.
+
+mod common;
+use common::*;
+use lattice_rt::scene::Object;
+use lattice_rt::trace::MissingEffects;
+use lattice_rt::{parse, Effects, Frame, LatticeConfig, Tracer};
+
+fn effects_of(text: &str) -> Effects {
+    let mut storage = vec![Object::<f64>::default(); 64];
+    Effects::of(&parse::<f64>(text, &mut storage).unwrap())
+}
+
+const LIGHT: &str = "light directional dir 0 -1 0\n";
+const TWO: &str = "sphere\nbox min 2 0 0 max 3 1 1\n";
+
+#[test]
+fn shadows_need_a_light_and_two_objects() {
+    assert!(effects_of(&format!("{LIGHT}{TWO}")).has(Effects::SHADOWS));
+    assert!(!effects_of(TWO).has(Effects::SHADOWS), "no light");
+    assert!(!effects_of(&format!("{LIGHT}sphere\n")).has(Effects::SHADOWS), "a lone convex object cannot shadow itself");
+}
+
+#[test]
+fn reflection_needs_a_mirror_material_in_use() {
+    assert!(effects_of(&format!("material m ks 0.5\nsphere material m\n{TWO}")).has(Effects::REFLECTION));
+    // Objects without a material get the first one defined, so the mirror comes second here.
+    assert!(!effects_of(&format!("material plain\nmaterial m ks 0.5\n{TWO}")).has(Effects::REFLECTION), "defined but unused");
+    assert!(!effects_of(TWO).has(Effects::REFLECTION));
+}
+
+#[test]
+fn refraction_needs_a_transparent_material_in_use() {
+    assert!(effects_of(&format!("material g kt 0.8 ior 1.5\nsphere material g\n")).has(Effects::REFRACTION));
+    assert!(!effects_of(&format!("material g kt 0\nsphere material g\n")).has(Effects::REFRACTION));
+}
+
+#[test]
+fn point_lights_are_their_own_effect() {
+    assert!(effects_of(&format!("light point pos 0 5 0\n{TWO}")).has(Effects::POINT_LIGHTS));
+    assert!(!effects_of(&format!("{LIGHT}{TWO}")).has(Effects::POINT_LIGHTS));
+}
+
+#[test]
+fn composites_are_their_own_effect() {
+    assert!(effects_of("group g\nsphere\nend\n").has(Effects::COMPOSITES));
+    assert!(!effects_of(TWO).has(Effects::COMPOSITES));
+}
+
+#[test]
+fn the_paper_scenes_call_for_what_they_show() {
+    let of = |s: &str| effects_of(&scene_text(s)).to_string();
+    assert_eq!(of("chair"), "shadows, composites");
+    assert_eq!(of("spheres"), "shadows, reflection");
+    assert_eq!(of("whitted"), "shadows, reflection, refraction");
+}
+
+#[test]
+fn a_tracer_without_refraction_refuses_glass() {
+    let text = scene_text("whitted");
+    let mut storage = vec![Object::<f64>::default(); 64];
+    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &mut bufs);
+    const MATTE: u8 = Effects::SHADOWS | Effects::COMPOSITES;
+    let err = Tracer::<_, _, MATTE>::compiled(&scene, &lat).unwrap_err();
+    assert_eq!(err, MissingEffects(Effects(Effects::REFLECTION | Effects::REFRACTION)));
+    assert_eq!(err.to_string(), "the scene needs effects this build leaves out: reflection, refraction");
+}
+
+#[test]
+fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
+    for s in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
+        let text = scene_text(s);
+        let mut storage = vec![Object::<f64>::default(); 64];
+        let scene = parse::<f64>(&text, &mut storage).unwrap();
+        let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+        let lat = build_lattice(&scene, &mut bufs);
+        let frame = Frame::new(160, 100);
+        let derived = Tracer::new(&scene, &lat);
+        let mut all = Tracer::new(&scene, &lat);
+        all.effects = Effects(Effects::ALL);
+        let (a, sa) = render_tracer(&derived, &frame);
+        let (b, sb) = render_tracer(&all, &frame);
+        assert!(a == b, "{s}: forcing all effects changed the image");
+        assert!(sa.total_rays() <= sb.total_rays(), "{s}");
+    }
+}
