@@ -194,7 +194,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let mut local = scene.ambient * m.ka;
             if m.kd > R::ZERO {
                 for light in scene.lights.iter() {
-                    local += self.direct(light, outside, n, m.kd, q);
+                    local += self.direct(light, outside, n, m.kd, node.weight, q);
                 }
             }
             total += node.weight * local;
@@ -223,8 +223,10 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     }
 
     /// `Ip * Kd * max(0, L.N)` for one light, or zero if the light is behind the surface or
-    /// (with shadows on) blocked.
-    fn direct(&self, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, q: &mut Query<'_>) -> R {
+    /// (with shadows on) blocked. When the term, times the weight of the node, is below the
+    /// cutoff, the shadow ray is not traced and the light counts as visible: either answer is
+    /// within the cutoff of the other.
+    fn direct(&self, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, weight: R, q: &mut Query<'_>) -> R {
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
@@ -240,12 +242,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         if cos <= R::ZERO {
             return R::ZERO;
         }
-        if self.simulates(Effects::SHADOWS) {
+        let term = ip * kd * cos;
+        if self.simulates(Effects::SHADOWS) && weight * term >= self.cutoff {
             q.stats.rays[RayKind::Shadow as usize] += 1;
             if self.accel.occluded(self.scene, &Ray::new(from, to_light), R::ZERO, reach, q) {
                 return R::ZERO;
             }
         }
-        ip * kd * cos
+        term
     }
 }

@@ -87,3 +87,22 @@ fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
         assert!(sa.total_rays() <= sb.total_rays(), "{s}");
     }
 }
+
+#[test]
+fn a_one_level_cutoff_prunes_the_whitted_tree_and_barely_changes_the_frame() {
+    let text = scene_text("whitted");
+    let mut storage = vec![Object::<f64>::default(); 64];
+    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &mut bufs);
+    let frame = Frame::new(128, 64);
+    let exact = Tracer::new(&scene, &lat);
+    let mut pruned = Tracer::new(&scene, &lat);
+    pruned.cutoff = 1.0 / 64.0;
+    let (a, sa) = render_tracer(&exact, &frame);
+    let (b, sb) = render_tracer(&pruned, &frame);
+    let fewer = 1.0 - sb.total_rays() as f64 / sa.total_rays() as f64;
+    let changed: u32 = a.iter().zip(&b).map(|(x, y)| (x ^ y).count_ones()).sum();
+    assert!(fewer >= 0.30, "only {:.1} % fewer rays", 100.0 * fewer);
+    assert!(changed as f64 <= 0.001 * 128.0 * 64.0, "{changed} pixels changed");
+}

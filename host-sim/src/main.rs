@@ -1,6 +1,7 @@
 //! host-sim: the desktop driver of the lattice-rt core. Renders scenes to PNG/PBM/PGM, prints
 //! statistics, and (with no arguments) renders the paper's four scenes into `out/`.
 
+mod effects;
 mod firmware;
 mod load;
 mod output;
@@ -59,6 +60,21 @@ enum Command {
         #[arg(long, default_value = "docs/accuracy.png")]
         plot: PathBuf,
         /// Instruction counts written by `host-sim firmware`.
+        #[arg(long, default_value = "docs/firmware.csv")]
+        firmware_csv: PathBuf,
+    },
+    /// What simulating only the effects a scene calls for saves (rays, time, instructions,
+    /// flash), and what the contribution cutoff saves and changes.
+    Effects {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Timed runs per configuration (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/effects.md")]
+        out: PathBuf,
+        /// Instruction counts and flash sizes written by `host-sim firmware`.
         #[arg(long, default_value = "docs/firmware.csv")]
         firmware_csv: PathBuf,
     },
@@ -243,6 +259,15 @@ pub struct StatsArgs {
     pub cells: Option<[u16; 3]>,
 }
 
+/// The scenes given, or the paper's four and the Whitted showcase.
+fn default_scenes(scenes: Vec<PathBuf>) -> Vec<PathBuf> {
+    if scenes.is_empty() {
+        ["chair", "desk", "polyhedron", "spheres", "whitted"].iter().map(|n| PathBuf::from(format!("scenes/{n}.scene"))).collect()
+    } else {
+        scenes
+    }
+}
+
 fn main() {
     if let Err(e) = real_main() {
         eprintln!("error: {e:#}");
@@ -266,13 +291,9 @@ fn real_main() -> Result<()> {
             }
         }
         Some(Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv }) => {
-            let scenes = if scenes.is_empty() {
-                ["chair", "desk", "polyhedron", "spheres", "whitted"].iter().map(|n| PathBuf::from(format!("scenes/{n}.scene"))).collect()
-            } else {
-                scenes
-            };
-            tradeoff::tradeoff_cmd(&scenes, size, runs, &out, &plot, &firmware_csv)
+            tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv)
         }
+        Some(Command::Effects { scenes, runs, out, firmware_csv }) => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
         Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),

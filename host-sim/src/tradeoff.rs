@@ -233,7 +233,9 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
     let mut instr_complete = true;
     for line in csv.lines().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
-        if f.len() >= 4 && names.contains(&f[0].to_string()) && w == 128 && h == 64 {
+        // Only the plain build of each scalar and board (not the effect-study variants).
+        let plain = f.get(5).is_some_and(|v| *v == format!("qemu-{}-{}", f[2], f[1]));
+        if plain && names.contains(&f[0].to_string()) && w == 128 && h == 64 {
             *instr.entry((f[1].to_string(), f[2].to_string())).or_default() += f[3].parse::<u64>().unwrap_or(0);
         }
     }

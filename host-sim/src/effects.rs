@@ -1,0 +1,128 @@
+//! `host-sim effects`: what simulating only the effects a scene calls for saves, in rays, host
+//! time, Cortex-M instructions and flash, and what the contribution cutoff (Hall and
+//! Greenberg's adaptive tree depth) saves and costs. Writes `docs/effects.md`.
+
+use crate::load::{object_storage, parse_scene, read, LatticeBufs};
+use crate::run::render_with;
+use anyhow::{Context, Result};
+use lattice_rt::{Effects, Frame, LatticeConfig, Stats, Tracer};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+struct Shot {
+    bits: Vec<u8>,
+    stats: Stats,
+    time: Duration,
+}
+
+fn shoot(path: &Path, text: &str, all: bool, cutoff: f64) -> Result<Shot> {
+    let mut storage = object_storage::<f64>(text);
+    let scene = parse_scene::<f64>(path, text, &mut storage)?;
+    let cfg = LatticeConfig::default();
+    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+    let lattice = bufs.build(&scene, &cfg)?;
+    let mut tracer = Tracer::new(&scene, &lattice);
+    if all {
+        tracer.effects = Effects(Effects::ALL);
+    }
+    tracer.cutoff = cutoff;
+    let r = render_with(&tracer, &Frame::new(128, 64), false)?;
+    Ok(Shot { bits: r.bits, stats: r.stats, time: r.elapsed })
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+fn differ(a: &[u8], b: &[u8]) -> u32 {
+    a.iter().zip(b).map(|(x, y)| (x ^ y).count_ones()).sum()
+}
+
+fn kinds(s: &Stats) -> String {
+    format!("{} / {} / {} / {}", s.rays[0], s.rays[1], s.rays[2], s.rays[3])
+}
+
+/// The command.
+pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &Path) -> Result<()> {
+    let csv = std::fs::read_to_string(firmware_csv).unwrap_or_default();
+    // (variant, scene) -> (instructions, flash)
+    let mut fw: BTreeMap<(String, String), (u64, u64)> = BTreeMap::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() >= 7 {
+            fw.insert((f[5].to_string(), f[0].to_string()), (f[3].parse().unwrap_or(0), f[6].parse().unwrap_or(0)));
+        }
+    }
+    let mut md = String::new();
+    writeln!(md, "# Simulating only the effects a scene calls for\n")?;
+    writeln!(md, "Written by `cargo run --release -p host-sim -- effects` (128x64, f64 on the host, median of {} interleaved\nruns; Cortex-M figures from `docs/firmware.csv`, written by `host-sim firmware`: QEMU `-icount\nshift=0`, fixed point, Cortex-M0+ build).\n", runs.max(1))?;
+    writeln!(md, "## Derived effect set against every effect forced on\n\nRays are primary / shadow / reflection / refraction. \"All\" forces every effect on at run time\n(and, on the Cortex-M, compiles every effect in).\n")?;
+    writeln!(md, "| scene | effect set | rays, derived | rays, all | host ms derived | host ms all | all / derived | same image | M0 Minstr derived | M0 Minstr all |\n|---|---|---|---|---|---|---|---|---|---|")?;
+    let mut cut_rows = Vec::new();
+    for path in scenes {
+        let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+        let text = read(path)?;
+        let mut storage = object_storage::<f64>(&text);
+        let fx = Effects::of(&parse_scene::<f64>(path, &text, &mut storage)?);
+        let (mut td, mut ta) = (Vec::new(), Vec::new());
+        let (mut d, mut a) = (None, None);
+        for _ in 0..runs.max(1) {
+            let x = shoot(path, &text, false, 0.0)?;
+            td.push(x.time);
+            d = Some(x);
+            let y = shoot(path, &text, true, 0.0)?;
+            ta.push(y.time);
+            a = Some(y);
+        }
+        let (d, a) = (d.expect("ran"), a.expect("ran"));
+        let (md_, ma) = (median(td), median(ta));
+        let ins = |v: &str| fw.get(&(v.to_string(), name.clone())).map_or("-".to_string(), |x| format!("{:.1}", x.0 as f64 / 1e6));
+        writeln!(
+            md,
+            "| {name} | {fx} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {} | {} |",
+            kinds(&d.stats),
+            kinds(&a.stats),
+            md_.as_secs_f64() * 1e3,
+            ma.as_secs_f64() * 1e3,
+            ma.as_secs_f64() / md_.as_secs_f64(),
+            if d.bits == a.bits { "yes" } else { "NO" },
+            ins("qemu-m0-fixed"),
+            ins("qemu-m0-fixed-allfx")
+        )?;
+        let mut row = (name.clone(), d.stats.total_rays(), Vec::new());
+        for c in [1.0 / 128.0, 1.0 / 64.0] {
+            let s = shoot(path, &text, false, c)?;
+            row.2.push((c, s.stats.total_rays(), differ(&s.bits, &d.bits)));
+        }
+        cut_rows.push(row);
+    }
+    writeln!(md, "\n## Contribution cutoff\n\nA branch of the intersection tree is not traced when its weight (the product of `Ks`/`Kt`\nalong the path) is below the cutoff; 1/64 is one of the 65 gray levels, 1/128 half of one.\nPixels are those of the 1-bit frame that differ from the frame without cutoff.\n")?;
+    writeln!(md, "| scene | rays, no cutoff | rays, 1/128 | fewer | px changed | rays, 1/64 | fewer | px changed |\n|---|---|---|---|---|---|---|---|")?;
+    let npx = 128.0 * 64.0;
+    for (name, base, cuts) in &cut_rows {
+        let mut row = format!("| {name} | {base} |");
+        for (_, rays, px) in cuts {
+            write!(row, " {rays} | {:.1} % | {px} ({:.2} %) |", 100.0 * (1.0 - *rays as f64 / *base as f64), 100.0 * *px as f64 / npx)?;
+        }
+        writeln!(md, "{row}")?;
+    }
+    writeln!(md, "\n## Flash: code for effects a scene does not need\n\nThe same scenes built with the effects they call for and with every effect compiled in\n(`firmware/build.rs` derives the set from the embedded scenes; a const parameter of the tracer\nremoves the rest).\n")?;
+    writeln!(md, "| scenes | derived effects | flash bytes, derived | flash bytes, every effect | saved |\n|---|---|---|---|---|")?;
+    for (label, derived, all, fx) in [
+        ("chair, desk, polyhedron (matte)", "qemu-m0-fixed-matte", "qemu-m0-fixed-matte-allfx", "shadows, composites"),
+        ("all five", "qemu-m0-fixed", "qemu-m0-fixed-allfx", "shadows, reflection, refraction, composites"),
+    ] {
+        let flash = |v: &str| fw.iter().find(|((var, _), _)| var == v).map(|(_, x)| x.1);
+        match (flash(derived), flash(all)) {
+            (Some(d), Some(a)) => writeln!(md, "| {label} | {fx} | {d} | {a} | {} bytes ({:.1} %) |", a as i64 - d as i64, 100.0 * (1.0 - d as f64 / a as f64))?,
+            _ => writeln!(md, "| {label} | {fx} | - | - | (run `host-sim firmware` first) |")?,
+        }
+    }
+    std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
+    std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
