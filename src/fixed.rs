@@ -174,7 +174,7 @@ impl Real for Fx {
         Fx(r as i32)
     }
     fn offset_eps() -> Self {
-        Fx(1 << 6) // 2^-10
+        Fx(1 << 3) // 2^-13
     }
     fn pad_eps() -> Self {
         Fx(1 << 6)

@@ -100,7 +100,7 @@ impl Real for f64 {
         libm::sqrt(self)
     }
     fn offset_eps() -> Self {
-        1e-9
+        1e-10
     }
     fn pad_eps() -> Self {
         1e-9
@@ -130,7 +130,7 @@ impl Real for f32 {
         libm::sqrtf(self)
     }
     fn offset_eps() -> Self {
-        1e-4
+        1e-5
     }
     fn pad_eps() -> Self {
         2e-5

@@ -7,8 +7,10 @@
 //! (depth-first, each node pushes at most two children).
 //!
 //! Secondary rays start at `p + n * eps` on the side they travel to, with `n` the normal
-//! flipped to face the incoming ray and `eps = offset_eps * (1 + max|p|)`: scale-aware, so the
-//! offset stays above the rounding error of `p` wherever the scene sits.
+//! flipped to face the incoming ray and `eps = offset_eps * (max|p| + extent of the world)`:
+//! above the rounding error of `p` wherever the scene sits (the `max|p|` term), never zero at
+//! the origin (the extent term), and exactly proportional to the scene when it is scaled by a
+//! power of two, so such a scaling leaves a floating-point image bit for bit the same.
 
 use crate::accel::{Accelerator, Query, RayKind};
 use crate::math::{Ray, Vec3};
@@ -122,6 +124,8 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL }> {
     pub max_depth: u8,
     /// Branches whose weight falls below this are not traced (0 traces everything).
     pub cutoff: R,
+    /// Extent of the world box, the scale term of the self-intersection offset.
+    scale: R,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -136,7 +140,14 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
     /// A tracer with every effect compiled in, the scene's own effect set and depth, and no
     /// cutoff.
     pub fn new(scene: &'s Scene<'a, R>, accel: &'s A) -> Self {
-        Tracer { scene, accel, effects: Effects::of(scene), max_depth: scene.max_depth.min(MAX_DEPTH), cutoff: R::ZERO }
+        Tracer {
+            scene,
+            accel,
+            effects: Effects::of(scene),
+            max_depth: scene.max_depth.min(MAX_DEPTH),
+            cutoff: R::ZERO,
+            scale: scene.world.extent(),
+        }
     }
 }
 
@@ -148,7 +159,14 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         if missing != 0 {
             return Err(MissingEffects(Effects(missing)));
         }
-        Ok(Tracer { scene, accel, effects: need, max_depth: scene.max_depth.min(MAX_DEPTH), cutoff: R::ZERO })
+        Ok(Tracer {
+            scene,
+            accel,
+            effects: need,
+            max_depth: scene.max_depth.min(MAX_DEPTH),
+            cutoff: R::ZERO,
+            scale: scene.world.extent(),
+        })
     }
 
     /// Whether an effect is both compiled in and switched on.
@@ -189,7 +207,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 n = -n;
             }
             let cos_i = cos_i.abs();
-            let eps = R::offset_eps() * (R::ONE + p.max_abs());
+            let eps = R::offset_eps() * (p.max_abs() + self.scale);
             let outside = p + n * eps;
             let mut local = scene.ambient * m.ka;
             if m.kd > R::ZERO {
