@@ -179,6 +179,11 @@ impl Real for Fx {
     fn pad_eps() -> Self {
         Fx(1 << 6)
     }
+    /// Fixed point has the same absolute precision everywhere, so the offset depends on the
+    /// size of the scene only, not on where the point lies.
+    fn offset(_p_max: Self, extent: Self) -> Self {
+        Self::offset_eps() * extent
+    }
     fn is_finite(self) -> bool {
         true
     }

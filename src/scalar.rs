@@ -70,9 +70,14 @@ pub trait Real:
             self
         }
     }
-    /// Relative epsilon for offsetting secondary-ray origins off a surface: the offset is
-    /// `OFFSET * (1 + |p|_max)` along the normal (see `trace`).
+    /// Relative epsilon for offsetting secondary-ray origins off a surface (see [`Real::offset`]).
     fn offset_eps() -> Self;
+    /// How far a secondary ray starts off the surface at a point whose largest coordinate is
+    /// `p_max`, in a world of extent `extent`. Floating point loses absolute precision as
+    /// coordinates grow, so the default grows with `p_max` too; fixed point overrides it.
+    fn offset(p_max: Self, extent: Self) -> Self {
+        Self::offset_eps() * (p_max + extent)
+    }
     /// Relative padding of bounding boxes registered in lattice cells, so that rounding in
     /// an object test can never put a hit outside the cells the object is listed in.
     fn pad_eps() -> Self;
@@ -130,7 +135,7 @@ impl Real for f32 {
         libm::sqrtf(self)
     }
     fn offset_eps() -> Self {
-        1e-5
+        3e-6
     }
     fn pad_eps() -> Self {
         2e-5

@@ -113,16 +113,26 @@ impl<R: Real> Camera<R> {
 pub struct Object<R> {
     /// The canonical primitive.
     pub shape: Shape<R>,
-    /// World-to-object transform (the inverse of the placement).
+    /// World-to-object transform (the inverse of the placement) multiplied by the power of two
+    /// `1 / unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
+    /// full precision however large or small the object is (exact in floating point).
     pub to_object: Affine<R>,
+    /// The world point at the object's origin: rays are taken relative to it before
+    /// `to_object` (whose translation is then zero), so a scene far from the world's origin
+    /// loses no precision to cancellation.
+    pub origin: Vec3<R>,
+    /// The power of two that `to_object`'s results are multiplied by to get object space.
+    pub unscale: R,
+    /// `unscale * dir_scale`: what `to_object`'s direction results are multiplied by.
+    pub dir_factor: R,
     /// Index into the scene's materials.
     pub material: u8,
     /// Composite object it belongs to, or [`NO_GROUP`].
     pub group: u16,
     /// World-space bounding box, padded for the scalar's rounding.
     pub bounds: Aabb<R>,
-    /// A power of two (at most 1) that object-space directions are multiplied by, so that
-    /// they stay near unit length however small the object is (exact in floating point).
+    /// A power of two that object-space directions are multiplied by, so that they stay near
+    /// unit length however small or large the object is (exact in floating point).
     pub dir_scale: R,
     /// `1 / dir_scale`.
     pub inv_dir_scale: R,
@@ -135,6 +145,9 @@ impl<R: Real> Default for Object<R> {
         Object {
             shape: Shape::Sphere,
             to_object: Affine::identity(),
+            origin: z,
+            unscale: R::ONE,
+            dir_factor: R::ONE,
             material: 0,
             group: NO_GROUP,
             bounds: Aabb { min: z, max: z },
@@ -148,8 +161,10 @@ impl<R: Real> Object<R> {
     /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` and the object-space normal.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
-        let mut r = self.to_object.ray(ray);
-        r.dir = r.dir * self.dir_scale;
+        let r = Ray::new(
+            self.to_object.vector(ray.origin - self.origin) * self.unscale,
+            self.to_object.vector(ray.dir) * self.dir_factor,
+        );
         // With the direction scaled by k, the object-space parameter is t / k.
         let far = if tmax == R::MAX { R::MAX } else { tmax * self.inv_dir_scale };
         self.shape
@@ -454,11 +469,20 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         };
         // Largest stretch of a direction into object space, rounded up to a power of two.
         let m = &inv.m;
-        let stretch = (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(1.0, f64::max);
-        let dir_scale = libm::exp2(-libm::ceil(libm::log2(stretch)));
+        let stretch = (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(0.0, f64::max);
+        let dir_scale = 1.0 / pow2_at_least(stretch);
+        let largest = m.iter().flat_map(|r| r[..3].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
+        let unscale = pow2_at_least(largest);
+        let mut scaled = inv;
+        scaled.m.iter_mut().flatten().for_each(|v| *v /= unscale);
+        scaled.m.iter_mut().for_each(|row| row[3] = 0.0);
+        let origin = Vec3::new(place.m[0][3], place.m[1][3], place.m[2][3]);
         self.storage[self.len] = Object {
             shape,
-            to_object: inv.cast(),
+            to_object: scaled.cast(),
+            origin: origin.cast(),
+            unscale: R::from_f64(unscale),
+            dir_factor: R::from_f64(unscale * dir_scale),
             material,
             group,
             bounds: bounds.cast_padded(),
@@ -510,6 +534,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         // coordinates never exceed those of the world box's corners in its space.
         for (i, o) in objects.iter().enumerate() {
             let inv = o.to_object.cast::<f64>();
+            let unscale = o.unscale.to_f64();
             let reach = (0..8)
                 .map(|c| {
                     let p = Vec3::new(
@@ -517,7 +542,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
                         if c & 2 == 0 { world.min.y } else { world.max.y },
                         if c & 4 == 0 { world.min.z } else { world.max.z },
                     );
-                    inv.point(p.cast()).max_abs()
+                    (inv.vector(p.cast() - o.origin.cast()) * unscale).max_abs()
                 })
                 .fold(0.0, f64::max);
             if reach >= R::LIMIT {
@@ -536,6 +561,19 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             world,
         })
     }
+}
+
+/// The smallest power of two at or above `x > 0` (without `log2`/`exp2`, which would bring
+/// libm's 4 KB table into the firmware).
+fn pow2_at_least(x: f64) -> f64 {
+    let mut p = 1.0;
+    while p < x {
+        p *= 2.0;
+    }
+    while p * 0.5 >= x {
+        p *= 0.5;
+    }
+    p
 }
 
 trait ToRadians {

@@ -7,10 +7,12 @@
 //! (depth-first, each node pushes at most two children).
 //!
 //! Secondary rays start at `p + n * eps` on the side they travel to, with `n` the normal
-//! flipped to face the incoming ray and `eps = offset_eps * (max|p| + extent of the world)`:
-//! above the rounding error of `p` wherever the scene sits (the `max|p|` term), never zero at
-//! the origin (the extent term), and exactly proportional to the scene when it is scaled by a
-//! power of two, so such a scaling leaves a floating-point image bit for bit the same.
+//! flipped to face the incoming ray and `eps = Real::offset(max|p|, extent of the world)`. In
+//! floating point that is `offset_eps * (max|p| + extent)`: above the rounding error of `p`
+//! wherever the scene sits (the `max|p|` term), never zero at the origin (the extent term), and
+//! exactly proportional to the scene when it is scaled by a power of two, so such a scaling
+//! leaves the image bit for bit the same. Fixed point, whose absolute precision is the same
+//! everywhere, uses `offset_eps * extent`.
 
 use crate::accel::{Accelerator, Query, RayKind};
 use crate::math::{Ray, Vec3};
@@ -108,6 +110,31 @@ impl core::fmt::Display for MissingEffects {
 
 impl core::error::Error for MissingEffects {}
 
+/// The side of a surface a ray meets: the normal turned to face the ray, the ratio of indices
+/// `eta = n_from / n_to` for a material of index `ior` in air, and whether the ray enters.
+/// A ray from inside (its direction along the outward normal) gets the flipped normal and the
+/// swapped ratio `ior / 1`.
+pub fn facing<R: Real>(d: Vec3<R>, outward: Vec3<R>, ior: R) -> (Vec3<R>, R, bool) {
+    if d.dot(outward) <= R::ZERO {
+        (outward, R::ONE / ior, true)
+    } else {
+        (-outward, ior, false)
+    }
+}
+
+/// Snell's law: the unit direction refracted from unit `d` at a surface with unit normal `n`
+/// facing the ray, for the ratio of indices `eta`; `None` past the critical angle (total
+/// internal reflection).
+pub fn refract<R: Real>(d: Vec3<R>, n: Vec3<R>, eta: R) -> Option<Vec3<R>> {
+    let cos_i = -d.dot(n);
+    let k = R::ONE - eta * eta * (R::ONE - cos_i * cos_i);
+    if k < R::ZERO {
+        None
+    } else {
+        Some(d * eta + n * (eta * cos_i - k.sqrt()))
+    }
+}
+
 /// Traces rays through a scene with one accelerator.
 ///
 /// `E` is the set of effects compiled in (an [`Effects`] bit set): code for the others is
@@ -200,14 +227,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let m = scene.materials[obj.material as usize];
             let p = node.ray.at(hit.t);
             let d = node.ray.dir.normalize();
-            let mut n = obj.world_normal(hit.normal);
+            let (n, eta, _) = facing(d, obj.world_normal(hit.normal), m.ior);
             let cos_i = -d.dot(n);
-            let entering = cos_i >= R::ZERO;
-            if !entering {
-                n = -n;
-            }
-            let cos_i = cos_i.abs();
-            let eps = R::offset_eps() * (p.max_abs() + self.scale);
+            let eps = R::offset(p.max_abs(), self.scale);
             let outside = p + n * eps;
             let mut local = scene.ambient * m.ka;
             if m.kd > R::ZERO {
@@ -223,14 +245,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let mirror = d + n * (cos_i + cos_i);
             let mut reflect_w = if self.simulates(Effects::REFLECTION) { m.ks } else { R::ZERO };
             if self.simulates(Effects::REFRACTION) && m.kt > R::ZERO {
-                let eta = if entering { R::ONE / m.ior } else { m.ior };
-                let k = R::ONE - eta * eta * (R::ONE - cos_i * cos_i);
-                if k < R::ZERO {
+                match refract(d, n, eta) {
                     // Total internal reflection: the transmitted share is reflected.
-                    reflect_w += m.kt;
-                } else if node.weight * m.kt > self.cutoff {
-                    let dir = d * eta + n * (eta * cos_i - k.sqrt());
-                    let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction));
+                    None => reflect_w += m.kt,
+                    Some(dir) if node.weight * m.kt > self.cutoff => {
+                        let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction));
+                    }
+                    Some(_) => {}
                 }
             }
             if reflect_w > R::ZERO && node.weight * reflect_w > self.cutoff {

@@ -100,3 +100,25 @@ pub fn assert_golden(name: &str, pbm: &[u8]) {
     };
     panic!("{name}: image differs from {golden} in {differing} pixels; actual: {actual}, diff (black = differs): {diff}");
 }
+
+/// Gray levels (0..=64) of a frame rendered with a tracer.
+pub fn gray_of<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, A>, frame: &Frame) -> Vec<u8> {
+    struct G(Vec<u8>, usize);
+    impl lattice_rt::Hooks for G {
+        fn gray_tile(&mut self, x: u16, y: u16, w: u16, h: u16, levels: &[u8]) {
+            for r in 0..h as usize {
+                for c in 0..w as usize {
+                    self.0[(y as usize + r) * self.1 + x as usize + c] = levels[r * w as usize + c];
+                }
+            }
+        }
+    }
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
+    let mut target = BitFrame::new(w as u32, h as u32, &mut bits).unwrap();
+    let mut mb = vec![0u32; Query::mailbox_len(t.scene)];
+    let mut scratch = vec![0i16; frame.scratch_len()];
+    let mut g = G(vec![0; w * h], w);
+    render(t, frame, &mut target, &mut mb, &mut scratch, &mut g).expect("render");
+    g.0
+}
