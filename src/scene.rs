@@ -165,11 +165,13 @@ impl<R: Real> Object<R> {
             self.to_object.vector(ray.origin - self.origin) * self.unscale,
             self.to_object.vector(ray.dir) * self.dir_factor,
         );
-        // With the direction scaled by k, the object-space parameter is t / k.
-        let far = if tmax == R::MAX { R::MAX } else { tmax * self.inv_dir_scale };
-        self.shape
-            .intersect(&r, tmin * self.inv_dir_scale, far)
-            .map(|(t, n)| (t * self.dir_scale, n))
+        // With the direction scaled by k, the object-space parameter is t / k. Multiplying by
+        // a power of two is exact in floating point but rounds in fixed point, so the range is
+        // checked on the world parameter: a hit exactly at `tmax` (a tie with the best hit so
+        // far) is then found whichever scalar runs.
+        let (t, n) = self.shape.intersect(&r, tmin * self.inv_dir_scale, R::MAX)?;
+        let t = t * self.dir_scale;
+        (t > tmin && t <= tmax).then_some((t, n))
     }
     /// Unit world-space normal from an object-space normal (inverse-transpose rule).
     pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
