@@ -46,6 +46,16 @@ pub enum Resolution {
     Uniform([u16; 3]),
 }
 
+/// Where the planes of a coordinate list go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spacing {
+    /// Equal cells.
+    Uniform,
+    /// The paper's free coordinate lists `X(), Y(), Z()`: planes at quantiles of the items'
+    /// box centres along each axis, so crowded regions get narrow cells and empty ones wide.
+    Adaptive,
+}
+
 /// Choices for building a lattice.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LatticeConfig {
@@ -55,13 +65,27 @@ pub struct LatticeConfig {
     pub sub: Resolution,
     /// Upper bound on cells per axis for [`Resolution::Auto`].
     pub max_per_axis: u16,
+    /// Where the planes go.
+    pub spacing: Spacing,
+    /// Whether composites get sub-lattices (the paper's hierarchy); if not, their primitives
+    /// are listed in the world lattice like any other (a flat lattice).
+    pub nested: bool,
 }
 
 impl Default for LatticeConfig {
     fn default() -> Self {
-        LatticeConfig { top: Resolution::Auto { density: 2.0 }, sub: Resolution::Auto { density: 2.0 }, max_per_axis: 64 }
+        LatticeConfig {
+            top: Resolution::Auto { density: 2.0 },
+            sub: Resolution::Auto { density: 2.0 },
+            max_per_axis: 64,
+            spacing: Spacing::Uniform,
+            nested: true,
+        }
     }
 }
+
+/// Most cells per axis of any lattice.
+pub const MAX_PER_AXIS: u16 = 1024;
 
 /// One lattice (the world's or a composite's sub-lattice) inside the shared storage.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -154,15 +178,17 @@ pub struct Lattice<'a, R> {
 
 /// The items one lattice holds: the world holds free objects and composites, a sub-lattice
 /// the objects of its composite.
-fn for_each_item<R: Real>(scene: &Scene<'_, R>, grid: usize, mut f: impl FnMut(u32, &Aabb<R>)) {
+fn for_each_item<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, grid: usize, mut f: impl FnMut(u32, &Aabb<R>)) {
     if grid == 0 {
         for (i, o) in scene.objects.iter().enumerate() {
-            if o.group == NO_GROUP {
+            if o.group == NO_GROUP || !cfg.nested {
                 f(i as u32, &o.bounds);
             }
         }
-        for (g, grp) in scene.groups.iter().enumerate() {
-            f(SUB_FLAG | g as u32, &grp.bounds);
+        if cfg.nested {
+            for (g, grp) in scene.groups.iter().enumerate() {
+                f(SUB_FLAG | g as u32, &grp.bounds);
+            }
         }
     } else {
         let grp = &scene.groups[grid - 1];
@@ -170,6 +196,13 @@ fn for_each_item<R: Real>(scene: &Scene<'_, R>, grid: usize, mut f: impl FnMut(u
             f(i as u32, &scene.objects[i].bounds);
         }
     }
+}
+
+/// Cells per axis of lattice `g`.
+fn grid_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>) -> [u16; 3] {
+    let mut items = 0;
+    for_each_item(scene, cfg, g, |_, _| items += 1);
+    resolution(b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis)
 }
 
 fn grid_bounds<R: Real>(scene: &Scene<'_, R>, grid: usize) -> Aabb<R> {
@@ -182,7 +215,7 @@ fn grid_bounds<R: Real>(scene: &Scene<'_, R>, grid: usize) -> Aabb<R> {
 
 fn resolution<R: Real>(b: &Aabb<R>, items: usize, res: Resolution, max_axis: u16) -> [u16; 3] {
     match res {
-        Resolution::Uniform(n) => n.map(|v| v.max(1)),
+        Resolution::Uniform(n) => n.map(|v| v.clamp(1, MAX_PER_AXIS)),
         Resolution::Auto { density } => {
             let ext = [0, 1, 2].map(|a| (b.max.axis(a) - b.min.axis(a)).to_f64().max(0.0));
             let longest = ext.iter().cloned().fold(0.0f64, f64::max);
@@ -194,7 +227,7 @@ fn resolution<R: Real>(b: &Aabb<R>, items: usize, res: Resolution, max_axis: u16
             let floor = longest / max_axis as f64;
             let vol: f64 = ext.iter().map(|e| e.max(floor)).product();
             let k = libm::cbrt(density * items.max(1) as f64 / vol);
-            ext.map(|e| (libm::round(e * k) as u16).clamp(1, max_axis))
+            ext.map(|e| (libm::round(e * k) as u16).clamp(1, max_axis.min(MAX_PER_AXIS)))
         }
     }
 }
@@ -225,6 +258,75 @@ fn locate_by<R: Real>(n: usize, x: R, c: impl Fn(usize) -> R) -> usize {
     lo
 }
 
+/// Writes the `n + 1` planes of axis `a` of lattice `g` (bounds `b`) into `out`.
+fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, b: &Aabb<R>, n: u16, out: &mut [R]) {
+    let (lo, hi) = (b.min.axis(a), b.max.axis(a));
+    match cfg.spacing {
+        Spacing::Uniform => {
+            for (i, c) in out.iter_mut().enumerate().take(n as usize + 1) {
+                *c = uniform_coord(lo, hi, n, i);
+            }
+        }
+        Spacing::Adaptive => adaptive_planes(scene, cfg, g, a, lo, hi, n, out),
+    }
+}
+
+/// Planes at quantiles of the items' box centres, from a histogram of 1024 bins (no
+/// allocation, no sorting). Out of line so its 4 KB histogram is only on the stack when used.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
+    const BINS: usize = 1024;
+    let (l, h) = (lo.to_f64(), hi.to_f64());
+    let width = (h - l).max(f64::MIN_POSITIVE);
+    let mut hist = [0u32; BINS];
+    let mut total = 0u32;
+    for_each_item(scene, cfg, g, |_, ib| {
+        let c = (ib.min.axis(a).to_f64() + ib.max.axis(a).to_f64()) * 0.5;
+        let bin = (((c - l) / width) * BINS as f64).clamp(0.0, (BINS - 1) as f64) as usize;
+        hist[bin] += 1;
+        total += 1;
+    });
+    out[0] = lo;
+    out[n as usize] = hi;
+    let (mut bin, mut below) = (0usize, 0u32);
+    for (i, plane) in out.iter_mut().enumerate().take(n as usize).skip(1) {
+        // The plane below which i/n of the centres lie, interpolated inside its bin.
+        let target = total as f64 * i as f64 / n as f64;
+        while bin < BINS - 1 && (below + hist[bin]) as f64 <= target {
+            below += hist[bin];
+            bin += 1;
+        }
+        let frac = if hist[bin] > 0 { ((target - below as f64) / hist[bin] as f64).clamp(0.0, 1.0) } else { 0.0 };
+        *plane = R::from_f64(l + width * (bin as f64 + frac) / BINS as f64);
+    }
+    // Keep the list non-decreasing after rounding.
+    for i in 1..=n as usize {
+        if out[i] < out[i - 1] {
+            out[i] = out[i - 1];
+        }
+    }
+}
+
+/// Storage entries of the planes of one lattice and of the references to its cells.
+#[inline(never)]
+fn plan_grid<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3]) -> usize {
+    let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
+    for (a, p) in planes.iter_mut().enumerate() {
+        axis_planes(scene, cfg, g, a, b, n[a], p);
+    }
+    let mut refs = 0;
+    for_each_item(scene, cfg, g, |_, ib| {
+        let mut count = 1usize;
+        for a in 0..3 {
+            let c = &planes[a][..n[a] as usize + 1];
+            count *= locate(c, ib.max.axis(a)) - locate(c, ib.min.axis(a)) + 1;
+        }
+        refs += count;
+    });
+    refs
+}
+
 /// [`locate_by`] over a stored coordinate list (`n + 1` entries).
 #[inline]
 fn locate<R: Real>(c: &[R], x: R) -> usize {
@@ -243,24 +345,14 @@ fn cell_range<R: Real>(coords: &[R], g: &Grid<R>, b: &Aabb<R>) -> [(usize, usize
 impl<'a, R: Real> Lattice<'a, R> {
     /// Storage a scene needs with this configuration.
     pub fn plan(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> LatticeSizes {
-        let mut s = LatticeSizes { grids: 1 + scene.groups.len(), cells: 1, ..Default::default() };
-        for g in 0..s.grids {
+        let grids = if cfg.nested { 1 + scene.groups.len() } else { 1 };
+        let mut s = LatticeSizes { grids, cells: 1, ..Default::default() };
+        for g in 0..grids {
             let b = grid_bounds(scene, g);
-            let mut items = 0;
-            for_each_item(scene, g, |_, _| items += 1);
-            let n = resolution(&b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis);
+            let n = grid_resolution(scene, cfg, g, &b);
             s.coords += n.iter().map(|&v| v as usize + 1).sum::<usize>();
             s.cells += n.iter().map(|&v| v as usize).product::<usize>();
-            // Reference count: each item's overlapped cells, located exactly as `build` does.
-            for_each_item(scene, g, |_, ib| {
-                let mut count = 1usize;
-                for a in 0..3 {
-                    let (lo, hi) = (b.min.axis(a), b.max.axis(a));
-                    let c = |x: R| locate_by(n[a] as usize, x, |i| uniform_coord(lo, hi, n[a], i));
-                    count *= c(ib.max.axis(a)) - c(ib.min.axis(a)) + 1;
-                }
-                s.refs += count;
-            });
+            s.refs += plan_grid(scene, cfg, g, &b, n);
         }
         s
     }
@@ -268,7 +360,7 @@ impl<'a, R: Real> Lattice<'a, R> {
     /// Builds the lattice into `storage`.
     pub fn build(scene: &Scene<'_, R>, cfg: &LatticeConfig, storage: LatticeStorage<'a, R>) -> Result<Self, LatticeError> {
         let LatticeStorage { grids, coords, cells, refs } = storage;
-        let ngrids = 1 + scene.groups.len();
+        let ngrids = if cfg.nested { 1 + scene.groups.len() } else { 1 };
         if grids.len() < ngrids {
             return Err(LatticeError { capacity: "grids", needed: ngrids, available: grids.len() });
         }
@@ -276,21 +368,18 @@ impl<'a, R: Real> Lattice<'a, R> {
         let (mut nc, mut ncells) = (0usize, 0usize);
         for (g, slot) in grids.iter_mut().enumerate().take(ngrids) {
             let b = grid_bounds(scene, g);
-            let mut items = 0;
-            for_each_item(scene, g, |_, _| items += 1);
-            let n = resolution(&b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis);
+            let n = grid_resolution(scene, cfg, g, &b);
             let mut grid = Grid { bounds: b, n, coord_start: [0; 3], cell_start: ncells as u32 };
             for a in 0..3 {
                 let need = nc + n[a] as usize + 1;
                 if need > coords.len() {
-                    let total = Self::plan(scene, cfg).coords;
+                    let total: usize = (0..ngrids)
+                        .map(|g| grid_resolution(scene, cfg, g, &grid_bounds(scene, g)).iter().map(|&v| v as usize + 1).sum::<usize>())
+                        .sum();
                     return Err(LatticeError { capacity: "coords", needed: total, available: coords.len() });
                 }
                 grid.coord_start[a] = nc as u32;
-                let (lo, hi) = (b.min.axis(a), b.max.axis(a));
-                for i in 0..=n[a] as usize {
-                    coords[nc + i] = uniform_coord(lo, hi, n[a], i);
-                }
+                axis_planes(scene, cfg, g, a, &b, n[a], &mut coords[nc..need]);
                 nc = need;
             }
             ncells += grid.cells();
@@ -304,7 +393,7 @@ impl<'a, R: Real> Lattice<'a, R> {
         // Pass 1: count references per cell (into cells[i + 1]).
         let mut nrefs = 0usize;
         for (g, grid) in grids.iter().enumerate().take(ngrids) {
-            for_each_item(scene, g, |_, ib| {
+            for_each_item(scene, cfg, g, |_, ib| {
                 visit_cells(coords, grid, ib, |c| {
                     cells[c + 1] += 1;
                     nrefs += 1;
@@ -320,7 +409,7 @@ impl<'a, R: Real> Lattice<'a, R> {
         // Pass 2: fill, using cells[i] as a cursor; afterwards cells[i] is the end of cell i,
         // so shifting by one restores the starts.
         for (g, grid) in grids.iter().enumerate().take(ngrids) {
-            for_each_item(scene, g, |item, ib| {
+            for_each_item(scene, cfg, g, |item, ib| {
                 visit_cells(coords, grid, ib, |c| {
                     refs[cells[c] as usize] = item;
                     cells[c] += 1;

@@ -116,10 +116,22 @@ proptest! {
     }
 
     #[test]
+    fn flat_and_adaptive_lattices_agree_too(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(4)]) {
+        use lattice_rt::lattice::Spacing;
+        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        for (spacing, nested) in [(Spacing::Adaptive, true), (Spacing::Uniform, false), (Spacing::Adaptive, false)] {
+            let cfg = LatticeConfig { spacing, nested, top: lattice_rt::lattice::Resolution::Auto { density: 8.0 }, ..LatticeConfig::default() };
+            check::<f64>(&p, &cfg, 300)?;
+            check::<f32>(&p, &cfg, 300)?;
+            check::<lattice_rt::Fx>(&p, &cfg, 300)?;
+        }
+    }
+
+    #[test]
     fn fine_and_coarse_lattices_agree_too(seed in any::<u64>(), n in 1usize..30, res in 1u16..12) {
         use lattice_rt::lattice::Resolution;
         let p = RandomScene { objects: n, group_size: 4, spread: 0.0, seed };
-        let cfg = LatticeConfig { top: Resolution::Uniform([res, res + 1, res.saturating_sub(1).max(1)]), sub: Resolution::Uniform([res; 3]), max_per_axis: 64 };
+        let cfg = LatticeConfig { top: Resolution::Uniform([res, res + 1, res.saturating_sub(1).max(1)]), sub: Resolution::Uniform([res; 3]), ..LatticeConfig::default() };
         check::<f64>(&p, &cfg, 200)?;
         check::<f32>(&p, &cfg, 200)?;
         check::<lattice_rt::Fx>(&p, &cfg, 200)?;

@@ -232,7 +232,7 @@ fn corners_faces_and_sub_lattices<R: Real>() {
     let text = "camera eye -4 -4 -4 look 0 0 0\nbox min 0 0 0 max 1 1 1\nsphere center 2 2 2 radius 0.5\ngroup g\n  box min 3 0 0 max 4 1 1\n  sphere center 3.5 2 0.5 radius 0.5\nend\n";
     let mut st = Vec::new();
     let scene = scene_in::<R>(text, &mut st);
-    let cfg = LatticeConfig { top: Resolution::Uniform([4, 4, 4]), sub: Resolution::Uniform([2, 2, 2]), max_per_axis: 64 };
+    let cfg = LatticeConfig { top: Resolution::Uniform([4, 4, 4]), sub: Resolution::Uniform([2, 2, 2]), ..LatticeConfig::default() };
     let w = scene.world;
     let g = scene.groups[0].bounds;
     let rays = [
