@@ -1,6 +1,7 @@
 //! host-sim: the desktop driver of the lattice-rt core. Renders scenes to PNG/PBM/PGM, prints
 //! statistics, and (with no arguments) renders the paper's four scenes into `out/`.
 
+mod bench;
 mod effects;
 mod firmware;
 mod load;
@@ -41,6 +42,22 @@ enum Command {
         /// Folder holding the scene files.
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
+    },
+    /// The paper's Table 1 reproduced, scaling to 100 000 primitives, and the lattice's
+    /// resolution choice against a sweep: docs/performance.md and a log-log plot.
+    Bench {
+        /// A short run for CI (N up to 1 000, one timed run).
+        #[arg(long)]
+        quick: bool,
+        /// Timed runs per measurement (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/performance.md")]
+        out: PathBuf,
+        /// Plot to write.
+        #[arg(long, default_value = "docs/performance.png")]
+        plot: PathBuf,
     },
     /// What accuracy costs in time: error against a 16-ray f64 reference and cost, one knob
     /// at a time (scalar, tree depth, cutoff, sampling, dithering).
@@ -293,6 +310,7 @@ fn real_main() -> Result<()> {
         Some(Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv }) => {
             tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv)
         }
+        Some(Command::Bench { quick, runs, out, plot }) => bench::bench_cmd(quick, runs, &out, &plot),
         Some(Command::Effects { scenes, runs, out, firmware_csv }) => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
         Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
         Some(Command::Stats(a)) => match a.scalar {

@@ -1,0 +1,54 @@
+//! Kernel benchmarks (criterion): each primitive's intersection, a lattice walk, a whole tile.
+//! `cargo bench --bench kernels`; regressions show as changes against the last run.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use lattice_rt::lattice::{Grid, LatticeSizes};
+use lattice_rt::scene::Object;
+use lattice_rt::shape::Shape;
+use lattice_rt::{parse, render, Accelerator, BitFrame, Frame, Fx, Lattice, LatticeConfig, LatticeStorage, NoHooks, Query, Ray, Real, Tracer, Vec3};
+
+fn primitives(c: &mut Criterion) {
+    let r = Ray::new(Vec3::new(-5.0, 0.3, 0.2), Vec3::new(1.0, 0.05, 0.02));
+    for (name, s) in [("sphere", Shape::Sphere), ("cylinder", Shape::Cylinder), ("cone", Shape::Cone { top: 0.3 }), ("box", Shape::Box)] {
+        c.bench_function(&format!("intersect {name} f64"), |b| b.iter(|| black_box(s).intersect(black_box(&r), 0.0, f64::MAX)));
+    }
+    let rf = Ray::new(Vec3::new(Fx::from_f64(-5.0), Fx::from_f64(0.3), Fx::from_f64(0.2)), Vec3::new(Fx::ONE, Fx::from_f64(0.05), Fx::from_f64(0.02)));
+    c.bench_function("intersect sphere fixed", |b| b.iter(|| black_box(Shape::<Fx>::Sphere).intersect(black_box(&rf), Fx::ZERO, Fx::MAX)));
+}
+
+fn scene_parts<'a, R: Real>(text: &str, st: &'a mut Vec<Object<R>>) -> lattice_rt::Scene<'a, R> {
+    *st = vec![Object::default(); 64];
+    parse::<R>(text, st).unwrap()
+}
+
+fn walk_and_tile(c: &mut Criterion) {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/desk.scene")).unwrap();
+    let mut st = Vec::new();
+    let scene = scene_parts::<f64>(&text, &mut st);
+    let cfg = LatticeConfig::default();
+    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(&scene, &cfg);
+    let (mut g, mut co, mut ce, mut re) = (vec![Grid::EMPTY; grids], vec![0.0; coords], vec![0; cells], vec![0; refs]);
+    let lat = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut co, cells: &mut ce, refs: &mut re }).unwrap();
+    let ray = scene.camera.ray(81, 99, 160, 100);
+    c.bench_function("lattice walk (cells only), desk", |b| b.iter(|| {
+        let mut n = 0;
+        lat.walk_cells(black_box(&ray), 0.0, f64::MAX, |_, _, _| n += 1);
+        n
+    }));
+    let mut mb = vec![0; Query::mailbox_len(&scene)];
+    c.bench_function("lattice nearest, desk eye ray", |b| b.iter(|| {
+        let mut q = Query::new(&mut mb);
+        lat.nearest(&scene, black_box(&ray), 0.0, f64::MAX, &mut q)
+    }));
+    let tracer = Tracer::new(&scene, &lat);
+    let frame = Frame::new(8, 8);
+    c.bench_function("tile 8x8, desk, f64", |b| b.iter(|| {
+        let mut bits = [0u8; 8];
+        let mut target = BitFrame::new(8, 8, &mut bits).unwrap();
+        let mut mb = [0u32; 32];
+        render(&tracer, &frame, &mut target, &mut mb, &mut [], &mut NoHooks).unwrap()
+    }));
+}
+
+criterion_group!(benches, primitives, walk_and_tile);
+criterion_main!(benches);

@@ -1,0 +1,321 @@
+//! `host-sim bench`: the paper's Table 1 reproduced, then scaling to 100 000 primitives, and
+//! the lattice's resolution choice against a sweep. Writes `docs/performance.md` and a plot.
+
+use crate::load::{object_storage, parse_scene, read, LatticeBufs};
+use crate::run::render_with;
+use anyhow::{Context, Result};
+use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
+use embedded_graphics::pixelcolor::Rgb888;
+use embedded_graphics::prelude::*;
+use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
+use embedded_graphics::text::Text;
+use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
+use lattice_rt::generate::{random_object, random_scene, RandomScene, Rng};
+use lattice_rt::lattice::{Resolution, Spacing};
+use lattice_rt::scene::Object;
+use lattice_rt::{Accelerator, BoundingBox, BruteForce, Effects, Frame, LatticeConfig, Query, Ray, Scene, SceneBuilder, Tracer, Vec3};
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+/// The paper's Table 1 (min:sec, IBM PC/AT): bounding box and lattice.
+const PAPER: [(&str, usize, f64, f64); 4] = [
+    ("chair", 7, 48.0 * 60.0 + 32.0, 19.0 * 60.0 + 30.0),
+    ("desk", 17, 63.0 * 60.0 + 17.0, 23.0 * 60.0 + 54.0),
+    ("polyhedron", 13, 55.0 * 60.0 + 24.0, 20.0 * 60.0 + 32.0),
+    ("spheres", 2, 34.0 * 60.0 + 49.0, 17.0 * 60.0 + 20.0),
+];
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Method {
+    Brute,
+    Bbox,
+    Flat,
+    Nested,
+}
+const METHODS: [Method; 4] = [Method::Brute, Method::Bbox, Method::Flat, Method::Nested];
+
+impl Method {
+    fn name(self) -> &'static str {
+        match self {
+            Method::Brute => "brute force",
+            Method::Bbox => "bounding box",
+            Method::Flat => "flat lattice",
+            Method::Nested => "nested lattice",
+        }
+    }
+}
+
+/// Renders with one method; returns (render time, lattice build time, lattice bytes, stats, bits).
+fn frame_with(scene: &Scene<'_, f64>, m: Method, frame: &Frame, primary_only: bool) -> Result<(Duration, Duration, usize, lattice_rt::Stats, Vec<u8>)> {
+    let cfg = LatticeConfig { nested: m != Method::Flat, ..LatticeConfig::default() };
+    let mut bufs = LatticeBufs::for_scene(scene, &cfg);
+    let t0 = Instant::now();
+    let lattice = bufs.build(scene, &cfg)?;
+    let build = t0.elapsed();
+    let bytes = lattice.bytes();
+    let a: &dyn Accelerator<f64> = match m {
+        Method::Brute => &BruteForce,
+        Method::Bbox => &BoundingBox,
+        _ => &lattice,
+    };
+    let mut t = Tracer::new(scene, a);
+    if primary_only {
+        t.max_depth = 0;
+        t.effects = Effects(0);
+    }
+    let r = render_with(&t, frame, false)?;
+    Ok((r.elapsed, build, bytes, r.stats, r.bits))
+}
+
+/// Mean time and work per ray of `nearest` over a set of rays.
+fn per_ray(scene: &Scene<'_, f64>, a: &dyn Accelerator<f64>, rays: &[Ray<f64>], runs: usize) -> (Duration, f64, f64) {
+    let mut mb = vec![0; lattice_rt::Query::mailbox_len(scene)];
+    let mut times = Vec::new();
+    let mut tests = 0.0;
+    let mut cells = 0.0;
+    for _ in 0..runs.max(1) {
+        let mut q = Query::new(&mut mb);
+        let t0 = Instant::now();
+        for r in rays {
+            std::hint::black_box(a.nearest(scene, r, 0.0, f64::MAX, &mut q));
+        }
+        times.push(t0.elapsed() / rays.len().max(1) as u32);
+        tests = q.stats.object_tests as f64 / rays.len() as f64;
+        cells = q.stats.cells_visited as f64 / rays.len() as f64;
+    }
+    (median(times), tests, cells)
+}
+
+fn camera_rays(scene: &Scene<'_, f64>, w: i32, h: i32) -> Vec<Ray<f64>> {
+    (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| scene.camera.ray(2 * x + 1, 2 * y + 1, 2 * w, 2 * h)).collect()
+}
+
+/// A generated scene: `n` random primitives, or the clustered "teapot in a stadium": most of
+/// them in one dense composite far from the sparse rest.
+fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
+    *storage = vec![Object::default(); n];
+    let mut b = SceneBuilder::new(storage);
+    if !clustered {
+        random_scene(&mut b, &RandomScene { objects: n, group_size: 0, spread: 0.0, seed: n as u64 })?;
+    } else {
+        let mut rng = Rng::new(7 + n as u64);
+        let side = 6.0 * (n as f64).cbrt().max(2.0);
+        b.add_material(lattice_rt::scene::Material::DEFAULT)?;
+        b.add_light(lattice_rt::scene::Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 })?;
+        let sparse = n / 10;
+        for _ in 0..sparse {
+            let c = Vec3::new(rng.range(0.0, side), rng.range(0.0, side * 0.2), rng.range(0.0, side));
+            let (s, t) = random_object(&mut rng, c, 0.8);
+            b.add_object(s, t, 0)?;
+        }
+        // The teapot: a composite of the other 90 % packed into a cube of side 2.
+        b.begin_group(lattice_rt::Affine::translate(Vec3::new(side * 0.8, side * 0.1, side * 0.8)))?;
+        for _ in sparse..n {
+            let c = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let (s, t) = random_object(&mut rng, c, 0.04);
+            b.add_object(s, t, 0)?;
+        }
+        b.end_group()?;
+        b.camera.eye = Vec3::new(side * 0.5, side * 0.6, -side * 0.6);
+        b.camera.look = Vec3::new(side * 0.8, side * 0.1, side * 0.8);
+    }
+    Ok(b.finish()?)
+}
+
+/// The command.
+pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()> {
+    let runs = if quick { 1 } else { runs.max(1) };
+    let mut md = String::new();
+    writeln!(md, "# Performance\n\nWritten by `cargo run --release -p host-sim -- bench{}` on the host (f64, one core). Times are\nmedians of {runs} runs, the methods interleaved in each run so drift on a shared machine hits all alike.\n", if quick { " --quick" } else { "" })?;
+    // Table 1.
+    writeln!(md, "## The paper's Table 1, reproduced\n\nThe four paper scenes at 160x100 with the paper's settings (directional light, 40x25 degree\nview, full Whitted tree). Ratio = bounding-box time / method time (the paper's \"how many\ntimes faster than the bounding box\"). Tests, inside tests and cells are per primary ray\n(eye rays alone).\n")?;
+    writeln!(md, "| scene | method | ms/frame | ratio to bbox | paper's ratio | object tests/ray | inside tests/ray | cells/ray | lattice build ms | lattice bytes |\n|---|---|---|---|---|---|---|---|---|---|")?;
+    let frame = Frame::new(160, 100);
+    let mut ratios = Vec::new();
+    for (name, _prims, p_bbox, p_lat) in PAPER {
+        let path = Path::new("scenes").join(format!("{name}.scene"));
+        let text = read(&path)?;
+        let mut storage = object_storage::<f64>(&text);
+        let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
+        let mut times = vec![Vec::new(); METHODS.len()];
+        let mut builds = vec![Vec::new(); METHODS.len()];
+        let mut bytes = vec![0; METHODS.len()];
+        let mut bits: Vec<Vec<u8>> = vec![Vec::new(); METHODS.len()];
+        for _ in 0..runs {
+            for (i, m) in METHODS.iter().enumerate() {
+                let (t, b, by, _, bi) = frame_with(&scene, *m, &frame, false)?;
+                times[i].push(t);
+                builds[i].push(b);
+                bytes[i] = by;
+                bits[i] = bi;
+            }
+        }
+        anyhow::ensure!(bits.windows(2).all(|w| w[0] == w[1]), "{name}: the methods drew different frames");
+        let med: Vec<Duration> = times.into_iter().map(median).collect();
+        for (i, m) in METHODS.iter().enumerate() {
+            let (_, _, _, s, _) = frame_with(&scene, *m, &frame, true)?;
+            let px = 160.0 * 100.0;
+            let ratio = med[1].as_secs_f64() / med[i].as_secs_f64();
+            let lat = matches!(m, Method::Flat | Method::Nested);
+            let paper = match m {
+                Method::Bbox => "1.00".to_string(),
+                Method::Nested => format!("{:.2}", p_bbox / p_lat),
+                _ => "-".into(),
+            };
+            writeln!(
+                md,
+                "| {name} | {} | {:.2} | {ratio:.2} | {paper} | {:.2} | {:.2} | {} | {} | {} |",
+                m.name(),
+                med[i].as_secs_f64() * 1e3,
+                s.object_tests as f64 / px,
+                s.inside_tests as f64 / px,
+                if lat { format!("{:.2}", s.cells_visited as f64 / px) } else { "-".into() },
+                if lat { format!("{:.3}", median(builds[i].clone()).as_secs_f64() * 1e3) } else { "-".into() },
+                if lat { bytes[i].to_string() } else { "-".into() },
+            )?;
+            if *m == Method::Nested {
+                ratios.push((name, ratio, p_bbox / p_lat));
+            }
+        }
+    }
+    writeln!(md, "\nNested lattice against bounding box: {}. The paper: 2.01x to 2.70x.\n", ratios.iter().map(|(n, r, _)| format!("{n} {r:.2}x")).collect::<Vec<_>>().join(", "))?;
+    // Scaling.
+    let sizes: Vec<usize> = if quick { vec![10, 100, 1000] } else { vec![10, 100, 1_000, 10_000, 100_000] };
+    writeln!(md, "## Scaling\n\nGenerated scenes (random mixes of the four primitives in a cube growing with N; \"clustered\":\n10 % spread over a stadium, 90 % packed in one composite far from them). Nearest-hit queries\nfor camera rays (a 64x40 grid; fewer for the O(N) methods at large N). Bytes: lattice storage\n(grids, coordinate lists, cells, references); the bounding-box method keeps one box per object.\n")?;
+    writeln!(md, "| scene | N | method | us/ray | object tests/ray | cells/ray | bytes | bytes/ref + bytes/cell |\n|---|---|---|---|---|---|---|---|")?;
+    let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for clustered in [false, true] {
+        for &n in &sizes {
+            let mut storage = Vec::new();
+            let scene = generated(n, clustered, &mut storage)?;
+            let all_rays = camera_rays(&scene, 64, 40);
+            let kind = if clustered { "clustered" } else { "random" };
+            let configs: Vec<(String, Option<LatticeConfig>)> = vec![
+                ("brute force".into(), None),
+                ("bounding box".into(), None),
+                ("lattice, uniform".into(), Some(LatticeConfig { nested: false, ..LatticeConfig::default() })),
+                ("lattice, adaptive".into(), Some(LatticeConfig { nested: false, spacing: Spacing::Adaptive, ..LatticeConfig::default() })),
+                ("lattice, nested".into(), Some(LatticeConfig::default())),
+            ];
+            for (label, cfg) in configs {
+                if !clustered && label == "lattice, nested" {
+                    continue;
+                }
+                let (time, tests, cells, bytes, per) = match cfg {
+                    None => {
+                        let cap = (20_000_000 / n).clamp(50, all_rays.len());
+                        let rays = &all_rays[..cap];
+                        let a: &dyn Accelerator<f64> = if label == "brute force" { &BruteForce } else { &BoundingBox };
+                        let (t, tests, _) = per_ray(&scene, a, rays, runs);
+                        let bytes = if label == "bounding box" { n * std::mem::size_of::<lattice_rt::Aabb<f64>>() } else { 0 };
+                        (t, tests, 0.0, bytes, String::from("-"))
+                    }
+                    Some(cfg) => {
+                        let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+                        let lat = bufs.build(&scene, &cfg)?;
+                        let (t, tests, cells) = per_ray(&scene, &lat, &all_rays, runs);
+                        let refs_b = lat.ref_count() * 4;
+                        let cells_b = (lat.cell_count() + 1) * 4;
+                        let other = lat.bytes() - refs_b - cells_b;
+                        (t, tests, cells, lat.bytes(), format!("4 x {} refs + 4 x {} cells + {other}", lat.ref_count(), lat.cell_count() + 1))
+                    }
+                };
+                let us = time.as_secs_f64() * 1e6;
+                writeln!(md, "| {kind} | {n} | {label} | {us:.3} | {tests:.2} | {} | {bytes} | {per} |", if cells > 0.0 { format!("{cells:.1}") } else { "-".into() })?;
+                let key = format!("{kind}: {label}");
+                match series.iter_mut().find(|(k, _)| *k == key) {
+                    Some((_, v)) => v.push((n as f64, us)),
+                    None => series.push((key, vec![(n as f64, us)])),
+                }
+            }
+            eprintln!("  {kind} N={n} done");
+        }
+    }
+    let at = |key: &str, n: f64| series.iter().find(|(k, _)| k == key).and_then(|(_, v)| v.iter().find(|p| p.0 == n)).map(|p| p.1);
+    writeln!(md)?;
+    if let (Some(b), Some(l)) = (at("random: bounding box", 10_000.0), at("random: lattice, uniform", 10_000.0)) {
+        writeln!(md, "At N = 10 000 (random): lattice {:.0}x faster per ray than the bounding-box method.", b / l)?;
+    }
+    if let (Some(a), Some(b)) = (at("random: lattice, uniform", 1_000.0), at("random: lattice, uniform", 100_000.0)) {
+        writeln!(md, "Lattice time per ray from N = 1 000 to 100 000: x{:.2} (log N grows x1.67).", b / a)?;
+    }
+    if let (Some(u), Some(a), Some(nst)) = (at("clustered: lattice, uniform", *sizes.last().unwrap() as f64), at("clustered: lattice, adaptive", *sizes.last().unwrap() as f64), at("clustered: lattice, nested", *sizes.last().unwrap() as f64)) {
+        writeln!(md, "Clustered, N = {}: uniform {u:.2} us/ray, adaptive coordinate lists {a:.2}, nested sub-lattice {nst:.2}.", sizes.last().unwrap())?;
+    }
+    // Resolution sweep.
+    let n = if quick { 1000 } else { 10_000 };
+    writeln!(md, "\n## Lattice resolution: automatic against a sweep\n\nRandom scene, N = {n}; uniform lists. The automatic choice aims at about 2 cells per object\n(cells per axis proportional to extent x cube root of the count, as in Cleary and Wyvill's\nanalysis and pbrt's `GridAccel`).\n")?;
+    writeln!(md, "| resolution | cells | us/ray | object tests/ray | cells/ray | bytes |\n|---|---|---|---|---|---|")?;
+    let mut storage = Vec::new();
+    let scene = generated(n, false, &mut storage)?;
+    let rays = camera_rays(&scene, 64, 40);
+    let mut sweep: Vec<(String, LatticeConfig)> = [4u16, 8, 16, 24, 32, 48, 64].iter().map(|&k| (format!("{k}^3"), LatticeConfig { top: Resolution::Uniform([k; 3]), nested: false, ..LatticeConfig::default() })).collect();
+    sweep.push(("auto (2 per object)".into(), LatticeConfig { nested: false, ..LatticeConfig::default() }));
+    sweep.push(("auto, adaptive lists".into(), LatticeConfig { nested: false, spacing: Spacing::Adaptive, ..LatticeConfig::default() }));
+    for (label, cfg) in sweep {
+        let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+        let lat = bufs.build(&scene, &cfg)?;
+        let (t, tests, cells) = per_ray(&scene, &lat, &rays, runs);
+        writeln!(md, "| {label} | {} | {:.3} | {tests:.2} | {cells:.1} | {} |", lat.cell_count(), t.as_secs_f64() * 1e6, lat.bytes())?;
+    }
+    writeln!(md, "\n![time per ray against N](performance.png)")?;
+    std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
+    std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
+    draw_loglog(&series, plot)?;
+    println!("wrote {} and {}", out.display(), plot.display());
+    Ok(())
+}
+
+/// Time per ray against N on log-log axes, one line per method.
+fn draw_loglog(series: &[(String, Vec<(f64, f64)>)], path: &Path) -> Result<()> {
+    let (w, h) = (900i32, 520i32);
+    let (left, right, top, bottom) = (70, 260, 30, 50);
+    let mut d = SimulatorDisplay::<Rgb888>::new(Size::new(w as u32, h as u32));
+    Rectangle::new(Point::zero(), Size::new(w as u32, h as u32)).into_styled(PrimitiveStyle::with_fill(Rgb888::WHITE)).draw(&mut d)?;
+    let pts = series.iter().flat_map(|(_, v)| v.iter());
+    let (xmin, xmax) = pts.clone().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0.log10()), b.max(p.0.log10())));
+    let (ymin, ymax) = pts.fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1.log10()), b.max(p.1.log10())));
+    let (ymin, ymax) = (ymin.floor(), ymax.ceil());
+    let px = |x: f64| left + ((x.log10() - xmin) / (xmax - xmin).max(1e-9) * (w - left - right) as f64) as i32;
+    let py = |y: f64| h - bottom - ((y.log10() - ymin) / (ymax - ymin).max(1e-9) * (h - top - bottom) as f64) as i32;
+    let black = PrimitiveStyle::with_stroke(Rgb888::BLACK, 1);
+    let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
+    Line::new(Point::new(left, h - bottom), Point::new(w - right, h - bottom)).into_styled(black).draw(&mut d)?;
+    Line::new(Point::new(left, top), Point::new(left, h - bottom)).into_styled(black).draw(&mut d)?;
+    let mut e = xmin.ceil() as i32;
+    while e as f64 <= xmax {
+        let x = 10f64.powi(e);
+        Text::new(&format!("1e{e}"), Point::new(px(x) - 10, h - bottom + 14), text).draw(&mut d)?;
+        e += 1;
+    }
+    let mut e = ymin as i32;
+    while e as f64 <= ymax {
+        let y = 10f64.powi(e);
+        Text::new(&format!("1e{e}"), Point::new(left - 40, py(y) + 3), text).draw(&mut d)?;
+        e += 1;
+    }
+    Text::new("primitives N (log)", Point::new(left + 200, h - 12), text).draw(&mut d)?;
+    Text::new("microseconds per ray (log)", Point::new(left, 16), text).draw(&mut d)?;
+    let colours = [Rgb888::new(200, 30, 30), Rgb888::new(30, 60, 200), Rgb888::new(30, 140, 30), Rgb888::new(150, 100, 0), Rgb888::new(140, 40, 160), Rgb888::new(0, 140, 140), Rgb888::new(90, 90, 90), Rgb888::new(230, 120, 0), Rgb888::new(0, 0, 0)];
+    for (i, (label, v)) in series.iter().enumerate() {
+        let c = colours[i % colours.len()];
+        let style = PrimitiveStyle::with_stroke(c, if label.starts_with("clustered") { 1 } else { 2 });
+        for p in v.windows(2) {
+            Line::new(Point::new(px(p[0].0), py(p[0].1)), Point::new(px(p[1].0), py(p[1].1))).into_styled(style).draw(&mut d)?;
+        }
+        for p in v {
+            Circle::with_center(Point::new(px(p.0), py(p.1)), 5).into_styled(PrimitiveStyle::with_fill(c)).draw(&mut d)?;
+        }
+        Text::new(label, Point::new(w - right + 10, top + 14 * i as i32), MonoTextStyle::new(&FONT_6X10, c)).draw(&mut d)?;
+    }
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    d.to_rgb_output_image(&OutputSettingsBuilder::new().scale(1).build()).save_png(path).with_context(|| format!("cannot write {}", path.display()))
+}
