@@ -42,12 +42,22 @@ pub struct Frame {
     pub dither: Dither,
     /// Eye rays per pixel (ignored by the patterning modes, which take one per block).
     pub sampling: Sampling,
+    /// The band of tile rows to render, `[first, end)` (all by default). Bands of a frame
+    /// rendered apart give the same pixels as the whole when the dithering carries nothing
+    /// between tiles ([`Frame::bands_independent`]): that is how a host renders in parallel.
+    pub rows: (u16, u16),
 }
 
 impl Frame {
     /// A frame with 8x8 tiles, Bayer dithering and one ray per pixel.
     pub fn new(width: u16, height: u16) -> Self {
-        Frame { width, height, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center }
+        Frame { width, height, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center, rows: (0, u16::MAX) }
+    }
+
+    /// Whether bands of tile rows can be rendered apart and give the same pixels: true unless
+    /// error diffusion or edge detection carries state from one tile row to the next.
+    pub fn bands_independent(&self) -> bool {
+        !self.dither.diffuses() && !self.edges()
     }
 
     /// Entries of `i16` scratch storage [`render`] needs: error-diffusion carries and the
@@ -160,7 +170,8 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     above.iter_mut().for_each(|v| *v = NO_OBJECT as i16);
     let mut q = Query::new(mailbox);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
-    let total = (tiles_x * tiles_y) as u32;
+    let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
+    let total = (tiles_x * end.saturating_sub(first)) as u32;
     let cam = &tracer.scene.camera;
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
     // An eye ray through the point (sx / 4, sy / 4) in pixels from the top-left corner.
@@ -169,7 +180,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     let mut ids = [NO_OBJECT; MAX_TILE * MAX_TILE];
     let mut left;
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
-    for ty in 0..tiles_y {
+    for ty in first..end {
         if let Some(c) = carry.as_mut() {
             c.next_band();
         }
@@ -247,7 +258,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
             target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
-            if !hooks.progress((ty * tiles_x + tx + 1) as u32, total) {
+            if !hooks.progress(((ty - first) * tiles_x + tx + 1) as u32, total) {
                 return Err(RenderError::Cancelled);
             }
         }

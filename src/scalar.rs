@@ -12,6 +12,8 @@ use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 /// Conversions from `f64` are used only while a scene is built, never per ray.
 pub trait Real:
     Copy
+    + Send
+    + Sync
     + Debug
     + PartialEq
     + PartialOrd

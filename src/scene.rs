@@ -169,7 +169,15 @@ impl<R: Real> Object<R> {
         // a power of two is exact in floating point but rounds in fixed point, so the range is
         // checked on the world parameter: a hit exactly at `tmax` (a tie with the best hit so
         // far) is then found whichever scalar runs.
-        let (t, n) = self.shape.intersect(&r, tmin * self.inv_dir_scale, R::MAX)?;
+        // The object-space limit is widened by the scalar's padding so rounding cannot exclude a
+        // hit at exactly `tmax`, yet still prunes hits well beyond it.
+        let far = if tmax == R::MAX {
+            R::MAX
+        } else {
+            let f = tmax * self.inv_dir_scale;
+            f + (f.abs() + R::ONE) * R::pad_eps()
+        };
+        let (t, n) = self.shape.intersect(&r, tmin * self.inv_dir_scale, far)?;
         let t = t * self.dir_scale;
         (t > tmin && t <= tmax).then_some((t, n))
     }

@@ -36,7 +36,7 @@ pub const WIDTH: u16 = 128;
 pub const HEIGHT: u16 = 64;
 
 /// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), Bayer dither.
-pub const FRAME: Frame = Frame { width: WIDTH, height: HEIGHT, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center };
+pub const FRAME: Frame = Frame { width: WIDTH, height: HEIGHT, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center, rows: (0, u16::MAX) };
 
 /// All memory a scene needs, owned by the caller (it lives on `main`'s stack).
 pub struct Storage<R> {

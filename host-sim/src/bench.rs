@@ -59,7 +59,7 @@ fn frame_with(scene: &Scene<'_, f64>, m: Method, frame: &Frame, primary_only: bo
     let lattice = bufs.build(scene, &cfg)?;
     let build = t0.elapsed();
     let bytes = lattice.bytes();
-    let a: &dyn Accelerator<f64> = match m {
+    let a: &(dyn Accelerator<f64> + Sync) = match m {
         Method::Brute => &BruteForce,
         Method::Bbox => &BoundingBox,
         _ => &lattice,

@@ -55,12 +55,44 @@ impl Hooks for HostHooks {
     }
 }
 
-/// Renders a frame with one accelerator into host buffers.
-pub fn render_with<R: Real, A: Accelerator<R> + ?Sized>(
+/// Renders a frame with one accelerator into host buffers: bands of tile rows in parallel on
+/// all cores when the frame allows it ([`Frame::bands_independent`]), serially otherwise.
+pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
     tracer: &Tracer<'_, '_, R, A>,
     frame: &Frame,
     progress: bool,
 ) -> Result<Rendered> {
+    let start = Instant::now();
+    let tiles_y = (frame.height as usize).div_ceil(frame.tile.max(1) as usize);
+    let threads = rayon::current_num_threads().min(tiles_y).max(1);
+    if !frame.bands_independent() || threads == 1 {
+        let mut r = render_band(tracer, frame, progress)?;
+        r.elapsed = start.elapsed();
+        return Ok(r);
+    }
+    use rayon::prelude::*;
+    let per = tiles_y.div_ceil(threads);
+    let bands: Vec<Result<Rendered>> = (0..threads)
+        .into_par_iter()
+        .map(|i| {
+            let rows = ((i * per) as u16, ((i + 1) * per).min(tiles_y) as u16);
+            render_band(tracer, &Frame { rows, ..*frame }, false)
+        })
+        .collect();
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let mut out = Rendered { bits: vec![0; BitFrame::bytes(w as u32, h as u32)], gray: vec![0; w * h], stats: Stats::default(), elapsed: Duration::ZERO };
+    for band in bands {
+        let band = band?;
+        out.bits.iter_mut().zip(&band.bits).for_each(|(a, b)| *a |= b);
+        out.gray.iter_mut().zip(&band.gray).for_each(|(a, b)| *a |= b);
+        out.stats.add(&band.stats);
+    }
+    out.elapsed = start.elapsed();
+    Ok(out)
+}
+
+/// Renders the frame's band of tile rows on this thread (pixels outside it stay 0).
+fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, R, A>, frame: &Frame, progress: bool) -> Result<Rendered> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
@@ -76,18 +108,47 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized>(
     Ok(Rendered { bits, gray: hooks.gray, stats, elapsed })
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::LatticeBufs;
+    use lattice_rt::Dither;
+
+    #[test]
+    fn parallel_bands_equal_the_serial_render() {
+        for name in ["chair", "whitted"] {
+            let path = std::path::PathBuf::from(format!("{}/../scenes/{name}.scene", env!("CARGO_MANIFEST_DIR")));
+            let text = read(&path).unwrap();
+            let mut storage = object_storage::<f64>(&text);
+            let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
+            let cfg = LatticeConfig::default();
+            let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+            let lat = bufs.build(&scene, &cfg).unwrap();
+            let t = Tracer::new(&scene, &lat);
+            for dither in [Dither::Bayer, Dither::Pattern(4)] {
+                let frame = Frame { dither, ..Frame::new(160, 100) };
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
+                let par = pool.install(|| render_with(&t, &frame, false)).unwrap();
+                let ser = render_band(&t, &frame, false).unwrap();
+                assert!(par.bits == ser.bits && par.gray == ser.gray, "{name} {dither:?}");
+                assert_eq!(par.stats, ser.stats, "{name}");
+            }
+        }
+    }
+}
+
 /// Renders with the accelerator chosen by `accel` (building the lattice when needed).
 pub fn render_accel<R: Real>(
     scene: &Scene<'_, R>,
     accel: Accel,
     cfg: &LatticeConfig,
     frame: &Frame,
-    tune: impl Fn(&mut Tracer<'_, '_, R, dyn Accelerator<R> + '_>),
+    tune: impl Fn(&mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>),
     progress: bool,
 ) -> Result<Rendered> {
     let mut bufs;
     let lattice;
-    let a: &dyn Accelerator<R> = match accel {
+    let a: &(dyn Accelerator<R> + Sync) = match accel {
         Accel::Lattice => {
             bufs = LatticeBufs::for_scene(scene, cfg);
             lattice = bufs.build(scene, cfg)?;
@@ -205,7 +266,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let frame = Frame::new(a.size.0, a.size.1);
     let pixels = frame.width as f64 * frame.height as f64;
     // Primary rays only: the paper's per-ray figures.
-    let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + '_>| {
+    let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>| {
         t.max_depth = 0;
         t.effects = Effects(0);
     };
