@@ -5,6 +5,7 @@ mod bench;
 mod effects;
 mod firmware;
 mod load;
+mod pov;
 mod output;
 mod run;
 mod tradeoff;
@@ -42,6 +43,20 @@ enum Command {
         /// Folder holding the scene files.
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
+    },
+    /// Write the POV-Ray equivalent of a scene (docs/povray.md has the mapping).
+    Export {
+        /// Scene file.
+        scene: PathBuf,
+        /// Write POV-Ray scene language.
+        #[arg(long)]
+        pov: bool,
+        /// Each object a flat distinct gray, no lights (for comparing object masks).
+        #[arg(long)]
+        ids: bool,
+        /// File to write.
+        #[arg(short, long, default_value = "out/scene.pov")]
+        output: PathBuf,
     },
     /// The paper's Table 1 reproduced, scaling to 100 000 primitives, and the lattice's
     /// resolution choice against a sweep: docs/performance.md and a log-log plot.
@@ -309,6 +324,21 @@ fn real_main() -> Result<()> {
         }
         Some(Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv }) => {
             tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv)
+        }
+        Some(Command::Export { scene, pov, ids, output }) => {
+            if !pov {
+                bail!("say which format: --pov is the one there is");
+            }
+            let text = load::read(&scene)?;
+            let mut storage = load::object_storage::<f64>(&text);
+            let s = load::parse_scene::<f64>(&scene, &text, &mut storage)?;
+            let out = pov::export(&s, if ids { pov::PovMode::Ids } else { pov::PovMode::Full })?;
+            if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir)?;
+            }
+            std::fs::write(&output, out)?;
+            println!("wrote {}", output.display());
+            Ok(())
         }
         Some(Command::Bench { quick, runs, out, plot }) => bench::bench_cmd(quick, runs, &out, &plot),
         Some(Command::Effects { scenes, runs, out, firmware_csv }) => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
