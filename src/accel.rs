@@ -16,7 +16,7 @@ pub struct Hit<R> {
     /// Ray parameter of the hit.
     pub t: R,
     /// Index of the object hit.
-    pub object: u16,
+    pub object: u32,
     /// Outward normal in object space (not normalised).
     pub normal: Vec3<R>,
 }
@@ -122,11 +122,11 @@ pub fn offer<R: Real>(
     match scene.objects[i].intersect(ray, tmin, limit) {
         Some((t, n)) => {
             let better = match best {
-                Some(b) => t < b.t || (t == b.t && (i as u16) < b.object),
+                Some(b) => t < b.t || (t == b.t && (i as u32) < b.object),
                 None => true,
             };
             if better {
-                *best = Some(Hit { t, object: i as u16, normal: n });
+                *best = Some(Hit { t, object: i as u32, normal: n });
             }
             true
         }

@@ -51,8 +51,9 @@ pub enum Resolution {
 pub enum Spacing {
     /// Equal cells.
     Uniform,
-    /// The paper's free coordinate lists `X(), Y(), Z()`: planes at quantiles of the items'
-    /// box centres along each axis, so crowded regions get narrow cells and empty ones wide.
+    /// The paper's free coordinate lists `X(), Y(), Z()`: planes at quantiles of an even mix of
+    /// the items' box centres and a uniform spread along each axis, so crowded regions get
+    /// narrow cells while empty ones are not left with a few huge cells.
     Adaptive,
 }
 
@@ -271,8 +272,8 @@ fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: 
     }
 }
 
-/// Planes at quantiles of the items' box centres, from a histogram of 1024 bins (no
-/// allocation, no sorting). Out of line so its 4 KB histogram is only on the stack when used.
+/// Planes at quantiles of the box centres mixed with a uniform spread, from a histogram of
+/// 1024 bins (no allocation, no sorting). Out of line so its 4 KB histogram is only on the stack when used.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
 fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
@@ -289,15 +290,19 @@ fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize,
     });
     out[0] = lo;
     out[n as usize] = hi;
+    // Planes at quantiles of a half-and-half mixture of the box centres and a uniform spread:
+    // crowded regions get narrow cells without starving the empty ones.
+    let share = |bin: usize, below: u32| 0.5 * bin as f64 / BINS as f64 + 0.5 * below as f64 / total.max(1) as f64;
     let (mut bin, mut below) = (0usize, 0u32);
     for (i, plane) in out.iter_mut().enumerate().take(n as usize).skip(1) {
-        // The plane below which i/n of the centres lie, interpolated inside its bin.
-        let target = total as f64 * i as f64 / n as f64;
-        while bin < BINS - 1 && (below + hist[bin]) as f64 <= target {
+        let target = i as f64 / n as f64;
+        while bin < BINS - 1 && share(bin + 1, below + hist[bin]) <= target {
             below += hist[bin];
             bin += 1;
         }
-        let frac = if hist[bin] > 0 { ((target - below as f64) / hist[bin] as f64).clamp(0.0, 1.0) } else { 0.0 };
+        // Interpolate inside the bin, where the mixture grows linearly.
+        let (a, b) = (share(bin, below), share(bin + 1, below + hist[bin]));
+        let frac = if b > a { ((target - a) / (b - a)).clamp(0.0, 1.0) } else { 0.0 };
         *plane = R::from_f64(l + width * (bin as f64 + frac) / BINS as f64);
     }
     // Keep the list non-decreasing after rounding.

@@ -167,7 +167,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     let scratch = scratch.get_mut(..frame.scratch_len()).ok_or(RenderError::ScratchTooSmall { needed: frame.scratch_len() })?;
     let (carry_store, above) = scratch.split_at_mut(if frame.dither.diffuses() { Carry::len(w) } else { 0 });
     let mut carry = if frame.dither.diffuses() { Carry::new(carry_store, w) } else { None };
-    above.iter_mut().for_each(|v| *v = NO_OBJECT as i16);
+    above.iter_mut().for_each(|v| *v = NO_OBJECT as u16 as i16);
     let mut q = Query::new(mailbox);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
@@ -175,16 +175,21 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     let cam = &tracer.scene.camera;
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
     // An eye ray through the point (sx / 4, sy / 4) in pixels from the top-left corner.
-    let mut shoot = |sx: usize, sy: usize, q: &mut Query<'_>| tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), q);
+    // Edge detection compares object ids modulo 2^16 (they only need to differ between
+    // neighbours), so the id row above the band fits the i16 scratch.
+    let mut shoot = |sx: usize, sy: usize, q: &mut Query<'_>| {
+        let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), q);
+        (v, id as u16)
+    };
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
-    let mut ids = [NO_OBJECT; MAX_TILE * MAX_TILE];
+    let mut ids = [NO_OBJECT as u16; MAX_TILE * MAX_TILE];
     let mut left;
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     for ty in first..end {
         if let Some(c) = carry.as_mut() {
             c.next_band();
         }
-        left = [NO_OBJECT; MAX_TILE];
+        left = [NO_OBJECT as u16; MAX_TILE];
         for tx in 0..tiles_x {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
@@ -270,7 +275,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
 /// units), and the object the first of them hit.
 fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize, &mut Query<'_>) -> (R, u16), cx: usize, cy: usize, q: &mut Query<'_>) -> (R, u16) {
     let mut sum = R::ZERO;
-    let mut first = NO_OBJECT;
+    let mut first = NO_OBJECT as u16;
     for (k, (dx, dy)) in [(0, 0), (2, 0), (0, 2), (2, 2)].into_iter().enumerate() {
         let (v, id) = shoot(cx - 1 + dx, cy - 1 + dy, q);
         sum += v;

@@ -438,7 +438,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
     /// Adds a primitive placed by `to_world` (inside an open composite, the composite's
     /// transform is applied after it).
     pub fn add_object(&mut self, shape: Shape<f64>, to_world: Affine<f64>, material: u8) -> Result<(), SceneError> {
-        if self.len >= self.storage.len() || self.len >= NO_GROUP as usize {
+        // Lattice references keep the top bit for sub-lattices, so 2^31 objects at most.
+        if self.len >= self.storage.len() || self.len >= 1 << 31 {
             return Err(SceneError::TooManyObjects { capacity: self.storage.len() });
         }
         let place = match &self.open_group {

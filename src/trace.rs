@@ -21,7 +21,7 @@ use crate::scene::{Light, Scene};
 use heapless::Vec;
 
 /// The object id reported for an eye ray that hits nothing.
-pub const NO_OBJECT: u16 = u16::MAX;
+pub const NO_OBJECT: u32 = u32::MAX;
 
 /// Deepest intersection tree the tracer supports (eye ray = depth 0).
 pub const MAX_DEPTH: u8 = 8;
@@ -208,7 +208,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     }
 
     /// Brightness along an eye ray and the object the eye ray hits ([`NO_OBJECT`] if none).
-    pub fn radiance_and_object(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u16) {
+    pub fn radiance_and_object(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u32) {
         let mut first = NO_OBJECT;
         let scene = self.scene;
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();

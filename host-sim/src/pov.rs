@@ -5,7 +5,9 @@ use lattice_rt::scene::Light;
 use lattice_rt::shape::Shape;
 use lattice_rt::{Affine, Scene, Vec3};
 use std::fmt::Write as _;
+#[cfg(test)]
 use std::path::Path;
+#[cfg(test)]
 use std::process::Command;
 
 /// What the exported scene shows.
@@ -27,6 +29,7 @@ pub fn id_gray(i: usize, n: usize) -> u8 {
 }
 
 /// The object an id gray stands for (`None`: background).
+#[cfg(test)]
 pub fn gray_id(g: u8, n: usize) -> Option<usize> {
     let step = (255 / (n + 1)).max(1) as f64;
     let k = (g as f64 / step).round() as usize;
@@ -107,6 +110,7 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
 }
 
 /// Renders POV-Ray text to 8-bit gray values (`w x h`, red channel) with `povray`.
+#[cfg(test)]
 pub fn render_povray(pov: &str, w: u32, h: u32, work: &Path, name: &str) -> Result<Vec<u8>> {
     std::fs::create_dir_all(work)?;
     let src = work.join(format!("{name}.pov"));
@@ -126,6 +130,7 @@ pub fn render_povray(pov: &str, w: u32, h: u32, work: &Path, name: &str) -> Resu
     Ok(img)
 }
 
+#[cfg(test)]
 fn image_gray(path: &Path) -> Result<Vec<u8>> {
     let bytes = std::fs::read(path)?;
     let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
