@@ -2,7 +2,7 @@
 //! the lattice's resolution choice against a sweep. Writes `docs/performance.md` and a plot.
 
 use crate::load::{object_storage, parse_scene, read, LatticeBufs};
-use crate::run::render_with;
+use crate::run::render_band;
 use anyhow::{Context, Result};
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Rgb888;
@@ -69,7 +69,7 @@ fn frame_with(scene: &Scene<'_, f64>, m: Method, frame: &Frame, primary_only: bo
         t.max_depth = 0;
         t.effects = Effects(0);
     }
-    let r = render_with(&t, frame, false)?;
+    let r = render_band(&t, frame, false)?;
     Ok((r.elapsed, build, bytes, r.stats, r.bits))
 }
 

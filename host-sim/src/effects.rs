@@ -3,7 +3,7 @@
 //! Greenberg's adaptive tree depth) saves and costs. Writes `docs/effects.md`.
 
 use crate::load::{object_storage, parse_scene, read, LatticeBufs};
-use crate::run::render_with;
+use crate::run::render_band;
 use anyhow::{Context, Result};
 use lattice_rt::{Effects, Frame, LatticeConfig, Stats, Tracer};
 use std::collections::BTreeMap;
@@ -28,7 +28,7 @@ fn shoot(path: &Path, text: &str, all: bool, cutoff: f64) -> Result<Shot> {
         tracer.effects = Effects(Effects::ALL);
     }
     tracer.cutoff = cutoff;
-    let r = render_with(&tracer, &Frame::new(128, 64), false)?;
+    let r = render_band(&tracer, &Frame::new(128, 64), false)?;
     Ok(Shot { bits: r.bits, stats: r.stats, time: r.elapsed })
 }
 

@@ -92,7 +92,8 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
 }
 
 /// Renders the frame's band of tile rows on this thread (pixels outside it stay 0).
-fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, R, A>, frame: &Frame, progress: bool) -> Result<Rendered> {
+/// Timing measurements use this: one core, so methods and modes compare fairly.
+pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, R, A>, frame: &Frame, progress: bool) -> Result<Rendered> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
@@ -145,6 +146,7 @@ pub fn render_accel<R: Real>(
     frame: &Frame,
     tune: impl Fn(&mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>),
     progress: bool,
+    parallel: bool,
 ) -> Result<Rendered> {
     let mut bufs;
     let lattice;
@@ -159,7 +161,11 @@ pub fn render_accel<R: Real>(
     };
     let mut tracer = Tracer::new(scene, a);
     tune(&mut tracer);
-    render_with(&tracer, frame, progress)
+    if parallel {
+        render_with(&tracer, frame, progress)
+    } else {
+        render_band(&tracer, frame, progress)
+    }
 }
 
 fn print_stats(label: &str, s: &Stats, elapsed: Duration) {
@@ -184,7 +190,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let mut storage = object_storage::<R>(&text);
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let frame = Frame { tile: a.tile, dither: a.dither.mode(), sampling: a.sampling.mode(), ..Frame::new(a.size.0, a.size.1) };
-    let out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true)?;
+    let out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true, true)?;
     let mut store = vec![0u8; out.bits.len()];
     let frame_bits = bitframe_from(&mut store, &frame, &out.bits);
     write_png(&frame_bits, &a.output, a.theme, a.scale)?;
@@ -273,7 +279,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     println!("  per primary ray at {}x{} (eye rays only):", frame.width, frame.height);
     let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];
     for acc in accels {
-        let r = render_accel(&scene, acc, &cfg, &frame, primary_only, false)?;
+        let r = render_accel(&scene, acc, &cfg, &frame, primary_only, false, false)?;
         println!(
             "    {:8} object tests {:6.3}, inside tests {:6.2}, cells visited {:6.2}",
             format!("{acc:?}").to_lowercase(),
@@ -288,7 +294,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     for _ in 0..a.runs.max(1) {
         last.clear();
         for (i, acc) in accels.iter().enumerate() {
-            let r = render_accel(&scene, *acc, &cfg, &frame, |_| {}, false)?;
+            let r = render_accel(&scene, *acc, &cfg, &frame, |_| {}, false, false)?;
             times[i].push(r.elapsed);
             last.push(r);
         }
@@ -327,7 +333,7 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
         let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
         for (w, h) in [(160u16, 100u16), (128, 64)] {
             let frame = Frame::new(w, h);
-            let r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true)?;
+            let r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true, true)?;
             let mut store = vec![0u8; r.bits.len()];
             let f = bitframe_from(&mut store, &frame, &r.bits);
             let png = out.join(format!("{name}-{w}x{h}.png"));

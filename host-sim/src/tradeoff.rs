@@ -3,7 +3,7 @@
 //! reference (f64, 4x4 rays per pixel) and the cost, and writes `docs/accuracy.md` and a plot.
 
 use crate::load::{object_storage, parse_scene, read, LatticeBufs};
-use crate::run::render_with;
+use crate::run::render_band;
 use anyhow::{Context, Result};
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Rgb888;
@@ -83,7 +83,7 @@ fn shoot_in<R: Real>(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Res
     }
     tracer.cutoff = R::from_f64(c.cutoff);
     let frame = Frame { dither: c.dither, sampling: c.sampling, ..Frame::new(w, h) };
-    let r = render_with(&tracer, &frame, false)?;
+    let r = render_band(&tracer, &frame, false)?;
     Ok(Shot { gray: r.gray, bits: r.bits, rays: r.stats.total_rays(), time: r.elapsed })
 }
 
