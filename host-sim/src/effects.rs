@@ -2,10 +2,9 @@
 //! time, Cortex-M instructions and flash, and what the contribution cutoff (Hall and
 //! Greenberg's adaptive tree depth) saves and costs. Writes `docs/effects.md`.
 
-use crate::load::{object_storage, parse_scene, read, LatticeBufs};
-use crate::run::render_band;
+use crate::load::{object_storage, parse_scene, read, render_text};
 use anyhow::{Context, Result};
-use lattice_rt::{Effects, Frame, LatticeConfig, Stats, Tracer};
+use lattice_rt::{Effects, Frame, Stats};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -18,17 +17,12 @@ struct Shot {
 }
 
 fn shoot(path: &Path, text: &str, all: bool, cutoff: f64) -> Result<Shot> {
-    let mut storage = object_storage::<f64>(text);
-    let scene = parse_scene::<f64>(path, text, &mut storage)?;
-    let cfg = LatticeConfig::default();
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
-    let lattice = bufs.build(&scene, &cfg)?;
-    let mut tracer = Tracer::new(&scene, &lattice);
-    if all {
-        tracer.effects = Effects(Effects::ALL);
-    }
-    tracer.cutoff = cutoff;
-    let r = render_band(&tracer, &Frame::new(128, 64), false)?;
+    let r = render_text::<f64>(path, text, &Frame::new(128, 64), |t| {
+        if all {
+            t.effects = Effects(Effects::ALL);
+        }
+        t.cutoff = cutoff;
+    })?;
     Ok(Shot { bits: r.bits, stats: r.stats, time: r.elapsed })
 }
 

@@ -2,10 +2,9 @@
 //! `-icount shift=0`, checks every frame bit for bit against the same render on the host,
 //! measures flash, RAM and instructions per frame, and writes `docs/firmware.md`.
 
-use crate::load::{object_storage, parse_scene, read};
-use crate::run::render_with;
+use crate::load::{read, render_text};
 use anyhow::{bail, Context, Result};
-use lattice_rt::{Frame, LatticeConfig, Tracer};
+use lattice_rt::Frame;
 use object::{Object, ObjectSection, SectionFlags};
 use std::fmt::Write as _;
 use std::io::Read;
@@ -230,13 +229,7 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
 /// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R`.
 fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str) -> Result<Vec<u8>> {
     let path = scenes.join(format!("{name}.scene"));
-    let text = read(&path)?;
-    let mut storage = object_storage::<R>(&text);
-    let scene = parse_scene::<R>(&path, &text, &mut storage)?;
-    let cfg = LatticeConfig::default();
-    let mut bufs = crate::load::LatticeBufs::for_scene(&scene, &cfg);
-    let lattice = bufs.build(&scene, &cfg)?;
-    Ok(render_with(&Tracer::new(&scene, &lattice), &Frame::new(128, 64), false)?.bits)
+    Ok(render_text::<R>(&path, &read(&path)?, &Frame::new(128, 64), |_| {})?.bits)
 }
 
 /// [`host_frame_in`] for a scalar named as in [`SCALARS`].

@@ -52,3 +52,21 @@ impl<R: Real> LatticeBufs<R> {
         Lattice::build(scene, cfg, storage).map_err(|e| anyhow!("{e}"))
     }
 }
+
+/// Parses scene text, builds its default lattice and renders `frame` on one core, after
+/// `tune` has adjusted the tracer (depth, cutoff, effects).
+pub fn render_text<R: Real>(
+    path: &Path,
+    text: &str,
+    frame: &lattice_rt::Frame,
+    tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, Lattice<'_, R>>),
+) -> Result<crate::run::Rendered> {
+    let mut storage = object_storage::<R>(text);
+    let scene = parse_scene::<R>(path, text, &mut storage)?;
+    let cfg = LatticeConfig::default();
+    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+    let lattice = bufs.build(&scene, &cfg)?;
+    let mut tracer = lattice_rt::Tracer::new(&scene, &lattice);
+    tune(&mut tracer);
+    crate::run::render_band(&tracer, frame, false)
+}

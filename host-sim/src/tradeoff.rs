@@ -2,8 +2,7 @@
 //! (f64, the scene's depth, no cutoff, one ray per pixel, Bayer), measures the error against a
 //! reference (f64, 4x4 rays per pixel) and the cost, and writes `docs/accuracy.md` and a plot.
 
-use crate::load::{object_storage, parse_scene, read, LatticeBufs};
-use crate::run::render_band;
+use crate::load::{object_storage, parse_scene, read, render_text, LatticeBufs};
 use anyhow::{Context, Result};
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Rgb888;
@@ -72,18 +71,13 @@ struct Shot {
 }
 
 fn shoot_in<R: Real>(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Result<Shot> {
-    let mut storage = object_storage::<R>(text);
-    let scene = parse_scene::<R>(path, text, &mut storage)?;
-    let cfg = LatticeConfig::default();
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
-    let lattice = bufs.build(&scene, &cfg)?;
-    let mut tracer = Tracer::new(&scene, &lattice);
-    if let Some(d) = c.depth {
-        tracer.max_depth = d;
-    }
-    tracer.cutoff = R::from_f64(c.cutoff);
     let frame = Frame { dither: c.dither, sampling: c.sampling, ..Frame::new(w, h) };
-    let r = render_band(&tracer, &frame, false)?;
+    let r = render_text::<R>(path, text, &frame, |t| {
+        if let Some(d) = c.depth {
+            t.max_depth = d;
+        }
+        t.cutoff = R::from_f64(c.cutoff);
+    })?;
     Ok(Shot { gray: r.gray, bits: r.bits, rays: r.stats.total_rays(), time: r.elapsed })
 }
 
