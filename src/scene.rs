@@ -273,7 +273,7 @@ impl fmt::Display for SceneError {
             SceneError::SingularTransform => write!(f, "transform is singular (zero or near-zero scale)"),
             SceneError::NotFinite => write!(f, "number is not finite"),
             SceneError::OutOfRange { limit, scalar } => {
-                write!(f, "coordinate out of range for {scalar}: magnitude must stay below {limit:e}")
+                write!(f, "coordinate out of range for {scalar}: magnitude must stay below {}", Round(*limit))
             }
             SceneError::NonPositiveSize => write!(f, "size must be positive"),
             SceneError::BadCoefficient => {
@@ -288,13 +288,37 @@ impl fmt::Display for SceneError {
             SceneError::ObjectOutOfRange { object, reach, limit, scalar } => write!(
                 f,
                 "object {object} is too small for this scene in {scalar}: its own coordinates reach \
-                 {reach:.0} inside the world box, the limit is {limit:.0} (make it larger or the scene smaller)"
+                 {} inside the world box, the limit is {} (make it larger or the scene smaller)",
+                Round(*reach),
+                Round(*limit)
             ),
         }
     }
 }
 
 impl core::error::Error for SceneError {}
+
+/// A non-negative number shown rounded, with integer formatting only (`8192`, `1e15`): core's
+/// float formatting would add about 12 KB to every firmware image for two error messages.
+struct Round(f64);
+
+impl fmt::Display for Round {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut v = self.0.abs();
+        if !v.is_finite() {
+            return write!(f, "inf");
+        }
+        if v < 1e6 {
+            return write!(f, "{}", (v + 0.5) as u64);
+        }
+        let mut e = 0;
+        while v >= 10.0 {
+            v /= 10.0;
+            e += 1;
+        }
+        write!(f, "{}e{e}", (v + 0.5) as u64)
+    }
+}
 
 /// A validated scene, ready to trace.
 #[derive(Debug)]
