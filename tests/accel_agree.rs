@@ -1,10 +1,11 @@
 //! Lattice, bounding-box and brute force answer every ray identically (object and `t`, bit
 //! for bit), on random scenes and adversarial rays, in every float scalar.
 
+mod common;
+use common::{build_lattice, lattice_bufs};
 use lattice_rt::generate::{random_scene, RandomScene, Rng};
-use lattice_rt::lattice::{Grid, LatticeSizes};
 use lattice_rt::scene::Object;
-use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, LatticeStorage, Query, Ray, Real, Scene, SceneBuilder, Vec3};
+use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, Query, Ray, Real, Scene, SceneBuilder, Vec3};
 use proptest::prelude::*;
 
 /// Rays aimed to hurt: random, axis-aligned with +0.0/-0.0 components, starting on lattice
@@ -56,20 +57,13 @@ fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &m
     rays
 }
 
-fn build<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, bufs: &mut (Vec<Grid<R>>, Vec<R>, Vec<u32>, Vec<u32>)) {
-    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(scene, cfg);
-    *bufs = (vec![Grid::EMPTY; grids], vec![R::ZERO; coords], vec![0; cells], vec![0; refs]);
-}
-
 fn check<R: Real>(p: &RandomScene, cfg: &LatticeConfig, nrays: usize) -> Result<(), TestCaseError> {
     let mut storage = vec![Object::<R>::default(); p.objects];
     let mut b = SceneBuilder::new(&mut storage);
     random_scene(&mut b, p).unwrap();
     let scene = b.finish().unwrap();
-    let mut bufs = Default::default();
-    build(&scene, cfg, &mut bufs);
-    let (g, c, ce, r) = &mut bufs;
-    let lat = Lattice::build(&scene, cfg, LatticeStorage { grids: g, coords: c, cells: ce, refs: r }).unwrap();
+    let mut bufs = lattice_bufs(&scene, cfg);
+    let lat = build_lattice(&scene, cfg, &mut bufs);
     let mut rng = Rng::new(p.seed ^ 0xABCD);
     let rays = adversarial_rays(&lat, &scene, &mut rng, nrays);
     let mut mb = vec![0; Query::mailbox_len(&scene)];

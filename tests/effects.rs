@@ -62,7 +62,7 @@ fn a_tracer_without_refraction_refuses_glass() {
     let mut storage = vec![Object::<f64>::default(); 64];
     let scene = parse::<f64>(&text, &mut storage).unwrap();
     let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &mut bufs);
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     const MATTE: u8 = Effects::SHADOWS | Effects::COMPOSITES;
     let err = Tracer::<_, _, MATTE>::compiled(&scene, &lat).unwrap_err();
     assert_eq!(err, MissingEffects(Effects(Effects::REFLECTION | Effects::REFRACTION)));
@@ -76,7 +76,7 @@ fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
         let mut storage = vec![Object::<f64>::default(); 64];
         let scene = parse::<f64>(&text, &mut storage).unwrap();
         let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
-        let lat = build_lattice(&scene, &mut bufs);
+        let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
         let frame = Frame::new(160, 100);
         let derived = Tracer::new(&scene, &lat);
         let mut all = Tracer::new(&scene, &lat);
@@ -94,7 +94,7 @@ fn a_one_level_cutoff_prunes_the_whitted_tree_and_barely_changes_the_frame() {
     let mut storage = vec![Object::<f64>::default(); 64];
     let scene = parse::<f64>(&text, &mut storage).unwrap();
     let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &mut bufs);
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let frame = Frame::new(128, 64);
     let exact = Tracer::new(&scene, &lat);
     let mut pruned = Tracer::new(&scene, &lat);

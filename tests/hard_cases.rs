@@ -4,12 +4,12 @@
 
 mod common;
 use common::*;
-use lattice_rt::lattice::{LatticeSizes, Resolution};
+use lattice_rt::lattice::Resolution;
 use lattice_rt::scene::Object;
 use lattice_rt::shape::Shape;
 use lattice_rt::trace::{facing, refract};
 use lattice_rt::{
-    parse, Accelerator, BoundingBox, BruteForce, Effects, Frame, Fx, Lattice, LatticeConfig, LatticeStorage, Query, Ray,
+    parse, Accelerator, BoundingBox, BruteForce, Effects, Frame, Fx, LatticeConfig, Query, Ray,
     Real, Scene, Tracer, Vec3,
 };
 
@@ -32,9 +32,8 @@ fn scene_in<'a, R: Real>(text: &str, storage: &'a mut Vec<Object<R>>) -> Scene<'
 
 /// Calls `f` with each accelerator over the scene (a lattice with `cfg`).
 fn with_accels<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut f: impl FnMut(&str, &dyn Accelerator<R>)) {
-    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(scene, cfg);
-    let (mut g, mut c, mut ce, mut r) = (vec![lattice_rt::lattice::Grid::EMPTY; grids], vec![R::ZERO; coords], vec![0; cells], vec![0; refs]);
-    let lat = Lattice::build(scene, cfg, LatticeStorage { grids: &mut g, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap();
+    let mut bufs = lattice_bufs(scene, cfg);
+    let lat = build_lattice(scene, cfg, &mut bufs);
     f("lattice", &lat);
     f("bbox", &BoundingBox);
     f("brute", &BruteForce);
@@ -262,9 +261,8 @@ fn long_walk_does_not_drift<R: Real>() {
     let mut st = Vec::new();
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([1000, 1000, 1]), ..LatticeConfig::default() };
-    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(&scene, &cfg);
-    let (mut g, mut c, mut ce, mut r) = (vec![lattice_rt::lattice::Grid::EMPTY; grids], vec![R::ZERO; coords], vec![0; cells], vec![0; refs]);
-    let lat = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap();
+    let mut bufs = lattice_bufs(&scene, &cfg);
+    let lat = build_lattice(&scene, &cfg, &mut bufs);
     let ray = Ray::new(v::<R>(0.37, 0.11, 0.5), v::<R>(0.8, 0.6, 0.0));
     let mut walked = Vec::new();
     lat.walk_cells(&ray, R::ZERO, R::MAX, |c, _, _| walked.push((c[0], c[1])));

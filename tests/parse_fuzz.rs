@@ -29,7 +29,7 @@ fn check<R: Real>(text: &str) -> Result<(), TestCaseError> {
                 return Ok(());
             }
             let mut bufs = lattice_bufs(&scene, &cfg);
-            let lat = build_lattice(&scene, &mut bufs);
+            let lat = build_lattice(&scene, &cfg, &mut bufs);
             let mut mb = vec![0; Query::mailbox_len(&scene)];
             let mut q = Query::new(&mut mb);
             for (x, y) in [(1, 1), (7, 3), (15, 9), (9, 5)] {

@@ -23,7 +23,7 @@ fn gray(sampling: Sampling) -> (Vec<u8>, u64) {
     let mut storage = vec![Object::<f64>::default(); 16];
     let scene = parse::<f64>(&text, &mut storage).unwrap();
     let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &mut bufs);
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let frame = Frame { sampling, ..Frame::new(128, 64) };
     let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
     let mut target = BitFrame::new(128, 64, &mut bits).unwrap();

@@ -37,9 +37,10 @@ pub fn lattice_bufs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Bufs<
     Bufs { grids: vec![Grid::EMPTY; grids], coords: vec![R::ZERO; coords], cells: vec![0; cells], refs: vec![0; refs] }
 }
 
-pub fn build_lattice<'a, R: Real>(scene: &Scene<'_, R>, b: &'a mut Bufs<R>) -> Lattice<'a, R> {
+/// Builds the lattice with `cfg` in storage from [`lattice_bufs`] with the same `cfg`.
+pub fn build_lattice<'a, R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: &'a mut Bufs<R>) -> Lattice<'a, R> {
     let st = LatticeStorage { grids: &mut b.grids, coords: &mut b.coords, cells: &mut b.cells, refs: &mut b.refs };
-    Lattice::build(scene, &LatticeConfig::default(), st).expect("lattice fits")
+    Lattice::build(scene, cfg, st).expect("lattice fits")
 }
 
 /// Renders with a tracer already set up; returns the PBM bytes and the statistics.
@@ -59,7 +60,7 @@ pub fn render_text<R: Real>(text: &str, accel: Accel, frame: &Frame) -> (Vec<u8>
     let mut storage = vec![Object::<R>::default(); text.lines().count()];
     let scene = parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{e}"));
     let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &mut bufs);
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let a: &dyn Accelerator<R> = match accel {
         Accel::Lattice => &lat,
         Accel::Bbox => &BoundingBox,
