@@ -24,8 +24,14 @@ impl<'b> BitFrame<'b> {
     }
     /// A cleared frame over `bits`, or `None` if `bits` is shorter than [`BitFrame::bytes`].
     pub fn new(width: u32, height: u32, bits: &'b mut [u8]) -> Option<Self> {
+        let f = Self::wrap(width, height, bits)?;
+        f.bits.iter_mut().for_each(|b| *b = 0);
+        Some(f)
+    }
+    /// A frame over a raster that already holds an image (rows packed as [`BitFrame::raster`]
+    /// gives them), or `None` if `bits` is shorter than [`BitFrame::bytes`].
+    pub fn wrap(width: u32, height: u32, bits: &'b mut [u8]) -> Option<Self> {
         let bits = bits.get_mut(..Self::bytes(width, height))?;
-        bits.iter_mut().for_each(|b| *b = 0);
         Some(BitFrame { width, height, bits })
     }
     /// The packed rows (the raster of a `P4` PBM).

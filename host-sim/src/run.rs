@@ -190,9 +190,8 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let mut storage = object_storage::<R>(&text);
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let frame = Frame { tile: a.tile, dither: a.dither.mode(), sampling: a.sampling.mode(), ..Frame::new(a.size.0, a.size.1) };
-    let out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true, true)?;
-    let mut store = vec![0u8; out.bits.len()];
-    let frame_bits = bitframe_from(&mut store, &frame, &out.bits);
+    let mut out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true, true)?;
+    let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
     write_png(&frame_bits, &a.output, a.theme, a.scale)?;
     println!("wrote {}", a.output.display());
     if let Some(p) = &a.pbm {
@@ -205,21 +204,6 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     }
     print_stats(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel_name()), &out.stats, out.elapsed);
     Ok(())
-}
-
-/// A `BitFrame` over `store` holding the packed bits `bits`.
-pub fn bitframe_from<'b>(store: &'b mut [u8], frame: &Frame, bits: &[u8]) -> BitFrame<'b> {
-    let mut f = BitFrame::new(frame.width as u32, frame.height as u32, store).expect("sized by render");
-    use embedded_graphics::prelude::*;
-    let stride = (frame.width as usize).div_ceil(8);
-    let pixels = (0..frame.height as i32).flat_map(|y| {
-        (0..frame.width as i32).map(move |x| {
-            let on = bits[y as usize * stride + x as usize / 8] & (0x80 >> (x % 8)) != 0;
-            Pixel(Point::new(x, y), embedded_graphics::pixelcolor::BinaryColor::from(on))
-        })
-    });
-    let _ = f.draw_iter(pixels);
-    f
 }
 
 impl RenderArgs {
@@ -333,9 +317,8 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
         let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
         for (w, h) in [(160u16, 100u16), (128, 64)] {
             let frame = Frame::new(w, h);
-            let r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true, true)?;
-            let mut store = vec![0u8; r.bits.len()];
-            let f = bitframe_from(&mut store, &frame, &r.bits);
+            let mut r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true, true)?;
+            let f = BitFrame::wrap(w as u32, h as u32, &mut r.bits).expect("sized by render");
             let png = out.join(format!("{name}-{w}x{h}.png"));
             write_png(&f, &png, Theme::Paper, 3)?;
             write_pbm(&f, &out.join(format!("{name}-{w}x{h}.pbm")))?;
