@@ -2,8 +2,9 @@
 //! `memory.x`; the emulated board's is `qemu/memory.x`), the linker scripts, and the scenes
 //! embedded in the firmware.
 //!
-//! Scenes: `FIRMWARE_SCENES` (comma-separated names from `scenes/`, default the paper's four
-//! and the Whitted showcase). Each is parsed here with the core itself, in the firmware's
+//! Scenes: `FIRMWARE_SCENES` (comma-separated names from `scenes/`), or the list in
+//! `default-scenes.txt` (the paper's four and the Whitted showcase; `host-sim board` reads it
+//! too, to know which frames the image shows). Each is parsed here with the core itself, in the firmware's
 //! scalar, so a broken scene fails the build with its line and column, and the storage
 //! capacities are the exact maximum the chosen scenes need (written to `capacities.rs`).
 use lattice_rt::lattice::{Lattice, LatticeConfig, LatticeSizes};
@@ -12,7 +13,6 @@ use lattice_rt::Real;
 use std::fmt::Write as _;
 use std::{env, fs, path::PathBuf};
 
-const DEFAULT_SCENES: &str = "chair,desk,polyhedron,spheres,whitted";
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
@@ -27,8 +27,16 @@ fn main() {
     if pico {
         println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
     }
+    // defmt drops everything below `error` unless DEFMT_LOG says otherwise; the repository's
+    // `.cargo/config.toml` sets it, but only for builds started inside the repository. The
+    // firmware's own log lines show at `info` however and wherever it is built.
+    println!("cargo:rerun-if-env-changed=DEFMT_LOG");
+    if env::var_os("DEFMT_LOG").is_none() {
+        println!("cargo:rustc-env=DEFMT_LOG=info");
+    }
 
-    let names = env::var("FIRMWARE_SCENES").unwrap_or_else(|_| DEFAULT_SCENES.to_string());
+    println!("cargo:rerun-if-changed=default-scenes.txt");
+    let names = env::var("FIRMWARE_SCENES").unwrap_or_else(|_| fs::read_to_string("default-scenes.txt").expect("default-scenes.txt"));
     let mut list = String::new();
     let (mut objects, mut groups, mut grids, mut coords, mut cells, mut refs) = (1, 0, 1, 1, 1, 1);
     let mut effects = 0u8;

@@ -121,7 +121,7 @@ fn build(root: &Path, v: &Variant) -> Result<()> {
 
 /// Flash bytes (every allocated section with contents, `.data` counted at its load address)
 /// and static RAM bytes (`.data`, `.bss`, `.uninit`).
-fn sizes(elf: &Path) -> Result<(u64, u64)> {
+pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
     let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file = object::File::parse(&*data)?;
     let (mut flash, mut ram) = (0, 0);
@@ -233,7 +233,7 @@ fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str) -> Result<Vec<u
 }
 
 /// [`host_frame_in`] for a scalar named as in [`SCALARS`].
-fn host_frame(scenes: &Path, name: &str, scalar: &str) -> Result<Vec<u8>> {
+pub fn host_frame(scenes: &Path, name: &str, scalar: &str) -> Result<Vec<u8>> {
     match scalar {
         "fixed" => host_frame_in::<lattice_rt::Fx>(scenes, name),
         "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(scenes, name),
@@ -255,7 +255,7 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
             build(root, v)?;
         }
         let elf = elf_path(root, v);
-        let (flash, _) = sizes(&elf)?;
+        let (flash, _) = elf_sizes(&elf)?;
         let run = match v.machine {
             Some(m) => {
                 eprintln!("  running {} on {m}", v.name);
@@ -311,7 +311,7 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
         for (v, r) in &runs {
             if let Some(s) = r.scenes.iter().find(|s| &s.name == scene) {
                 let board = if v.target.starts_with("thumbv6m") { "m0" } else { "m4f" };
-                let flash = sizes(&elf_path(root, v)).map(|f| f.0).unwrap_or(0);
+                let flash = elf_sizes(&elf_path(root, v)).map(|f| f.0).unwrap_or(0);
                 csv.push_str(&format!("{scene},{},{board},{},{},{},{flash}\n", v.scalar, s.ticks * INSTRUCTIONS_PER_TICK, s.rays, v.name));
             }
         }

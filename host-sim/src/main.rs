@@ -2,6 +2,7 @@
 //! statistics, and (with no arguments) renders the paper's four scenes into `out/`.
 
 mod bench;
+mod board;
 mod effects;
 mod firmware;
 mod load;
@@ -119,6 +120,30 @@ enum Command {
         /// Use the firmware already built instead of building it.
         #[arg(long)]
         no_build: bool,
+    },
+    /// Run the Pico image (the one `cargo pico` flashes) on an emulated RP2040 with an SSD1306:
+    /// every frame must match host-sim bit for bit; writes the board's budgets to a report.
+    ///
+    /// Needs Node.js (rp2040js is installed from firmware/board/package-lock.json), python3 and
+    /// PyPI (for the RP2040 bootrom), and flip-link (`cargo install flip-link`).
+    Board {
+        /// Report to write.
+        #[arg(long, default_value = "docs/board.md")]
+        out: PathBuf,
+        /// Folder for the UF2 file that was run, the frames the panel showed (PNG), and, when a
+        /// frame differs, host-sim's frame and a picture of the difference.
+        #[arg(long, default_value = "target/board")]
+        frames: PathBuf,
+        /// Use the image already built instead of running `cargo pico-build`.
+        #[arg(long)]
+        no_build: bool,
+    },
+    /// Build the Pico image and write it as a UF2 file, for flashing without a probe: hold
+    /// BOOTSEL while plugging the Pico in and copy the file onto the RPI-RP2 drive.
+    Uf2 {
+        /// UF2 file to write.
+        #[arg(short, long, default_value = "out/lattice-rt-pico.uf2")]
+        output: PathBuf,
     },
 }
 
@@ -343,6 +368,8 @@ fn real_main() -> Result<()> {
         Some(Command::Bench { quick, runs, out, plot }) => bench::bench_cmd(quick, runs, &out, &plot),
         Some(Command::Effects { scenes, runs, out, firmware_csv }) => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
         Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
+        Some(Command::Board { out, frames, no_build }) => board::board_cmd(&std::env::current_dir()?, &out, &frames, no_build),
+        Some(Command::Uf2 { output }) => board::uf2_cmd(&std::env::current_dir()?, &output),
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),
             Scalar::F32 => run::stats_cmd::<f32>(&a),

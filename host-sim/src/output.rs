@@ -95,3 +95,16 @@ pub fn write_gray_png(width: u32, height: u32, levels: &[u8], path: &Path, scale
         .save_png(path)
         .with_context(|| format!("cannot write {}", path.display()))
 }
+
+/// Writes `bytes` to `path` through a temporary file in the same folder, renamed into place
+/// once complete, so a failed write never leaves a partial file behind.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    create_parent(path)?;
+    let name = path.file_name().with_context(|| format!("{} names no file", path.display()))?;
+    let tmp = path.with_file_name(format!(".{}.tmp", name.to_string_lossy()));
+    std::fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("cannot write {}", path.display())
+    })
+}

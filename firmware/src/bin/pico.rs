@@ -2,6 +2,11 @@
 //! tile straight to the display (each 8x8 tile is one SSD1306 page high, so it is sent as eight
 //! column bytes; no framebuffer), and logs per-frame time and statistics over defmt-rtt.
 //!
+//! The on-board LED (GP25) is lit while a frame is being rendered and goes out when the frame is
+//! on the display; between scenes the core sleeps (`wfi`) until a timer alarm. With no display
+//! answering, the log says so and the LED blinks quickly while the firmware retries every second.
+//! `host-sim board` runs this image in an RP2040 emulator and relies on that LED protocol.
+//!
 //! Wiring (change it here, in `Wiring` below, and nowhere else): SDA on GP4, SCL on GP5,
 //! display address 0x3C, VCC on 3V3(OUT), GND on GND.
 #![no_std]
@@ -16,8 +21,11 @@ use embedded_graphics_core::Pixel;
 use firmware::app::{render_scene, Scalar, Storage, HEIGHT, SCENES, WIDTH};
 use firmware::stack;
 use hal::fugit::RateExtU32;
+use hal::Clock;
 use hal::pac;
-use lattice_rt::render::Hooks;
+use hal::pac::interrupt;
+use embedded_hal::digital::OutputPin;
+use lattice_rt::NoHooks;
 use panic_probe as _;
 use rp2040_hal as hal;
 use ssd1306::mode::BasicMode;
@@ -67,21 +75,90 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
                 cols[i % w] |= 1 << (i / w);
             }
         }
-        let page = (y0 / 8) as u8;
-        self.display.set_draw_area((x0 as u8, page), ((x0 as usize + w) as u8, page + 1))?;
+        // `set_draw_area` takes pixel coordinates (it divides rows by 8 into pages itself).
+        let (x1, y1) = ((x0 as usize + w) as u8, (y0 as usize + h) as u8);
+        self.display.set_draw_area((x0 as u8, y0 as u8), (x1, y1))?;
         self.display.draw(&cols[..w])
     }
 }
 
-/// Logs progress every few tiles (the display shows it anyway).
-struct Progress;
-impl Hooks for Progress {}
+/// I2C0 that reports a device that does not answer. rp2040-hal 0.12 checks the controller's
+/// abort flags only while a write waits for room in the 16-byte TX FIFO, so a shorter write to
+/// an address nobody acknowledges (every SSD1306 command is one) returns `Ok` and the display
+/// seems to be there. This reads the abort source after each transaction, as the hardware
+/// leaves it once the STOP has gone out.
+struct CheckedI2c<P>(hal::I2C<pac::I2C0, P>);
+
+impl<P> embedded_hal::i2c::ErrorType for CheckedI2c<P> {
+    type Error = hal::i2c::Error;
+}
+
+impl<P> embedded_hal::i2c::I2c for CheckedI2c<P>
+where
+    hal::I2C<pac::I2C0, P>: embedded_hal::i2c::I2c<Error = hal::i2c::Error>,
+{
+    fn transaction(&mut self, address: u8, operations: &mut [embedded_hal::i2c::Operation<'_>]) -> Result<(), Self::Error> {
+        self.0.transaction(address, operations)?;
+        // SAFETY: I2C0 belongs to `self.0`, and no transaction is under way; reading
+        // IC_TX_ABRT_SOURCE has no side effect, reading IC_CLR_TX_ABRT clears the abort (and
+        // releases the TX FIFO) exactly as the HAL itself does after an abort it noticed.
+        #[allow(unsafe_code)]
+        let regs = unsafe { &*pac::I2C0::ptr() };
+        let reason = regs.ic_tx_abrt_source().read().bits();
+        if reason != 0 {
+            regs.ic_clr_tx_abrt().read();
+            return Err(hal::i2c::Error::Abort(reason));
+        }
+        Ok(())
+    }
+}
+
+/// The pause between two scenes.
+const PAUSE_MS: u32 = 3000;
+
+/// Sleeps (`wfi`) until `alarm` has run `ms` milliseconds, instead of spinning: the core draws
+/// less power, and an emulator skips the idle time. The check and the `wfi` run with interrupts
+/// masked, so an alarm that fires between them still ends the `wfi` (a pending interrupt wakes
+/// the core whatever PRIMASK says); [`TIMER_IRQ_0`] then clears it.
+fn sleep_ms(alarm: &mut hal::timer::Alarm0, ms: u32) {
+    use hal::timer::Alarm;
+    if alarm.schedule(hal::fugit::MicrosDurationU32::millis(ms)).is_err() {
+        return;
+    }
+    alarm.enable_interrupt();
+    // SAFETY: TIMER_IRQ_0's handler touches nothing but the alarm's own interrupt flag, so
+    // enabling it cannot break any critical section or data the main loop holds.
+    #[allow(unsafe_code)]
+    unsafe {
+        pac::NVIC::unmask(pac::Interrupt::TIMER_IRQ_0)
+    };
+    while !cortex_m::interrupt::free(|_| {
+        let done = alarm.finished();
+        if !done {
+            cortex_m::asm::wfi();
+        }
+        done
+    }) {}
+    pac::NVIC::mask(pac::Interrupt::TIMER_IRQ_0);
+    alarm.disable_interrupt();
+}
+
+/// Alarm 0 has fired: clear its interrupt (the main loop only needed to wake up).
+#[interrupt]
+fn TIMER_IRQ_0() {
+    // SAFETY: a write-1-to-clear of alarm 0's bit in TIMER.INTR; no other code writes INTR
+    // while this alarm is armed, and the write is a single atomic store.
+    #[allow(unsafe_code)]
+    unsafe {
+        (*pac::TIMER::ptr()).intr().write(|w| w.alarm_0().clear_bit_by_one())
+    };
+}
 
 #[hal::entry]
 fn main() -> ! {
     let mut pac = pac::Peripherals::take().unwrap();
     let mut watchdog = hal::Watchdog::new(pac.WATCHDOG);
-    let clocks = hal::clocks::init_clocks_and_plls(
+    let Ok(clocks) = hal::clocks::init_clocks_and_plls(
         XTAL_FREQ_HZ,
         pac.XOSC,
         pac.CLOCKS,
@@ -89,29 +166,42 @@ fn main() -> ! {
         pac.PLL_USB,
         &mut pac.RESETS,
         &mut watchdog,
-    )
-    .ok()
-    .unwrap();
+    ) else {
+        defmt::panic!("the clocks did not start (crystal or PLL)");
+    };
     let sio = hal::Sio::new(pac.SIO);
     let pins = hal::gpio::Pins::new(pac.IO_BANK0, pac.PADS_BANK0, sio.gpio_bank0, &mut pac.RESETS);
     // Wiring: the two pins and the address of the display.
     let sda = pins.gpio4.reconfigure::<hal::gpio::FunctionI2C, hal::gpio::PullUp>();
     let scl = pins.gpio5.reconfigure::<hal::gpio::FunctionI2C, hal::gpio::PullUp>();
     let i2c = hal::I2C::i2c0(pac.I2C0, sda, scl, I2C_HZ.Hz(), &mut pac.RESETS, &clocks.system_clock);
-    let interface = I2CDisplayInterface::new(i2c); // address 0x3C; new_alternate_address() for 0x3D
-    let timer = hal::Timer::new(pac.TIMER, &mut pac.RESETS, &clocks);
+    let interface = I2CDisplayInterface::new(CheckedI2c(i2c)); // address 0x3C; new_alternate_address() for 0x3D
+    let mut led = pins.gpio25.into_push_pull_output();
+    let mut timer = hal::Timer::new(pac.TIMER, &mut pac.RESETS, &clocks);
+    let Some(mut alarm) = timer.alarm_0() else {
+        defmt::panic!("timer alarm 0 is taken");
+    };
 
     let mut display = Ssd1306::new(interface, DisplaySize128x64, DisplayRotation::Rotate0);
-    if display.init().is_err() {
-        defmt::panic!("no SSD1306 answers on I2C0 (GP4 SDA, GP5 SCL, address 0x3C)");
+    while display.init().is_err() {
+        defmt::error!("no SSD1306 answers on I2C0 (SDA GP4, SCL GP5, address 0x3C): check the wiring; retrying in 1 s");
+        for _ in 0..5 {
+            let _ = led.set_high();
+            sleep_ms(&mut alarm, 100);
+            let _ = led.set_low();
+            sleep_ms(&mut alarm, 100);
+        }
     }
     let mut target = PageTiles { display };
     let mut st = Storage::<Scalar>::new();
-    defmt::info!("lattice-rt on the Pico: {} scenes, {}x{}", SCENES.len(), WIDTH, HEIGHT);
+    defmt::info!("lattice-rt on the Pico: {} scenes, {}x{}, {} MHz", SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz());
     loop {
         for (name, text) in SCENES {
             let t0 = timer.get_counter();
-            match render_scene(text, &mut st, &mut target, &mut Progress) {
+            let _ = led.set_high();
+            let result = render_scene(text, &mut st, &mut target, &mut NoHooks);
+            let _ = led.set_low();
+            match result {
                 Ok(r) => {
                     let ms = (timer.get_counter() - t0).to_millis();
                     let s = r.stats;
@@ -123,8 +213,7 @@ fn main() -> ! {
                 }
                 Err(e) => defmt::error!("{}: {}", name, defmt::Display2Format(&e)),
             }
-            let t1 = timer.get_counter();
-            while (timer.get_counter() - t1).to_millis() < 3000 {}
+            sleep_ms(&mut alarm, PAUSE_MS);
         }
     }
 }

@@ -1,0 +1,271 @@
+#!/usr/bin/env node
+// Runs the Pico image a user flashes (its UF2 file) on rp2040js, core 0 of an RP2040 with the
+// B1 bootrom, with an SSD1306 on I2C0 at 0x3C, and reports on stdout, one JSON object a line:
+//   {"event":"frame", ...}  each frame the panel shows: the moment the board's LED (GP25, lit
+//                           while a frame is being rendered) goes out, with the cycles and
+//                           instructions the frame took and the panel's pixels as hex rows
+//   {"event":"end", ...}    why the run ended, with totals
+// The device's defmt log (the RTT up channel, read as a probe reads it) goes to --log as raw
+// bytes for `host-sim board` to decode. Exit code 0 when the run ended as asked, 1 otherwise.
+//
+// rp2040js has no SSI flash model, so the run starts at boot2 (PC = 0x10000000) with the
+// bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2.
+//
+// Usage: node run.mjs --uf2 FILE --bootrom FILE --rtt ADDR --log FILE
+//                     [--frames N] [--max-cycles N] [--no-display] [--until-ms T]
+import { readFileSync, writeFileSync } from 'node:fs';
+import { RP2040, GPIOPinState } from 'rp2040js';
+import { Ssd1306 } from './ssd1306.mjs';
+
+const FLASH = 0x10000000;
+const LED_PIN = 25;
+
+function parseArgs(argv) {
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null };
+  for (let i = 2; i < argv.length; i++) {
+    const a = argv[i];
+    const next = () => {
+      if (i + 1 >= argv.length) throw new Error(`${a} needs a value`);
+      return argv[++i];
+    };
+    if (a === '--uf2') o.uf2 = next();
+    else if (a === '--bootrom') o.bootrom = next();
+    else if (a === '--rtt') o.rtt = Number(next());
+    else if (a === '--log') o.log = next();
+    else if (a === '--frames') o.frames = Number(next());
+    else if (a === '--max-cycles') o.maxCycles = Number(next());
+    else if (a === '--until-ms') o.untilMs = Number(next());
+    else if (a === '--no-display') o.display = false;
+    else throw new Error(`unknown argument ${a}`);
+  }
+  for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
+  if (!Number.isInteger(o.rtt)) throw new Error('--rtt ADDR (the _SEGGER_RTT symbol) is required');
+  return o;
+}
+
+/** Writes the blocks of a UF2 file (microsoft/uf2) into flash; returns the bytes written. */
+function loadUf2(mcu, data) {
+  let written = 0;
+  for (let off = 0; off + 512 <= data.length; off += 512) {
+    const v = new DataView(data.buffer, data.byteOffset + off, 512);
+    if (v.getUint32(0, true) !== 0x0a324655 || v.getUint32(4, true) !== 0x9e5d5157 || v.getUint32(508, true) !== 0x0ab16f30) {
+      throw new Error(`UF2 block at byte ${off}: bad magic`);
+    }
+    const flags = v.getUint32(8, true);
+    if (flags & 1) continue; // not for the main flash
+    if ((flags & 0x2000) && v.getUint32(28, true) !== 0xe48bff56) throw new Error(`UF2 block at byte ${off}: not for the RP2040 family`);
+    const addr = v.getUint32(12, true);
+    const size = v.getUint32(16, true);
+    if (addr < FLASH || addr + size > FLASH + mcu.flash.length || size > 476) throw new Error(`UF2 block at byte ${off}: ${size} bytes at ${addr.toString(16)} outside the flash`);
+    mcu.flash.set(data.subarray(off + 32, off + 32 + size), addr - FLASH);
+    written += size;
+  }
+  if (written === 0) throw new Error('UF2 file holds no flash blocks');
+  return written;
+}
+
+/** Reads what the firmware wrote to the RTT up channel since the last call, as a probe does. */
+class RttReader {
+  constructor(mcu, address) {
+    this.mcu = mcu;
+    this.address = address;
+    this.chunks = [];
+    this.bytes = 0;
+  }
+  poll() {
+    const m = this.mcu;
+    const a = this.address;
+    // "SEGGER RTT" id written by the firmware's .data initialisation
+    if (m.readUint32(a) !== 0x47474553) return;
+    const ch = a + 24;
+    const buf = m.readUint32(ch + 4);
+    const size = m.readUint32(ch + 8);
+    const write = m.readUint32(ch + 12);
+    let read = m.readUint32(ch + 16);
+    if (size === 0 || write >= size || read >= size) return;
+    // Block when full, as probe-rs sets it: nothing is lost while the runner keeps reading.
+    if ((m.readUint32(ch + 20) & 3) !== 2) m.writeUint32(ch + 20, (m.readUint32(ch + 20) & ~3) | 2);
+    while (read !== write) {
+      const end = write > read ? write : size;
+      const out = new Uint8Array(end - read);
+      for (let i = 0; i < out.length; i++) out[i] = m.readUint8(buf + read + i);
+      this.chunks.push(out);
+      this.bytes += out.length;
+      read = end % size;
+    }
+    m.writeUint32(ch + 16, read);
+  }
+  save(path) {
+    writeFileSync(path, Buffer.concat(this.chunks.map((c) => Buffer.from(c))));
+  }
+}
+
+const emit = (o) => process.stdout.write(JSON.stringify(o) + '\n');
+const toHex = (bytes) => Buffer.from(bytes).toString('hex');
+
+function main() {
+  const opt = parseArgs(process.argv);
+  const mcu = new RP2040();
+  const bootrom = readFileSync(opt.bootrom);
+  if (bootrom.length !== 16384) throw new Error(`${opt.bootrom}: ${bootrom.length} bytes, a bootrom is 16384`);
+  mcu.loadBootrom(new Uint32Array(bootrom.buffer, bootrom.byteOffset, 4096));
+  const flashBytes = loadUf2(mcu, readFileSync(opt.uf2));
+  const warnings = [];
+  mcu.logger = { debug() {}, info() {}, warn() {}, error: (c, m) => warnings.push(`${c}: ${m}`) };
+
+  // I2C0 with the display model (or nothing: every address NACKs).
+  const display = opt.display ? new Ssd1306(0x3c) : null;
+  const i2c = mcu.i2c[0];
+  let i2cBytes = 0; // bytes after the address byte
+  let i2cTransfers = 0; // address bytes sent (each START or repeated START)
+  let naks = 0;
+  i2c.onStart = () => {
+    display?.start();
+    i2c.completeStart();
+  };
+  i2c.onConnect = (address, mode) => {
+    i2cTransfers++;
+    const ack = display ? display.connect(address, mode === 1) : false;
+    if (!ack) naks++;
+    i2c.completeConnect(ack);
+  };
+  i2c.onWriteByte = (value) => {
+    i2cBytes++;
+    i2c.completeWrite(display ? display.write(value) : false);
+  };
+  i2c.onReadByte = () => i2c.completeRead(0xff);
+  i2c.onStop = () => {
+    display?.stop();
+    i2c.completeStop();
+  };
+
+  const rtt = new RttReader(mcu, opt.rtt);
+  const core = mcu.core;
+  let instructions = 0;
+  let idleNanos = 0;
+  const frames = [];
+  let ledOn = false;
+  let frameStart = null;
+  let firstByteOfFrame = null;
+  let ledToggles = 0;
+  let stop = null;
+  let ok = false;
+  // After the last frame: run on until the core sleeps (it logs the frame first), or at most
+  // DRAIN instructions, so the log holds the last frame's line.
+  let draining = false;
+  let drainLeft = 50_000_000;
+
+  const snapshot = () => ({ cycles: core.cycles, instructions, i2cBytes, i2cTransfers, nanos: mcu.clock.nanos });
+  mcu.gpio[LED_PIN].addListener((state) => {
+    const on = state === GPIOPinState.High;
+    if (on === ledOn) return;
+    ledOn = on;
+    ledToggles++;
+    if (!display) return;
+    if (on) {
+      frameStart = snapshot();
+      firstByteOfFrame = null;
+      return;
+    }
+    if (!frameStart) return;
+    const end = snapshot();
+    const why = display.notShowable();
+    const first = firstByteOfFrame ?? end;
+    const frame = {
+      event: 'frame',
+      index: frames.length,
+      cycles: end.cycles - frameStart.cycles,
+      instructions: end.instructions - frameStart.instructions,
+      setupCycles: first.cycles - frameStart.cycles,
+      setupInstructions: first.instructions - frameStart.instructions,
+      i2cBytes: end.i2cBytes - frameStart.i2cBytes,
+      i2cTransfers: end.i2cTransfers - frameStart.i2cTransfers,
+      startMs: frameStart.nanos / 1e6,
+      endMs: end.nanos / 1e6,
+      error: why,
+      pixels: why ? null : toHex(display.shown()),
+    };
+    frames.push(frame);
+    emit(frame);
+    frameStart = null;
+    if (why) stop = `display: ${why}`;
+    else if (frames.length >= opt.frames) draining = true;
+  });
+  const onByte = i2c.onWriteByte;
+  i2c.onWriteByte = (value) => {
+    if (ledOn && firstByteOfFrame === null) firstByteOfFrame = snapshot();
+    onByte(value);
+  };
+  mcu.onBreak = (code) => {
+    stop = `the core stopped at a breakpoint or undefined instruction (code ${code}) at pc 0x${(core.PC >>> 0).toString(16)}: a panic`;
+  };
+
+  // Start at boot2 with the stack pointer the bootrom would leave.
+  core.SP = mcu.readUint32(0);
+  core.PC = FLASH;
+
+  const untilNanos = opt.untilMs === null ? Infinity : opt.untilMs * 1e6;
+  const nanosPerCycle = () => 1e9 / mcu.clkSys;
+  let nextPoll = 0;
+  while (stop === null) {
+    if (draining && (core.waiting || --drainLeft <= 0)) {
+      stop = `${frames.length} frames shown`;
+      ok = true;
+      break;
+    }
+    if (core.waiting) {
+      const dt = mcu.clock.nanosToNextAlarm;
+      if (!(dt > 0) || !Number.isFinite(dt)) {
+        stop = 'the core sleeps (wfi) with no timer alarm to wake it';
+        break;
+      }
+      mcu.clock.tick(dt);
+      idleNanos += dt;
+      if (mcu.clock.nanos >= untilNanos) nextPoll = 0; // time is up while asleep: check now
+    } else {
+      const c = core.executeInstruction();
+      mcu.clock.tick(c * nanosPerCycle());
+      instructions++;
+    }
+    if (instructions >= nextPoll) {
+      nextPoll = instructions + 200000;
+      rtt.poll();
+      if (core.IPSR === 3) stop = `HardFault at pc 0x${(core.PC >>> 0).toString(16)}`;
+      else if (core.cycles > opt.maxCycles) stop = `no result within ${opt.maxCycles} cycles`;
+      else if (display?.error) stop = `display: ${display.error}`;
+      if (mcu.clock.nanos >= untilNanos) {
+        stop = `${opt.untilMs} ms of emulated time`;
+        ok = true;
+      }
+    }
+  }
+  rtt.poll();
+  rtt.save(opt.log);
+  emit({
+    event: 'end',
+    ok,
+    reason: stop,
+    frames: frames.length,
+    cycles: core.cycles,
+    instructions,
+    emulatedMs: mcu.clock.nanos / 1e6,
+    idleMs: idleNanos / 1e6,
+    clkSysHz: mcu.clkSys,
+    flashBytes,
+    logBytes: rtt.bytes,
+    i2cBytes,
+    naks,
+    ledToggles,
+    displayInitialised: display ? display.everOn : false,
+    displayCommands: display ? display.commands : 0,
+    warnings: warnings.slice(0, 20),
+  });
+  process.exitCode = ok ? 0 : 1;
+}
+
+try {
+  main();
+} catch (e) {
+  emit({ event: 'end', ok: false, reason: String(e.message ?? e) });
+  process.exitCode = 1;
+}

