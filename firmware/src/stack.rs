@@ -6,15 +6,17 @@ extern "C" {
     static mut _stack_end: u32;
     static mut _stack_start: u32;
     static mut __sdata: u32;
+    static mut __euninit: u32;
 }
 
 const PAINT: u32 = 0xCCCC_CCCC;
 
-/// Bytes of RAM holding statics (`.data` + `.bss` + `.uninit`), from the linker symbols.
+/// Bytes of RAM holding statics (`.data` + `.bss` + `.uninit`), from the linker symbols. They
+/// are contiguous wherever the stack is: above them by default, below them with flip-link.
 pub fn static_bytes() -> usize {
     // Only the addresses of the linker symbols are taken; nothing is read or written.
     let start = core::ptr::addr_of!(__sdata) as usize;
-    let end = core::ptr::addr_of!(_stack_end) as usize;
+    let end = core::ptr::addr_of!(__euninit) as usize;
     end - start
 }
 

@@ -88,7 +88,7 @@ fn variants() -> Vec<Variant> {
         machine: None,
         scenes: None,
         scalar: "fixed",
-        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes (default linker; `cargo pico` links the same code with flip-link)".into(),
+        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes (run on an emulated board by `host-sim board`: docs/board.md)".into(),
     });
     v
 }
@@ -265,7 +265,7 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
         };
         match &run {
             Some(r) => writeln!(md, "| {} | {} | {flash} | {} | {} | {} |", v.name, v.what, r.statics, r.stack, r.statics + r.stack)?,
-            None => writeln!(md, "| {} | {} | {flash} | (needs a board) | (needs a board) | |", v.name, v.what)?,
+            None => writeln!(md, "| {} | {} | {flash} | (docs/board.md) | (docs/board.md) | |", v.name, v.what)?,
         }
         if let Some(r) = run {
             runs.push((v, r));
