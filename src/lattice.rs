@@ -193,7 +193,7 @@ fn for_each_item<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, grid: usize
         }
     } else {
         let grp = &scene.groups[grid - 1];
-        for i in grp.first as usize..(grp.first + grp.len) as usize {
+        for i in grp.first as usize..grp.first as usize + grp.len as usize {
             f(i as u32, &scene.objects[i].bounds);
         }
     }

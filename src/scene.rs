@@ -190,10 +190,10 @@ impl<R: Real> Object<R> {
 /// A composite object: a contiguous run of objects with a common box (gets a sub-lattice).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Group<R> {
-    /// Index of its first object.
-    pub first: u16,
-    /// Number of objects.
-    pub len: u16,
+    /// Index of its first object (as wide as object indices: a group may start anywhere).
+    pub first: u32,
+    /// Number of objects (as wide as object indices: a group may hold any number).
+    pub len: u32,
     /// Union of its objects' boxes.
     pub bounds: Aabb<R>,
 }
@@ -455,7 +455,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if self.len == first {
             return Err(SceneError::EmptyGroup);
         }
-        let g = Group { first: first as u16, len: (self.len - first) as u16, bounds: bounds.cast_padded() };
+        // Object indices are below 2^31 (checked in `add_object`), so both fit in u32.
+        let g = Group { first: first as u32, len: (self.len - first) as u32, bounds: bounds.cast_padded() };
         self.groups.push(g).map_err(|_| SceneError::TooManyGroups)
     }
 

@@ -131,3 +131,63 @@ proptest! {
         check::<lattice_rt::Fx>(&p, &cfg, 200)?;
     }
 }
+
+/// A scene of `lead` ungrouped objects followed by one composite of `members` objects, so that
+/// group indices and sizes cross the 16-bit limits (65,535): every accelerator must see every
+/// member. Rays are aimed at members, first and last among them.
+fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<(), TestCaseError> {
+    use lattice_rt::generate::random_object;
+    use lattice_rt::{Affine, Shape};
+    let mut storage = vec![Object::<R>::default(); lead + members];
+    let mut b = SceneBuilder::new(&mut storage);
+    let mut rng = Rng::new(seed);
+    // The lead objects: a thin sheet of small spheres far behind the group.
+    let side = (lead as f64).sqrt().ceil() as usize;
+    for i in 0..lead {
+        let c = Vec3::new((i % side) as f64 * 0.5, (i / side) as f64 * 0.5, 400.0);
+        b.add_object(Shape::Sphere, Affine::translate(c).after(&Affine::scale(Vec3::new(0.2, 0.2, 0.2))), 0).unwrap();
+    }
+    b.begin_group(Affine::translate(Vec3::new(3.0, 3.0, 20.0))).unwrap();
+    let mut centers = Vec::with_capacity(members);
+    let span = (members as f64).cbrt().ceil().max(1.0);
+    for _ in 0..members {
+        let c = Vec3::new(rng.range(0.0, span), rng.range(0.0, span), rng.range(0.0, span));
+        let (shape, t) = random_object(&mut rng, c, 0.3);
+        b.add_object(shape, t, 0).unwrap();
+        centers.push(c + Vec3::new(3.0, 3.0, 20.0));
+    }
+    b.end_group().unwrap();
+    let scene = b.finish().unwrap();
+    let cfg = LatticeConfig::default();
+    let mut bufs = lattice_bufs(&scene, &cfg);
+    let lat = build_lattice(&scene, &cfg, &mut bufs);
+    let mut mb = vec![0; Query::mailbox_len(&scene)];
+    let mut q = Query::new(&mut mb);
+    let picks = [0, members / 2, members - 1].into_iter().chain((0..20).map(|_| rng.below(members as u64) as usize));
+    let mut hits = 0;
+    for k in picks {
+        let o = Vec3::new(R::from_f64(1.0), R::from_f64(2.0), R::from_f64(-5.0));
+        let c = centers[k];
+        let ray = Ray::new(o, Vec3::new(R::from_f64(c.x), R::from_f64(c.y), R::from_f64(c.z)) - o);
+        let want = BruteForce.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q);
+        hits += usize::from(want.is_some());
+        prop_assert_eq!(want, lat.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q), "lattice, lead {} members {} ray {:?}", lead, members, ray);
+        prop_assert_eq!(want, BoundingBox.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q), "bbox, lead {} members {} ray {:?}", lead, members, ray);
+    }
+    prop_assert!(hits > 0, "no ray hit the group: the test aims badly");
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 3, ..ProptestConfig::default() })]
+
+    #[test]
+    fn groups_past_the_16_bit_index_limits_agree(
+        lead in prop_oneof![Just(3usize), 65_530usize..65_542],
+        members in prop_oneof![1usize..6, 65_534usize..65_538],
+        seed in any::<u64>(),
+    ) {
+        check_big_group::<f64>(lead, members, seed)?;
+        check_big_group::<f32>(lead, members, seed)?;
+    }
+}
