@@ -358,10 +358,7 @@ fn real_main() -> Result<()> {
             let mut storage = load::object_storage::<f64>(&text);
             let s = load::parse_scene::<f64>(&scene, &text, &mut storage)?;
             let out = pov::export(&s, if ids { pov::PovMode::Ids } else { pov::PovMode::Full })?;
-            if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir)?;
-            }
-            std::fs::write(&output, out)?;
+            output::write_atomic(&output, out.as_bytes())?;
             println!("wrote {}", output.display());
             Ok(())
         }

@@ -3,7 +3,7 @@
 use crate::load::{object_storage, parse_scene, read, LatticeBufs};
 use crate::output::{write_gray_png, write_pbm, write_pgm, write_png, Theme};
 use crate::{Accel, RenderArgs, StatsArgs};
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, Context, Result};
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::Effects;
 use lattice_rt::{
@@ -192,14 +192,17 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let frame = Frame { tile: a.tile, dither: a.dither.mode(), sampling: a.sampling.mode(), ..Frame::new(a.size.0, a.size.1) };
     let mut out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true, true)?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
-    write_png(&frame_bits, &a.output, a.theme, a.scale)?;
-    println!("wrote {}", a.output.display());
+    // Every output under a temporary name first: if one cannot be written, none is left.
+    let mut staged = crate::output::Staged::default();
+    write_png(&frame_bits, &staged.stage(&a.output)?, a.theme, a.scale).with_context(|| format!("cannot write {}", a.output.display()))?;
     if let Some(p) = &a.pbm {
-        write_pbm(&frame_bits, p)?;
-        println!("wrote {}", p.display());
+        write_pbm(&frame_bits, &staged.stage(p)?).with_context(|| format!("cannot write {}", p.display()))?;
     }
     if let Some(p) = &a.gray {
-        write_pgm(frame.width as u32, frame.height as u32, &out.gray, p)?;
+        write_pgm(frame.width as u32, frame.height as u32, &out.gray, &staged.stage(p)?).with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    staged.commit()?;
+    for p in [Some(&a.output), a.pbm.as_ref(), a.gray.as_ref()].into_iter().flatten() {
         println!("wrote {}", p.display());
     }
     print_stats(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel_name()), &out.stats, out.elapsed);
