@@ -54,7 +54,7 @@ impl Method {
 /// Renders with one method; returns (render time, lattice build time, lattice bytes, stats, bits).
 fn frame_with(scene: &Scene<'_, f64>, m: Method, frame: &Frame, primary_only: bool) -> Result<(Duration, Duration, usize, lattice_rt::Stats, Vec<u8>)> {
     let cfg = LatticeConfig { nested: m != Method::Flat, ..LatticeConfig::default() };
-    let mut bufs = LatticeBufs::for_scene(scene, &cfg);
+    let mut bufs = LatticeBufs::for_scene(scene, &cfg)?;
     let t0 = Instant::now();
     let lattice = bufs.build(scene, &cfg)?;
     let build = t0.elapsed();
@@ -217,7 +217,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
                         (t, tests, 0.0, bytes, String::from("-"))
                     }
                     Some(cfg) => {
-                        let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+                        let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
                         let lat = bufs.build(&scene, &cfg)?;
                         let (t, tests, cells) = per_ray(&scene, &lat, &all_rays, runs);
                         let refs_b = lat.ref_count() * 4;
@@ -259,7 +259,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     sweep.push(("auto (2 per object)".into(), LatticeConfig { nested: false, ..LatticeConfig::default() }));
     sweep.push(("auto, adaptive lists".into(), LatticeConfig { nested: false, spacing: Spacing::Adaptive, ..LatticeConfig::default() }));
     for (label, cfg) in sweep {
-        let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+        let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
         let lat = bufs.build(&scene, &cfg)?;
         let (t, tests, cells) = per_ray(&scene, &lat, &rays, runs);
         writeln!(md, "| {label} | {} | {:.3} | {tests:.2} | {cells:.1} | {} |", lat.cell_count(), t.as_secs_f64() * 1e6, lat.bytes())?;

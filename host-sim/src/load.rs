@@ -1,7 +1,7 @@
 //! Loading scene files and building accelerators with heap-backed storage (the host's side of
 //! the core's caller-provided buffers).
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::lattice::{Grid, LatticeSizes};
 use lattice_rt::scene::Object;
 use lattice_rt::{parse, Lattice, LatticeConfig, LatticeStorage, Real, Scene};
@@ -22,6 +22,10 @@ pub fn parse_scene<'a, R: Real>(path: &Path, text: &str, storage: &'a mut [Objec
     parse::<R>(text, storage).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
+/// The most memory a lattice may take on the host (so that no flag makes host-sim allocate
+/// gigabytes: `--cells 1024x1024x1024` alone would be 4.3 GB).
+pub const MAX_LATTICE_BYTES: usize = 512 << 20;
+
 /// Heap storage for a lattice, sized by [`Lattice::plan`].
 pub struct LatticeBufs<R> {
     grids: Vec<Grid<R>>,
@@ -31,15 +35,24 @@ pub struct LatticeBufs<R> {
 }
 
 impl<R: Real> LatticeBufs<R> {
-    /// Storage for the lattice of `scene` with `cfg`.
-    pub fn for_scene(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Self {
+    /// Storage for the lattice of `scene` with `cfg`, or an error when it would take more than
+    /// [`MAX_LATTICE_BYTES`] (checked before anything is allocated).
+    pub fn for_scene(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Self> {
         let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(scene, cfg);
-        LatticeBufs {
+        let bytes = (grids as u128) * core::mem::size_of::<Grid<R>>() as u128
+            + (coords as u128) * core::mem::size_of::<R>() as u128
+            + (cells as u128 + refs as u128) * 4;
+        if bytes > MAX_LATTICE_BYTES as u128 {
+            bail!(
+                "the lattice would need {bytes} bytes ({cells} cells, {refs} references), more than the limit of {MAX_LATTICE_BYTES}: ask for fewer cells with --cells"
+            );
+        }
+        Ok(LatticeBufs {
             grids: vec![Grid::EMPTY; grids],
             coords: vec![R::ZERO; coords],
             cells: vec![0; cells],
             refs: vec![0; refs],
-        }
+        })
     }
     /// Builds the lattice in this storage.
     pub fn build<'a>(&'a mut self, scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Lattice<'a, R>> {
@@ -64,9 +77,33 @@ pub fn render_text<R: Real>(
     let mut storage = object_storage::<R>(text);
     let scene = parse_scene::<R>(path, text, &mut storage)?;
     let cfg = LatticeConfig::default();
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+    let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
     let lattice = bufs.build(&scene, &cfg)?;
     let mut tracer = lattice_rt::Tracer::new(&scene, &lattice);
     tune(&mut tracer);
     crate::run::render_band(&tracer, frame, false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lattice_too_large_for_the_host_is_refused_before_allocation() {
+        let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/chair.scene"));
+        let text = read(path).unwrap();
+        let mut storage = object_storage::<f64>(&text);
+        let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
+        let err = LatticeBufs::for_scene(&scene, &crate::lattice_config(Some([1024, 1024, 1024]))).err().expect("refused");
+        let msg = format!("{err:#}");
+        assert!(msg.contains("--cells") && msg.contains(&MAX_LATTICE_BYTES.to_string()), "{msg}");
+        assert!(LatticeBufs::for_scene(&scene, &crate::lattice_config(Some([64, 64, 64]))).is_ok());
+    }
+
+    #[test]
+    fn a_png_too_large_is_refused_with_the_flags_to_change() {
+        let msg = format!("{:#}", crate::output::check_png_size(4096, 4096, 64).unwrap_err());
+        assert!(msg.contains("--scale") && msg.contains("--size"), "{msg}");
+        assert!(crate::output::check_png_size(4096, 4096, 2).is_ok());
+    }
 }

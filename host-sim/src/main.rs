@@ -280,8 +280,8 @@ pub struct RenderArgs {
     /// Display theme of the PNG.
     #[arg(long, value_enum, default_value_t = output::Theme::OledWhite)]
     pub theme: output::Theme,
-    /// PNG pixel scale.
-    #[arg(long, default_value_t = 4)]
+    /// PNG pixel scale (1 to 64; the PNG may have at most 2^26 pixels).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub scale: u32,
     /// Also write the gray levels (0..=64) as PGM.
     #[arg(long)]

@@ -9,6 +9,20 @@ use embedded_graphics_simulator::{BinaryColorTheme, OutputSettingsBuilder, Simul
 use lattice_rt::BitFrame;
 use std::path::Path;
 
+/// The largest PNG host-sim writes (2^26 pixels, 192 MiB of RGB before compression).
+pub const MAX_PNG_PIXELS: u64 = 1 << 26;
+
+/// Refuses a PNG of more than [`MAX_PNG_PIXELS`] (check it before rendering the frame).
+pub fn check_png_size(width: u32, height: u32, scale: u32) -> Result<()> {
+    let pixels = width as u64 * height as u64 * scale as u64 * scale as u64;
+    if pixels > MAX_PNG_PIXELS {
+        anyhow::bail!(
+            "a {width}x{height} frame at --scale {scale} would be a PNG of {pixels} pixels, more than the limit of {MAX_PNG_PIXELS}: lower --scale or --size"
+        );
+    }
+    Ok(())
+}
+
 /// Display themes offered on the command line.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum Theme {
@@ -43,6 +57,7 @@ fn create_parent(path: &Path) -> Result<()> {
 /// Writes a 1-bit frame as PNG with a display theme and pixel scale.
 pub fn write_png(frame: &BitFrame<'_>, path: &Path, theme: Theme, scale: u32) -> Result<()> {
     let size = frame.size();
+    check_png_size(size.width, size.height, scale)?;
     let mut display = SimulatorDisplay::<BinaryColor>::new(Size::new(size.width, size.height));
     for y in 0..size.height {
         for x in 0..size.width {

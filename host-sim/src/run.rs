@@ -123,7 +123,7 @@ mod tests {
             let mut storage = object_storage::<f64>(&text);
             let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
             let cfg = LatticeConfig::default();
-            let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+            let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
             let lat = bufs.build(&scene, &cfg).unwrap();
             let t = Tracer::new(&scene, &lat);
             for dither in [Dither::Bayer, Dither::Pattern(4)] {
@@ -152,7 +152,7 @@ pub fn render_accel<R: Real>(
     let lattice;
     let a: &(dyn Accelerator<R> + Sync) = match accel {
         Accel::Lattice => {
-            bufs = LatticeBufs::for_scene(scene, cfg);
+            bufs = LatticeBufs::for_scene(scene, cfg)?;
             lattice = bufs.build(scene, cfg)?;
             &lattice
         }
@@ -186,6 +186,7 @@ fn print_stats(label: &str, s: &Stats, elapsed: Duration) {
 
 /// `host-sim render`.
 pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
+    crate::output::check_png_size(a.size.0 as u32, a.size.1 as u32, a.scale)?;
     let text = read(&a.scene)?;
     let mut storage = object_storage::<R>(&text);
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
@@ -230,7 +231,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let mut storage = object_storage::<R>(&text);
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let cfg = crate::lattice_config(a.cells);
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+    let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
     let t0 = Instant::now();
     let lattice = bufs.build(&scene, &cfg)?;
     let build = t0.elapsed();

@@ -96,7 +96,7 @@ fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f6
     let mut storage = object_storage::<f64>(text);
     let scene = parse_scene::<f64>(path, text, &mut storage)?;
     let cfg = LatticeConfig::default();
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg);
+    let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
     let lattice = bufs.build(&scene, &cfg)?;
     let tracer = Tracer::new(&scene, &lattice);
     let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(&scene)];
