@@ -191,7 +191,7 @@ mod tests {
         let agree = ours.iter().zip(&ids).filter(|(o, g)| **o == gray_id(**g, n)).count() as f64 / ours.len() as f64;
         let pov = render_povray(&export(scene, PovMode::Full).unwrap(), W, H, &work(), name).unwrap();
         let cfg = LatticeConfig::default();
-        let mut bufs = LatticeBufs::for_scene(scene, &cfg)?;
+        let mut bufs = LatticeBufs::for_scene(scene, &cfg).expect("lattice fits");
         let lat = bufs.build(scene, &cfg).unwrap();
         let mine = render_with(&Tracer::new(scene, &lat), &Frame::new(W as u16, H as u16), false).unwrap().gray;
         let opaque: Vec<usize> = (0..mine.len()).filter(|&i| ours[i].map_or(true, |o| scene.materials[scene.objects[o].material as usize].kt == 0.0)).collect();

@@ -123,7 +123,7 @@ mod tests {
             let mut storage = object_storage::<f64>(&text);
             let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
             let cfg = LatticeConfig::default();
-            let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
+            let mut bufs = LatticeBufs::for_scene(&scene, &cfg).expect("lattice fits");
             let lat = bufs.build(&scene, &cfg).unwrap();
             let t = Tracer::new(&scene, &lat);
             for dither in [Dither::Bayer, Dither::Pattern(4)] {
