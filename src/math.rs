@@ -185,15 +185,14 @@ impl<R: Real> Aabb<R> {
     /// Converts to another scalar, rounding outwards by the target's padding so the box stays
     /// conservative.
     pub fn cast_padded<S: Real>(&self) -> Aabb<S> {
+        let p = self.padded_for::<S>();
+        Aabb { min: p.min.cast(), max: p.max.cast() }
+    }
+    /// The box grown (in `f64`) by the padding [`Aabb::cast_padded`] gives it in `S`.
+    pub fn padded_for<S: Real>(&self) -> Aabb<f64> {
         let ext = self.min.max_abs().max(self.max.max_abs()).to_f64();
         let pad = S::pad_eps().to_f64() * (1.0 + ext);
-        let grow = |v: Vec3<R>, s: f64| {
-            Vec3::new(
-                S::from_f64(v.x.to_f64() + s * pad),
-                S::from_f64(v.y.to_f64() + s * pad),
-                S::from_f64(v.z.to_f64() + s * pad),
-            )
-        };
+        let grow = |v: Vec3<R>, s: f64| Vec3::new(v.x.to_f64() + s * pad, v.y.to_f64() + s * pad, v.z.to_f64() + s * pad);
         Aabb { min: grow(self.min, -1.0), max: grow(self.max, 1.0) }
     }
 }
@@ -320,10 +319,14 @@ impl Affine<f64> {
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
     }
     /// The inverse transform, or `None` when the linear part is singular (or nearly so).
+    ///
+    /// Singular means the computed inverse does not undo the transform: `inverse * self` is
+    /// off the identity by more than `1e-9` in some entry. A large but exact inverse (a shear by
+    /// `1e12`, whose determinant is 1) is not singular; a determinant that is zero, or tiny
+    /// against the entries so that rounding dominates, is.
     pub fn inverse(&self) -> Option<Self> {
         let d = self.det();
-        let scale = self.m.iter().flat_map(|r| r[..3].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
-        if !(d.abs() > 1e-12 * scale * scale * scale) || !d.is_finite() {
+        if d == 0.0 || !d.is_finite() {
             return None;
         }
         let m = &self.m;
@@ -337,6 +340,15 @@ impl Affine<f64> {
         }
         for i in 0..3 {
             inv[i][3] = -(inv[i][0] * m[0][3] + inv[i][1] * m[1][3] + inv[i][2] * m[2][3]);
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                let p = inv[i][0] * m[0][j] + inv[i][1] * m[1][j] + inv[i][2] * m[2][j];
+                let want = if i == j { 1.0 } else { 0.0 };
+                if !((p - want).abs() <= 1e-9) {
+                    return None;
+                }
+            }
         }
         Some(Affine { m: inv })
     }

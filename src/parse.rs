@@ -7,7 +7,7 @@
 
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
-use crate::scene::{Light, Material, Object, Scene, SceneBuilder, SceneError, MAX_MATERIALS};
+use crate::scene::{check_value, Light, Material, Object, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
 use crate::shape::Shape;
 use crate::trace::MAX_DEPTH;
 use core::fmt;
@@ -34,6 +34,15 @@ pub enum ParseErrorKind {
     UnknownLightKind,
     /// `depth` must be a whole number from 0 to the tracer's maximum.
     BadDepth,
+    /// A number beyond `f64` (`1e999`, `0e999`).
+    NumberOutOfRange,
+    /// A shear of an axis by itself (`shear x x K`).
+    SameAxisShear,
+    /// The text is not UTF-8: the byte at this position starts no character.
+    InvalidUtf8 {
+        /// The offending byte.
+        byte: u8,
+    },
     /// The scene itself is invalid.
     Scene(SceneError),
 }
@@ -67,6 +76,11 @@ impl fmt::Display for ParseErrorKind {
             ParseErrorKind::UnknownAxis => write!(f, "axis must be x, y or z"),
             ParseErrorKind::UnknownLightKind => write!(f, "light must be `directional` or `point`"),
             ParseErrorKind::BadDepth => write!(f, "depth must be a whole number from 0 to {MAX_DEPTH}"),
+            ParseErrorKind::NumberOutOfRange => write!(f, "number out of range: beyond the largest f64 (about 1.8e308)"),
+            ParseErrorKind::SameAxisShear => {
+                write!(f, "a shear needs two different axes (`shear x y K`: x gains K times y)")
+            }
+            ParseErrorKind::InvalidUtf8 { byte } => write!(f, "not UTF-8 text (byte 0x{byte:02x})"),
             ParseErrorKind::Scene(e) => write!(f, "{e}"),
         }
     }
@@ -76,13 +90,89 @@ impl fmt::Display for ParseError<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "line {}, column {}", self.line, self.col)?;
         if !self.token.is_empty() {
-            write!(f, " at `{}`", self.token)?;
+            write!(f, " at `{}`", Shown(self.token))?;
         }
         write!(f, ": {}", self.kind)
     }
 }
 
-impl core::error::Error for ParseError<'_> {}
+/// Longest part of a token an error message repeats (in characters).
+pub const SHOWN_TOKEN: usize = 40;
+
+/// A token as an error message shows it: control and bidirectional-formatting characters
+/// escaped (so a scene cannot send escape sequences to the terminal), and cut after
+/// [`SHOWN_TOKEN`] characters with the length it had.
+struct Shown<'t>(&'t str);
+
+impl fmt::Display for Shown<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for c in self.0.chars().take(SHOWN_TOKEN) {
+            let bidi = matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+            if c.is_control() || bidi {
+                write!(f, "{}", c.escape_unicode())?;
+            } else {
+                write!(f, "{c}")?;
+            }
+        }
+        if self.0.chars().nth(SHOWN_TOKEN).is_some() {
+            write!(f, "... ({} bytes)", self.0.len())?;
+        }
+        Ok(())
+    }
+}
+
+/// The scene text in `bytes`, or an error at the line and column of the first byte that is
+/// not UTF-8 (for scenes read from files or received at run time).
+pub fn text_from_bytes(bytes: &[u8]) -> Result<&str, ParseError<'static>> {
+    match core::str::from_utf8(bytes) {
+        Ok(t) => Ok(t),
+        Err(e) => {
+            let good = &bytes[..e.valid_up_to()];
+            // Lines end as in `Lines`: `\n`, `\r\n` or a lone `\r`.
+            let (mut line, mut start, mut i) = (1u32, 0usize, 0usize);
+            while i < good.len() {
+                if good[i] == b'\r' && good.get(i + 1) == Some(&b'\n') {
+                    i += 1;
+                }
+                if good[i] == b'\n' || good[i] == b'\r' {
+                    line += 1;
+                    start = i + 1;
+                }
+                i += 1;
+            }
+            let col = (good.len() - start) as u32 + 1;
+            Err(ParseError { line, col, token: "", kind: ParseErrorKind::InvalidUtf8 { byte: bytes[e.valid_up_to()] } })
+        }
+    }
+}
+
+/// The lines of a scene text: ended by `\n`, `\r\n` or a lone `\r` (old Mac files), so that
+/// every convention gives the same lines and line numbers. A leading byte-order mark is skipped
+/// by [`parse`] before this.
+struct Lines<'t> {
+    rest: &'t str,
+}
+
+impl<'t> Iterator for Lines<'t> {
+    type Item = &'t str;
+    fn next(&mut self) -> Option<&'t str> {
+        if self.rest.is_empty() {
+            return None;
+        }
+        let (line, used) = match self.rest.find(['\n', '\r']) {
+            Some(i) if self.rest[i..].starts_with("\r\n") => (&self.rest[..i], i + 2),
+            Some(i) => (&self.rest[..i], i + 1),
+            None => (self.rest, self.rest.len()),
+        };
+        self.rest = &self.rest[used..];
+        Some(line)
+    }
+}
+
+/// The lines of `text` (see [`Lines`]), without a leading byte-order mark.
+fn lines(text: &str) -> Lines<'_> {
+    Lines { rest: text.strip_prefix('\u{feff}').unwrap_or(text) }
+}
 
 /// Parses a decimal number (`[+-]digits[.digits][(e|E)[+-]digits]`) without core's `f64`
 /// parser, whose 1.7 KB stack frame is more than the whole render needs on a Cortex-M0+.
@@ -174,6 +264,9 @@ struct Words<'t> {
     line: &'t str,
     pos: usize,
     lineno: u32,
+    /// The largest coordinate magnitude of the scalar the scene is parsed for, and its name.
+    limit: f64,
+    scalar: &'static str,
 }
 
 impl<'t> Words<'t> {
@@ -182,7 +275,12 @@ impl<'t> Words<'t> {
             Some(i) => &line[..i],
             None => line,
         };
-        Words { line, pos: 0, lineno }
+        Words { line, pos: 0, lineno, limit: f64::MAX, scalar: "f64" }
+    }
+
+    /// Words whose coordinates are checked against the range of `R`.
+    fn for_scalar<R: Real>(line: &'t str, lineno: u32) -> Self {
+        Words { limit: R::LIMIT, scalar: R::NAME, ..Self::new(line, lineno) }
     }
 
     fn next(&mut self) -> Option<(u32, &'t str)> {
@@ -209,18 +307,43 @@ impl<'t> Words<'t> {
         self.next().ok_or_else(|| self.end_err())
     }
 
-    fn number(&mut self) -> Result<f64, ParseError<'t>> {
+    /// A finite number, with its column and token.
+    fn number_at(&mut self) -> Result<(f64, u32, &'t str), ParseError<'t>> {
         let (col, tok) = self.word()?;
         let v = parse_number(tok).ok_or_else(|| self.err(col, tok, ParseErrorKind::ExpectedNumber))?;
         if !v.is_finite() {
-            return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::NotFinite)));
+            let digits = tok.trim_start_matches(['+', '-']).starts_with(|c: char| c.is_ascii_digit() || c == '.');
+            let kind = if digits { ParseErrorKind::NumberOutOfRange } else { ParseErrorKind::Scene(SceneError::NotFinite) };
+            return Err(self.err(col, tok, kind));
+        }
+        Ok((v, col, tok))
+    }
+
+    /// A finite number (a factor composed in `f64`: scale, shear, angle, field of view).
+    fn number(&mut self) -> Result<f64, ParseError<'t>> {
+        Ok(self.number_at()?.0)
+    }
+
+    /// A coordinate or length: below the scalar's coordinate limit.
+    fn coord(&mut self) -> Result<f64, ParseError<'t>> {
+        let (v, col, tok) = self.number_at()?;
+        if v.abs() >= self.limit {
+            return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::OutOfRange { limit: self.limit, scalar: self.scalar })));
         }
         Ok(v)
     }
 
+    /// A shading number (intensity, ambient, background, coefficient, index of refraction),
+    /// checked against the range of `R`.
+    fn value<R: Real>(&mut self, what: &'static str) -> Result<(f64, u32, &'t str), ParseError<'t>> {
+        let (v, col, tok) = self.number_at()?;
+        check_value::<R>(what, v).map_err(|e| self.err(col, tok, ParseErrorKind::Scene(e)))?;
+        Ok((v, col, tok))
+    }
+
     fn positive(&mut self) -> Result<f64, ParseError<'t>> {
         let save = self.pos;
-        let v = self.number()?;
+        let v = self.coord()?;
         if v <= 0.0 {
             self.pos = save;
             let (col, tok) = self.word()?;
@@ -229,6 +352,12 @@ impl<'t> Words<'t> {
         Ok(v)
     }
 
+    /// A point: three coordinates.
+    fn point(&mut self) -> Result<Vec3<f64>, ParseError<'t>> {
+        Ok(Vec3::new(self.coord()?, self.coord()?, self.coord()?))
+    }
+
+    /// A direction: three finite numbers (only their ratios matter).
     fn vec3(&mut self) -> Result<Vec3<f64>, ParseError<'t>> {
         Ok(Vec3::new(self.number()?, self.number()?, self.number()?))
     }
@@ -243,10 +372,10 @@ impl<'t> Words<'t> {
         }
     }
 
-    /// Parses a transform attribute if `key` is one, composing it after `t`.
-    fn transform(&mut self, key: &str, t: &mut Affine<f64>) -> Result<bool, ParseError<'t>> {
+    /// Parses a transform attribute if `key` (at `col`) is one, composing it after `t`.
+    fn transform(&mut self, col: u32, key: &'t str, t: &mut Affine<f64>) -> Result<bool, ParseError<'t>> {
         let op = match key {
-            "translate" => Affine::translate(self.vec3()?),
+            "translate" => Affine::translate(self.point()?),
             "rotate" => {
                 let a = self.axis()?;
                 Affine::rotate(a, self.number()?)
@@ -267,20 +396,39 @@ impl<'t> Words<'t> {
                 }
             }
             "shear" => {
-                let (i, j) = (self.axis()?, self.axis()?);
+                let i = self.axis()?;
+                let save = self.pos;
+                let j = self.axis()?;
+                if i == j {
+                    self.pos = save;
+                    let (jcol, jtok) = self.word()?;
+                    return Err(self.err(jcol, jtok, ParseErrorKind::SameAxisShear));
+                }
                 Affine::shear(i, j, self.number()?)
             }
             _ => return Ok(false),
         };
         *t = op.after(t);
+        if t.m.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(self.err(col, key, ParseErrorKind::Scene(SceneError::TransformOverflow)));
+        }
         Ok(true)
     }
 }
 
-/// Line, column and keyword of the `index`-th object statement (for errors found after parsing).
-fn object_statement(text: &str, index: usize) -> (u32, u32, &str) {
+/// The number of object statements (`sphere`, `cylinder`, `cone`, `box`) in scene text: the
+/// object storage [`parse`] needs for it (line endings and comments as [`parse`] reads them).
+pub fn object_count(text: &str) -> usize {
+    lines(text)
+        .filter(|line| matches!(Words::new(line, 0).next(), Some((_, "sphere" | "cylinder" | "cone" | "box"))))
+        .count()
+}
+
+/// Line, column and keyword of the `index`-th object statement (for errors found after
+/// parsing, by the parser or by tools that use the scene).
+pub fn object_statement(text: &str, index: usize) -> (u32, u32, &str) {
     let mut seen = 0;
-    for (i, line) in text.lines().enumerate() {
+    for (i, line) in lines(text).enumerate() {
         let mut w = Words::new(line, i as u32 + 1);
         if let Some((col, key)) = w.next() {
             if matches!(key, "sphere" | "cylinder" | "cone" | "box") {
@@ -304,28 +452,37 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
     let mut names: Vec<(&'t str, u8), MAX_MATERIALS> = Vec::new();
     let mut camera_at = (0u32, 0u32, "");
     let mut group_at = (0u32, 0u32, "");
+    // The largest shading number so far: what a too-bright scene is blamed on.
+    let mut bright_at = (0u32, 0u32, "", -1.0f64);
     let mut last_line = 1u32;
-    for (i, line) in text.lines().enumerate() {
+    for (i, line) in lines(text).enumerate() {
         let lineno = i as u32 + 1;
         last_line = lineno;
-        let mut w = Words::new(line, lineno);
+        let mut w = Words::for_scalar::<R>(line, lineno);
         let Some((kcol, key)) = w.next() else { continue };
         let scene_err = |e: SceneError| ParseError { line: lineno, col: kcol, token: key, kind: ParseErrorKind::Scene(e) };
+        let mut shading = |w: &mut Words<'t>, what: &'static str| -> Result<f64, ParseError<'t>> {
+            let (v, col, tok) = w.value::<R>(what)?;
+            if v.abs() > bright_at.3 {
+                bright_at = (lineno, col, tok, v.abs());
+            }
+            Ok(v)
+        };
         match key {
             "camera" => {
                 camera_at = (lineno, kcol, key);
                 while let Some((col, attr)) = w.next() {
                     match attr {
-                        "eye" => b.camera.eye = w.vec3()?,
-                        "look" => b.camera.look = w.vec3()?,
+                        "eye" => b.camera.eye = w.point()?,
+                        "look" => b.camera.look = w.point()?,
                         "up" => b.camera.up = w.vec3()?,
                         "fov" => b.camera.fov = (w.number()?, w.number()?),
                         _ => return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute)),
                     }
                 }
             }
-            "ambient" => b.ambient = w.number()?,
-            "background" => b.background = w.number()?,
+            "ambient" => b.ambient = shading(&mut w, "ambient")?,
+            "background" => b.background = shading(&mut w, "background")?,
             "depth" => {
                 let (col, tok) = w.word()?;
                 b.max_depth = match tok.parse::<u8>() {
@@ -344,8 +501,9 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
                 };
                 while let Some((col, attr)) = w.next() {
                     match attr {
-                        a if a == want => v = w.vec3()?,
-                        "intensity" => intensity = w.number()?,
+                        "dir" if want == "dir" => v = w.vec3()?,
+                        "pos" if want == "pos" => v = w.point()?,
+                        "intensity" => intensity = shading(&mut w, "light intensity")?,
                         _ => return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute)),
                     }
                 }
@@ -363,15 +521,21 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
                 }
                 let mut m = Material::DEFAULT;
                 while let Some((col, attr)) = w.next() {
-                    let slot = match attr {
-                        "ka" => &mut m.ka,
-                        "kd" => &mut m.kd,
-                        "ks" => &mut m.ks,
-                        "kt" => &mut m.kt,
-                        "ior" => &mut m.ior,
+                    let (slot, what) = match attr {
+                        "ka" => (&mut m.ka, "coefficient"),
+                        "kd" => (&mut m.kd, "coefficient"),
+                        "ks" => (&mut m.ks, "coefficient"),
+                        "kt" => (&mut m.kt, "coefficient"),
+                        "ior" => (&mut m.ior, IOR),
                         _ => return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute)),
                     };
-                    *slot = w.number()?;
+                    let save = w.pos;
+                    *slot = if what == IOR { w.value::<R>(what)?.0 } else { shading(&mut w, what)? };
+                    if *slot < if what == IOR { 1.0 } else { 0.0 } {
+                        w.pos = save;
+                        let (vcol, tok) = w.word()?;
+                        return Err(w.err(vcol, tok, ParseErrorKind::Scene(SceneError::BadCoefficient)));
+                    }
                 }
                 let id = b.add_material(m).map_err(|e| w.err(ncol, name, ParseErrorKind::Scene(e)))?;
                 let _ = names.push((name, id));
@@ -383,17 +547,17 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
                 let mut t = Affine::identity();
                 while let Some((col, attr)) = w.next() {
                     match (key, attr) {
-                        ("sphere", "center") | ("cylinder" | "cone", "base") => pos = w.vec3()?,
+                        ("sphere", "center") | ("cylinder" | "cone", "base") => pos = w.point()?,
                         ("sphere" | "cylinder" | "cone", "radius") => radius = w.positive()?,
                         ("cylinder" | "cone", "height") => height = w.positive()?,
                         ("cone", "top") => {
-                            top = w.number()?;
+                            top = w.coord()?;
                             if top < 0.0 {
                                 return Err(w.err(col, attr, ParseErrorKind::Scene(SceneError::NonPositiveSize)));
                             }
                         }
-                        ("box", "min") => lo = w.vec3()?,
-                        ("box", "max") => hi = w.vec3()?,
+                        ("box", "min") => lo = w.point()?,
+                        ("box", "max") => hi = w.point()?,
                         (_, "material") => {
                             let (mcol, name) = w.word()?;
                             material = names
@@ -403,7 +567,7 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
                                 .ok_or_else(|| w.err(mcol, name, ParseErrorKind::UnknownMaterial))?;
                         }
                         _ => {
-                            if !w.transform(attr, &mut t)? {
+                            if !w.transform(col, attr, &mut t)? {
                                 return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute));
                             }
                         }
@@ -436,7 +600,7 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
                     }
                 }
                 while let Some((col, attr)) = w.next() {
-                    if !w.transform(attr, &mut t)? {
+                    if !w.transform(col, attr, &mut t)? {
                         return Err(w.err(col, attr, ParseErrorKind::UnknownAttribute));
                     }
                 }
@@ -451,8 +615,11 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
     }
     b.finish().map_err(|e| {
         let (line, col, token) = match e {
-            SceneError::ObjectOutOfRange { object, .. } => object_statement(text, object),
+            SceneError::ObjectOutOfRange { object, .. } | SceneError::ObjectTooThin { object, .. } => {
+                object_statement(text, object)
+            }
             SceneError::UnclosedGroup => group_at,
+            SceneError::TooBright { .. } if bright_at.0 > 0 => (bright_at.0, bright_at.1, bright_at.2),
             SceneError::DegenerateCamera | SceneError::BadFieldOfView | SceneError::OutOfRange { .. }
                 if camera_at.0 > 0 =>
             {

@@ -231,6 +231,40 @@ pub enum SceneError {
         /// The scalar's name.
         scalar: &'static str,
     },
+    /// A number other than a coordinate (light intensity, ambient, background, material
+    /// coefficient, index of refraction) beyond what the scalar holds.
+    ValueOutOfRange {
+        /// What the number is.
+        what: &'static str,
+        /// The largest magnitude allowed.
+        limit: f64,
+        /// The scalar's name.
+        scalar: &'static str,
+    },
+    /// Transforms composed into one whose entries overflow `f64` (`scale 1e200 scale 1e200`).
+    TransformOverflow,
+    /// The brightness summed along one ray's intersection tree could exceed what the scalar
+    /// holds (huge intensities, or reflection and transmission coefficients well above 1).
+    TooBright {
+        /// The largest sum the scene allows (at the deepest tree the tracer supports).
+        bound: f64,
+        /// The scalar's limit.
+        limit: f64,
+        /// The scalar's name.
+        scalar: &'static str,
+    },
+    /// An object thinner than the distance secondary rays start off a surface in this scalar:
+    /// a ray leaving one face would start beyond the other.
+    ObjectTooThin {
+        /// Index of the object (in the order it was added).
+        object: usize,
+        /// Its smallest width.
+        size: f64,
+        /// The smallest width the scalar can trace at the object's place in this scene.
+        smallest: f64,
+        /// The scalar's name.
+        scalar: &'static str,
+    },
     /// A size that must be positive is not (radius, height, box extent).
     NonPositiveSize,
     /// A material coefficient below zero, or an index of refraction below 1.
@@ -275,6 +309,29 @@ impl fmt::Display for SceneError {
             SceneError::OutOfRange { limit, scalar } => {
                 write!(f, "coordinate out of range for {scalar}: magnitude must stay below {}", Round(*limit))
             }
+            SceneError::ValueOutOfRange { what, limit, scalar } => {
+                write!(f, "{what} out of range for {scalar}: magnitude must stay below {}", Round(*limit))
+            }
+            SceneError::TransformOverflow => {
+                write!(f, "transform out of range: composed, its entries overflow (more than 1e308)")
+            }
+            SceneError::TooBright { bound, limit, scalar } => write!(
+                f,
+                "brightness out of range for {scalar}: lights, ambient, background and coefficients \
+                 add up to {} along one ray, the limit is {} (lower the intensities, or keep ks + kt \
+                 near 1 or below)",
+                Round(*bound),
+                Round(*limit)
+            ),
+            SceneError::ObjectTooThin { object, size, smallest, scalar } => write!(
+                f,
+                "object {object} is too thin for this scene in {scalar}: it is {} across, the \
+                 smallest this scalar traces here is {} (secondary rays start that far off a \
+                 surface; make it thicker or the scene smaller{})",
+                Round(*size),
+                Round(*smallest),
+                if *scalar == "f64" { "" } else { ", or trace in f64" }
+            ),
             SceneError::NonPositiveSize => write!(f, "size must be positive"),
             SceneError::BadCoefficient => {
                 write!(f, "coefficients must be >= 0 and the index of refraction >= 1")
@@ -298,8 +355,9 @@ impl fmt::Display for SceneError {
 
 impl core::error::Error for SceneError {}
 
-/// A non-negative number shown rounded, with integer formatting only (`8192`, `1e15`): core's
-/// float formatting would add about 12 KB to every firmware image for two error messages.
+/// A non-negative number shown rounded, with integer formatting only (`8192`, `1e15`,
+/// `3e-5`): core's float formatting would add about 12 KB to every firmware image for a few
+/// error messages.
 struct Round(f64);
 
 impl fmt::Display for Round {
@@ -307,6 +365,18 @@ impl fmt::Display for Round {
         let mut v = self.0.abs();
         if !v.is_finite() {
             return write!(f, "inf");
+        }
+        if v == 0.0 {
+            return write!(f, "0");
+        }
+        if v < 0.5 {
+            // One significant digit: 0.00012 is `1e-4`.
+            let mut e = 0;
+            while v < 0.95 {
+                v *= 10.0;
+                e += 1;
+            }
+            return write!(f, "{}e-{e}", ((v + 0.5) as u64).min(9));
         }
         if v < 1e6 {
             return write!(f, "{}", (v + 0.5) as u64);
@@ -370,6 +440,30 @@ fn check_finite(vals: &[f64]) -> Result<(), SceneError> {
     }
 }
 
+/// Checks a number other than a coordinate against the scalar's range (`what` names it).
+pub fn check_value<R: Real>(what: &'static str, v: f64) -> Result<(), SceneError> {
+    check_finite(&[v])?;
+    let limit = value_limit::<R>(what);
+    if v.abs() < limit {
+        Ok(())
+    } else {
+        Err(SceneError::ValueOutOfRange { what, limit, scalar: R::NAME })
+    }
+}
+
+/// The largest magnitude of a shading number in `R`: coordinates' limit, or for the index of
+/// refraction its square root (refraction squares the ratio of indices).
+fn value_limit<R: Real>(what: &'static str) -> f64 {
+    if what == IOR {
+        libm::sqrt(R::LIMIT)
+    } else {
+        R::LIMIT
+    }
+}
+
+/// The name [`check_value`] uses for the index of refraction.
+pub const IOR: &str = "index of refraction";
+
 fn check_range<R: Real>(v: Vec3<f64>) -> Result<(), SceneError> {
     check_finite(&[v.x, v.y, v.z])?;
     if v.max_abs() < R::LIMIT {
@@ -412,6 +506,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if m.ka < 0.0 || m.kd < 0.0 || m.ks < 0.0 || m.kt < 0.0 || m.ior < 1.0 {
             return Err(SceneError::BadCoefficient);
         }
+        for v in [m.ka, m.kd, m.ks, m.kt] {
+            check_value::<R>("coefficient", v)?;
+        }
+        check_value::<R>(IOR, m.ior)?;
         let f = R::from_f64;
         let conv = Material { ka: f(m.ka), kd: f(m.kd), ks: f(m.ks), kt: f(m.kt), ior: f(m.ior) };
         self.materials.push(conv).map_err(|_| SceneError::TooManyMaterials)?;
@@ -422,7 +520,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
     pub fn add_light(&mut self, l: Light<f64>) -> Result<(), SceneError> {
         let conv = match l {
             Light::Directional { to_light, intensity } => {
-                check_finite(&[to_light.x, to_light.y, to_light.z, intensity])?;
+                check_finite(&[to_light.x, to_light.y, to_light.z])?;
+                check_value::<R>("light intensity", intensity)?;
                 if to_light.max_abs() == 0.0 {
                     return Err(SceneError::DegenerateLight);
                 }
@@ -430,7 +529,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             }
             Light::Point { pos, intensity } => {
                 check_range::<R>(pos)?;
-                check_finite(&[intensity])?;
+                check_value::<R>("light intensity", intensity)?;
                 Light::Point { pos: pos.cast(), intensity: R::from_f64(intensity) }
             }
         };
@@ -445,6 +544,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if self.groups.is_full() {
             return Err(SceneError::TooManyGroups);
         }
+        check_transform(&t)?;
         self.open_group = Some((self.len, t, Aabb::empty()));
         Ok(())
     }
@@ -471,9 +571,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             Some((_, g, _)) => g.after(&to_world),
             None => to_world,
         };
-        for row in &place.m {
-            check_finite(row)?;
-        }
+        check_transform(&to_world)?;
+        check_transform(&place)?;
         let top = match shape {
             Shape::Cone { top } => top,
             _ => 0.0,
@@ -484,8 +583,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         }
         let inv = place.inverse().ok_or(SceneError::SingularTransform)?;
         let bounds = world_bounds(&shape, &place);
-        check_range::<R>(bounds.min)?;
-        check_range::<R>(bounds.max)?;
+        // The padded box is what the lattice registers: it must be in range too.
+        let padded = bounds.padded_for::<R>();
+        check_range::<R>(padded.min)?;
+        check_range::<R>(padded.max)?;
         let material = material.min(self.materials.len().saturating_sub(1) as u8);
         if self.materials.is_empty() {
             self.add_material(Material::DEFAULT)?;
@@ -506,8 +607,13 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         // Largest stretch of a direction into object space, rounded up to a power of two.
         let m = &inv.m;
         let stretch = (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(0.0, f64::max);
-        let dir_scale = 1.0 / pow2_at_least(stretch);
         let largest = m.iter().flat_map(|r| r[..3].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
+        // An object so small that its inverse transform leaves f64's comfortable range is too
+        // small for any scene (its own coordinates would overflow).
+        if !(stretch < 1e200 && largest > 1e-200) {
+            return Err(SceneError::ObjectOutOfRange { object: self.len, reach: f64::INFINITY, limit: R::LIMIT, scalar: R::NAME });
+        }
+        let dir_scale = 1.0 / pow2_at_least(stretch);
         let unscale = pow2_at_least(largest);
         let mut scaled = inv;
         scaled.m.iter_mut().flatten().for_each(|v| *v /= unscale);
@@ -543,7 +649,9 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let c = self.camera;
         check_range::<R>(c.eye)?;
         check_range::<R>(c.look)?;
-        check_finite(&[c.up.x, c.up.y, c.up.z, c.fov.0, c.fov.1, self.ambient, self.background])?;
+        check_finite(&[c.up.x, c.up.y, c.up.z, c.fov.0, c.fov.1])?;
+        check_value::<R>("ambient", self.ambient)?;
+        check_value::<R>("background", self.background)?;
         if !(c.fov.0 > 0.0 && c.fov.0 < 180.0 && c.fov.1 > 0.0 && c.fov.1 < 180.0) {
             return Err(SceneError::BadFieldOfView);
         }
@@ -585,6 +693,17 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
                 return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
             }
         }
+        let extent = world.extent();
+        for (i, o) in objects.iter().enumerate() {
+            let (size, smallest) = thickness(o, extent);
+            if size < smallest {
+                return Err(SceneError::ObjectTooThin { object: i, size, smallest, scalar: R::NAME });
+            }
+        }
+        let bound = brightness_bound(&self.materials, &self.lights, self.ambient, self.background);
+        if !(bound < R::LIMIT) {
+            return Err(SceneError::TooBright { bound, limit: R::LIMIT, scalar: R::NAME });
+        }
         Ok(Scene {
             objects,
             groups: self.groups,
@@ -599,11 +718,57 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
     }
 }
 
+/// Refuses a transform whose entries overflowed (composition of huge factors) or that is singular.
+fn check_transform(t: &Affine<f64>) -> Result<(), SceneError> {
+    if t.m.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(SceneError::TransformOverflow);
+    }
+    t.inverse().map(|_| ()).ok_or(SceneError::SingularTransform)
+}
+
+/// An object's smallest width (its canonical primitive's narrowest width divided by the
+/// largest stretch of its world-to-object map), and the smallest width the scalar can trace
+/// there: twice the offset of secondary rays at the object's farthest point (a ray entering
+/// the object starts that far inside it, so it must stay in the inner half).
+fn thickness<R: Real>(o: &Object<R>, extent: R) -> (f64, f64) {
+    let m = o.to_object.cast::<f64>();
+    let unscale = o.unscale.to_f64();
+    let stretch = (0..3)
+        .map(|i| libm::sqrt(m.m[i][0] * m.m[i][0] + m.m[i][1] * m.m[i][1] + m.m[i][2] * m.m[i][2]))
+        .fold(0.0, f64::max)
+        * unscale;
+    // Narrowest width of the canonical primitive: sphere 2 (diameter), the others 1.
+    let width = if let crate::shape::Shape::Sphere = o.shape { 2.0 } else { 1.0 };
+    let far = o.bounds.min.max_abs().max(o.bounds.max.max_abs());
+    (width / stretch, 2.0 * R::offset(far, extent).to_f64())
+}
+
+/// The largest brightness one eye ray can sum in the intersection tree at the deepest depth
+/// the tracer supports: each node adds `Ia*Ka + Kd * sum |Ip|` (or the background) and passes
+/// `Ks + Kt` of its weight to its children (a ray that misses adds the background).
+fn brightness_bound<R: Real>(materials: &[Material<R>], lights: &[Light<R>], ambient: f64, background: f64) -> f64 {
+    let ip: f64 = lights
+        .iter()
+        .map(|l| match *l {
+            Light::Directional { intensity, .. } | Light::Point { intensity, .. } => intensity.to_f64().abs(),
+        })
+        .sum();
+    let bg = background.abs();
+    let mut below = materials.iter().map(|m| ambient.abs() * m.ka.to_f64() + m.kd.to_f64() * ip).fold(bg, f64::max);
+    for _ in 0..crate::trace::MAX_DEPTH {
+        below = materials
+            .iter()
+            .map(|m| ambient.abs() * m.ka.to_f64() + m.kd.to_f64() * ip + (m.ks.to_f64() + m.kt.to_f64()) * below)
+            .fold(bg, f64::max);
+    }
+    below
+}
+
 /// The smallest power of two at or above `x > 0` (without `log2`/`exp2`, which would bring
 /// libm's 4 KB table into the firmware).
 fn pow2_at_least(x: f64) -> f64 {
     let mut p = 1.0;
-    while p < x {
+    while p < x && p < f64::MAX {
         p *= 2.0;
     }
     while p * 0.5 >= x {

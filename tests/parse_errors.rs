@@ -83,8 +83,8 @@ fn zero_scale_is_a_singular_transform() {
 
 #[test]
 fn bad_coefficients() {
-    check("material m kd -0.5", "line 1, column 10 at `m`: coefficients must be >= 0 and the index of refraction >= 1");
-    check("material m ior 0.5", "line 1, column 10 at `m`: coefficients must be >= 0 and the index of refraction >= 1");
+    check("material m kd -0.5", "line 1, column 15 at `-0.5`: coefficients must be >= 0 and the index of refraction >= 1");
+    check("material m ior 0.5", "line 1, column 16 at `0.5`: coefficients must be >= 0 and the index of refraction >= 1");
 }
 
 #[test]
@@ -134,7 +134,7 @@ fn empty_scene() {
 fn out_of_range_for_the_scalar() {
     assert_eq!(
         err::<f32>("sphere center 1e16 0 0"),
-        "line 1, column 1 at `sphere`: coordinate out of range for f32: magnitude must stay below 1e15"
+        "line 1, column 15 at `1e16`: coordinate out of range for f32: magnitude must stay below 1e15"
     );
 }
 
@@ -151,7 +151,7 @@ fn comments_blank_lines_and_groups_parse() {
 fn fixed_point_refuses_coordinates_beyond_its_range() {
     assert_eq!(
         err::<lattice_rt::Fx>("camera eye 0 0 -9000\nsphere"),
-        "line 1, column 1 at `camera`: coordinate out of range for fixed: magnitude must stay below 8192"
+        "line 1, column 16 at `-9000`: coordinate out of range for fixed: magnitude must stay below 8192"
     );
 }
 

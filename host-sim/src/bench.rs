@@ -141,7 +141,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     for (name, _prims, p_bbox, p_lat) in PAPER {
         let path = Path::new("scenes").join(format!("{name}.scene"));
         let text = read(&path)?;
-        let mut storage = object_storage::<f64>(&text);
+        let mut storage = object_storage::<f64>(&text)?;
         let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
         let mut times = vec![Vec::new(); METHODS.len()];
         let mut builds = vec![Vec::new(); METHODS.len()];

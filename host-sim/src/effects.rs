@@ -59,7 +59,7 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
     for path in scenes {
         let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
         let text = read(path)?;
-        let mut storage = object_storage::<f64>(&text);
+        let mut storage = object_storage::<f64>(&text)?;
         let fx = Effects::of(&parse_scene::<f64>(path, &text, &mut storage)?);
         let (mut td, mut ta) = (Vec::new(), Vec::new());
         let (mut d, mut a) = (None, None);

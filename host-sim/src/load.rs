@@ -3,18 +3,48 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::lattice::{Grid, LatticeSizes};
+use lattice_rt::parse::{object_count, text_from_bytes};
 use lattice_rt::scene::Object;
 use lattice_rt::{parse, Lattice, LatticeConfig, LatticeStorage, Real, Scene};
+use std::io::Read;
 use std::path::Path;
 
-/// Reads a scene file.
+/// The largest scene file host-sim reads (a 100,000-object scene is about 5 MB).
+pub const MAX_SCENE_BYTES: u64 = 32 << 20;
+
+/// The most memory object storage may take (about a million objects in f64).
+pub const MAX_OBJECT_BYTES: usize = 128 << 20;
+
+/// Reads a scene file: at most [`MAX_SCENE_BYTES`], UTF-8 (an error says the line and column
+/// of the first byte that is not).
 pub fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("cannot read scene file {}", path.display()))
+    let file = std::fs::File::open(path).with_context(|| format!("cannot read scene file {}", path.display()))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .with_context(|| format!("cannot read scene file {}", path.display()))?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        bail!("{}: the scene file is larger than {} MiB, the most host-sim reads", path.display(), MAX_SCENE_BYTES >> 20);
+    }
+    text_from_bytes(&bytes).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    // Checked just above: the bytes are UTF-8.
+    Ok(String::from_utf8(bytes).unwrap_or_default())
 }
 
-/// Object storage big enough for any scene in `text` (one object per line at most).
-pub fn object_storage<R: Real>(text: &str) -> Vec<Object<R>> {
-    vec![Object::default(); text.lines().count().max(1)]
+/// Object storage for the objects `text` declares (counted before anything is allocated), or
+/// an error when it would take more than [`MAX_OBJECT_BYTES`].
+pub fn object_storage<R: Real>(text: &str) -> Result<Vec<Object<R>>> {
+    let n = object_count(text);
+    let each = core::mem::size_of::<Object<R>>();
+    if n.saturating_mul(each) > MAX_OBJECT_BYTES {
+        bail!(
+            "the scene declares {n} objects: {} bytes of object storage, more than the limit of {MAX_OBJECT_BYTES} (at most {} objects in {})",
+            n.saturating_mul(each),
+            MAX_OBJECT_BYTES / each,
+            R::NAME
+        );
+    }
+    Ok(vec![Object::default(); n.max(1)])
 }
 
 /// Parses `text` into `storage`, turning errors into messages that name the file.
@@ -74,7 +104,7 @@ pub fn render_text<R: Real>(
     frame: &lattice_rt::Frame,
     tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, Lattice<'_, R>>),
 ) -> Result<crate::run::Rendered> {
-    let mut storage = object_storage::<R>(text);
+    let mut storage = object_storage::<R>(text)?;
     let scene = parse_scene::<R>(path, text, &mut storage)?;
     let cfg = LatticeConfig::default();
     let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
@@ -92,7 +122,7 @@ mod tests {
     fn a_lattice_too_large_for_the_host_is_refused_before_allocation() {
         let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/chair.scene"));
         let text = read(path).unwrap();
-        let mut storage = object_storage::<f64>(&text);
+        let mut storage = object_storage::<f64>(&text).unwrap();
         let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
         let err = LatticeBufs::for_scene(&scene, &crate::lattice_config(Some([1024, 1024, 1024]))).err().expect("refused");
         let msg = format!("{err:#}");

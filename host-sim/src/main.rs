@@ -355,9 +355,17 @@ fn real_main() -> Result<()> {
                 bail!("say which format: --pov is the one there is");
             }
             let text = load::read(&scene)?;
-            let mut storage = load::object_storage::<f64>(&text);
+            let mut storage = load::object_storage::<f64>(&text)?;
             let s = load::parse_scene::<f64>(&scene, &text, &mut storage)?;
-            let out = pov::export(&s, if ids { pov::PovMode::Ids } else { pov::PovMode::Full })?;
+            let out = pov::export(&s, if ids { pov::PovMode::Ids } else { pov::PovMode::Full }).map_err(|e| {
+                match e.downcast_ref::<pov::Unrepresentable>() {
+                    Some(u) => {
+                        let (line, col, _) = lattice_rt::parse::object_statement(&text, u.object);
+                        anyhow::anyhow!("{}: line {line}, column {col}: cannot export {u}", scene.display())
+                    }
+                    None => e,
+                }
+            })?;
             output::write_atomic(&output, out.as_bytes())?;
             println!("wrote {}", output.display());
             Ok(())

@@ -49,7 +49,8 @@ impl Theme {
 
 fn create_parent(path: &Path) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot write {}: cannot create its folder {}", path.display(), dir.display()))?;
     }
     Ok(())
 }

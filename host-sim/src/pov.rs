@@ -1,6 +1,8 @@
 //! POV-Ray export and the cross-check against it. See docs/povray.md for the mapping.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
+#[cfg(test)]
+use anyhow::Context;
 use lattice_rt::scene::Light;
 use lattice_rt::shape::Shape;
 use lattice_rt::{Affine, Scene, Vec3};
@@ -20,26 +22,58 @@ pub enum PovMode {
 }
 
 fn v(p: Vec3<f64>) -> String {
-    format!("<{:.9}, {:.9}, {:.9}>", p.x, p.y, p.z)
+    format!("<{:e}, {:e}, {:e}>", p.x, p.y, p.z)
 }
 
-/// Gray value (0..=255) of object `i` in [`PovMode::Ids`].
-pub fn id_gray(i: usize, n: usize) -> u8 {
-    ((i + 1) * (255 / (n + 1)).max(1)) as u8
+/// Most objects an id export tells apart (24-bit colours, black for the background).
+pub const MAX_ID_OBJECTS: usize = (1 << 24) - 2;
+
+/// Spacing of id colours for `n` objects: spread over the 24-bit range so few objects get
+/// clearly different colours.
+fn id_step(n: usize) -> usize {
+    (((1usize << 24) - 1) / (n + 1)).max(1)
 }
 
-/// The object an id gray stands for (`None`: background).
+/// Colour (8 bits per channel) of object `i` of `n` in [`PovMode::Ids`].
+pub fn id_rgb(i: usize, n: usize) -> [u8; 3] {
+    let k = (i + 1) * id_step(n);
+    [(k >> 16) as u8, (k >> 8) as u8, k as u8]
+}
+
+/// The object an id colour stands for (`None`: background).
 #[cfg(test)]
-pub fn gray_id(g: u8, n: usize) -> Option<usize> {
-    let step = (255 / (n + 1)).max(1) as f64;
-    let k = (g as f64 / step).round() as usize;
-    (k >= 1 && k <= n).then(|| k - 1)
+pub fn rgb_id(c: [u8; 3], n: usize) -> Option<usize> {
+    let k = (c[0] as usize) << 16 | (c[1] as usize) << 8 | c[2] as usize;
+    let step = id_step(n);
+    let i = (k + step / 2) / step;
+    (i >= 1 && i <= n).then(|| i - 1)
 }
+
+/// The smallest magnitude POV-Ray keeps in a matrix column (smaller columns it reads as a
+/// scale by zero and replaces; its `EPSILON`, 1e-10), with a margin of ten.
+const POV_SMALLEST: f64 = 1e-9;
+
+/// An object the POV-Ray export cannot represent.
+#[derive(Debug)]
+pub struct Unrepresentable {
+    /// Index of the object.
+    pub object: usize,
+    /// Why.
+    pub why: String,
+}
+
+impl std::fmt::Display for Unrepresentable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "object {}: {}", self.object, self.why)
+    }
+}
+
+impl std::error::Error for Unrepresentable {}
 
 /// The POV-Ray scene text of a scene.
 pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
-    if scene.objects.len() > 254 && mode == PovMode::Ids {
-        bail!("an id export holds at most 254 objects");
+    if scene.objects.len() > MAX_ID_OBJECTS && mode == PovMode::Ids {
+        bail!("an id export holds at most {MAX_ID_OBJECTS} objects");
     }
     let mut s = String::new();
     let c = &scene.camera;
@@ -69,8 +103,18 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
         // object = A (world - origin), A = to_object * unscale; so world = A^-1 object + origin.
         let mut a = o.to_object;
         a.m.iter_mut().flatten().for_each(|x| *x *= o.unscale);
-        let inv = a.inverse().context("an object transform has no inverse")?;
+        let unrepresentable = |why: String| Unrepresentable { object: i, why };
+        let inv = a.inverse().ok_or_else(|| unrepresentable("its transform has no inverse".into()))?;
         let m = Affine { m: inv.m };
+        for j in 0..3 {
+            let col = (0..3).map(|r| m.m[r][j].abs()).fold(0.0, f64::max);
+            if col < POV_SMALLEST {
+                return Err(unrepresentable(format!(
+                    "POV-Ray cannot represent its transform: it scales a direction by {col:e}, and POV-Ray reads a matrix column below {POV_SMALLEST:e} as a scale by zero"
+                ))
+                .into());
+            }
+        }
         let prim = match o.shape {
             Shape::Sphere => "sphere { <0, 0, 0>, 1".to_string(),
             Shape::Cylinder => "cylinder { <0, 0, 0>, <0, 1, 0>, 1".to_string(),
@@ -80,8 +124,8 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
         let mat = &scene.materials[o.material as usize];
         let look = match mode {
             PovMode::Ids => {
-                let g = id_gray(i, n) as f64 / 255.0;
-                format!("pigment {{ rgb {g} }} finish {{ ambient 1 diffuse 0 }}")
+                let [r, g, b] = id_rgb(i, n).map(|c| c as f64 / 255.0);
+                format!("pigment {{ rgb <{r:e}, {g:e}, {b:e}> }} finish {{ ambient 1 diffuse 0 }}")
             }
             PovMode::Full => {
                 let pig = if mat.kt > 0.0 { format!("rgbt <1, 1, 1, {}>", mat.kt) } else { "rgb 1".into() };
@@ -92,8 +136,9 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
                 )
             }
         };
+        // Shortest round-trip scientific notation: every f64 exactly, however small or large.
         let matrix = format!(
-            "matrix <{:.12}, {:.12}, {:.12}, {:.12}, {:.12}, {:.12}, {:.12}, {:.12}, {:.12}, {:.12}, {:.12}, {:.12}>",
+            "matrix <{:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}>",
             m.m[0][0], m.m[1][0], m.m[2][0], m.m[0][1], m.m[1][1], m.m[2][1], m.m[0][2], m.m[1][2], m.m[2][2],
             m.m[0][3] + o.origin.x, m.m[1][3] + o.origin.y, m.m[2][3] + o.origin.z
         );
@@ -112,6 +157,12 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
 /// Renders POV-Ray text to 8-bit gray values (`w x h`, red channel) with `povray`.
 #[cfg(test)]
 pub fn render_povray(pov: &str, w: u32, h: u32, work: &Path, name: &str) -> Result<Vec<u8>> {
+    Ok(render_povray_rgb(pov, w, h, work, name)?.into_iter().map(|p| p[0]).collect())
+}
+
+/// Renders POV-Ray text to 8-bit RGB pixels (`w x h`) with `povray`.
+#[cfg(test)]
+pub fn render_povray_rgb(pov: &str, w: u32, h: u32, work: &Path, name: &str) -> Result<Vec<[u8; 3]>> {
     std::fs::create_dir_all(work)?;
     let src = work.join(format!("{name}.pov"));
     let png = work.join(format!("{name}-povray.png"));
@@ -126,12 +177,11 @@ pub fn render_povray(pov: &str, w: u32, h: u32, work: &Path, name: &str) -> Resu
     if !out.status.success() {
         bail!("povray failed on {}: {}", src.display(), String::from_utf8_lossy(&out.stderr));
     }
-    let img = image_gray(&png)?;
-    Ok(img)
+    image_rgb(&png)
 }
 
 #[cfg(test)]
-fn image_gray(path: &Path) -> Result<Vec<u8>> {
+fn image_rgb(path: &Path) -> Result<Vec<[u8; 3]>> {
     let bytes = std::fs::read(path)?;
     let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     let mut reader = decoder.read_info()?;
@@ -139,7 +189,8 @@ fn image_gray(path: &Path) -> Result<Vec<u8>> {
     let info = reader.next_frame(&mut buf)?;
     let ch = info.color_type.samples();
     let depth = if info.bit_depth == png::BitDepth::Sixteen { 2 } else { 1 };
-    Ok(buf[..info.buffer_size()].chunks(ch * depth).map(|p| p[0]).collect())
+    let px = |p: &[u8], c: usize| p[c.min(ch.saturating_sub(1)) * depth];
+    Ok(buf[..info.buffer_size()].chunks(ch * depth).map(|p| [px(p, 0), px(p, 1), px(p, 2)]).collect())
 }
 
 #[cfg(test)]
@@ -179,7 +230,7 @@ mod tests {
     /// the pixels whose object is opaque).
     fn compare(name: &str, scene: &Scene<'_, f64>) -> (f64, f64, f64) {
         let n = scene.objects.len();
-        let ids = render_povray(&export(scene, PovMode::Ids).unwrap(), W, H, &work(), &format!("{name}-ids")).unwrap();
+        let ids = render_povray_rgb(&export(scene, PovMode::Ids).unwrap(), W, H, &work(), &format!("{name}-ids")).unwrap();
         let mut mb = vec![0; lattice_rt::Query::mailbox_len(scene)];
         let mut q = Query::new(&mut mb);
         let ours: Vec<Option<usize>> = (0..(W * H) as i32)
@@ -188,7 +239,7 @@ mod tests {
                 BruteForce.nearest(scene, &r, 0.0, f64::MAX, &mut q).map(|h| h.object as usize)
             })
             .collect();
-        let agree = ours.iter().zip(&ids).filter(|(o, g)| **o == gray_id(**g, n)).count() as f64 / ours.len() as f64;
+        let agree = ours.iter().zip(&ids).filter(|(o, g)| **o == rgb_id(**g, n)).count() as f64 / ours.len() as f64;
         let pov = render_povray(&export(scene, PovMode::Full).unwrap(), W, H, &work(), name).unwrap();
         let cfg = LatticeConfig::default();
         let mut bufs = LatticeBufs::for_scene(scene, &cfg).expect("lattice fits");
@@ -217,7 +268,7 @@ mod tests {
         for path in &names {
             let name = path.file_stem().unwrap().to_string_lossy().to_string();
             let text = read(path).unwrap();
-            let mut storage = object_storage::<f64>(&text);
+            let mut storage = object_storage::<f64>(&text).unwrap();
             let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
             let (agree, mean, far) = compare(&name, &scene);
             report.push_str(&format!("{name}: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n", agree * 100.0, far * 100.0));

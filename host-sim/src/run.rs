@@ -120,7 +120,7 @@ mod tests {
         for name in ["chair", "whitted"] {
             let path = std::path::PathBuf::from(format!("{}/../scenes/{name}.scene", env!("CARGO_MANIFEST_DIR")));
             let text = read(&path).unwrap();
-            let mut storage = object_storage::<f64>(&text);
+            let mut storage = object_storage::<f64>(&text).unwrap();
             let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
             let cfg = LatticeConfig::default();
             let mut bufs = LatticeBufs::for_scene(&scene, &cfg).expect("lattice fits");
@@ -188,7 +188,7 @@ fn print_stats(label: &str, s: &Stats, elapsed: Duration) {
 pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     crate::output::check_png_size(a.size.0 as u32, a.size.1 as u32, a.scale)?;
     let text = read(&a.scene)?;
-    let mut storage = object_storage::<R>(&text);
+    let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let frame = Frame { tile: a.tile, dither: a.dither.mode(), sampling: a.sampling.mode(), ..Frame::new(a.size.0, a.size.1) };
     let mut out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true, true)?;
@@ -228,7 +228,7 @@ fn median(mut v: Vec<Duration>) -> Duration {
 /// `host-sim stats`.
 pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let text = read(&a.scene)?;
-    let mut storage = object_storage::<R>(&text);
+    let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let cfg = crate::lattice_config(a.cells);
     let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
@@ -317,7 +317,7 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
     for name in PAPER_SCENES {
         let path = scenes.join(format!("{name}.scene"));
         let text = read(&path)?;
-        let mut storage = object_storage::<f64>(&text);
+        let mut storage = object_storage::<f64>(&text)?;
         let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
         for (w, h) in [(160u16, 100u16), (128, 64)] {
             let frame = Frame::new(w, h);
