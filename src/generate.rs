@@ -7,6 +7,8 @@ use crate::scene::{Light, Material, SceneBuilder, SceneError};
 use crate::shape::Shape;
 
 /// Xorshift64* pseudo-random numbers.
+// Not `Copy`: a copy would silently repeat the sequence.
+#[allow(missing_copy_implementations)]
 #[derive(Clone, Debug)]
 pub struct Rng(u64);
 

@@ -144,6 +144,7 @@ pub struct LatticeSizes {
 }
 
 /// A storage slice too small for the lattice.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LatticeError {
     /// Which storage ran out ("grids", "coords", "cells", "refs").
@@ -436,10 +437,10 @@ impl<'a, R: Real> Lattice<'a, R> {
 
     /// Bytes the built lattice occupies (grids, coordinate lists, cells, references).
     pub fn bytes(&self) -> usize {
-        core::mem::size_of_val(self.grids)
-            + core::mem::size_of_val(self.coords)
-            + core::mem::size_of_val(self.cells)
-            + core::mem::size_of_val(self.refs)
+        size_of_val(self.grids)
+            + size_of_val(self.coords)
+            + size_of_val(self.cells)
+            + size_of_val(self.refs)
     }
 
     /// The lattices: index 0 is the world, then one per composite.
@@ -482,7 +483,7 @@ impl<'a, R: Real> Lattice<'a, R> {
     }
 
     fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
-        let Some((t0, t1)) = self.grids[0].bounds.clip(ray, tmin, tmax) else { return None };
+        let (t0, t1) = self.grids[0].bounds.clip(ray, tmin, tmax)?;
         q.next_ray();
         let inv = Inverse::new(ray);
         let mut best: Option<Hit<R>> = None;

@@ -1,6 +1,10 @@
 #![doc = include_str!("../README.md")]
 #![no_std]
 #![deny(missing_docs, missing_debug_implementations, unsafe_code, rustdoc::broken_intra_doc_links)]
+// Matrix and lattice code indexes rows and axes as the maths does; `!(a < b)` is deliberate
+// wherever a NaN must fail a test.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+#![deny(trivial_casts, trivial_numeric_casts, unused_qualifications, missing_copy_implementations)]
 
 #[cfg(test)]
 extern crate std;

@@ -14,6 +14,7 @@ use core::fmt;
 use heapless::Vec;
 
 /// What is wrong at a position of the scene text.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ParseErrorKind {
     /// The first word of a line is not a statement.
@@ -48,6 +49,7 @@ pub enum ParseErrorKind {
 }
 
 /// A scene-text error: where, what token, why.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParseError<'t> {
     /// 1-based line.

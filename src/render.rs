@@ -88,6 +88,7 @@ pub struct NoHooks;
 impl Hooks for NoHooks {}
 
 /// Why a render stopped.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RenderError<E> {
     /// The draw target failed.
@@ -157,7 +158,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
 ) -> Result<Stats, RenderError<D::Error>> {
     let t = frame.tile as usize;
     let block = frame.dither.block() as usize;
-    if t == 0 || t > MAX_TILE || t % block != 0 {
+    if t == 0 || t > MAX_TILE || !t.is_multiple_of(block) {
         return Err(RenderError::BadTile);
     }
     if frame.edges() && E & Effects::EDGE_AA == 0 {

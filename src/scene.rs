@@ -199,6 +199,7 @@ pub struct Group<R> {
 }
 
 /// Why a scene was refused.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SceneError {
     /// More objects than the storage holds.
@@ -738,7 +739,7 @@ fn thickness<R: Real>(o: &Object<R>, extent: R) -> (f64, f64) {
         .fold(0.0, f64::max)
         * unscale;
     // Narrowest width of the canonical primitive: sphere 2 (diameter), the others 1.
-    let width = if let crate::shape::Shape::Sphere = o.shape { 2.0 } else { 1.0 };
+    let width = if let Shape::Sphere = o.shape { 2.0 } else { 1.0 };
     let far = o.bounds.min.max_abs().max(o.bounds.max.max_abs());
     (width / stretch, 2.0 * R::offset(far, extent).to_f64())
 }

@@ -28,6 +28,7 @@ pub const MAX_DEPTH: u8 = 8;
 
 /// The effects a render simulates, as a bit set: the scene's own set ([`Effects::of`]), a
 /// forced one, and at compile time the set a [`Tracer`] is built with (its const parameter).
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Effects(pub u8);
 
@@ -99,6 +100,7 @@ impl core::fmt::Display for Effects {
 }
 
 /// A scene needs effects the tracer was compiled without.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MissingEffects(pub Effects);
 

@@ -32,8 +32,8 @@ fn reflection_needs_a_mirror_material_in_use() {
 
 #[test]
 fn refraction_needs_a_transparent_material_in_use() {
-    assert!(effects_of(&format!("material g kt 0.8 ior 1.5\nsphere material g\n")).has(Effects::REFRACTION));
-    assert!(!effects_of(&format!("material g kt 0\nsphere material g\n")).has(Effects::REFRACTION));
+    assert!(effects_of("material g kt 0.8 ior 1.5\nsphere material g\n").has(Effects::REFRACTION));
+    assert!(!effects_of("material g kt 0\nsphere material g\n").has(Effects::REFRACTION));
 }
 
 #[test]

@@ -373,7 +373,7 @@ fn boxes_under_extreme_transforms<R: Real>() {
                 (None, None) => {}
                 (a, b) => {
                     // Disagreement only for rays grazing an edge: the f64 hit is near the box's silhouette.
-                    let grazing = b.map_or(true, |b| s64.objects[0].world_normal(b.normal).dot(r64.dir.normalize()).abs() < 0.05);
+                    let grazing = b.is_none_or(|b| s64.objects[0].world_normal(b.normal).dot(r64.dir.normalize()).abs() < 0.05);
                     assert!(grazing, "{} {name}: hit {:?} vs {:?}", R::NAME, a.map(|h| h.t), b.map(|h| h.t));
                 }
             }

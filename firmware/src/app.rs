@@ -93,6 +93,26 @@ impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
     }
 }
 
+/// Logged by defmt without `core::fmt`: the core's errors derive `defmt::Format` (its `defmt`
+/// feature); only the display's own error goes through `Debug`.
+#[cfg(feature = "pico")]
+impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        match self {
+            AppError::Parse(e) => defmt::write!(f, "scene: {}", e),
+            AppError::Lattice(e) => defmt::write!(f, "{}", e),
+            AppError::Effects(e) => defmt::write!(f, "{}", e),
+            AppError::Render(RenderError::Draw(e)) => defmt::write!(f, "display: {}", defmt::Debug2Format(e)),
+            AppError::Render(RenderError::Cancelled) => defmt::write!(f, "render cancelled"),
+            AppError::Render(RenderError::BadTile) => defmt::write!(f, "bad tile size"),
+            AppError::Render(RenderError::NotCompiled(e)) => defmt::write!(f, "not compiled in: {}", e),
+            AppError::Render(RenderError::ScratchTooSmall { needed }) => {
+                defmt::write!(f, "scratch storage too small: {} entries needed", needed)
+            }
+        }
+    }
+}
+
 /// What a finished frame reports.
 #[derive(Clone, Copy, Debug)]
 pub struct Report {

@@ -55,7 +55,7 @@ pub fn build_pico(root: &Path) -> Result<PathBuf> {
 pub fn write_uf2(elf: &Path, out: &Path) -> Result<()> {
     let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let mut bytes = Vec::new();
-    elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2040::default(), elf2flash_core::NoProgress)
+    elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2040, elf2flash_core::NoProgress)
         .map_err(|e| anyhow::anyhow!("cannot convert {} to UF2: {e}", elf.display()))?;
     crate::output::write_atomic(out, &bytes)
 }

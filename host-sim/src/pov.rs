@@ -245,7 +245,7 @@ mod tests {
         let mut bufs = LatticeBufs::for_scene(scene, &cfg).expect("lattice fits");
         let lat = bufs.build(scene, &cfg).unwrap();
         let mine = render_with(&Tracer::new(scene, &lat), &Frame::new(W as u16, H as u16), false).unwrap().gray;
-        let opaque: Vec<usize> = (0..mine.len()).filter(|&i| ours[i].map_or(true, |o| scene.materials[scene.objects[o].material as usize].kt == 0.0)).collect();
+        let opaque: Vec<usize> = (0..mine.len()).filter(|&i| ours[i].is_none_or(|o| scene.materials[scene.objects[o].material as usize].kt == 0.0)).collect();
         let diff: Vec<f64> = opaque.iter().map(|&i| (mine[i] as f64 - pov[i] as f64 * 64.0 / 255.0).abs()).collect();
         let mean = diff.iter().sum::<f64>() / diff.len().max(1) as f64;
         let far = diff.iter().filter(|&&d| d > 8.0).count() as f64 / diff.len().max(1) as f64;

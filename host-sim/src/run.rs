@@ -109,34 +109,6 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
     Ok(Rendered { bits, gray: hooks.gray, stats, elapsed })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::load::LatticeBufs;
-    use lattice_rt::Dither;
-
-    #[test]
-    fn parallel_bands_equal_the_serial_render() {
-        for name in ["chair", "whitted"] {
-            let path = std::path::PathBuf::from(format!("{}/../scenes/{name}.scene", env!("CARGO_MANIFEST_DIR")));
-            let text = read(&path).unwrap();
-            let mut storage = object_storage::<f64>(&text).unwrap();
-            let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
-            let cfg = LatticeConfig::default();
-            let mut bufs = LatticeBufs::for_scene(&scene, &cfg).expect("lattice fits");
-            let lat = bufs.build(&scene, &cfg).unwrap();
-            let t = Tracer::new(&scene, &lat);
-            for dither in [Dither::Bayer, Dither::Pattern(4)] {
-                let frame = Frame { dither, ..Frame::new(160, 100) };
-                let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
-                let par = pool.install(|| render_with(&t, &frame, false)).unwrap();
-                let ser = render_band(&t, &frame, false).unwrap();
-                assert!(par.bits == ser.bits && par.gray == ser.gray, "{name} {dither:?}");
-                assert_eq!(par.stats, ser.stats, "{name}");
-            }
-        }
-    }
-}
 
 /// Renders with the accelerator chosen by `accel` (building the lattice when needed).
 pub fn render_accel<R: Real>(
@@ -332,4 +304,33 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
     }
     println!("wrote the paper's four scenes to {}/", out.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::LatticeBufs;
+    use lattice_rt::Dither;
+
+    #[test]
+    fn parallel_bands_equal_the_serial_render() {
+        for name in ["chair", "whitted"] {
+            let path = std::path::PathBuf::from(format!("{}/../scenes/{name}.scene", env!("CARGO_MANIFEST_DIR")));
+            let text = read(&path).unwrap();
+            let mut storage = object_storage::<f64>(&text).unwrap();
+            let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
+            let cfg = LatticeConfig::default();
+            let mut bufs = LatticeBufs::for_scene(&scene, &cfg).expect("lattice fits");
+            let lat = bufs.build(&scene, &cfg).unwrap();
+            let t = Tracer::new(&scene, &lat);
+            for dither in [Dither::Bayer, Dither::Pattern(4)] {
+                let frame = Frame { dither, ..Frame::new(160, 100) };
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
+                let par = pool.install(|| render_with(&t, &frame, false)).unwrap();
+                let ser = render_band(&t, &frame, false).unwrap();
+                assert!(par.bits == ser.bits && par.gray == ser.gray, "{name} {dither:?}");
+                assert_eq!(par.stats, ser.stats, "{name}");
+            }
+        }
+    }
 }

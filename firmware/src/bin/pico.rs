@@ -211,7 +211,7 @@ fn main() -> ! {
                         r.lattice_bytes, stack::high_water()
                     );
                 }
-                Err(e) => defmt::error!("{}: {}", name, defmt::Display2Format(&e)),
+                Err(e) => defmt::error!("{}: {}", name, e),
             }
             sleep_ms(&mut alarm, PAUSE_MS);
         }

@@ -102,12 +102,16 @@ fn main() -> ! {
 unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
     hprintln!("HARDFAULT at pc {:#010x}", ef.pc());
     debug::exit(debug::EXIT_FAILURE);
-    loop {}
+    loop {
+        cortex_m::asm::wfi();
+    }
 }
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     hprintln!("PANIC {}", info);
     debug::exit(debug::EXIT_FAILURE);
-    loop {}
+    loop {
+        cortex_m::asm::wfi();
+    }
 }
