@@ -462,7 +462,13 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
         last_line = lineno;
         let mut w = Words::for_scalar::<R>(line, lineno);
         let Some((kcol, key)) = w.next() else { continue };
-        let scene_err = |e: SceneError| ParseError { line: lineno, col: kcol, token: key, kind: ParseErrorKind::Scene(e) };
+        let scene_err = |e: SceneError| {
+            let e = match e {
+                SceneError::TooManyObjects { capacity, .. } => SceneError::TooManyObjects { capacity, needed: object_count(text) },
+                e => e,
+            };
+            ParseError { line: lineno, col: kcol, token: key, kind: ParseErrorKind::Scene(e) }
+        };
         let mut shading = |w: &mut Words<'t>, what: &'static str| -> Result<f64, ParseError<'t>> {
             let (v, col, tok) = w.value::<R>(what)?;
             if v.abs() > bright_at.3 {

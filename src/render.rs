@@ -173,7 +173,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
     let total = (tiles_x * end.saturating_sub(first)) as u32;
-    let cam = &tracer.scene.camera;
+    let cam = &tracer.scene().camera;
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
     // An eye ray through the point (sx / 4, sy / 4) in pixels from the top-left corner.
     // Edge detection compares object ids modulo 2^16 (they only need to differ between

@@ -206,6 +206,9 @@ pub enum SceneError {
     TooManyObjects {
         /// Objects the storage holds.
         capacity: usize,
+        /// Objects the scene has (at least: the builder knows those added so far; the
+        /// parser counts the whole text).
+        needed: usize,
     },
     /// More than [`MAX_MATERIALS`] materials.
     TooManyMaterials,
@@ -295,8 +298,8 @@ pub enum SceneError {
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SceneError::TooManyObjects { capacity } => {
-                write!(f, "too many objects: the object storage holds {capacity}")
+            SceneError::TooManyObjects { capacity, needed } => {
+                write!(f, "too many objects: the scene needs storage for {needed}, it holds {capacity}")
             }
             SceneError::TooManyMaterials => write!(f, "too many materials (at most {MAX_MATERIALS})"),
             SceneError::TooManyLights => write!(f, "too many lights (at most {MAX_LIGHTS})"),
@@ -523,10 +526,13 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             Light::Directional { to_light, intensity } => {
                 check_finite(&[to_light.x, to_light.y, to_light.z])?;
                 check_value::<R>("light intensity", intensity)?;
-                if to_light.max_abs() == 0.0 {
+                // A direction so short (subnormal) that normalising it overflows is as unusable
+                // as a zero one.
+                let unit = to_light.normalize();
+                if to_light.max_abs() == 0.0 || !is_unit(unit) {
                     return Err(SceneError::DegenerateLight);
                 }
-                Light::Directional { to_light: to_light.normalize().cast(), intensity: R::from_f64(intensity) }
+                Light::Directional { to_light: unit.cast(), intensity: R::from_f64(intensity) }
             }
             Light::Point { pos, intensity } => {
                 check_range::<R>(pos)?;
@@ -566,7 +572,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
     pub fn add_object(&mut self, shape: Shape<f64>, to_world: Affine<f64>, material: u8) -> Result<(), SceneError> {
         // Lattice references keep the top bit for sub-lattices, so 2^31 objects at most.
         if self.len >= self.storage.len() || self.len >= 1 << 31 {
-            return Err(SceneError::TooManyObjects { capacity: self.storage.len() });
+            return Err(SceneError::TooManyObjects { capacity: self.storage.len(), needed: self.len + 1 });
         }
         let place = match &self.open_group {
             Some((_, g, _)) => g.after(&to_world),
@@ -664,6 +670,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         // Left-handed like POV-Ray: x right, y up, z into the screen, so right = up x forward.
         let right = -right.normalize();
         let up = forward.cross(right).normalize();
+        if !(is_unit(forward) && is_unit(right) && is_unit(up)) {
+            // Directions so short (subnormal) or long that normalising them overflowed.
+            return Err(SceneError::DegenerateCamera);
+        }
         let tx = libm::tan(c.fov.0.to_radians_core() / 2.0);
         let ty = libm::tan(c.fov.1.to_radians_core() / 2.0);
         let camera =
@@ -717,6 +727,11 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             world,
         })
     }
+}
+
+/// Whether `v` is finite and of length 1 (to rounding).
+fn is_unit(v: Vec3<f64>) -> bool {
+    (v.length() - 1.0).abs() < 1e-6
 }
 
 /// Refuses a transform whose entries overflowed (composition of huge factors) or that is singular.

@@ -112,6 +112,22 @@ impl core::fmt::Display for MissingEffects {
 
 impl core::error::Error for MissingEffects {}
 
+/// A tree depth beyond [`MAX_DEPTH`] was asked for.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooDeep {
+    /// The depth asked for.
+    pub depth: u8,
+}
+
+impl core::fmt::Display for TooDeep {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "depth {} is deeper than the tracer supports ({MAX_DEPTH})", self.depth)
+    }
+}
+
+impl core::error::Error for TooDeep {}
+
 /// The side of a surface a ray meets: the normal turned to face the ray, the ratio of indices
 /// `eta = n_from / n_to` for a material of index `ior` in air, and whether the ray enters.
 /// A ray from inside (its direction along the outward normal) gets the flipped normal and the
@@ -143,16 +159,13 @@ pub fn refract<R: Real>(d: Vec3<R>, n: Vec3<R>, eta: R) -> Option<Vec3<R>> {
 /// removed by the compiler, so firmware for a matte scene carries no mirror or glass code.
 #[derive(Debug)]
 pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL }> {
-    /// The scene.
-    pub scene: &'s Scene<'a, R>,
-    /// The accelerator answering ray queries.
-    pub accel: &'s A,
-    /// Effects simulated at run time (within those compiled in): the scene's own by default.
-    pub effects: Effects,
-    /// Maximum depth of the intersection tree.
-    pub max_depth: u8,
-    /// Branches whose weight falls below this are not traced (0 traces everything).
-    pub cutoff: R,
+    scene: &'s Scene<'a, R>,
+    accel: &'s A,
+    effects: Effects,
+    /// At most [`MAX_DEPTH`] (checked by [`Tracer::set_max_depth`]), so the node stack never
+    /// overflows.
+    max_depth: u8,
+    cutoff: R,
     /// Extent of the world box, the scale term of the self-intersection offset.
     scale: R,
 }
@@ -198,6 +211,51 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         })
     }
 
+    /// The scene traced.
+    pub fn scene(&self) -> &'s Scene<'a, R> {
+        self.scene
+    }
+
+    /// The accelerator answering ray queries.
+    pub fn accel(&self) -> &'s A {
+        self.accel
+    }
+
+    /// Effects simulated at run time (within those compiled in): the scene's own by default.
+    pub fn effects(&self) -> Effects {
+        self.effects
+    }
+
+    /// Simulates `effects` (those not compiled in stay off: see [`Tracer::simulates`]).
+    pub fn set_effects(&mut self, effects: Effects) {
+        self.effects = effects;
+    }
+
+    /// Maximum depth of the intersection tree (0: eye rays only).
+    pub fn max_depth(&self) -> u8 {
+        self.max_depth
+    }
+
+    /// Sets the maximum depth of the intersection tree; deeper than [`MAX_DEPTH`] is refused
+    /// (the tracer's node stack holds that many levels).
+    pub fn set_max_depth(&mut self, depth: u8) -> Result<(), TooDeep> {
+        if depth > MAX_DEPTH {
+            return Err(TooDeep { depth });
+        }
+        self.max_depth = depth;
+        Ok(())
+    }
+
+    /// Branches whose weight falls below this are not traced (0 traces everything).
+    pub fn cutoff(&self) -> R {
+        self.cutoff
+    }
+
+    /// Sets the contribution cutoff (see [`Tracer::cutoff`]).
+    pub fn set_cutoff(&mut self, cutoff: R) {
+        self.cutoff = cutoff;
+    }
+
     /// Whether an effect is both compiled in and switched on.
     #[inline(always)]
     pub fn simulates(&self, bit: u8) -> bool {
@@ -213,6 +271,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     pub fn radiance_and_object(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u32) {
         let mut first = NO_OBJECT;
         let scene = self.scene;
+        // Depth-first, each node pushes at most two children and `max_depth <= MAX_DEPTH`, so at
+        // most `MAX_DEPTH + 2` nodes wait: no push below can fail.
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
         let _ = stack.push(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary });
         let mut total = R::ZERO;

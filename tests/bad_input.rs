@@ -134,6 +134,20 @@ fn an_object_scaled_to_nothing_is_refused_in_every_scalar() {
     }
 }
 
+#[test]
+fn directions_too_short_to_normalise_are_refused() {
+    assert_eq!(err::<f64>("light directional dir 1e-320 0 0\nsphere"), "line 1, column 1 at `light`: light direction is zero");
+    assert_eq!(
+        err::<f64>("camera eye 0 0 0 look 1e-320 0 1e-320\nsphere"),
+        "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector"
+    );
+    assert_eq!(
+        err::<f64>("camera up 1e-320 1e-320 0\nsphere"),
+        "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector"
+    );
+    assert!(accepted::<f64>("camera up 1e300 1e300 0\nlight directional dir 1e300 -1e300 0\nsphere"));
+}
+
 // Class 7: encodings, line endings, numbers out of range, tokens that cannot be echoed.
 #[test]
 fn invalid_utf8_is_reported_at_its_line_and_column() {

@@ -80,7 +80,7 @@ fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
         let frame = Frame::new(160, 100);
         let derived = Tracer::new(&scene, &lat);
         let mut all = Tracer::new(&scene, &lat);
-        all.effects = Effects(Effects::ALL);
+        all.set_effects(Effects(Effects::ALL));
         let (a, sa) = render_tracer(&derived, &frame);
         let (b, sb) = render_tracer(&all, &frame);
         assert!(a == b, "{s}: forcing all effects changed the image");
@@ -98,7 +98,7 @@ fn a_one_level_cutoff_prunes_the_whitted_tree_and_barely_changes_the_frame() {
     let frame = Frame::new(128, 64);
     let exact = Tracer::new(&scene, &lat);
     let mut pruned = Tracer::new(&scene, &lat);
-    pruned.cutoff = 1.0 / 64.0;
+    pruned.set_cutoff(1.0 / 64.0);
     let (a, sa) = render_tracer(&exact, &frame);
     let (b, sb) = render_tracer(&pruned, &frame);
     let fewer = 1.0 - sb.total_rays() as f64 / sa.total_rays() as f64;

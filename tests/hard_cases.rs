@@ -49,7 +49,7 @@ fn gray_all<R: Real>(scene: &Scene<'_, R>, frame: &Frame, shadows: bool) -> Vec<
     with_accels(scene, &LatticeConfig::default(), |name, a| {
         let mut t = Tracer::new(scene, a);
         if !shadows {
-            t.effects = Effects(t.effects.0 & !Effects::SHADOWS);
+            t.set_effects(Effects(t.effects().0 & !Effects::SHADOWS));
         }
         let g = gray_of(&t, frame);
         match &out {

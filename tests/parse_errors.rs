@@ -114,7 +114,7 @@ fn groups_must_nest_properly() {
 #[test]
 fn too_many_objects_names_the_capacity() {
     let text = "sphere\n".repeat(9);
-    check(&text, "line 9, column 1 at `sphere`: too many objects: the object storage holds 8");
+    check(&text, "line 9, column 1 at `sphere`: too many objects: the scene needs storage for 9, it holds 8");
 }
 
 #[test]

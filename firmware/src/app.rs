@@ -136,7 +136,7 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     let lattice = Lattice::build(&scene, &LatticeConfig::default(), storage).map_err(AppError::Lattice)?;
     let mut tracer = Tracer::<_, _, EFFECTS>::compiled(&scene, &lattice).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
-        tracer.effects = Effects(Effects::ALL);
+        tracer.set_effects(Effects(Effects::ALL));
     }
     let stats = render(&tracer, &FRAME, target, &mut st.mailbox, &mut [], hooks).map_err(AppError::Render)?;
     Ok(Report { stats, objects: scene.objects.len(), lattice_bytes: lattice.bytes() })

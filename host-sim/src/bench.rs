@@ -66,8 +66,8 @@ fn frame_with(scene: &Scene<'_, f64>, m: Method, frame: &Frame, primary_only: bo
     };
     let mut t = Tracer::new(scene, a);
     if primary_only {
-        t.max_depth = 0;
-        t.effects = Effects(0);
+        t.set_max_depth(0).expect("depth 0 is always valid");
+        t.set_effects(Effects(0));
     }
     let r = render_band(&t, frame, false)?;
     Ok((r.elapsed, build, bytes, r.stats, r.bits))

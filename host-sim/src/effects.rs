@@ -19,9 +19,9 @@ struct Shot {
 fn shoot(path: &Path, text: &str, all: bool, cutoff: f64) -> Result<Shot> {
     let r = render_text::<f64>(path, text, &Frame::new(128, 64), |t| {
         if all {
-            t.effects = Effects(Effects::ALL);
+            t.set_effects(Effects(Effects::ALL));
         }
-        t.cutoff = cutoff;
+        t.set_cutoff(cutoff);
     })?;
     Ok(Shot { bits: r.bits, stats: r.stats, time: r.elapsed })
 }

@@ -97,7 +97,7 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
-    let mut mailbox = vec![0u32; Query::mailbox_len(tracer.scene)];
+    let mut mailbox = vec![0u32; Query::mailbox_len(tracer.scene())];
     let mut carry = vec![0i16; frame.scratch_len()];
     let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, shown: false };
     let start = Instant::now();
@@ -233,8 +233,8 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let pixels = frame.width as f64 * frame.height as f64;
     // Primary rays only: the paper's per-ray figures.
     let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>| {
-        t.max_depth = 0;
-        t.effects = Effects(0);
+        t.set_max_depth(0).expect("depth 0 is always valid");
+        t.set_effects(Effects(0));
     };
     println!("  per primary ray at {}x{} (eye rays only):", frame.width, frame.height);
     let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];

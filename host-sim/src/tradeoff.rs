@@ -74,9 +74,9 @@ fn shoot_in<R: Real>(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Res
     let frame = Frame { dither: c.dither, sampling: c.sampling, ..Frame::new(w, h) };
     let r = render_text::<R>(path, text, &frame, |t| {
         if let Some(d) = c.depth {
-            t.max_depth = d;
+            t.set_max_depth(d).expect("the study stays within MAX_DEPTH");
         }
-        t.cutoff = R::from_f64(c.cutoff);
+        t.set_cutoff(R::from_f64(c.cutoff));
     })?;
     Ok(Shot { gray: r.gray, bits: r.bits, rays: r.stats.total_rays(), time: r.elapsed })
 }

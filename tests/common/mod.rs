@@ -47,7 +47,7 @@ pub fn build_lattice<'a, R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: 
 pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, A>, frame: &Frame) -> (Vec<u8>, Stats) {
     let mut bits = vec![0u8; BitFrame::bytes(frame.width as u32, frame.height as u32)];
     let mut target = BitFrame::new(frame.width as u32, frame.height as u32, &mut bits).unwrap();
-    let mut mb = vec![0u32; Query::mailbox_len(t.scene)];
+    let mut mb = vec![0u32; Query::mailbox_len(t.scene())];
     let mut carry = vec![0i16; frame.scratch_len()];
     let stats = render(t, frame, &mut target, &mut mb, &mut carry, &mut NoHooks).expect("render");
     let mut pbm = Vec::new();
@@ -117,7 +117,7 @@ pub fn gray_of<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, A>, fr
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).unwrap();
-    let mut mb = vec![0u32; Query::mailbox_len(t.scene)];
+    let mut mb = vec![0u32; Query::mailbox_len(t.scene())];
     let mut scratch = vec![0i16; frame.scratch_len()];
     let mut g = G(vec![0; w * h], w);
     render(t, frame, &mut target, &mut mb, &mut scratch, &mut g).expect("render");
