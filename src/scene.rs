@@ -551,7 +551,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if self.groups.is_full() {
             return Err(SceneError::TooManyGroups);
         }
-        check_transform(&t)?;
+        checked_inverse(&t)?;
         self.open_group = Some((self.len, t, Aabb::empty()));
         Ok(())
     }
@@ -578,8 +578,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             Some((_, g, _)) => g.after(&to_world),
             None => to_world,
         };
-        check_transform(&to_world)?;
-        check_transform(&place)?;
+        // `place` is `to_world` after an invertible group transform: checking it covers both.
+        let inv = checked_inverse(&place)?;
         let top = match shape {
             Shape::Cone { top } => top,
             _ => 0.0,
@@ -588,7 +588,6 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if top < 0.0 {
             return Err(SceneError::NonPositiveSize);
         }
-        let inv = place.inverse().ok_or(SceneError::SingularTransform)?;
         let bounds = world_bounds(&shape, &place);
         // The padded box is what the lattice registers: it must be in range too.
         let padded = bounds.padded_for::<R>();
@@ -734,12 +733,13 @@ fn is_unit(v: Vec3<f64>) -> bool {
     (v.length() - 1.0).abs() < 1e-6
 }
 
-/// Refuses a transform whose entries overflowed (composition of huge factors) or that is singular.
-fn check_transform(t: &Affine<f64>) -> Result<(), SceneError> {
+/// The inverse of a transform, refusing one whose entries overflowed (composition of huge
+/// factors) or that is singular.
+fn checked_inverse(t: &Affine<f64>) -> Result<Affine<f64>, SceneError> {
     if t.m.iter().flatten().any(|v| !v.is_finite()) {
         return Err(SceneError::TransformOverflow);
     }
-    t.inverse().map(|_| ()).ok_or(SceneError::SingularTransform)
+    t.inverse().ok_or(SceneError::SingularTransform)
 }
 
 /// An object's smallest width (its canonical primitive's narrowest width divided by the

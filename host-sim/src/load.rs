@@ -26,9 +26,11 @@ pub fn read(path: &Path) -> Result<String> {
     if bytes.len() as u64 > MAX_SCENE_BYTES {
         bail!("{}: the scene file is larger than {} MiB, the most host-sim reads", path.display(), MAX_SCENE_BYTES >> 20);
     }
-    text_from_bytes(&bytes).map_err(|e| anyhow!("{}: {e}", path.display()))?;
-    // Checked just above: the bytes are UTF-8.
-    Ok(String::from_utf8(bytes).unwrap_or_default())
+    // Validated once; only a failure is located (line and column) by the core.
+    String::from_utf8(bytes).map_err(|e| match text_from_bytes(e.as_bytes()) {
+        Err(at) => anyhow!("{}: {at}", path.display()),
+        Ok(_) => anyhow!("{}: not UTF-8 text", path.display()),
+    })
 }
 
 /// Object storage for the objects `text` declares (counted before anything is allocated), or
