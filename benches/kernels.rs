@@ -2,10 +2,11 @@
 //! `cargo bench --bench kernels`; regressions show as changes against the last run.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use lattice_rt::lattice::{Grid, LatticeSizes};
 use lattice_rt::scene::Object;
 use lattice_rt::shape::Shape;
-use lattice_rt::{parse, render, Accelerator, BitFrame, Frame, Fx, Lattice, LatticeConfig, LatticeStorage, NoHooks, Query, Ray, Real, Tracer, Vec3};
+use lattice_rt::{
+    parse, render, Accelerator, BitFrame, Frame, Fx, HeapStorage, LatticeConfig, NoHooks, Query, Ray, Real, Scratch, Sizes, Tracer, Vec3,
+};
 
 fn primitives(c: &mut Criterion) {
     let r = Ray::new(Vec3::new(-5.0, 0.3, 0.2), Vec3::new(1.0, 0.05, 0.02));
@@ -26,9 +27,8 @@ fn walk_and_tile(c: &mut Criterion) {
     let mut st = Vec::new();
     let scene = scene_parts::<f64>(&text, &mut st);
     let cfg = LatticeConfig::default();
-    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(&scene, &cfg);
-    let (mut g, mut co, mut ce, mut re) = (vec![Grid::EMPTY; grids], vec![0.0; coords], vec![0; cells], vec![0; refs]);
-    let lat = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut co, cells: &mut ce, refs: &mut re }).unwrap();
+    let mut storage = HeapStorage::new(Sizes { objects: 0, ..Sizes::of(&scene, Some(&cfg), &Frame::new(8, 8)) });
+    let (lat, _) = storage.view().split().1.lattice(&scene, &cfg).unwrap();
     let ray = scene.camera.ray(81, 99, 160, 100);
     c.bench_function("lattice walk (cells only), desk", |b| b.iter(|| {
         let mut n = 0;
@@ -46,7 +46,7 @@ fn walk_and_tile(c: &mut Criterion) {
         let mut bits = [0u8; 8];
         let mut target = BitFrame::new(8, 8, &mut bits).unwrap();
         let mut mb = [0u32; 32];
-        render(&tracer, &frame, &mut target, &mut mb, &mut [], &mut NoHooks).unwrap()
+        render(&tracer, &frame, &mut target, &mut Scratch::new(&mut mb, &mut []), &mut NoHooks).unwrap()
     }));
 }
 

@@ -7,9 +7,13 @@
 //! too, to know which frames the image shows). Each is parsed here with the core itself, in the firmware's
 //! scalar, so a broken scene fails the build with its line and column, and the storage
 //! capacities are the exact maximum the chosen scenes need (written to `capacities.rs`).
-use lattice_rt::lattice::{Lattice, LatticeConfig, LatticeSizes};
+use lattice_rt::lattice::LatticeConfig;
 use lattice_rt::scene::Object;
-use lattice_rt::Real;
+use lattice_rt::{Real, Sizes};
+
+#[path = "src/frame.rs"]
+#[allow(dead_code)]
+mod frame;
 use std::fmt::Write as _;
 use std::{env, fs, path::PathBuf};
 
@@ -38,14 +42,14 @@ fn main() {
     println!("cargo:rerun-if-changed=default-scenes.txt");
     let names = env::var("FIRMWARE_SCENES").unwrap_or_else(|_| fs::read_to_string("default-scenes.txt").expect("default-scenes.txt"));
     let mut list = String::new();
-    let (mut objects, mut groups, mut grids, mut coords, mut cells, mut refs) = (1, 0, 1, 1, 1, 1);
+    let mut sizes = Sizes { objects: 1, grids: 1, coords: 1, words: 1, rows: 0 };
     let mut effects = 0u8;
     for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));
         println!("cargo:rerun-if-changed={}", path.display());
         let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
         let feature = |f: &str| env::var_os(format!("CARGO_FEATURE_{f}")).is_some();
-        let (n, g, s, e) = if feature("SCALAR_FIXED") {
+        let (s, e) = if feature("SCALAR_FIXED") {
             plan::<lattice_rt::Fx>(&path, &text)
         } else if feature("SCALAR_MICROMATH") {
             plan::<lattice_rt::F32Micro>(&path, &text)
@@ -55,12 +59,7 @@ fn main() {
             plan::<f32>(&path, &text)
         };
         effects |= e;
-        objects = objects.max(n);
-        groups = groups.max(g);
-        grids = grids.max(s.grids);
-        coords = coords.max(s.coords);
-        cells = cells.max(s.cells);
-        refs = refs.max(s.refs);
+        sizes = sizes.max(s);
         let abs = fs::canonicalize(&path).unwrap();
         writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
     }
@@ -71,21 +70,21 @@ fn main() {
     let code = format!(
         "/// The scenes embedded in this build (`FIRMWARE_SCENES`).\n\
          pub const SCENES: [(&str, &str); {count}] = [\n{list}];\n\
-         /// Most primitives in an embedded scene.\npub const MAX_OBJECTS: usize = {objects};\n\
-         /// Most composites in an embedded scene.\npub const MAX_COMPOSITES: usize = {groups};\n\
-         /// Most lattices (world + composites).\npub const MAX_GRIDS: usize = {grids};\n\
-         /// Coordinate-list entries.\npub const MAX_COORDS: usize = {coords};\n\
-         /// Cell entries (cells + 1).\npub const MAX_CELLS: usize = {cells};\n\
-         /// Cell references.\npub const MAX_REFS: usize = {refs};\n\
-         /// Effects compiled in: those the embedded scenes call for (`Effects` bits).\npub const EFFECTS: u8 = {effects};\n"
+         /// Most primitives in an embedded scene.\npub const MAX_OBJECTS: usize = {};\n\
+         /// Most lattices (world + composites).\npub const MAX_GRIDS: usize = {};\n\
+         /// Coordinate-list entries.\npub const MAX_COORDS: usize = {};\n\
+         /// Words: cells + 1, references and the mailbox.\npub const MAX_WORDS: usize = {};\n\
+         /// Render rows (dither carries, edge ids).\npub const MAX_ROWS: usize = {};\n\
+         /// Effects compiled in: those the embedded scenes call for (`Effects` bits).\npub const EFFECTS: u8 = {effects};\n",
+        sizes.objects, sizes.grids, sizes.coords, sizes.words, sizes.rows
     );
     fs::write(out.join("capacities.rs"), code).unwrap();
 }
 
-/// Objects, composites, lattice storage and effects of one scene in the firmware's scalar.
-fn plan<R: Real>(path: &std::path::Path, text: &str) -> (usize, usize, LatticeSizes, u8) {
+/// Storage and effects of one scene in the firmware's scalar.
+fn plan<R: Real>(path: &std::path::Path, text: &str) -> (Sizes, u8) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
     let scene = lattice_rt::parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let effects = lattice_rt::Effects::of(&scene).0;
-    (scene.objects.len(), scene.groups.len(), Lattice::plan(&scene, &LatticeConfig::default()), effects)
+    (Sizes::of(&scene, Some(&LatticeConfig::default()), &frame::FRAME), effects)
 }

@@ -124,10 +124,10 @@ pub struct LatticeStorage<'a, R> {
     pub grids: &'a mut [Grid<R>],
     /// All coordinate lists, concatenated.
     pub coords: &'a mut [R],
-    /// Per cell, the index of its first reference; one extra entry at the end.
-    pub cells: &'a mut [u32],
-    /// Cell contents: object indices, or `SUB_FLAG | composite index`.
-    pub refs: &'a mut [u32],
+    /// Cells and references in one pool: per cell the index of its first reference (one
+    /// extra entry at the end), then the references (object indices, or `SUB_FLAG |
+    /// composite index`). Words beyond those are left to the caller ([`Lattice::build_leaving`]).
+    pub words: &'a mut [u32],
 }
 
 /// How much storage a scene's lattice needs.
@@ -141,6 +141,13 @@ pub struct LatticeSizes {
     pub cells: usize,
     /// References.
     pub refs: usize,
+}
+
+impl LatticeSizes {
+    /// Words of [`LatticeStorage::words`] the lattice takes: its cells and references.
+    pub fn words(&self) -> usize {
+        self.cells + self.refs
+    }
 }
 
 /// A storage slice too small for the lattice.
@@ -365,7 +372,17 @@ impl<'a, R: Real> Lattice<'a, R> {
 
     /// Builds the lattice into `storage`.
     pub fn build(scene: &Scene<'_, R>, cfg: &LatticeConfig, storage: LatticeStorage<'a, R>) -> Result<Self, LatticeError> {
-        let LatticeStorage { grids, coords, cells, refs } = storage;
+        Self::build_leaving(scene, cfg, storage).map(|(lattice, _)| lattice)
+    }
+
+    /// Builds the lattice into `storage` and returns the words it left unused (the storage
+    /// module hands them to the render as its scratch).
+    pub fn build_leaving(
+        scene: &Scene<'_, R>,
+        cfg: &LatticeConfig,
+        storage: LatticeStorage<'a, R>,
+    ) -> Result<(Self, &'a mut [u32]), LatticeError> {
+        let LatticeStorage { grids, coords, words } = storage;
         let ngrids = if cfg.nested { 1 + scene.groups.len() } else { 1 };
         if grids.len() < ngrids {
             return Err(LatticeError { capacity: "grids", needed: ngrids, available: grids.len() });
@@ -391,10 +408,10 @@ impl<'a, R: Real> Lattice<'a, R> {
             ncells += grid.cells();
             *slot = grid;
         }
-        if ncells + 1 > cells.len() {
-            return Err(LatticeError { capacity: "cells", needed: ncells + 1, available: cells.len() });
+        if ncells + 1 > words.len() {
+            return Err(LatticeError { capacity: "cells", needed: ncells + 1, available: words.len() });
         }
-        let cells = &mut cells[..ncells + 1];
+        let (cells, refs) = words.split_at_mut(ncells + 1);
         cells.iter_mut().for_each(|c| *c = 0);
         // Pass 1: count references per cell (into cells[i + 1]).
         let mut nrefs = 0usize;
@@ -409,6 +426,7 @@ impl<'a, R: Real> Lattice<'a, R> {
         if nrefs > refs.len() {
             return Err(LatticeError { capacity: "refs", needed: nrefs, available: refs.len() });
         }
+        let (refs, rest) = refs.split_at_mut(nrefs);
         for i in 1..cells.len() {
             cells[i] += cells[i - 1];
         }
@@ -426,13 +444,8 @@ impl<'a, R: Real> Lattice<'a, R> {
             cells[i] = cells[i - 1];
         }
         cells[0] = 0;
-        Ok(Lattice {
-            grids: &grids[..ngrids],
-            coords: &coords[..nc],
-            cells,
-            refs: &refs[..nrefs],
-            objects: scene.objects.len(),
-        })
+        let lattice = Lattice { grids: &grids[..ngrids], coords: &coords[..nc], cells, refs, objects: scene.objects.len() };
+        Ok((lattice, rest))
     }
 
     /// Bytes the built lattice occupies (grids, coordinate lists, cells, references).
@@ -668,8 +681,8 @@ mod tests {
         random_scene(&mut b, &RandomScene { objects: n, group_size: group, spread: 0.0, seed: 7 }).unwrap();
         let scene = b.finish().unwrap();
         let s = Lattice::plan(&scene, &cfg);
-        let (mut g, mut c, mut ce, mut r) = (vec![Grid::EMPTY; s.grids], vec![0.0; s.coords], vec![0; s.cells], vec![0; s.refs]);
-        let lat = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap();
+        let (mut g, mut c, mut w) = (vec![Grid::EMPTY; s.grids], vec![0.0; s.coords], vec![0; s.words()]);
+        let lat = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, words: &mut w }).unwrap();
         assert_eq!((lat.grids.len(), lat.coords.len(), lat.cells.len(), lat.refs.len()), (s.grids, s.coords, s.cells, s.refs));
         f(&scene, &lat);
     }
@@ -688,11 +701,11 @@ mod tests {
         let scene = b.finish().unwrap();
         let cfg = LatticeConfig::default();
         let s = Lattice::plan(&scene, &cfg);
-        let (mut g, mut c, mut ce, mut r) = (vec![Grid::EMPTY; s.grids], vec![0.0; s.coords], vec![0; s.cells], vec![0; s.refs - 1]);
-        let e = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap_err();
+        let (mut g, mut c, mut w) = (vec![Grid::EMPTY; s.grids], vec![0.0; s.coords], vec![0; s.words() - 1]);
+        let e = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, words: &mut w }).unwrap_err();
         assert_eq!(e, LatticeError { capacity: "refs", needed: s.refs, available: s.refs - 1 });
         let mut g2 = vec![Grid::EMPTY; 1];
-        let e = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g2, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap_err();
+        let e = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g2, coords: &mut c, words: &mut w }).unwrap_err();
         assert_eq!(e.capacity, "grids");
         assert_eq!(std::format!("{e}"), "lattice capacity `grids` too small: 5 entries needed, 1 available");
     }

@@ -8,6 +8,8 @@
 
 #[cfg(test)]
 extern crate std;
+#[cfg(feature = "alloc")]
+extern crate alloc;
 
 pub mod math;
 pub mod scalar;
@@ -30,6 +32,10 @@ pub mod render;
 pub use render::{render, Frame, Hooks, NoHooks, Sampling};
 pub mod parse;
 pub use parse::{parse, ParseError};
+pub mod storage;
+pub use storage::{Loaded, Scratch, Sizes, Storage, StorageView};
+#[cfg(feature = "alloc")]
+pub use storage::{HeapScratch, HeapStorage};
 pub mod bitframe;
 pub use bitframe::BitFrame;
 pub mod generate;

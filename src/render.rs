@@ -5,6 +5,7 @@
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{ordered, Carry, Dither, LEVELS, MAX_TILE};
 use crate::scalar::Real;
+use crate::storage::Scratch;
 use crate::trace::{Effects, Tracer, NO_OBJECT};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -144,16 +145,15 @@ pub fn level<R: Real>(v: R) -> u8 {
 /// Kept out of line so the firmware report can check that nothing it calls uses floating point
 /// when the scalar is fixed point.
 ///
-/// `mailbox` is the accelerator's per-object scratch ([`Query::mailbox_len`] entries);
-/// `scratch` must hold [`Frame::scratch_len`] entries (it may be empty for Bayer or patterning
-/// with one ray per pixel).
+/// `scratch` comes from the storage the scene was loaded into ([`crate::storage`]); its rows
+/// must hold [`Frame::scratch_len`] entries (none for Bayer or patterning with one ray per
+/// pixel).
 #[inline(never)]
 pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     target: &mut D,
-    mailbox: &mut [u32],
-    scratch: &mut [i16],
+    scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
     let t = frame.tile as usize;
@@ -165,11 +165,12 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
         return Err(RenderError::NotCompiled(Effects(Effects::EDGE_AA)));
     }
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let scratch = scratch.get_mut(..frame.scratch_len()).ok_or(RenderError::ScratchTooSmall { needed: frame.scratch_len() })?;
-    let (carry_store, above) = scratch.split_at_mut(if frame.dither.diffuses() { Carry::len(w) } else { 0 });
+    let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or(RenderError::ScratchTooSmall { needed: frame.scratch_len() })?;
+    let (carry_store, above) = rows.split_at_mut(if frame.dither.diffuses() { Carry::len(w) } else { 0 });
     let mut carry = if frame.dither.diffuses() { Carry::new(carry_store, w) } else { None };
     above.iter_mut().for_each(|v| *v = NO_OBJECT as u16 as i16);
-    let mut q = Query::new(mailbox);
+    let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
+    let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
     let total = (tiles_x * end.saturating_sub(first)) as u32;

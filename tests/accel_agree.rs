@@ -2,7 +2,7 @@
 //! for bit), on random scenes and adversarial rays, in every float scalar.
 
 mod common;
-use common::{build_lattice, lattice_bufs};
+use common::{build_lattice, lattice_storage};
 use lattice_rt::generate::{random_scene, RandomScene, Rng};
 use lattice_rt::scene::Object;
 use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, Query, Ray, Real, Scene, SceneBuilder, Vec3};
@@ -62,7 +62,7 @@ fn check<R: Real>(p: &RandomScene, cfg: &LatticeConfig, nrays: usize) -> Result<
     let mut b = SceneBuilder::new(&mut storage);
     random_scene(&mut b, p).unwrap();
     let scene = b.finish().unwrap();
-    let mut bufs = lattice_bufs(&scene, cfg);
+    let mut bufs = lattice_storage(&scene, cfg);
     let lat = build_lattice(&scene, cfg, &mut bufs);
     let mut rng = Rng::new(p.seed ^ 0xABCD);
     let rays = adversarial_rays(&lat, &scene, &mut rng, nrays);
@@ -157,7 +157,7 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
     b.end_group().unwrap();
     let scene = b.finish().unwrap();
     let cfg = LatticeConfig::default();
-    let mut bufs = lattice_bufs(&scene, &cfg);
+    let mut bufs = lattice_storage(&scene, &cfg);
     let lat = build_lattice(&scene, &cfg, &mut bufs);
     let mut mb = vec![0; Query::mailbox_len(&scene)];
     let mut q = Query::new(&mut mb);

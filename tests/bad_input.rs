@@ -28,7 +28,7 @@ fn gray<R: Real>(text: &str, frame: &Frame) -> Vec<u8> {
     let mut storage = vec![Object::<R>::default(); 16];
     let scene = parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", R::NAME));
     let cfg = LatticeConfig::default();
-    let mut bufs = lattice_bufs(&scene, &cfg);
+    let mut bufs = lattice_storage(&scene, &cfg);
     let lat = build_lattice(&scene, &cfg, &mut bufs);
     gray_of(&Tracer::new(&scene, &lat), frame)
 }

@@ -61,7 +61,7 @@ fn a_tracer_without_refraction_refuses_glass() {
     let text = scene_text("whitted");
     let mut storage = vec![Object::<f64>::default(); 64];
     let scene = parse::<f64>(&text, &mut storage).unwrap();
-    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     const MATTE: u8 = Effects::SHADOWS | Effects::COMPOSITES;
     let err = Tracer::<_, _, MATTE>::compiled(&scene, &lat).unwrap_err();
@@ -75,7 +75,7 @@ fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
         let text = scene_text(s);
         let mut storage = vec![Object::<f64>::default(); 64];
         let scene = parse::<f64>(&text, &mut storage).unwrap();
-        let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+        let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
         let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
         let frame = Frame::new(160, 100);
         let derived = Tracer::new(&scene, &lat);
@@ -93,7 +93,7 @@ fn a_one_level_cutoff_prunes_the_whitted_tree_and_barely_changes_the_frame() {
     let text = scene_text("whitted");
     let mut storage = vec![Object::<f64>::default(); 64];
     let scene = parse::<f64>(&text, &mut storage).unwrap();
-    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let frame = Frame::new(128, 64);
     let exact = Tracer::new(&scene, &lat);

@@ -32,7 +32,7 @@ fn scene_in<'a, R: Real>(text: &str, storage: &'a mut Vec<Object<R>>) -> Scene<'
 
 /// Calls `f` with each accelerator over the scene (a lattice with `cfg`).
 fn with_accels<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut f: impl FnMut(&str, &dyn Accelerator<R>)) {
-    let mut bufs = lattice_bufs(scene, cfg);
+    let mut bufs = lattice_storage(scene, cfg);
     let lat = build_lattice(scene, cfg, &mut bufs);
     f("lattice", &lat);
     f("bbox", &BoundingBox);
@@ -261,7 +261,7 @@ fn long_walk_does_not_drift<R: Real>() {
     let mut st = Vec::new();
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([1000, 1000, 1]), ..LatticeConfig::default() };
-    let mut bufs = lattice_bufs(&scene, &cfg);
+    let mut bufs = lattice_storage(&scene, &cfg);
     let lat = build_lattice(&scene, &cfg, &mut bufs);
     let ray = Ray::new(v::<R>(0.37, 0.11, 0.5), v::<R>(0.8, 0.6, 0.0));
     let mut walked = Vec::new();

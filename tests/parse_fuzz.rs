@@ -28,7 +28,7 @@ fn check<R: Real>(text: &str) -> Result<(), TestCaseError> {
             if sizes.cells > 1 << 18 || sizes.refs > 1 << 18 {
                 return Ok(());
             }
-            let mut bufs = lattice_bufs(&scene, &cfg);
+            let mut bufs = lattice_storage(&scene, &cfg);
             let lat = build_lattice(&scene, &cfg, &mut bufs);
             let mut mb = vec![0; Query::mailbox_len(&scene)];
             let mut q = Query::new(&mut mb);

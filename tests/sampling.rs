@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use lattice_rt::render::Hooks;
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, render, BitFrame, Frame, LatticeConfig, Query, Sampling, Tracer};
+use lattice_rt::{parse, render, BitFrame, Frame, HeapScratch, LatticeConfig, Sampling, Tracer};
 
 struct Gray(Vec<u8>, usize);
 impl Hooks for Gray {
@@ -22,15 +22,14 @@ fn gray(sampling: Sampling) -> (Vec<u8>, u64) {
     let text = scene_text("spheres");
     let mut storage = vec![Object::<f64>::default(); 16];
     let scene = parse::<f64>(&text, &mut storage).unwrap();
-    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
+    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let frame = Frame { sampling, ..Frame::new(128, 64) };
     let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
     let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
-    let mut mb = vec![0u32; Query::mailbox_len(&scene)];
-    let mut scratch = vec![0i16; frame.scratch_len()];
+    let mut scratch = HeapScratch::new(&scene, &frame);
     let mut hooks = Gray(vec![0; 128 * 64], 128);
-    let stats = render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut mb, &mut scratch, &mut hooks).unwrap();
+    let stats = render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut scratch.scratch(), &mut hooks).unwrap();
     (hooks.0, stats.rays[0])
 }
 

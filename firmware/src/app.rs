@@ -3,16 +3,14 @@
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::BinaryColor;
-use lattice_rt::lattice::{Grid, LatticeError, LatticeStorage};
+use lattice_rt::lattice::LatticeError;
 use lattice_rt::parse::ParseError;
 use lattice_rt::render::{Hooks, RenderError};
-use lattice_rt::scene::{Object, MAX_GROUPS};
-
-// The composites of every embedded scene fit the core's fixed table (checked at compile time).
-const _: () = assert!(MAX_COMPOSITES <= MAX_GROUPS);
-use lattice_rt::render::Sampling;
+use lattice_rt::storage::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
-use lattice_rt::{parse, render, Dither, Effects, Frame, Lattice, LatticeConfig, Real, Stats, Tracer};
+use lattice_rt::{render, Effects, LatticeConfig, Real, Stats, Tracer};
+
+pub use crate::frame::{FRAME, HEIGHT, WIDTH};
 
 /// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).
 #[cfg(feature = "scalar-fixed")]
@@ -30,44 +28,8 @@ pub type Scalar = f32;
 // SCENES and the capacities, computed by build.rs from the scenes chosen for this build.
 include!(concat!(env!("OUT_DIR"), "/capacities.rs"));
 
-/// Display width (SSD1306 128x64).
-pub const WIDTH: u16 = 128;
-/// Display height.
-pub const HEIGHT: u16 = 64;
-
-/// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), Bayer dither.
-pub const FRAME: Frame = Frame { width: WIDTH, height: HEIGHT, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center, rows: (0, u16::MAX) };
-
-/// All memory a scene needs, owned by the caller (it lives on `main`'s stack).
-pub struct Storage<R> {
-    objects: [Object<R>; MAX_OBJECTS],
-    grids: [Grid<R>; MAX_GRIDS],
-    coords: [R; MAX_COORDS],
-    cells: [u32; MAX_CELLS],
-    refs: [u32; MAX_REFS],
-    mailbox: [u32; MAX_OBJECTS + MAX_COMPOSITES],
-}
-
-impl<R: Real> Storage<R> {
-    /// Empty storage.
-    pub fn new() -> Self {
-        let z = Object::default();
-        Storage {
-            objects: [z; MAX_OBJECTS],
-            grids: [Grid::EMPTY; MAX_GRIDS],
-            coords: [R::ZERO; MAX_COORDS],
-            cells: [0; MAX_CELLS],
-            refs: [0; MAX_REFS],
-            mailbox: [0; MAX_OBJECTS + MAX_COMPOSITES],
-        }
-    }
-}
-
-impl<R: Real> Default for Storage<R> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+/// All memory a frame of any embedded scene needs, with the capacities build.rs computed.
+pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_GRIDS, MAX_COORDS, MAX_WORDS, MAX_ROWS>;
 
 /// Why a scene could not be shown.
 #[derive(Debug)]
@@ -131,13 +93,20 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     target: &mut D,
     hooks: &mut impl Hooks,
 ) -> Result<Report, AppError<'t, D::Error>> {
-    let scene = parse::<R>(text, &mut st.objects).map_err(AppError::Parse)?;
-    let storage = LatticeStorage { grids: &mut st.grids, coords: &mut st.coords, cells: &mut st.cells, refs: &mut st.refs };
-    let lattice = Lattice::build(&scene, &LatticeConfig::default(), storage).map_err(AppError::Lattice)?;
+    let Loaded { scene, lattice, mut scratch } = st.view().load(text, &LatticeConfig::default())?;
     let mut tracer = Tracer::<_, _, EFFECTS>::compiled(&scene, &lattice).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
         tracer.set_effects(Effects(Effects::ALL));
     }
-    let stats = render(&tracer, &FRAME, target, &mut st.mailbox, &mut [], hooks).map_err(AppError::Render)?;
+    let stats = render(&tracer, &FRAME, target, &mut scratch, hooks).map_err(AppError::Render)?;
     Ok(Report { stats, objects: scene.objects.len(), lattice_bytes: lattice.bytes() })
+}
+
+impl<'t, E> From<LoadError<'t>> for AppError<'t, E> {
+    fn from(e: LoadError<'t>) -> Self {
+        match e {
+            LoadError::Parse(e) => AppError::Parse(e),
+            LoadError::Lattice(e) => AppError::Lattice(e),
+        }
+    }
 }

@@ -6,4 +6,5 @@
 #![deny(missing_docs)]
 
 pub mod app;
+pub mod frame;
 pub mod stack;

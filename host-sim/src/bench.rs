@@ -1,7 +1,7 @@
 //! `host-sim bench`: the paper's Table 1 reproduced, then scaling to 100 000 primitives, and
 //! the lattice's resolution choice against a sweep. Writes `docs/performance.md` and a plot.
 
-use crate::load::{object_storage, parse_scene, read, LatticeBufs};
+use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
 use crate::run::render_band;
 use anyhow::{Context, Result};
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
@@ -54,9 +54,9 @@ impl Method {
 /// Renders with one method; returns (render time, lattice build time, lattice bytes, stats, bits).
 fn frame_with(scene: &Scene<'_, f64>, m: Method, frame: &Frame, primary_only: bool) -> Result<(Duration, Duration, usize, lattice_rt::Stats, Vec<u8>)> {
     let cfg = LatticeConfig { nested: m != Method::Flat, ..LatticeConfig::default() };
-    let mut bufs = LatticeBufs::for_scene(scene, &cfg)?;
+    let mut bufs = lattice_storage(scene, &cfg)?;
     let t0 = Instant::now();
-    let lattice = bufs.build(scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, scene, &cfg)?;
     let build = t0.elapsed();
     let bytes = lattice.bytes();
     let a: &(dyn Accelerator<f64> + Sync) = match m {
@@ -217,8 +217,8 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
                         (t, tests, 0.0, bytes, String::from("-"))
                     }
                     Some(cfg) => {
-                        let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
-                        let lat = bufs.build(&scene, &cfg)?;
+                        let mut bufs = lattice_storage(&scene, &cfg)?;
+                        let lat = build_lattice(&mut bufs, &scene, &cfg)?;
                         let (t, tests, cells) = per_ray(&scene, &lat, &all_rays, runs);
                         let refs_b = lat.ref_count() * 4;
                         let cells_b = (lat.cell_count() + 1) * 4;
@@ -259,8 +259,8 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     sweep.push(("auto (2 per object)".into(), LatticeConfig { nested: false, ..LatticeConfig::default() }));
     sweep.push(("auto, adaptive lists".into(), LatticeConfig { nested: false, spacing: Spacing::Adaptive, ..LatticeConfig::default() }));
     for (label, cfg) in sweep {
-        let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
-        let lat = bufs.build(&scene, &cfg)?;
+        let mut bufs = lattice_storage(&scene, &cfg)?;
+        let lat = build_lattice(&mut bufs, &scene, &cfg)?;
         let (t, tests, cells) = per_ray(&scene, &lat, &rays, runs);
         writeln!(md, "| {label} | {} | {:.3} | {tests:.2} | {cells:.1} | {} |", lat.cell_count(), t.as_secs_f64() * 1e6, lat.bytes())?;
     }

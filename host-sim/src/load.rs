@@ -2,10 +2,10 @@
 //! the core's caller-provided buffers).
 
 use anyhow::{anyhow, bail, Context, Result};
-use lattice_rt::lattice::{Grid, LatticeSizes};
+use lattice_rt::lattice::LatticeSizes;
 use lattice_rt::parse::{object_count, text_from_bytes};
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, Lattice, LatticeConfig, LatticeStorage, Real, Scene};
+use lattice_rt::{parse, Frame, HeapStorage, Lattice, LatticeConfig, Real, Scene, Sizes};
 use std::io::Read;
 use std::path::Path;
 
@@ -58,44 +58,25 @@ pub fn parse_scene<'a, R: Real>(path: &Path, text: &str, storage: &'a mut [Objec
 /// gigabytes: `--cells 1024x1024x1024` alone would be 4.3 GB).
 pub const MAX_LATTICE_BYTES: usize = 512 << 20;
 
-/// Heap storage for a lattice, sized by [`Lattice::plan`].
-pub struct LatticeBufs<R> {
-    grids: Vec<Grid<R>>,
-    coords: Vec<R>,
-    cells: Vec<u32>,
-    refs: Vec<u32>,
+/// Heap storage for the lattice of `scene` with `cfg` and a render's mailbox (objects are
+/// parsed apart, into [`object_storage`]), or an error when it would take more than
+/// [`MAX_LATTICE_BYTES`] (checked before anything is allocated).
+pub fn lattice_storage<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<HeapStorage<R>> {
+    let sizes = Sizes { objects: 0, rows: 0, ..Sizes::of(scene, Some(cfg), &Frame::new(1, 1)) };
+    let bytes = sizes.bytes::<R>();
+    if bytes > MAX_LATTICE_BYTES {
+        let LatticeSizes { cells, refs, .. } = Lattice::plan(scene, cfg);
+        bail!(
+            "the lattice would need {bytes} bytes ({cells} cells, {refs} references), more than the limit of {MAX_LATTICE_BYTES}: ask for fewer cells with --cells"
+        );
+    }
+    Ok(HeapStorage::new(sizes))
 }
 
-impl<R: Real> LatticeBufs<R> {
-    /// Storage for the lattice of `scene` with `cfg`, or an error when it would take more than
-    /// [`MAX_LATTICE_BYTES`] (checked before anything is allocated).
-    pub fn for_scene(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Self> {
-        let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(scene, cfg);
-        let bytes = (grids as u128) * core::mem::size_of::<Grid<R>>() as u128
-            + (coords as u128) * core::mem::size_of::<R>() as u128
-            + (cells as u128 + refs as u128) * 4;
-        if bytes > MAX_LATTICE_BYTES as u128 {
-            bail!(
-                "the lattice would need {bytes} bytes ({cells} cells, {refs} references), more than the limit of {MAX_LATTICE_BYTES}: ask for fewer cells with --cells"
-            );
-        }
-        Ok(LatticeBufs {
-            grids: vec![Grid::EMPTY; grids],
-            coords: vec![R::ZERO; coords],
-            cells: vec![0; cells],
-            refs: vec![0; refs],
-        })
-    }
-    /// Builds the lattice in this storage.
-    pub fn build<'a>(&'a mut self, scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Lattice<'a, R>> {
-        let storage = LatticeStorage {
-            grids: &mut self.grids,
-            coords: &mut self.coords,
-            cells: &mut self.cells,
-            refs: &mut self.refs,
-        };
-        Lattice::build(scene, cfg, storage).map_err(|e| anyhow!("{e}"))
-    }
+/// Builds the lattice of `scene` with `cfg` in `storage` (from [`lattice_storage`]).
+pub fn build_lattice<'a, R: Real>(storage: &'a mut HeapStorage<R>, scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Lattice<'a, R>> {
+    let (lattice, _) = storage.view().split().1.lattice(scene, cfg).map_err(|e| anyhow!("{e}"))?;
+    Ok(lattice)
 }
 
 /// Parses scene text, builds its default lattice and renders `frame` on one core, after
@@ -109,8 +90,8 @@ pub fn render_text<R: Real>(
     let mut storage = object_storage::<R>(text)?;
     let scene = parse_scene::<R>(path, text, &mut storage)?;
     let cfg = LatticeConfig::default();
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
-    let lattice = bufs.build(&scene, &cfg)?;
+    let mut bufs = lattice_storage(&scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
     let mut tracer = lattice_rt::Tracer::new(&scene, &lattice);
     tune(&mut tracer);
     crate::run::render_band(&tracer, frame, false)
@@ -126,10 +107,10 @@ mod tests {
         let text = read(path).unwrap();
         let mut storage = object_storage::<f64>(&text).unwrap();
         let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
-        let err = LatticeBufs::for_scene(&scene, &crate::lattice_config(Some([1024, 1024, 1024]))).err().expect("refused");
+        let err = lattice_storage(&scene, &crate::lattice_config(Some([1024, 1024, 1024]))).err().expect("refused");
         let msg = format!("{err:#}");
         assert!(msg.contains("--cells") && msg.contains(&MAX_LATTICE_BYTES.to_string()), "{msg}");
-        assert!(LatticeBufs::for_scene(&scene, &crate::lattice_config(Some([64, 64, 64]))).is_ok());
+        assert!(lattice_storage(&scene, &crate::lattice_config(Some([64, 64, 64]))).is_ok());
     }
 
     #[test]

@@ -196,7 +196,7 @@ fn image_rgb(path: &Path) -> Result<Vec<[u8; 3]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::load::{object_storage, parse_scene, read, LatticeBufs};
+    use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
     use crate::run::render_with;
     use lattice_rt::generate::{random_scene, RandomScene};
     use lattice_rt::scene::Object;
@@ -242,8 +242,8 @@ mod tests {
         let agree = ours.iter().zip(&ids).filter(|(o, g)| **o == rgb_id(**g, n)).count() as f64 / ours.len() as f64;
         let pov = render_povray(&export(scene, PovMode::Full).unwrap(), W, H, &work(), name).unwrap();
         let cfg = LatticeConfig::default();
-        let mut bufs = LatticeBufs::for_scene(scene, &cfg).expect("lattice fits");
-        let lat = bufs.build(scene, &cfg).unwrap();
+        let mut bufs = lattice_storage(scene, &cfg).expect("lattice fits");
+        let lat = build_lattice(&mut bufs, scene, &cfg).unwrap();
         let mine = render_with(&Tracer::new(scene, &lat), &Frame::new(W as u16, H as u16), false).unwrap().gray;
         let opaque: Vec<usize> = (0..mine.len()).filter(|&i| ours[i].is_none_or(|o| scene.materials[scene.objects[o].material as usize].kt == 0.0)).collect();
         let diff: Vec<f64> = opaque.iter().map(|&i| (mine[i] as f64 - pov[i] as f64 * 64.0 / 255.0).abs()).collect();

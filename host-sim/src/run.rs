@@ -1,13 +1,13 @@
 //! The commands: render, stats and the default gallery job.
 
-use crate::load::{object_storage, parse_scene, read, LatticeBufs};
+use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
 use crate::output::{write_gray_png, write_pbm, write_pgm, write_png, Theme};
 use crate::{Accel, RenderArgs, StatsArgs};
 use anyhow::{anyhow, Context, Result};
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::Effects;
 use lattice_rt::{
-    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, LatticeConfig, Query, Real, Scene, Stats,
+    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, LatticeConfig, Real, Scene, Stats,
     Tracer,
 };
 use std::io::Write;
@@ -97,11 +97,10 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
-    let mut mailbox = vec![0u32; Query::mailbox_len(tracer.scene())];
-    let mut carry = vec![0i16; frame.scratch_len()];
+    let mut scratch = HeapScratch::new(tracer.scene(), frame);
     let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, shown: false };
     let start = Instant::now();
-    let stats = render(tracer, frame, &mut target, &mut mailbox, &mut carry, &mut hooks).map_err(|e| match e {
+    let stats = render(tracer, frame, &mut target, &mut scratch.scratch(), &mut hooks).map_err(|e| match e {
         RenderError::Draw(never) => match never {},
         other => anyhow!("{other}"),
     })?;
@@ -124,8 +123,8 @@ pub fn render_accel<R: Real>(
     let lattice;
     let a: &(dyn Accelerator<R> + Sync) = match accel {
         Accel::Lattice => {
-            bufs = LatticeBufs::for_scene(scene, cfg)?;
-            lattice = bufs.build(scene, cfg)?;
+            bufs = lattice_storage(scene, cfg)?;
+            lattice = build_lattice(&mut bufs, scene, cfg)?;
             &lattice
         }
         Accel::Bbox => &BoundingBox,
@@ -203,9 +202,9 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let cfg = crate::lattice_config(a.cells);
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
+    let mut bufs = lattice_storage(&scene, &cfg)?;
     let t0 = Instant::now();
-    let lattice = bufs.build(&scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
     let build = t0.elapsed();
     let fx = Effects::of(&scene);
     println!("scene {} ({})", a.scene.display(), R::NAME);
@@ -309,7 +308,7 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::load::LatticeBufs;
+    use crate::load::{build_lattice, lattice_storage};
     use lattice_rt::Dither;
 
     #[test]
@@ -320,8 +319,8 @@ mod tests {
             let mut storage = object_storage::<f64>(&text).unwrap();
             let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
             let cfg = LatticeConfig::default();
-            let mut bufs = LatticeBufs::for_scene(&scene, &cfg).expect("lattice fits");
-            let lat = bufs.build(&scene, &cfg).unwrap();
+            let mut bufs = lattice_storage(&scene, &cfg).expect("lattice fits");
+            let lat = build_lattice(&mut bufs, &scene, &cfg).unwrap();
             let t = Tracer::new(&scene, &lat);
             for dither in [Dither::Bayer, Dither::Pattern(4)] {
                 let frame = Frame { dither, ..Frame::new(160, 100) };

@@ -2,7 +2,7 @@
 //! (f64, the scene's depth, no cutoff, one ray per pixel, Bayer), measures the error against a
 //! reference (f64, 4x4 rays per pixel) and the cost, and writes `docs/accuracy.md` and a plot.
 
-use crate::load::{object_storage, parse_scene, read, render_text, LatticeBufs};
+use crate::load::{object_storage, parse_scene, read, render_text, build_lattice, lattice_storage};
 use anyhow::{Context, Result};
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Rgb888;
@@ -96,8 +96,8 @@ fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f6
     let mut storage = object_storage::<f64>(text)?;
     let scene = parse_scene::<f64>(path, text, &mut storage)?;
     let cfg = LatticeConfig::default();
-    let mut bufs = LatticeBufs::for_scene(&scene, &cfg)?;
-    let lattice = bufs.build(&scene, &cfg)?;
+    let mut bufs = lattice_storage(&scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
     let tracer = Tracer::new(&scene, &lattice);
     let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(&scene)];
     let mut q = lattice_rt::Query::new(&mut mb);

@@ -1,11 +1,10 @@
 //! Helpers shared by the integration tests: parse a scene, build an accelerator, render.
 #![allow(dead_code)]
 
-use lattice_rt::lattice::{Grid, LatticeSizes};
 use lattice_rt::scene::Object;
 use lattice_rt::{
-    parse, render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, Lattice, LatticeConfig, LatticeStorage,
-    NoHooks, Query, Real, Scene, Stats, Tracer,
+    parse, render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, HeapStorage, Lattice, LatticeConfig,
+    NoHooks, Real, Scene, Sizes, Stats, Tracer,
 };
 
 /// The accelerators under test.
@@ -24,32 +23,22 @@ pub fn scene_text(name: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
-/// Heap storage for a lattice.
-pub struct Bufs<R> {
-    pub grids: Vec<Grid<R>>,
-    pub coords: Vec<R>,
-    pub cells: Vec<u32>,
-    pub refs: Vec<u32>,
+/// Heap storage for the lattice of `scene` with `cfg` (and a render's scratch).
+pub fn lattice_storage<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> HeapStorage<R> {
+    HeapStorage::new(Sizes { objects: 0, ..Sizes::of(scene, Some(cfg), &Frame::new(1, 1)) })
 }
 
-pub fn lattice_bufs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Bufs<R> {
-    let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(scene, cfg);
-    Bufs { grids: vec![Grid::EMPTY; grids], coords: vec![R::ZERO; coords], cells: vec![0; cells], refs: vec![0; refs] }
-}
-
-/// Builds the lattice with `cfg` in storage from [`lattice_bufs`] with the same `cfg`.
-pub fn build_lattice<'a, R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: &'a mut Bufs<R>) -> Lattice<'a, R> {
-    let st = LatticeStorage { grids: &mut b.grids, coords: &mut b.coords, cells: &mut b.cells, refs: &mut b.refs };
-    Lattice::build(scene, cfg, st).expect("lattice fits")
+/// Builds the lattice with `cfg` in storage from [`lattice_storage`] with the same `cfg`.
+pub fn build_lattice<'a, R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, st: &'a mut HeapStorage<R>) -> Lattice<'a, R> {
+    st.view().split().1.lattice(scene, cfg).expect("lattice fits").0
 }
 
 /// Renders with a tracer already set up; returns the PBM bytes and the statistics.
 pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, A>, frame: &Frame) -> (Vec<u8>, Stats) {
     let mut bits = vec![0u8; BitFrame::bytes(frame.width as u32, frame.height as u32)];
     let mut target = BitFrame::new(frame.width as u32, frame.height as u32, &mut bits).unwrap();
-    let mut mb = vec![0u32; Query::mailbox_len(t.scene())];
-    let mut carry = vec![0i16; frame.scratch_len()];
-    let stats = render(t, frame, &mut target, &mut mb, &mut carry, &mut NoHooks).expect("render");
+    let mut scratch = HeapScratch::new(t.scene(), frame);
+    let stats = render(t, frame, &mut target, &mut scratch.scratch(), &mut NoHooks).expect("render");
     let mut pbm = Vec::new();
     target.write_pbm(|b| pbm.extend_from_slice(b));
     (pbm, stats)
@@ -59,8 +48,8 @@ pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, 
 pub fn render_text<R: Real>(text: &str, accel: Accel, frame: &Frame) -> (Vec<u8>, Stats) {
     let mut storage = vec![Object::<R>::default(); text.lines().count()];
     let scene = parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{e}"));
-    let mut bufs = lattice_bufs(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
+    let mut st = lattice_storage(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut st);
     let a: &dyn Accelerator<R> = match accel {
         Accel::Lattice => &lat,
         Accel::Bbox => &BoundingBox,
@@ -117,9 +106,8 @@ pub fn gray_of<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, A>, fr
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).unwrap();
-    let mut mb = vec![0u32; Query::mailbox_len(t.scene())];
-    let mut scratch = vec![0i16; frame.scratch_len()];
+    let mut scratch = HeapScratch::new(t.scene(), frame);
     let mut g = G(vec![0; w * h], w);
-    render(t, frame, &mut target, &mut mb, &mut scratch, &mut g).expect("render");
+    render(t, frame, &mut target, &mut scratch.scratch(), &mut g).expect("render");
     g.0
 }

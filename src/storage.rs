@@ -1,0 +1,340 @@
+//! Storage: all memory a frame needs, in one place. [`Storage`] holds it in arrays whose
+//! capacities are const parameters (heapless style: firmware sizes them at build time);
+//! with the `alloc` feature, [`HeapStorage`] holds the same on the heap, sized at run time by
+//! [`Sizes::of`]. Both lend a [`StorageView`] that erases the capacities, so the code that
+//! loads a scene, builds its lattice and hands the rest to the render is written once.
+//!
+//! The view is used up in the order the data flows: objects (the scene), then grids,
+//! coordinate lists and the word pool (the lattice's cells and references), then what is
+//! left of the pool and the `i16` rows (the render's [`Scratch`]).
+
+use crate::accel::Query;
+use crate::lattice::{Grid, Lattice, LatticeConfig, LatticeError, LatticeStorage};
+use crate::parse::{parse, ParseError};
+use crate::render::Frame;
+use crate::scalar::Real;
+use crate::scene::{Object, Scene};
+use core::fmt;
+
+/// How much of each kind of storage a scene and a frame need.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sizes {
+    /// Primitives.
+    pub objects: usize,
+    /// Lattices (world and sub-lattices).
+    pub grids: usize,
+    /// Coordinate-list entries.
+    pub coords: usize,
+    /// `u32` words: the lattice's cells and references, then the render's mailbox (one per
+    /// primitive and one per composite).
+    pub words: usize,
+    /// `i16` entries of the render's rows: error-diffusion carries and the object ids above a
+    /// band ([`Frame::scratch_len`]).
+    pub rows: usize,
+}
+
+impl Sizes {
+    /// What `scene` needs to be rendered as `frame`, with a lattice built by `cfg` (`None`:
+    /// an accelerator that needs no storage, such as the bounding-box method).
+    pub fn of<R: Real>(scene: &Scene<'_, R>, cfg: Option<&LatticeConfig>, frame: &Frame) -> Self {
+        let lattice = cfg.map(|c| Lattice::plan(scene, c)).unwrap_or_default();
+        Sizes {
+            objects: scene.objects.len(),
+            grids: lattice.grids,
+            coords: lattice.coords,
+            words: lattice.words() + Query::mailbox_len(scene),
+            rows: frame.scratch_len(),
+        }
+    }
+
+    /// Bytes these sizes take in scalar `R` (saturating: a host checks a limit against it
+    /// before allocating).
+    pub fn bytes<R>(&self) -> usize {
+        [
+            self.objects.saturating_mul(size_of::<Object<R>>()),
+            self.grids.saturating_mul(size_of::<Grid<R>>()),
+            self.coords.saturating_mul(size_of::<R>()),
+            self.words.saturating_mul(4),
+            self.rows.saturating_mul(2),
+        ]
+        .into_iter()
+        .fold(0, usize::saturating_add)
+    }
+
+    /// The larger of each size: storage for either.
+    pub fn max(self, o: Sizes) -> Sizes {
+        Sizes {
+            objects: self.objects.max(o.objects),
+            grids: self.grids.max(o.grids),
+            coords: self.coords.max(o.coords),
+            words: self.words.max(o.words),
+            rows: self.rows.max(o.rows),
+        }
+    }
+}
+
+/// All memory a frame needs, with capacities fixed at compile time (see [`Sizes`] for what
+/// each holds). It is plain arrays: put it on the stack or in a `static`.
+#[derive(Debug)]
+pub struct Storage<
+    R,
+    const OBJECTS: usize,
+    const GRIDS: usize,
+    const COORDS: usize,
+    const WORDS: usize,
+    const ROWS: usize,
+> {
+    objects: [Object<R>; OBJECTS],
+    grids: [Grid<R>; GRIDS],
+    coords: [R; COORDS],
+    words: [u32; WORDS],
+    rows: [i16; ROWS],
+}
+
+impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, const S: usize>
+    Storage<R, O, G, C, W, S>
+{
+    /// Empty storage.
+    pub fn new() -> Self {
+        Storage {
+            objects: [Object::default(); O],
+            grids: [Grid::EMPTY; G],
+            coords: [R::ZERO; C],
+            words: [0; W],
+            rows: [0; S],
+        }
+    }
+
+    /// The capacities as [`Sizes`].
+    pub const fn sizes() -> Sizes {
+        Sizes {
+            objects: O,
+            grids: G,
+            coords: C,
+            words: W,
+            rows: S,
+        }
+    }
+
+    /// The storage with its capacities erased.
+    pub fn view(&mut self) -> StorageView<'_, R> {
+        StorageView::new(
+            &mut self.objects,
+            &mut self.grids,
+            &mut self.coords,
+            &mut self.words,
+            &mut self.rows,
+        )
+    }
+}
+
+impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, const S: usize>
+    Default for Storage<R, O, G, C, W, S>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// All memory a frame needs, on the heap, sized at run time (the host's [`Storage`]).
+#[cfg(feature = "alloc")]
+#[derive(Debug)]
+pub struct HeapStorage<R> {
+    objects: alloc::vec::Vec<Object<R>>,
+    grids: alloc::vec::Vec<Grid<R>>,
+    coords: alloc::vec::Vec<R>,
+    words: alloc::vec::Vec<u32>,
+    rows: alloc::vec::Vec<i16>,
+}
+
+#[cfg(feature = "alloc")]
+impl<R: Real> HeapStorage<R> {
+    /// Storage of exactly `sizes`.
+    pub fn new(sizes: Sizes) -> Self {
+        use alloc::vec;
+        HeapStorage {
+            objects: vec![Object::default(); sizes.objects],
+            grids: vec![Grid::EMPTY; sizes.grids],
+            coords: vec![R::ZERO; sizes.coords],
+            words: vec![0; sizes.words],
+            rows: vec![0; sizes.rows],
+        }
+    }
+
+    /// Bytes this storage occupies.
+    pub fn bytes(&self) -> usize {
+        size_of_val(&self.objects[..])
+            + size_of_val(&self.grids[..])
+            + size_of_val(&self.coords[..])
+            + size_of_val(&self.words[..])
+            + size_of_val(&self.rows[..])
+    }
+
+    /// The storage as a view.
+    pub fn view(&mut self) -> StorageView<'_, R> {
+        StorageView::new(
+            &mut self.objects,
+            &mut self.grids,
+            &mut self.coords,
+            &mut self.words,
+            &mut self.rows,
+        )
+    }
+}
+
+/// Storage with its capacities erased: the slices of a [`Storage`] or [`HeapStorage`] (or
+/// any the caller owns), used up as a frame is set up.
+#[derive(Debug)]
+pub struct StorageView<'a, R> {
+    objects: &'a mut [Object<R>],
+    rest: FrameStorage<'a, R>,
+}
+
+/// The part of a [`StorageView`] that follows the scene: the lattice's storage and the
+/// render's scratch.
+#[derive(Debug)]
+pub struct FrameStorage<'a, R> {
+    grids: &'a mut [Grid<R>],
+    coords: &'a mut [R],
+    words: &'a mut [u32],
+    rows: &'a mut [i16],
+}
+
+/// A scene loaded from text with its lattice built, and the scratch left for the render.
+#[derive(Debug)]
+pub struct Loaded<'a, R> {
+    /// The validated scene.
+    pub scene: Scene<'a, R>,
+    /// Its lattice.
+    pub lattice: Lattice<'a, R>,
+    /// What the render works in.
+    pub scratch: Scratch<'a>,
+}
+
+/// Why a scene could not be loaded into a [`StorageView`].
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadError<'t> {
+    /// The text is not a valid scene, or declares more objects than the storage holds.
+    Parse(ParseError<'t>),
+    /// The lattice does not fit the storage.
+    Lattice(LatticeError),
+}
+
+impl fmt::Display for LoadError<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LoadError::Parse(e) => write!(f, "scene: {e}"),
+            LoadError::Lattice(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl core::error::Error for LoadError<'_> {}
+
+impl<'a, R: Real> StorageView<'a, R> {
+    /// A view of caller-owned slices.
+    pub fn new(
+        objects: &'a mut [Object<R>],
+        grids: &'a mut [Grid<R>],
+        coords: &'a mut [R],
+        words: &'a mut [u32],
+        rows: &'a mut [i16],
+    ) -> Self {
+        StorageView {
+            objects,
+            rest: FrameStorage {
+                grids,
+                coords,
+                words,
+                rows,
+            },
+        }
+    }
+
+    /// Parses `text` into the object storage and builds its lattice with `cfg` in the rest;
+    /// what is left becomes the render's scratch.
+    pub fn load<'t>(
+        self,
+        text: &'t str,
+        cfg: &LatticeConfig,
+    ) -> Result<Loaded<'a, R>, LoadError<'t>> {
+        let (objects, rest) = self.split();
+        let scene = parse::<R>(text, objects).map_err(LoadError::Parse)?;
+        let (lattice, scratch) = rest.lattice(&scene, cfg).map_err(LoadError::Lattice)?;
+        Ok(Loaded {
+            scene,
+            lattice,
+            scratch,
+        })
+    }
+
+    /// The object storage (for a [`crate::SceneBuilder`]) and the rest.
+    pub fn split(self) -> (&'a mut [Object<R>], FrameStorage<'a, R>) {
+        (self.objects, self.rest)
+    }
+}
+
+impl<'a, R: Real> FrameStorage<'a, R> {
+    /// Builds the lattice of `scene` with `cfg`; the words it leaves and the rows become the
+    /// render's scratch.
+    pub fn lattice(
+        self,
+        scene: &Scene<'_, R>,
+        cfg: &LatticeConfig,
+    ) -> Result<(Lattice<'a, R>, Scratch<'a>), LatticeError> {
+        let storage = LatticeStorage {
+            grids: self.grids,
+            coords: self.coords,
+            words: self.words,
+        };
+        let (lattice, mailbox) = Lattice::build_leaving(scene, cfg, storage)?;
+        Ok((lattice, Scratch::new(mailbox, self.rows)))
+    }
+
+    /// No lattice (an accelerator that needs no storage): every word is scratch.
+    pub fn scratch(self) -> Scratch<'a> {
+        Scratch::new(self.words, self.rows)
+    }
+}
+
+/// The memory a render works in: the mailbox (one stamp per primitive and per composite,
+/// so a ray tests each once; a shorter one only costs repeated tests) and the rows
+/// ([`Frame::scratch_len`] entries; error diffusion and edge detection fail without them).
+#[derive(Debug)]
+pub struct Scratch<'a> {
+    pub(crate) mailbox: &'a mut [u32],
+    pub(crate) rows: &'a mut [i16],
+}
+
+impl<'a> Scratch<'a> {
+    /// Scratch in caller-owned slices.
+    pub fn new(mailbox: &'a mut [u32], rows: &'a mut [i16]) -> Self {
+        Scratch { mailbox, rows }
+    }
+}
+
+/// Scratch on the heap for `scene` and `frame`: an exact mailbox and rows (for renders on
+/// several threads, each with its own).
+#[cfg(feature = "alloc")]
+#[derive(Debug)]
+pub struct HeapScratch {
+    mailbox: alloc::vec::Vec<u32>,
+    rows: alloc::vec::Vec<i16>,
+}
+
+#[cfg(feature = "alloc")]
+impl HeapScratch {
+    /// Scratch sized for `scene` and `frame`.
+    pub fn new<R: Real>(scene: &Scene<'_, R>, frame: &Frame) -> Self {
+        HeapScratch {
+            mailbox: alloc::vec![0; Query::mailbox_len(scene)],
+            rows: alloc::vec![0; frame.scratch_len()],
+        }
+    }
+
+    /// The scratch to render in.
+    pub fn scratch(&mut self) -> Scratch<'_> {
+        Scratch::new(&mut self.mailbox, &mut self.rows)
+    }
+}
