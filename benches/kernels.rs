@@ -29,7 +29,7 @@ fn walk_and_tile(c: &mut Criterion) {
     let cfg = LatticeConfig::default();
     let mut storage = HeapStorage::new(Sizes { objects: 0, ..Sizes::of(&scene, Some(&cfg), &Frame::new(8, 8)) });
     let (lat, _) = storage.view().split().1.lattice(&scene, &cfg).unwrap();
-    let ray = scene.camera.ray(81, 99, 160, 100);
+    let ray = scene.camera().ray(81, 99, 160, 100);
     c.bench_function("lattice walk (cells only), desk", |b| b.iter(|| {
         let mut n = 0;
         lat.walk_cells(black_box(&ray), 0.0, f64::MAX, |_, _, _| n += 1);

@@ -65,7 +65,7 @@ fn main() {
     }
     let count = list.lines().count();
     if env::var_os("CARGO_FEATURE_EFFECTS_ALL").is_some() {
-        effects = lattice_rt::Effects::ALL;
+        effects = lattice_rt::Effects::ALL.bits();
     }
     let code = format!(
         "/// The scenes embedded in this build (`FIRMWARE_SCENES`).\n\
@@ -85,6 +85,6 @@ fn main() {
 fn plan<R: Real>(path: &std::path::Path, text: &str) -> (Sizes, u8) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
     let scene = lattice_rt::parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let effects = lattice_rt::Effects::of(&scene).0;
+    let effects = lattice_rt::Effects::of(&scene).bits();
     (Sizes::of(&scene, Some(&LatticeConfig::default()), &frame::FRAME), effects)
 }

@@ -161,8 +161,8 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     if t == 0 || t > MAX_TILE || !t.is_multiple_of(block) {
         return Err(RenderError::BadTile);
     }
-    if frame.edges() && E & Effects::EDGE_AA == 0 {
-        return Err(RenderError::NotCompiled(Effects(Effects::EDGE_AA)));
+    if frame.edges() && !Effects::from_bits(E).contains(Effects::EDGE_AA) {
+        return Err(RenderError::NotCompiled(Effects::EDGE_AA));
     }
     let (w, h) = (frame.width as usize, frame.height as usize);
     let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or(RenderError::ScratchTooSmall { needed: frame.scratch_len() })?;
@@ -213,7 +213,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
                     }
                 }
             }
-            if E & Effects::EDGE_AA != 0 && frame.edges() {
+            if Effects::from_bits(E).contains(Effects::EDGE_AA) && frame.edges() {
                 // A pixel is on an edge if its eye ray hit another object than a neighbour's:
                 // left and above come from the tiles already drawn, right and below from this
                 // tile; a pair split by a later tile's border is caught by that later pixel.

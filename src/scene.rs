@@ -112,30 +112,30 @@ impl<R: Real> Camera<R> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Object<R> {
     /// The canonical primitive.
-    pub shape: Shape<R>,
+    pub(crate) shape: Shape<R>,
     /// World-to-object transform (the inverse of the placement) multiplied by the power of two
     /// `1 / unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
     /// full precision however large or small the object is (exact in floating point).
-    pub to_object: Affine<R>,
+    pub(crate) to_object: Affine<R>,
     /// The world point at the object's origin: rays are taken relative to it before
     /// `to_object` (whose translation is then zero), so a scene far from the world's origin
     /// loses no precision to cancellation.
-    pub origin: Vec3<R>,
+    pub(crate) origin: Vec3<R>,
     /// The power of two that `to_object`'s results are multiplied by to get object space.
-    pub unscale: R,
+    pub(crate) unscale: R,
     /// `unscale * dir_scale`: what `to_object`'s direction results are multiplied by.
-    pub dir_factor: R,
+    pub(crate) dir_factor: R,
     /// Index into the scene's materials.
-    pub material: u8,
+    pub(crate) material: u8,
     /// Composite object it belongs to, or [`NO_GROUP`].
-    pub group: u16,
+    pub(crate) group: u16,
     /// World-space bounding box, padded for the scalar's rounding.
-    pub bounds: Aabb<R>,
+    pub(crate) bounds: Aabb<R>,
     /// A power of two that object-space directions are multiplied by, so that they stay near
     /// unit length however small or large the object is (exact in floating point).
-    pub dir_scale: R,
+    pub(crate) dir_scale: R,
     /// `1 / dir_scale`.
-    pub inv_dir_scale: R,
+    pub(crate) inv_dir_scale: R,
 }
 
 impl<R: Real> Default for Object<R> {
@@ -180,6 +180,37 @@ impl<R: Real> Object<R> {
         let (t, n) = self.shape.intersect(&r, tmin * self.inv_dir_scale, far)?;
         let t = t * self.dir_scale;
         (t > tmin && t <= tmax).then_some((t, n))
+    }
+    /// The canonical primitive.
+    pub fn shape(&self) -> Shape<R> {
+        self.shape
+    }
+    /// Index into the scene's materials.
+    pub fn material(&self) -> u8 {
+        self.material
+    }
+    /// Composite object it belongs to, or [`NO_GROUP`].
+    pub fn group(&self) -> u16 {
+        self.group
+    }
+    /// World-space bounding box, padded for the scalar's rounding.
+    pub fn bounds(&self) -> Aabb<R> {
+        self.bounds
+    }
+    /// The world point at the object's origin.
+    pub fn origin(&self) -> Vec3<R> {
+        self.origin
+    }
+    /// The map from a world offset relative to [`Object::origin`] to object space (the
+    /// inverse of the placement), without the scaling the stored copy carries for precision.
+    pub fn world_to_object(&self) -> Affine<R> {
+        let mut t = self.to_object;
+        for row in t.m.iter_mut() {
+            for v in row.iter_mut() {
+                *v *= self.unscale;
+            }
+        }
+        t
     }
     /// Unit world-space normal from an object-space normal (inverse-transpose rule).
     pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
@@ -398,23 +429,62 @@ impl fmt::Display for Round {
 #[derive(Debug)]
 pub struct Scene<'a, R> {
     /// All primitives; the objects of a composite are contiguous.
-    pub objects: &'a [Object<R>],
+    pub(crate) objects: &'a [Object<R>],
     /// Composite objects.
-    pub groups: Vec<Group<R>, MAX_GROUPS>,
+    pub(crate) groups: Vec<Group<R>, MAX_GROUPS>,
     /// Materials.
-    pub materials: Vec<Material<R>, MAX_MATERIALS>,
+    pub(crate) materials: Vec<Material<R>, MAX_MATERIALS>,
     /// Lights.
-    pub lights: Vec<Light<R>, MAX_LIGHTS>,
+    pub(crate) lights: Vec<Light<R>, MAX_LIGHTS>,
     /// Ambient intensity `Ia`.
-    pub ambient: R,
+    pub(crate) ambient: R,
     /// Gray of rays that hit nothing (0 black .. 1 white).
-    pub background: R,
+    pub(crate) background: R,
     /// Camera.
-    pub camera: Camera<R>,
+    pub(crate) camera: Camera<R>,
     /// Maximum depth of the intersection tree (0: eye rays only).
-    pub max_depth: u8,
+    pub(crate) max_depth: u8,
     /// Box holding the viewpoint and every object (the paper's world range).
-    pub world: Aabb<R>,
+    pub(crate) world: Aabb<R>,
+}
+
+impl<'a, R: Real> Scene<'a, R> {
+    /// All primitives; the objects of a composite are contiguous.
+    pub fn objects(&self) -> &'a [Object<R>] {
+        self.objects
+    }
+    /// Composite objects.
+    pub fn groups(&self) -> &[Group<R>] {
+        &self.groups
+    }
+    /// Materials.
+    pub fn materials(&self) -> &[Material<R>] {
+        &self.materials
+    }
+    /// Lights.
+    pub fn lights(&self) -> &[Light<R>] {
+        &self.lights
+    }
+    /// Ambient intensity `Ia`.
+    pub fn ambient(&self) -> R {
+        self.ambient
+    }
+    /// Gray of rays that hit nothing (0 black .. 1 white).
+    pub fn background(&self) -> R {
+        self.background
+    }
+    /// Camera.
+    pub fn camera(&self) -> &Camera<R> {
+        &self.camera
+    }
+    /// Maximum depth of the intersection tree the scene asks for (0: eye rays only).
+    pub fn max_depth(&self) -> u8 {
+        self.max_depth
+    }
+    /// Box holding the viewpoint and every object (the paper's world range).
+    pub fn world(&self) -> Aabb<R> {
+        self.world
+    }
 }
 
 /// Builds and validates a [`Scene`] into caller-provided object storage.

@@ -26,33 +26,60 @@ pub const NO_OBJECT: u32 = u32::MAX;
 /// Deepest intersection tree the tracer supports (eye ray = depth 0).
 pub const MAX_DEPTH: u8 = 8;
 
-/// The effects a render simulates, as a bit set: the scene's own set ([`Effects::of`]), a
-/// forced one, and at compile time the set a [`Tracer`] is built with (its const parameter).
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+/// The effects a render simulates, as a typed flag set: the scene's own set ([`Effects::of`]),
+/// a forced one, and at compile time the set a [`Tracer`] is built with (its const parameter
+/// holds [`Effects::bits`], since a const parameter must be an integer).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct Effects(pub u8);
+pub struct Effects(u8);
 
 impl Effects {
+    /// No effect: ambient and diffuse shading only.
+    pub const NONE: Self = Effects(0);
     /// Shadow rays towards lights.
-    pub const SHADOWS: u8 = 1;
+    pub const SHADOWS: Self = Effects(1);
     /// Mirror-reflection rays (`Ks > 0`).
-    pub const REFLECTION: u8 = 2;
+    pub const REFLECTION: Self = Effects(2);
     /// Refraction rays (`Kt > 0`).
-    pub const REFRACTION: u8 = 4;
+    pub const REFRACTION: Self = Effects(4);
     /// Point lights (directional lights are always compiled in).
-    pub const POINT_LIGHTS: u8 = 8;
+    pub const POINT_LIGHTS: Self = Effects(8);
     /// Composite objects, walked as sub-lattices.
-    pub const COMPOSITES: u8 = 16;
+    pub const COMPOSITES: Self = Effects(16);
     /// Extra eye rays at object edges ([`crate::render::Sampling::Edges`]).
-    pub const EDGE_AA: u8 = 32;
+    pub const EDGE_AA: Self = Effects(32);
     /// Every effect.
-    pub const ALL: u8 = 63;
-    /// Names of the bits, lowest first.
+    pub const ALL: Self = Effects(63);
+    /// Names of the effects, lowest bit first.
     pub const NAMES: [&'static str; 6] = ["shadows", "reflection", "refraction", "point lights", "composites", "edge anti-aliasing"];
 
-    /// Whether every bit of `bits` is set.
-    pub const fn has(self, bits: u8) -> bool {
-        self.0 & bits == bits
+    /// The set as bits (for a [`Tracer`]'s const parameter).
+    pub const fn bits(self) -> u8 {
+        self.0
+    }
+
+    /// The set with these bits; bits that name no effect are dropped.
+    pub const fn from_bits(bits: u8) -> Self {
+        Effects(bits & Self::ALL.0)
+    }
+
+    /// Whether every effect of `other` is in the set.
+    pub const fn contains(self, other: Self) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether the set is empty.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The effects in either set.
+    pub const fn union(self, other: Self) -> Self {
+        Effects(self.0 | other.0)
+    }
+
+    /// The effects in this set and not in `other`.
+    pub const fn difference(self, other: Self) -> Self {
+        Effects(self.0 & !other.0)
     }
 
     /// The effects a scene calls for. Shadows need a light and at least two objects (every
@@ -63,23 +90,37 @@ impl Effects {
         let used = |f: fn(&crate::scene::Material<R>) -> R| {
             scene.objects.iter().any(|o| f(&scene.materials[o.material as usize]) > R::ZERO)
         };
-        let mut e = 0;
+        let mut e = Self::NONE;
         if !scene.lights.is_empty() && scene.objects.len() > 1 {
-            e |= Self::SHADOWS;
+            e = e | Self::SHADOWS;
         }
         if used(|m| m.ks) {
-            e |= Self::REFLECTION;
+            e = e | Self::REFLECTION;
         }
         if used(|m| m.kt) {
-            e |= Self::REFRACTION;
+            e = e | Self::REFRACTION;
         }
         if scene.lights.iter().any(|l| matches!(l, Light::Point { .. })) {
-            e |= Self::POINT_LIGHTS;
+            e = e | Self::POINT_LIGHTS;
         }
         if !scene.groups.is_empty() {
-            e |= Self::COMPOSITES;
+            e = e | Self::COMPOSITES;
         }
-        Effects(e)
+        e
+    }
+}
+
+impl core::ops::BitOr for Effects {
+    type Output = Self;
+    fn bitor(self, o: Self) -> Self {
+        self.union(o)
+    }
+}
+
+impl core::ops::Sub for Effects {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        self.difference(o)
     }
 }
 
@@ -96,6 +137,23 @@ impl core::fmt::Display for Effects {
             write!(f, "diffuse only")?;
         }
         Ok(())
+    }
+}
+
+/// Logged as the same words [`Display`](core::fmt::Display) writes.
+#[cfg(feature = "defmt")]
+impl defmt::Format for Effects {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        let mut first = true;
+        for (i, name) in Self::NAMES.iter().enumerate() {
+            if self.0 & (1 << i) != 0 {
+                defmt::write!(f, "{=str}{=str}", if first { "" } else { ", " }, name);
+                first = false;
+            }
+        }
+        if first {
+            defmt::write!(f, "diffuse only");
+        }
     }
 }
 
@@ -158,7 +216,7 @@ pub fn refract<R: Real>(d: Vec3<R>, n: Vec3<R>, eta: R) -> Option<Vec3<R>> {
 /// `E` is the set of effects compiled in (an [`Effects`] bit set): code for the others is
 /// removed by the compiler, so firmware for a matte scene carries no mirror or glass code.
 #[derive(Debug)]
-pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL }> {
+pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     scene: &'s Scene<'a, R>,
     accel: &'s A,
     effects: Effects,
@@ -197,9 +255,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// A tracer with only the effects `E` compiled in; fails if the scene needs others.
     pub fn compiled(scene: &'s Scene<'a, R>, accel: &'s A) -> Result<Self, MissingEffects> {
         let need = Effects::of(scene);
-        let missing = need.0 & !E;
-        if missing != 0 {
-            return Err(MissingEffects(Effects(missing)));
+        let missing = need - Effects::from_bits(E);
+        if !missing.is_empty() {
+            return Err(MissingEffects(missing));
         }
         Ok(Tracer {
             scene,
@@ -258,8 +316,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
 
     /// Whether an effect is both compiled in and switched on.
     #[inline(always)]
-    pub fn simulates(&self, bit: u8) -> bool {
-        E & bit != 0 && self.effects.0 & bit != 0
+    pub fn simulates(&self, effect: Effects) -> bool {
+        Effects::from_bits(E).contains(effect) && self.effects.contains(effect)
     }
 
     /// Brightness (0 black .. 1 white, clamped) seen along an eye ray.
@@ -331,7 +389,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
-            Light::Point { pos, intensity } if E & Effects::POINT_LIGHTS != 0 => {
+            Light::Point { pos, intensity } if Effects::from_bits(E).contains(Effects::POINT_LIGHTS) => {
                 let v = pos - from;
                 let dir = v.normalize();
                 (dir, v.dot(dir), intensity)

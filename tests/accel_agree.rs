@@ -11,7 +11,7 @@ use proptest::prelude::*;
 /// Rays aimed to hurt: random, axis-aligned with +0.0/-0.0 components, starting on lattice
 /// planes, and through lattice corners.
 fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &mut Rng, n: usize) -> Vec<Ray<R>> {
-    let w = scene.world;
+    let w = scene.world();
     let pick = |rng: &mut Rng, a: usize| {
         let c = lat.coordinate_list(0, a);
         c[rng.below(c.len() as u64) as usize]
@@ -46,7 +46,7 @@ fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &m
                 d = target - o;
             }
             // From the camera, as eye rays do.
-            4 => o = scene.camera.eye,
+            4 => o = scene.camera().eye,
             _ => {}
         }
         if d.max_abs() == R::ZERO {
@@ -165,7 +165,7 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
     let mut hits = 0;
     for k in picks {
         // Aimed at a random point of the member's box: most such rays hit it.
-        let bx = scene.objects[lead + k].bounds;
+        let bx = scene.objects()[lead + k].bounds();
         let at = |a: usize, rng: &mut Rng| R::from_f64(rng.range(bx.min.axis(a).to_f64(), bx.max.axis(a).to_f64()));
         let target = Vec3::new(at(0, &mut rng), at(1, &mut rng), at(2, &mut rng));
         let o = Vec3::new(R::from_f64(1.0), R::from_f64(2.0), R::from_f64(-5.0));

@@ -168,7 +168,7 @@ fn a_byte_order_mark_and_every_line_ending_parse_alike() {
     ] {
         let mut storage = vec![Object::<f64>::default(); 4];
         let scene = parse::<f64>(&text, &mut storage).unwrap_or_else(|e| panic!("{text:?}: {e}"));
-        assert_eq!(scene.objects.len(), 2);
+        assert_eq!(scene.objects().len(), 2);
     }
     // Line numbers count CR-only lines too.
     assert_eq!(err::<f64>("sphere\rsphere\rcone material gold"), "line 3, column 15 at `gold`: material not defined before this line");

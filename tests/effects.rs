@@ -17,35 +17,35 @@ const TWO: &str = "sphere\nbox min 2 0 0 max 3 1 1\n";
 
 #[test]
 fn shadows_need_a_light_and_two_objects() {
-    assert!(effects_of(&format!("{LIGHT}{TWO}")).has(Effects::SHADOWS));
-    assert!(!effects_of(TWO).has(Effects::SHADOWS), "no light");
-    assert!(!effects_of(&format!("{LIGHT}sphere\n")).has(Effects::SHADOWS), "a lone convex object cannot shadow itself");
+    assert!(effects_of(&format!("{LIGHT}{TWO}")).contains(Effects::SHADOWS));
+    assert!(!effects_of(TWO).contains(Effects::SHADOWS), "no light");
+    assert!(!effects_of(&format!("{LIGHT}sphere\n")).contains(Effects::SHADOWS), "a lone convex object cannot shadow itself");
 }
 
 #[test]
 fn reflection_needs_a_mirror_material_in_use() {
-    assert!(effects_of(&format!("material m ks 0.5\nsphere material m\n{TWO}")).has(Effects::REFLECTION));
+    assert!(effects_of(&format!("material m ks 0.5\nsphere material m\n{TWO}")).contains(Effects::REFLECTION));
     // Objects without a material get the first one defined, so the mirror comes second here.
-    assert!(!effects_of(&format!("material plain\nmaterial m ks 0.5\n{TWO}")).has(Effects::REFLECTION), "defined but unused");
-    assert!(!effects_of(TWO).has(Effects::REFLECTION));
+    assert!(!effects_of(&format!("material plain\nmaterial m ks 0.5\n{TWO}")).contains(Effects::REFLECTION), "defined but unused");
+    assert!(!effects_of(TWO).contains(Effects::REFLECTION));
 }
 
 #[test]
 fn refraction_needs_a_transparent_material_in_use() {
-    assert!(effects_of("material g kt 0.8 ior 1.5\nsphere material g\n").has(Effects::REFRACTION));
-    assert!(!effects_of("material g kt 0\nsphere material g\n").has(Effects::REFRACTION));
+    assert!(effects_of("material g kt 0.8 ior 1.5\nsphere material g\n").contains(Effects::REFRACTION));
+    assert!(!effects_of("material g kt 0\nsphere material g\n").contains(Effects::REFRACTION));
 }
 
 #[test]
 fn point_lights_are_their_own_effect() {
-    assert!(effects_of(&format!("light point pos 0 5 0\n{TWO}")).has(Effects::POINT_LIGHTS));
-    assert!(!effects_of(&format!("{LIGHT}{TWO}")).has(Effects::POINT_LIGHTS));
+    assert!(effects_of(&format!("light point pos 0 5 0\n{TWO}")).contains(Effects::POINT_LIGHTS));
+    assert!(!effects_of(&format!("{LIGHT}{TWO}")).contains(Effects::POINT_LIGHTS));
 }
 
 #[test]
 fn composites_are_their_own_effect() {
-    assert!(effects_of("group g\nsphere\nend\n").has(Effects::COMPOSITES));
-    assert!(!effects_of(TWO).has(Effects::COMPOSITES));
+    assert!(effects_of("group g\nsphere\nend\n").contains(Effects::COMPOSITES));
+    assert!(!effects_of(TWO).contains(Effects::COMPOSITES));
 }
 
 #[test]
@@ -63,9 +63,9 @@ fn a_tracer_without_refraction_refuses_glass() {
     let scene = parse::<f64>(&text, &mut storage).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
-    const MATTE: u8 = Effects::SHADOWS | Effects::COMPOSITES;
+    const MATTE: u8 = Effects::SHADOWS.union(Effects::COMPOSITES).bits();
     let err = Tracer::<_, _, MATTE>::compiled(&scene, &lat).unwrap_err();
-    assert_eq!(err, MissingEffects(Effects(Effects::REFLECTION | Effects::REFRACTION)));
+    assert_eq!(err, MissingEffects(Effects::REFLECTION | Effects::REFRACTION));
     assert_eq!(err.to_string(), "the scene needs effects this build leaves out: reflection, refraction");
 }
 
@@ -80,7 +80,7 @@ fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
         let frame = Frame::new(160, 100);
         let derived = Tracer::new(&scene, &lat);
         let mut all = Tracer::new(&scene, &lat);
-        all.set_effects(Effects(Effects::ALL));
+        all.set_effects(Effects::ALL);
         let (a, sa) = render_tracer(&derived, &frame);
         let (b, sb) = render_tracer(&all, &frame);
         assert!(a == b, "{s}: forcing all effects changed the image");

@@ -49,7 +49,7 @@ fn gray_all<R: Real>(scene: &Scene<'_, R>, frame: &Frame, shadows: bool) -> Vec<
     with_accels(scene, &LatticeConfig::default(), |name, a| {
         let mut t = Tracer::new(scene, a);
         if !shadows {
-            t.set_effects(Effects(t.effects().0 & !Effects::SHADOWS));
+            t.set_effects(t.effects() - Effects::SHADOWS);
         }
         let g = gray_of(&t, frame);
         match &out {
@@ -131,8 +131,8 @@ fn small_far_sphere<R: Real>() {
     let mut q = Query::new(&mut mb);
     for y in 0..n {
         for x in 0..n {
-            let r = scene.camera.ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
-            let r64 = s64.camera.ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
+            let r = scene.camera().ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
+            let r64 = s64.camera().ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
             let hit = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q).is_some();
             let hit64 = BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &mut q).is_some();
             if hit != hit64 {
@@ -232,8 +232,8 @@ fn corners_faces_and_sub_lattices<R: Real>() {
     let mut st = Vec::new();
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([4, 4, 4]), sub: Resolution::Uniform([2, 2, 2]), ..LatticeConfig::default() };
-    let w = scene.world;
-    let g = scene.groups[0].bounds;
+    let w = scene.world();
+    let g = scene.groups()[0].bounds;
     let rays = [
         Ray::new(w.min, w.max - w.min),                                         // corner to corner
         Ray::new(Vec3::new(w.min.x, w.min.y, w.min.z), v::<R>(1.0, 1.0, 0.0)),   // along a face edge
@@ -359,21 +359,21 @@ fn boxes_under_extreme_transforms<R: Real>() {
         for k in 0..50 {
             let (x, y) = ((k % 7) as f64 * 0.13 - 0.4, (k / 7) as f64 * 0.11 - 0.35);
             let d = [x * 0.04, y * 0.04, 1.0];
-            let r = Ray::new(scene.camera.eye, v::<R>(d[0], d[1], d[2]));
-            let r64 = Ray::new(s64.camera.eye, Vec3::new(d[0], d[1], d[2]));
+            let r = Ray::new(scene.camera().eye, v::<R>(d[0], d[1], d[2]));
+            let r64 = Ray::new(s64.camera().eye, Vec3::new(d[0], d[1], d[2]));
             let h = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q);
             let h64 = BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &mut q);
             match (h, h64) {
                 (Some(a), Some(b)) => {
                     let rel = (a.t.to_f64() - b.t).abs() / b.t;
                     assert!(rel < 1e-3, "{} {name}: t {} vs {}", R::NAME, a.t.to_f64(), b.t);
-                    let (na, nb) = (scene.objects[0].world_normal(a.normal), s64.objects[0].world_normal(b.normal));
+                    let (na, nb) = (scene.objects()[0].world_normal(a.normal), s64.objects()[0].world_normal(b.normal));
                     assert!(na.x.to_f64() * nb.x + na.y.to_f64() * nb.y + na.z.to_f64() * nb.z > 0.99, "{} {name}: normal", R::NAME);
                 }
                 (None, None) => {}
                 (a, b) => {
                     // Disagreement only for rays grazing an edge: the f64 hit is near the box's silhouette.
-                    let grazing = b.is_none_or(|b| s64.objects[0].world_normal(b.normal).dot(r64.dir.normalize()).abs() < 0.05);
+                    let grazing = b.is_none_or(|b| s64.objects()[0].world_normal(b.normal).dot(r64.dir.normalize()).abs() < 0.05);
                     assert!(grazing, "{} {name}: hit {:?} vs {:?}", R::NAME, a.map(|h| h.t), b.map(|h| h.t));
                 }
             }
@@ -391,8 +391,8 @@ fn fixed_point_far_spheres_are_right_and_tiny_ones_refused() {
     let (fx, f) = (parse::<Fx>(text, &mut a).unwrap(), parse::<f64>(text, &mut b).unwrap());
     let mut mb = vec![0; 2];
     let mut q = Query::new(&mut mb);
-    let h = BruteForce.nearest(&fx, &Ray::new(fx.camera.eye, fx.camera.forward), Fx::ZERO, Fx::MAX, &mut q).unwrap();
-    let h64 = BruteForce.nearest(&f, &Ray::new(f.camera.eye, f.camera.forward), 0.0, f64::MAX, &mut q).unwrap();
+    let h = BruteForce.nearest(&fx, &Ray::new(fx.camera().eye, fx.camera().forward), Fx::ZERO, Fx::MAX, &mut q).unwrap();
+    let h64 = BruteForce.nearest(&f, &Ray::new(f.camera().eye, f.camera().forward), 0.0, f64::MAX, &mut q).unwrap();
     // Right to 1e-4 of the distance (the saturating, unshifted quadratic would be off by far more).
     assert!((h.t.to_f64() - h64.t).abs() < 1e-4 * h64.t, "{} vs {}", h.t.to_f64(), h64.t);
     // A radius near the LSB in a scene of size 10 is refused, with the object's line.

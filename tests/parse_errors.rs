@@ -143,8 +143,8 @@ fn comments_blank_lines_and_groups_parse() {
     let text = "# a chair\n\nmaterial wood kd 0.7 # brown\ngroup chair rotate y 20\n  box min 0 0 0 max 1 1 1 material wood\nend\n";
     let mut storage = vec![Object::<f64>::default(); 4];
     let scene = parse::<f64>(text, &mut storage).unwrap();
-    assert_eq!(scene.objects.len(), 1);
-    assert_eq!(scene.groups.len(), 1);
+    assert_eq!(scene.objects().len(), 1);
+    assert_eq!(scene.groups().len(), 1);
 }
 
 #[test]

@@ -96,10 +96,10 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     let Loaded { scene, lattice, mut scratch } = st.view().load(text, &LatticeConfig::default())?;
     let mut tracer = Tracer::<_, _, EFFECTS>::compiled(&scene, &lattice).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
-        tracer.set_effects(Effects(Effects::ALL));
+        tracer.set_effects(Effects::ALL);
     }
     let stats = render(&tracer, &FRAME, target, &mut scratch, hooks).map_err(AppError::Render)?;
-    Ok(Report { stats, objects: scene.objects.len(), lattice_bytes: lattice.bytes() })
+    Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes() })
 }
 
 impl<'t, E> From<LoadError<'t>> for AppError<'t, E> {

@@ -67,7 +67,7 @@ fn frame_with(scene: &Scene<'_, f64>, m: Method, frame: &Frame, primary_only: bo
     let mut t = Tracer::new(scene, a);
     if primary_only {
         t.set_max_depth(0).expect("depth 0 is always valid");
-        t.set_effects(Effects(0));
+        t.set_effects(Effects::NONE);
     }
     let r = render_band(&t, frame, false)?;
     Ok((r.elapsed, build, bytes, r.stats, r.bits))
@@ -93,7 +93,7 @@ fn per_ray(scene: &Scene<'_, f64>, a: &dyn Accelerator<f64>, rays: &[Ray<f64>], 
 }
 
 fn camera_rays(scene: &Scene<'_, f64>, w: i32, h: i32) -> Vec<Ray<f64>> {
-    (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| scene.camera.ray(2 * x + 1, 2 * y + 1, 2 * w, 2 * h)).collect()
+    (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| scene.camera().ray(2 * x + 1, 2 * y + 1, 2 * w, 2 * h)).collect()
 }
 
 /// A generated scene: `n` random primitives, or the clustered "teapot in a stadium": most of

@@ -19,7 +19,7 @@ struct Shot {
 fn shoot(path: &Path, text: &str, all: bool, cutoff: f64) -> Result<Shot> {
     let r = render_text::<f64>(path, text, &Frame::new(128, 64), |t| {
         if all {
-            t.set_effects(Effects(Effects::ALL));
+            t.set_effects(Effects::ALL);
         }
         t.set_cutoff(cutoff);
     })?;

@@ -107,7 +107,7 @@ mod tests {
         let text = read(path).unwrap();
         let mut storage = object_storage::<f64>(&text).unwrap();
         let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
-        let err = lattice_storage(&scene, &crate::lattice_config(Some([1024, 1024, 1024]))).err().expect("refused");
+        let err = lattice_storage(&scene, &crate::lattice_config(Some([1024, 1024, 1024]))).expect_err("refused");
         let msg = format!("{err:#}");
         assert!(msg.contains("--cells") && msg.contains(&MAX_LATTICE_BYTES.to_string()), "{msg}");
         assert!(lattice_storage(&scene, &crate::lattice_config(Some([64, 64, 64]))).is_ok());

@@ -72,22 +72,22 @@ impl std::error::Error for Unrepresentable {}
 
 /// The POV-Ray scene text of a scene.
 pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
-    if scene.objects.len() > MAX_ID_OBJECTS && mode == PovMode::Ids {
+    if scene.objects().len() > MAX_ID_OBJECTS && mode == PovMode::Ids {
         bail!("an id export holds at most {MAX_ID_OBJECTS} objects");
     }
     let mut s = String::new();
-    let c = &scene.camera;
+    let c = &scene.camera();
     writeln!(s, "// Exported by host-sim (lattice-rt). Left-handed like lattice-rt: x right, y up, z forward.")?;
     let (ambient, trace) = match mode {
-        PovMode::Full => (scene.ambient, scene.max_depth as u32 + 1),
+        PovMode::Full => (scene.ambient(), scene.max_depth() as u32 + 1),
         PovMode::Ids => (1.0, 1),
     };
     writeln!(s, "global_settings {{ assumed_gamma 1.0 max_trace_level {trace} ambient_light rgb {ambient} }}")?;
-    writeln!(s, "background {{ rgb {} }}", if mode == PovMode::Full { scene.background } else { 0.0 })?;
+    writeln!(s, "background {{ rgb {} }}", if mode == PovMode::Full { scene.background() } else { 0.0 })?;
     // The same image plane: direction, and right/up spanning twice tan(fov/2).
     writeln!(s, "camera {{ perspective location {} direction {} right {} up {} }}", v(c.eye), v(c.forward), v(c.right * 2.0), v(c.up * 2.0))?;
     if mode == PovMode::Full {
-        for l in scene.lights.iter() {
+        for l in scene.lights().iter() {
             match *l {
                 Light::Directional { to_light, intensity } => writeln!(
                     s,
@@ -98,11 +98,10 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
             }
         }
     }
-    let n = scene.objects.len();
-    for (i, o) in scene.objects.iter().enumerate() {
+    let n = scene.objects().len();
+    for (i, o) in scene.objects().iter().enumerate() {
         // object = A (world - origin), A = to_object * unscale; so world = A^-1 object + origin.
-        let mut a = o.to_object;
-        a.m.iter_mut().flatten().for_each(|x| *x *= o.unscale);
+        let a = o.world_to_object();
         let unrepresentable = |why: String| Unrepresentable { object: i, why };
         let inv = a.inverse().ok_or_else(|| unrepresentable("its transform has no inverse".into()))?;
         let m = Affine { m: inv.m };
@@ -115,13 +114,13 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
                 .into());
             }
         }
-        let prim = match o.shape {
+        let prim = match o.shape() {
             Shape::Sphere => "sphere { <0, 0, 0>, 1".to_string(),
             Shape::Cylinder => "cylinder { <0, 0, 0>, <0, 1, 0>, 1".to_string(),
             Shape::Cone { top } => format!("cone {{ <0, 0, 0>, 1, <0, 1, 0>, {top}"),
             Shape::Box => "box { <0, 0, 0>, <1, 1, 1>".to_string(),
         };
-        let mat = &scene.materials[o.material as usize];
+        let mat = &scene.materials()[o.material() as usize];
         let look = match mode {
             PovMode::Ids => {
                 let [r, g, b] = id_rgb(i, n).map(|c| c as f64 / 255.0);
@@ -140,7 +139,7 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
         let matrix = format!(
             "matrix <{:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}>",
             m.m[0][0], m.m[1][0], m.m[2][0], m.m[0][1], m.m[1][1], m.m[2][1], m.m[0][2], m.m[1][2], m.m[2][2],
-            m.m[0][3] + o.origin.x, m.m[1][3] + o.origin.y, m.m[2][3] + o.origin.z
+            m.m[0][3] + o.origin().x, m.m[1][3] + o.origin().y, m.m[2][3] + o.origin().z
         );
         if mode == PovMode::Full && mat.kt > 0.0 {
             // Whitted's shadow rays stop at glass; POV-Ray would let filtered light through.
@@ -229,13 +228,13 @@ mod tests {
     /// (mean absolute gray difference in levels of 64, share off by more than 8 levels, over
     /// the pixels whose object is opaque).
     fn compare(name: &str, scene: &Scene<'_, f64>) -> (f64, f64, f64) {
-        let n = scene.objects.len();
+        let n = scene.objects().len();
         let ids = render_povray_rgb(&export(scene, PovMode::Ids).unwrap(), W, H, &work(), &format!("{name}-ids")).unwrap();
         let mut mb = vec![0; lattice_rt::Query::mailbox_len(scene)];
         let mut q = Query::new(&mut mb);
         let ours: Vec<Option<usize>> = (0..(W * H) as i32)
             .map(|i| {
-                let r = scene.camera.ray(2 * (i % W as i32) + 1, 2 * (i / W as i32) + 1, 2 * W as i32, 2 * H as i32);
+                let r = scene.camera().ray(2 * (i % W as i32) + 1, 2 * (i / W as i32) + 1, 2 * W as i32, 2 * H as i32);
                 BruteForce.nearest(scene, &r, 0.0, f64::MAX, &mut q).map(|h| h.object as usize)
             })
             .collect();
@@ -245,7 +244,7 @@ mod tests {
         let mut bufs = lattice_storage(scene, &cfg).expect("lattice fits");
         let lat = build_lattice(&mut bufs, scene, &cfg).unwrap();
         let mine = render_with(&Tracer::new(scene, &lat), &Frame::new(W as u16, H as u16), false).unwrap().gray;
-        let opaque: Vec<usize> = (0..mine.len()).filter(|&i| ours[i].is_none_or(|o| scene.materials[scene.objects[o].material as usize].kt == 0.0)).collect();
+        let opaque: Vec<usize> = (0..mine.len()).filter(|&i| ours[i].is_none_or(|o| scene.materials()[scene.objects()[o].material() as usize].kt == 0.0)).collect();
         let diff: Vec<f64> = opaque.iter().map(|&i| (mine[i] as f64 - pov[i] as f64 * 64.0 / 255.0).abs()).collect();
         let mean = diff.iter().sum::<f64>() / diff.len().max(1) as f64;
         let far = diff.iter().filter(|&&d| d > 8.0).count() as f64 / diff.len().max(1) as f64;

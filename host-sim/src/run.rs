@@ -210,11 +210,11 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     println!("scene {} ({})", a.scene.display(), R::NAME);
     println!(
         "  objects {}, composites {}, materials {}, lights {}, depth {}",
-        scene.objects.len(),
-        scene.groups.len(),
-        scene.materials.len(),
-        scene.lights.len(),
-        scene.max_depth
+        scene.objects().len(),
+        scene.groups().len(),
+        scene.materials().len(),
+        scene.lights().len(),
+        scene.max_depth()
     );
     println!("  effects: {fx}");
     for (i, g) in lattice.grids().iter().enumerate() {
@@ -233,7 +233,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     // Primary rays only: the paper's per-ray figures.
     let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>| {
         t.set_max_depth(0).expect("depth 0 is always valid");
-        t.set_effects(Effects(0));
+        t.set_effects(Effects::NONE);
     };
     println!("  per primary ray at {}x{} (eye rays only):", frame.width, frame.height);
     let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];

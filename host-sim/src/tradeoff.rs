@@ -108,7 +108,7 @@ fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f6
             let mut sum = 0.0;
             for j in 0..n {
                 for i in 0..n {
-                    let ray = scene.camera.ray((2 * n * x + 2 * i + 1) as i32, (2 * n * y + 2 * j + 1) as i32, ws as i32, hs as i32);
+                    let ray = scene.camera().ray((2 * n * x + 2 * i + 1) as i32, (2 * n * y + 2 * j + 1) as i32, ws as i32, hs as i32);
                     sum += tracer.radiance(ray, &mut q);
                 }
             }
