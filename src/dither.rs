@@ -169,6 +169,54 @@ impl<'c> Carry<'c> {
     }
 }
 
+/// Dithers tiles in the render's order, owning the state its mode carries between tiles
+/// (error diffusion's carries; ordered modes carry nothing).
+#[derive(Debug)]
+pub struct Ditherer<'c> {
+    mode: Dither,
+    carry: Option<Carry<'c>>,
+}
+
+impl<'c> Ditherer<'c> {
+    /// Entries of `i16` storage `mode` needs for an image `width` pixels wide.
+    pub fn rows_len(mode: Dither, width: usize) -> usize {
+        if mode.diffuses() {
+            Carry::len(width)
+        } else {
+            0
+        }
+    }
+
+    /// A ditherer over storage of at least [`Ditherer::rows_len`] entries, or `None` if it is
+    /// shorter.
+    pub fn new(mode: Dither, width: usize, rows: &'c mut [i16]) -> Option<Self> {
+        let carry = if mode.diffuses() { Some(Carry::new(rows, width)?) } else { None };
+        Some(Ditherer { mode, carry })
+    }
+
+    /// Call when a new band of tiles (a new tile row) starts.
+    pub fn next_band(&mut self) {
+        if let Some(c) = self.carry.as_mut() {
+            c.next_band();
+        }
+    }
+
+    /// Dithers the `w x h` tile of `levels` (row-major) at `(x0, y0)` into `out`.
+    pub fn tile(&mut self, x0: usize, y0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
+        match self.carry.as_mut() {
+            Some(c) => c.tile(self.mode, x0, w, h, levels, out),
+            None => {
+                let n = if self.mode == Dither::Bayer { 8 } else { self.mode.block() };
+                for y in 0..h {
+                    for x in 0..w {
+                        out[y * w + x] = ordered(levels[y * w + x], (x0 + x) as u32, (y0 + y) as u32, n);
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -28,6 +28,7 @@ pub mod trace;
 pub use trace::{Effects, Tracer};
 pub mod dither;
 pub use dither::Dither;
+pub mod sample;
 pub mod render;
 pub use render::{render, Frame, Hooks, NoHooks, Sampling};
 pub mod parse;

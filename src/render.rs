@@ -3,32 +3,17 @@
 //! buffer exists; between tiles a hook reports progress and may cancel.
 
 use crate::accel::{Accelerator, Query, Stats};
-use crate::dither::{ordered, Carry, Dither, LEVELS, MAX_TILE};
+use crate::dither::{Dither, Ditherer, MAX_TILE};
 use crate::scalar::Real;
+pub use crate::sample::{level, Sampling};
+use crate::sample::Sampler;
 use crate::storage::Scratch;
-use crate::trace::{Effects, Tracer, NO_OBJECT};
+use crate::trace::Tracer;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
-
-/// How many eye rays a pixel gets.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Sampling {
-    /// One ray through the centre of each pixel (or of each pattern block).
-    Center,
-    /// Four rays per pixel on a 2x2 grid, averaged.
-    Grid2x2,
-    /// One ray per pixel, and the 2x2 grid only where a neighbouring pixel's eye ray hit a
-    /// different object (the paper's "area anti-aliasing only at object edges"), or where the
-    /// one-ray gray levels of neighbours in the tile differ by at least `contrast` (shadow,
-    /// mirror and refraction edges inside one object; above 64 turns this test off).
-    Edges {
-        /// Gray-level jump (of 64) that also counts as an edge.
-        contrast: u8,
-    },
-}
 
 /// What to render.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -65,11 +50,11 @@ impl Frame {
     /// object ids of the row above the current band for edge detection.
     pub fn scratch_len(&self) -> usize {
         let w = self.width as usize;
-        (if self.dither.diffuses() { Carry::len(w) } else { 0 }) + if self.edges() { w } else { 0 }
+        Ditherer::rows_len(self.dither, w) + Sampler::rows_len(self.sampling, self.dither.block(), w)
     }
 
     fn edges(&self) -> bool {
-        matches!(self.sampling, Sampling::Edges { .. }) && self.dither.block() == 1
+        Sampler::refines_edges(self.sampling, self.dither.block())
     }
 }
 
@@ -98,8 +83,9 @@ pub enum RenderError<E> {
     Cancelled,
     /// The tile size is 0, above [`MAX_TILE`], or not a multiple of the pattern block.
     BadTile,
-    /// The frame asks for an effect the tracer was compiled without.
-    NotCompiled(Effects),
+    /// The frame asks for edge sampling and the core was built without its `edge-sampling`
+    /// feature.
+    EdgesNotCompiled,
     /// The scratch storage is smaller than [`Frame::scratch_len`].
     ScratchTooSmall {
         /// Entries needed.
@@ -115,29 +101,12 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
             RenderError::BadTile => {
                 write!(f, "tile side must be 1..={MAX_TILE} and a multiple of the pattern block")
             }
-            RenderError::NotCompiled(e) => write!(f, "this build leaves out {e}"),
+            RenderError::EdgesNotCompiled => write!(f, "this build leaves out edge sampling (the core's `edge-sampling` feature)"),
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
         }
     }
-}
-
-/// Gray level (0..=64) of a brightness in `[0, 1]`, rounded to nearest.
-pub fn level<R: Real>(v: R) -> u8 {
-    let l = v * R::from_i32(LEVELS as i32) + R::HALF;
-    // Bisection over the 65 levels: no float-to-int conversion the scalar may not have.
-    let mut lo = 0u8;
-    let mut hi = LEVELS + 1;
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        if R::from_i32(mid as i32) <= l {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
 }
 
 /// Renders a frame tile by tile into `target`, returning the statistics.
@@ -161,107 +130,36 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     if t == 0 || t > MAX_TILE || !t.is_multiple_of(block) {
         return Err(RenderError::BadTile);
     }
-    if frame.edges() && !Effects::from_bits(E).contains(Effects::EDGE_AA) {
-        return Err(RenderError::NotCompiled(Effects::EDGE_AA));
+    if frame.edges() && !cfg!(feature = "edge-sampling") {
+        return Err(RenderError::EdgesNotCompiled);
     }
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or(RenderError::ScratchTooSmall { needed: frame.scratch_len() })?;
-    let (carry_store, above) = rows.split_at_mut(if frame.dither.diffuses() { Carry::len(w) } else { 0 });
-    let mut carry = if frame.dither.diffuses() { Carry::new(carry_store, w) } else { None };
-    above.iter_mut().for_each(|v| *v = NO_OBJECT as u16 as i16);
+    let too_small = || RenderError::ScratchTooSmall { needed: frame.scratch_len() };
+    let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or_else(too_small)?;
+    let (carries, above) = rows.split_at_mut(Ditherer::rows_len(frame.dither, w));
+    let mut dither = Ditherer::new(frame.dither, w, carries).ok_or_else(too_small)?;
+    let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
     let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
     let total = (tiles_x * end.saturating_sub(first)) as u32;
-    let cam = &tracer.scene().camera;
+    let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
-    // An eye ray through the point (sx / 4, sy / 4) in pixels from the top-left corner.
-    // Edge detection compares object ids modulo 2^16 (they only need to differ between
-    // neighbours), so the id row above the band fits the i16 scratch.
-    let mut shoot = |sx: usize, sy: usize, q: &mut Query<'_>| {
-        let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), q);
+    let mut shoot = |sx: usize, sy: usize| {
+        let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
         (v, id as u16)
     };
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
-    let mut ids = [NO_OBJECT as u16; MAX_TILE * MAX_TILE];
-    let mut left;
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     for ty in first..end {
-        if let Some(c) = carry.as_mut() {
-            c.next_band();
-        }
-        left = [NO_OBJECT as u16; MAX_TILE];
+        dither.next_band();
+        sampler.next_band();
         for tx in 0..tiles_x {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
-            // One ray per block through the block's centre; Grid2x2 takes four per pixel.
-            for by in (0..th).step_by(block) {
-                for bx in (0..tw).step_by(block) {
-                    let (cx, cy) = (4 * (x0 + bx) + 2 * block, 4 * (y0 + by) + 2 * block);
-                    let (v, id) = if frame.sampling == Sampling::Grid2x2 && block == 1 {
-                        grid2x2(&mut shoot, cx, cy, &mut q)
-                    } else {
-                        shoot(cx, cy, &mut q)
-                    };
-                    let l = level(v);
-                    for y in by..(by + block).min(th) {
-                        for x in bx..(bx + block).min(tw) {
-                            levels[y * tw + x] = l;
-                            ids[y * tw + x] = id;
-                        }
-                    }
-                }
-            }
-            if Effects::from_bits(E).contains(Effects::EDGE_AA) && frame.edges() {
-                // A pixel is on an edge if its eye ray hit another object than a neighbour's:
-                // left and above come from the tiles already drawn, right and below from this
-                // tile; a pair split by a later tile's border is caught by that later pixel.
-                let centre = levels;
-                let threshold = match frame.sampling {
-                    Sampling::Edges { contrast } => contrast,
-                    _ => u8::MAX,
-                };
-                for y in 0..th {
-                    for x in 0..tw {
-                        let id = ids[y * tw + x];
-                        let l = if x > 0 { ids[y * tw + x - 1] } else { left[y] };
-                        let u = if y > 0 { ids[(y - 1) * tw + x] } else { above[x0 + x] as u16 };
-                        let r = if x + 1 < tw { ids[y * tw + x + 1] } else { id };
-                        let d = if y + 1 < th { ids[(y + 1) * tw + x] } else { id };
-                        let edge = (x0 + x > 0 && l != id) || (y0 + y > 0 && u != id) || r != id || d != id;
-                        // A shadow, mirror or refraction edge inside one object shows as a jump in
-                        // the one-ray levels of this tile.
-                        let c = centre[y * tw + x];
-                        let jump = |n: u8| c.abs_diff(n) >= threshold;
-                        let contrast = (x > 0 && jump(centre[y * tw + x - 1]))
-                            || (y > 0 && jump(centre[(y - 1) * tw + x]))
-                            || (x + 1 < tw && jump(centre[y * tw + x + 1]))
-                            || (y + 1 < th && jump(centre[(y + 1) * tw + x]));
-                        if edge || contrast {
-                            let (cx, cy) = (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
-                            levels[y * tw + x] = level(grid2x2(&mut shoot, cx, cy, &mut q).0);
-                        }
-                    }
-                }
-                for y in 0..th {
-                    left[y] = ids[y * tw + tw - 1];
-                }
-                for x in 0..tw {
-                    above[x0 + x] = ids[(th - 1) * tw + x] as i16;
-                }
-            }
-            match carry.as_mut() {
-                Some(c) => c.tile(frame.dither, x0, tw, th, &levels[..tw * th], &mut bits),
-                None => {
-                    let n = if frame.dither == Dither::Bayer { 8 } else { block as u8 };
-                    for y in 0..th {
-                        for x in 0..tw {
-                            bits[y * tw + x] = ordered(levels[y * tw + x], (x0 + x) as u32, (y0 + y) as u32, n);
-                        }
-                    }
-                }
-            }
+            sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels);
+            dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
             target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
@@ -271,19 +169,4 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
         }
     }
     Ok(q.stats)
-}
-
-/// The mean of four eye rays on a 2x2 grid around the pixel centre `(cx, cy)` (quarter-pixel
-/// units), and the object the first of them hit.
-fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize, &mut Query<'_>) -> (R, u16), cx: usize, cy: usize, q: &mut Query<'_>) -> (R, u16) {
-    let mut sum = R::ZERO;
-    let mut first = NO_OBJECT as u16;
-    for (k, (dx, dy)) in [(0, 0), (2, 0), (0, 2), (2, 2)].into_iter().enumerate() {
-        let (v, id) = shoot(cx - 1 + dx, cy - 1 + dy, q);
-        sum += v;
-        if k == 0 {
-            first = id;
-        }
-    }
-    (sum * (R::HALF * R::HALF), first)
 }

@@ -45,12 +45,10 @@ impl Effects {
     pub const POINT_LIGHTS: Self = Effects(8);
     /// Composite objects, walked as sub-lattices.
     pub const COMPOSITES: Self = Effects(16);
-    /// Extra eye rays at object edges ([`crate::render::Sampling::Edges`]).
-    pub const EDGE_AA: Self = Effects(32);
     /// Every effect.
-    pub const ALL: Self = Effects(63);
+    pub const ALL: Self = Effects(31);
     /// Names of the effects, lowest bit first.
-    pub const NAMES: [&'static str; 6] = ["shadows", "reflection", "refraction", "point lights", "composites", "edge anti-aliasing"];
+    pub const NAMES: [&'static str; 5] = ["shadows", "reflection", "refraction", "point lights", "composites"];
 
     /// The set as bits (for a [`Tracer`]'s const parameter).
     pub const fn bits(self) -> u8 {
@@ -84,8 +82,7 @@ impl Effects {
 
     /// The effects a scene calls for. Shadows need a light and at least two objects (every
     /// primitive is convex, so a lone object never shadows itself); reflection needs a
-    /// material with `Ks > 0` on some object, refraction one with `Kt > 0`. Edge
-    /// anti-aliasing is never called for by a scene; a frame asks for it.
+    /// material with `Ks > 0` on some object, refraction one with `Kt > 0`.
     pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
         let used = |f: fn(&crate::scene::Material<R>) -> R| {
             scene.objects.iter().any(|o| f(&scene.materials[o.material as usize]) > R::ZERO)

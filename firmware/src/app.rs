@@ -67,7 +67,7 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Render(RenderError::Draw(e)) => defmt::write!(f, "display: {}", defmt::Debug2Format(e)),
             AppError::Render(RenderError::Cancelled) => defmt::write!(f, "render cancelled"),
             AppError::Render(RenderError::BadTile) => defmt::write!(f, "bad tile size"),
-            AppError::Render(RenderError::NotCompiled(e)) => defmt::write!(f, "not compiled in: {}", e),
+            AppError::Render(RenderError::EdgesNotCompiled) => defmt::write!(f, "edge sampling not compiled in"),
             AppError::Render(RenderError::ScratchTooSmall { needed }) => {
                 defmt::write!(f, "scratch storage too small: {} entries needed", needed)
             }

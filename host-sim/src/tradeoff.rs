@@ -10,7 +10,7 @@ use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
 use embedded_graphics::text::Text;
 use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
-use lattice_rt::dither::{ordered, Carry};
+use lattice_rt::dither::Ditherer;
 use lattice_rt::{Dither, F32Micro, F32MicroNewton, Frame, Fx, LatticeConfig, Real, Sampling, Tracer};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -122,23 +122,16 @@ fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f6
 /// diffusion in the renderer's tile order with its carries).
 fn dither_reference(levels: &[u8], w: usize, h: usize, d: Dither) -> Vec<bool> {
     let mut out = vec![false; w * h];
-    if !d.diffuses() {
-        let n = if d == Dither::Bayer { 8 } else { d.block() };
-        for (i, l) in levels.iter().enumerate() {
-            out[i] = ordered(*l, (i % w) as u32, (i / w) as u32, n).is_on();
-        }
-        return out;
-    }
-    let mut store = vec![0i16; Carry::len(w)];
-    let mut carry = Carry::new(&mut store, w).expect("sized");
+    let mut store = vec![0i16; Ditherer::rows_len(d, w)];
+    let mut dither = Ditherer::new(d, w, &mut store).expect("sized");
     let t = 8;
     for ty in (0..h).step_by(t) {
-        carry.next_band();
+        dither.next_band();
         for tx in (0..w).step_by(t) {
             let (tw, th) = (t.min(w - tx), t.min(h - ty));
             let tile: Vec<u8> = (0..th).flat_map(|y| (0..tw).map(move |x| (y, x))).map(|(y, x)| levels[(ty + y) * w + tx + x]).collect();
             let mut bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; tw * th];
-            carry.tile(d, tx, tw, th, &tile, &mut bits);
+            dither.tile(tx, ty, tw, th, &tile, &mut bits);
             for (k, b) in bits.iter().enumerate() {
                 out[(ty + k / tw) * w + tx + k % tw] = b.is_on();
             }

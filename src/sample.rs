@@ -1,0 +1,187 @@
+//! Eye-ray sampling of a tile: how many eye rays each pixel gets, and the gray level (0..=64)
+//! each pixel ends with. The [`Sampler`] owns the state that crosses tile borders (the object
+//! ids of the column left of the tile and of the row above the band), so the render's tile
+//! loop only asks it for a tile of levels.
+
+use crate::dither::{LEVELS, MAX_TILE};
+use crate::scalar::Real;
+use crate::trace::NO_OBJECT;
+
+/// How many eye rays a pixel gets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampling {
+    /// One ray through the centre of each pixel (or of each pattern block).
+    Center,
+    /// Four rays per pixel on a 2x2 grid, averaged.
+    Grid2x2,
+    /// One ray per pixel, and the 2x2 grid only where a neighbouring pixel's eye ray hit a
+    /// different object (the paper's "area anti-aliasing only at object edges"), or where the
+    /// one-ray gray levels of neighbours in the tile differ by at least `contrast` (shadow,
+    /// mirror and refraction edges inside one object; above 64 turns this test off). Needs the
+    /// core's `edge-sampling` feature (on by default).
+    Edges {
+        /// Gray-level jump (of 64) that also counts as an edge.
+        contrast: u8,
+    },
+}
+
+/// Gray level (0..=64) of a brightness in `[0, 1]`, rounded to nearest.
+pub fn level<R: Real>(v: R) -> u8 {
+    let l = v * R::from_i32(LEVELS as i32) + R::HALF;
+    // Bisection over the 65 levels: no float-to-int conversion the scalar may not have.
+    let mut lo = 0u8;
+    let mut hi = LEVELS + 1;
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if R::from_i32(mid as i32) <= l {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Samples tiles in the render's order (tile rows top to bottom, tiles left to right).
+#[derive(Debug)]
+pub struct Sampler<'r> {
+    mode: Sampling,
+    /// Side of the block that shares one eye ray (the patterning dithers' block).
+    block: usize,
+    /// Whether edges are refined (edge sampling, one ray per pixel).
+    edges: bool,
+    /// Object ids (modulo 2^16) of the row above the current band, one per image column.
+    above: &'r mut [i16],
+    /// Object ids of the column left of the current tile.
+    left: [u16; MAX_TILE],
+}
+
+impl<'r> Sampler<'r> {
+    /// Entries of `i16` storage the sampler needs for an image `width` pixels wide.
+    pub fn rows_len(mode: Sampling, block: u8, width: usize) -> usize {
+        if Self::refines_edges(mode, block) {
+            width
+        } else {
+            0
+        }
+    }
+
+    /// Whether `mode` with blocks of `block` pixels refines edges.
+    pub fn refines_edges(mode: Sampling, block: u8) -> bool {
+        matches!(mode, Sampling::Edges { .. }) && block == 1
+    }
+
+    /// A sampler over storage of at least [`Sampler::rows_len`] entries, or `None` if it is
+    /// shorter.
+    pub fn new(mode: Sampling, block: u8, width: usize, rows: &'r mut [i16]) -> Option<Self> {
+        let edges = Self::refines_edges(mode, block);
+        let above = rows.get_mut(..Self::rows_len(mode, block, width))?;
+        above.iter_mut().for_each(|v| *v = NO_OBJECT as u16 as i16);
+        Some(Sampler { mode, block: block.max(1) as usize, edges, above, left: [NO_OBJECT as u16; MAX_TILE] })
+    }
+
+    /// Call when a new band of tiles (a new tile row) starts.
+    pub fn next_band(&mut self) {
+        self.left = [NO_OBJECT as u16; MAX_TILE];
+    }
+
+    /// Gray levels of the `tw x th` tile at `(x0, y0)` into `levels` (row-major). `shoot(sx,
+    /// sy)` traces the eye ray through `(sx / 4, sy / 4)` pixels from the top-left corner
+    /// and returns its brightness and the object it hit (modulo 2^16: ids only need to differ
+    /// between neighbours).
+    pub fn tile<R: Real>(
+        &mut self,
+        x0: usize,
+        y0: usize,
+        tw: usize,
+        th: usize,
+        shoot: &mut impl FnMut(usize, usize) -> (R, u16),
+        levels: &mut [u8; MAX_TILE * MAX_TILE],
+    ) {
+        let block = self.block;
+        let mut ids = [NO_OBJECT as u16; MAX_TILE * MAX_TILE];
+        // One ray per block through the block's centre; Grid2x2 takes four per pixel.
+        for by in (0..th).step_by(block) {
+            for bx in (0..tw).step_by(block) {
+                let (cx, cy) = (4 * (x0 + bx) + 2 * block, 4 * (y0 + by) + 2 * block);
+                let (v, id) = if self.mode == Sampling::Grid2x2 && block == 1 { grid2x2(shoot, cx, cy) } else { shoot(cx, cy) };
+                let l = level(v);
+                for y in by..(by + block).min(th) {
+                    for x in bx..(bx + block).min(tw) {
+                        levels[y * tw + x] = l;
+                        ids[y * tw + x] = id;
+                    }
+                }
+            }
+        }
+        // Without the feature the branch is a constant false and its code is not linked.
+        if cfg!(feature = "edge-sampling") && self.edges {
+            self.refine_edges(x0, y0, tw, th, shoot, levels, &ids);
+        }
+    }
+
+    /// Re-samples pixels on an edge with the 2x2 grid. A pixel is on an edge if its eye ray
+    /// hit another object than a neighbour's: left and above come from the tiles already
+    /// drawn, right and below from this tile; a pair split by a later tile's border is caught
+    /// by that later pixel.
+    #[allow(clippy::too_many_arguments)]
+    fn refine_edges<R: Real>(
+        &mut self,
+        x0: usize,
+        y0: usize,
+        tw: usize,
+        th: usize,
+        shoot: &mut impl FnMut(usize, usize) -> (R, u16),
+        levels: &mut [u8; MAX_TILE * MAX_TILE],
+        ids: &[u16; MAX_TILE * MAX_TILE],
+    ) {
+        let centre = *levels;
+        let threshold = match self.mode {
+            Sampling::Edges { contrast } => contrast,
+            _ => u8::MAX,
+        };
+        for y in 0..th {
+            for x in 0..tw {
+                let id = ids[y * tw + x];
+                let l = if x > 0 { ids[y * tw + x - 1] } else { self.left[y] };
+                let u = if y > 0 { ids[(y - 1) * tw + x] } else { self.above[x0 + x] as u16 };
+                let r = if x + 1 < tw { ids[y * tw + x + 1] } else { id };
+                let d = if y + 1 < th { ids[(y + 1) * tw + x] } else { id };
+                let edge = (x0 + x > 0 && l != id) || (y0 + y > 0 && u != id) || r != id || d != id;
+                // A shadow, mirror or refraction edge inside one object shows as a jump in the
+                // one-ray levels of this tile.
+                let c = centre[y * tw + x];
+                let jump = |n: u8| c.abs_diff(n) >= threshold;
+                let contrast = (x > 0 && jump(centre[y * tw + x - 1]))
+                    || (y > 0 && jump(centre[(y - 1) * tw + x]))
+                    || (x + 1 < tw && jump(centre[y * tw + x + 1]))
+                    || (y + 1 < th && jump(centre[(y + 1) * tw + x]));
+                if edge || contrast {
+                    let (cx, cy) = (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
+                    levels[y * tw + x] = level(grid2x2(shoot, cx, cy).0);
+                }
+            }
+        }
+        for y in 0..th {
+            self.left[y] = ids[y * tw + tw - 1];
+        }
+        for x in 0..tw {
+            self.above[x0 + x] = ids[(th - 1) * tw + x] as i16;
+        }
+    }
+}
+
+/// The mean of four eye rays on a 2x2 grid around the pixel centre `(cx, cy)` (quarter-pixel
+/// units), and the object the first of them hit.
+fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize) -> (R, u16), cx: usize, cy: usize) -> (R, u16) {
+    let mut sum = R::ZERO;
+    let mut first = NO_OBJECT as u16;
+    for (k, (dx, dy)) in [(0, 0), (2, 0), (0, 2), (2, 2)].into_iter().enumerate() {
+        let (v, id) = shoot(cx - 1 + dx, cy - 1 + dy);
+        sum += v;
+        if k == 0 {
+            first = id;
+        }
+    }
+    (sum * (R::HALF * R::HALF), first)
+}
