@@ -190,6 +190,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     writeln!(md, "## Scaling\n\nGenerated scenes (random mixes of the four primitives in a cube growing with N; \"clustered\":\n10 % spread over a stadium, 90 % packed in one composite far from them). Nearest-hit queries\nfor camera rays (a 64x40 grid; fewer for the O(N) methods at large N). Bytes: lattice storage\n(grids, coordinate lists, cells, references); the bounding-box method keeps one box per object.\n")?;
     writeln!(md, "| scene | N | method | us/ray | object tests/ray | cells/ray | bytes | bytes/ref + bytes/cell |\n|---|---|---|---|---|---|---|---|")?;
     let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    let bar = crate::progress::bar(2 * sizes.len(), "generated scenes");
     for clustered in [false, true] {
         for &n in &sizes {
             let mut storage = Vec::new();
@@ -234,7 +235,8 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
                     None => series.push((key, vec![(n as f64, us)])),
                 }
             }
-            eprintln!("  {kind} N={n} done");
+            bar.inc(1);
+            crate::progress::log(&bar, format_args!("  {kind} N={n} done"));
         }
     }
     let at = |key: &str, n: f64| series.iter().find(|(k, _)| k == key).and_then(|(_, v)| v.iter().find(|p| p.0 == n)).map(|p| p.1);

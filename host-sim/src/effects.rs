@@ -56,8 +56,11 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
     writeln!(md, "## Derived effect set against every effect forced on\n\nRays are primary / shadow / reflection / refraction. \"All\" forces every effect on at run time\n(and, on the Cortex-M, compiles every effect in).\n")?;
     writeln!(md, "| scene | effect set | rays, derived | rays, all | host ms derived | host ms all | all / derived | same image | M0 Minstr derived | M0 Minstr all |\n|---|---|---|---|---|---|---|---|---|---|")?;
     let mut cut_rows = Vec::new();
+    let bar = crate::progress::bar(scenes.len(), "scenes");
     for path in scenes {
         let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+        bar.set_message(name.clone());
+        bar.inc(1);
         let text = read(path)?;
         let mut storage = object_storage::<f64>(&text)?;
         let fx = Effects::of(&parse_scene::<f64>(path, &text, &mut storage)?);

@@ -102,7 +102,6 @@ fn elf_path(root: &Path, v: &Variant) -> PathBuf {
 }
 
 fn build(root: &Path, v: &Variant) -> Result<()> {
-    eprintln!("  building {} ({})", v.name, v.target);
     let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cmd.current_dir(root.join("firmware"))
         .args(["build", "--release", "--features", &v.features, "--bin", v.bin, "--target", v.target, "--target-dir"])
@@ -250,15 +249,19 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     writeln!(md, "## Builds\n\n| variant | what | flash bytes | static RAM | stack high-water | RAM total |\n|---|---|---|---|---|---|")?;
     let variants = variants();
     let mut runs = Vec::new();
+    let bar = crate::progress::bar(variants.len(), "firmware variants");
     for v in &variants {
+        bar.set_message(v.name.clone());
+        bar.inc(1);
         if !skip_build {
+            crate::progress::log(&bar, format_args!("  building {} ({})", v.name, v.target));
             build(root, v)?;
         }
         let elf = elf_path(root, v);
         let (flash, _) = elf_sizes(&elf)?;
         let run = match v.machine {
             Some(m) => {
-                eprintln!("  running {} on {m}", v.name);
+                crate::progress::log(&bar, format_args!("  running {} on {m}", v.name));
                 Some(run_qemu(&elf, m)?)
             }
             None => None,

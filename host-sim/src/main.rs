@@ -7,6 +7,7 @@ mod effects;
 mod firmware;
 mod load;
 mod pov;
+mod progress;
 mod output;
 mod run;
 mod tradeoff;

@@ -10,7 +10,6 @@ use lattice_rt::{
     render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, LatticeConfig, Real, Scene, Stats,
     Tracer,
 };
-use std::io::Write;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -32,7 +31,8 @@ struct HostHooks {
     gray: Vec<u8>,
     start: Instant,
     progress: bool,
-    shown: bool,
+    /// Shown once a render has taken 0.7 s.
+    bar: Option<indicatif::ProgressBar>,
 }
 
 impl Hooks for HostHooks {
@@ -43,13 +43,14 @@ impl Hooks for HostHooks {
         }
     }
     fn progress(&mut self, done: u32, total: u32) -> bool {
-        if self.progress && (self.shown || self.start.elapsed() > Duration::from_millis(700)) {
-            self.shown = true;
-            eprint!("\r  rendering: {:3}% ({done}/{total} tiles)", done * 100 / total);
+        if self.progress && self.bar.is_none() && self.start.elapsed() > Duration::from_millis(700) {
+            self.bar = Some(crate::progress::bar(total as usize, "rendering tiles"));
+        }
+        if let Some(b) = &self.bar {
+            b.set_position(done as u64);
             if done == total {
-                eprintln!();
+                b.finish_and_clear();
             }
-            let _ = std::io::stderr().flush();
         }
         true
     }
@@ -98,7 +99,7 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
     let mut scratch = HeapScratch::new(tracer.scene(), frame);
-    let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, shown: false };
+    let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, bar: None };
     let start = Instant::now();
     let stats = render(tracer, frame, &mut target, &mut scratch.scratch(), &mut hooks).map_err(|e| match e {
         RenderError::Draw(never) => match never {},

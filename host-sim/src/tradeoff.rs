@@ -170,9 +170,11 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
     let configs = configs();
     let mut tallies = vec![Tally::default(); configs.len()];
     let mut per_scene: BTreeMap<(String, &'static str), (usize, usize)> = BTreeMap::new();
+    let bar = crate::progress::bar(scenes.len(), "scenes");
     for path in scenes {
         let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
-        eprintln!("  {name}: reference (16 rays/pixel, f64)");
+        bar.inc(1);
+        crate::progress::log(&bar, format_args!("  {name}: reference (16 rays/pixel, f64)"));
         let text = read(path)?;
         let reference = reference(&text, path, w, h, 4)?;
         let ref_levels: Vec<u8> = reference.iter().map(|v| v.round().clamp(0.0, 64.0) as u8).collect();
