@@ -1,6 +1,7 @@
 //! `host-sim bench`: the paper's Table 1 reproduced, then scaling to 100 000 primitives, and
 //! the lattice's resolution choice against a sweep. Writes `docs/performance.md` and a plot.
 
+use crate::shared::median;
 use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
 use crate::run::render_band;
 use anyhow::{Context, Result};
@@ -18,10 +19,6 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-fn median(mut v: Vec<Duration>) -> Duration {
-    v.sort();
-    v[v.len() / 2]
-}
 
 /// The paper's Table 1 (min:sec, IBM PC/AT): bounding box and lattice.
 const PAPER: [(&str, usize, f64, f64); 4] = [

@@ -2,7 +2,9 @@
 //! time, Cortex-M instructions and flash, and what the contribution cutoff (Hall and
 //! Greenberg's adaptive tree depth) saves and costs. Writes `docs/effects.md`.
 
-use crate::load::{object_storage, parse_scene, read, render_text};
+use crate::shared::median;
+use crate::run::render_text;
+use crate::load::{object_storage, parse_scene, read};
 use anyhow::{Context, Result};
 use lattice_rt::{Effects, Frame, Stats};
 use std::collections::BTreeMap;
@@ -26,10 +28,6 @@ fn shoot(path: &Path, text: &str, all: bool, cutoff: f64) -> Result<Shot> {
     Ok(Shot { bits: r.bits, stats: r.stats, time: r.elapsed })
 }
 
-fn median(mut v: Vec<Duration>) -> Duration {
-    v.sort();
-    v[v.len() / 2]
-}
 
 fn differ(a: &[u8], b: &[u8]) -> u32 {
     a.iter().zip(b).map(|(x, y)| (x ^ y).count_ones()).sum()

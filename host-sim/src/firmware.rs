@@ -2,7 +2,8 @@
 //! `-icount shift=0`, checks every frame bit for bit against the same render on the host,
 //! measures flash, RAM and instructions per frame, and writes `docs/firmware.md`.
 
-use crate::load::{read, render_text};
+use crate::run::render_text;
+use crate::load::read;
 use anyhow::{bail, Context, Result};
 use lattice_rt::Frame;
 use object::{Object, ObjectSection, SectionFlags};

@@ -79,24 +79,6 @@ pub fn build_lattice<'a, R: Real>(storage: &'a mut HeapStorage<R>, scene: &Scene
     Ok(lattice)
 }
 
-/// Parses scene text, builds its default lattice and renders `frame` on one core, after
-/// `tune` has adjusted the tracer (depth, cutoff, effects).
-pub fn render_text<R: Real>(
-    path: &Path,
-    text: &str,
-    frame: &lattice_rt::Frame,
-    tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, Lattice<'_, R>>),
-) -> Result<crate::run::Rendered> {
-    let mut storage = object_storage::<R>(text)?;
-    let scene = parse_scene::<R>(path, text, &mut storage)?;
-    let cfg = LatticeConfig::default();
-    let mut bufs = lattice_storage(&scene, &cfg)?;
-    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
-    let mut tracer = lattice_rt::Tracer::new(&scene, &lattice);
-    tune(&mut tracer);
-    crate::run::render_band(&tracer, frame, false)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,6 +7,7 @@ mod effects;
 mod firmware;
 mod load;
 mod pov;
+mod shared;
 mod progress;
 mod output;
 mod run;
@@ -320,7 +321,7 @@ pub struct StatsArgs {
 /// The scenes given, or the paper's four and the Whitted showcase.
 fn default_scenes(scenes: Vec<PathBuf>) -> Vec<PathBuf> {
     if scenes.is_empty() {
-        ["chair", "desk", "polyhedron", "spheres", "whitted"].iter().map(|n| PathBuf::from(format!("scenes/{n}.scene"))).collect()
+        shared::default_scene_paths()
     } else {
         scenes
     }

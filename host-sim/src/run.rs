@@ -1,5 +1,6 @@
 //! The commands: render, stats and the default gallery job.
 
+use crate::shared::{median, PAPER_SCENES};
 use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
 use crate::output::{write_gray_png, write_pbm, write_pgm, write_png, Theme};
 use crate::{Accel, RenderArgs, StatsArgs};
@@ -110,6 +111,24 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
 }
 
 
+/// Parses scene text, builds its default lattice and renders `frame` on one core, after
+/// `tune` has adjusted the tracer (depth, cutoff, effects).
+pub fn render_text<R: Real>(
+    path: &Path,
+    text: &str,
+    frame: &lattice_rt::Frame,
+    tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>),
+) -> Result<Rendered> {
+    let mut storage = object_storage::<R>(text)?;
+    let scene = parse_scene::<R>(path, text, &mut storage)?;
+    let cfg = LatticeConfig::default();
+    let mut bufs = lattice_storage(&scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+    let mut tracer = lattice_rt::Tracer::new(&scene, &lattice);
+    tune(&mut tracer);
+    render_band(&tracer, frame, false)
+}
+
 /// Renders with the accelerator chosen by `accel` (building the lattice when needed).
 pub fn render_accel<R: Real>(
     scene: &Scene<'_, R>,
@@ -178,24 +197,11 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     for p in [Some(&a.output), a.pbm.as_ref(), a.gray.as_ref()].into_iter().flatten() {
         println!("wrote {}", p.display());
     }
-    print_stats(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel_name()), &out.stats, out.elapsed);
+    print_stats(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel.name()), &out.stats, out.elapsed);
     Ok(())
 }
 
-impl RenderArgs {
-    fn accel_name(&self) -> &'static str {
-        match self.accel {
-            Accel::Lattice => "lattice",
-            Accel::Bbox => "bbox",
-            Accel::Brute => "brute",
-        }
-    }
-}
 
-fn median(mut v: Vec<Duration>) -> Duration {
-    v.sort();
-    v[v.len() / 2]
-}
 
 /// `host-sim stats`.
 pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
@@ -281,8 +287,6 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     Ok(())
 }
 
-/// The paper's four scenes.
-pub const PAPER_SCENES: [&str; 4] = ["chair", "desk", "polyhedron", "spheres"];
 
 /// The default job: the paper's scenes at 160x100 and 128x64.
 pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {

@@ -2,7 +2,9 @@
 //! (f64, the scene's depth, no cutoff, one ray per pixel, Bayer), measures the error against a
 //! reference (f64, 4x4 rays per pixel) and the cost, and writes `docs/accuracy.md` and a plot.
 
-use crate::load::{object_storage, parse_scene, read, render_text, build_lattice, lattice_storage};
+use crate::shared::median;
+use crate::run::render_text;
+use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
 use anyhow::{Context, Result};
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Rgb888;
@@ -159,10 +161,6 @@ struct Tally {
     same_settings_diff: usize,
 }
 
-fn median(mut v: Vec<Duration>) -> Duration {
-    v.sort();
-    v[v.len() / 2]
-}
 
 /// The command.
 pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Path, plot: &Path, firmware_csv: &Path) -> Result<()> {

@@ -1,0 +1,47 @@
+//! What the commands share: the scene lists, the accelerator names and the median of timings.
+
+use crate::Accel;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// The paper's four scenes.
+pub const PAPER_SCENES: [&str; 4] = ["chair", "desk", "polyhedron", "spheres"];
+
+/// The scenes the studies and the firmware use by default: the paper's four and the Whitted
+/// showcase, as listed once in `firmware/default-scenes.txt` (which `firmware/build.rs` reads).
+pub fn default_scene_paths() -> Vec<PathBuf> {
+    include_str!("../../firmware/default-scenes.txt")
+        .split(',')
+        .map(str::trim)
+        .filter(|n| !n.is_empty())
+        .map(|n| PathBuf::from(format!("scenes/{n}.scene")))
+        .collect()
+}
+
+impl Accel {
+    /// The name reports use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Lattice => "lattice",
+            Accel::Bbox => "bbox",
+            Accel::Brute => "brute",
+        }
+    }
+}
+
+/// The median of timings (the upper one of an even count).
+pub fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_scenes_start_with_the_papers_four() {
+        let names: Vec<String> = default_scene_paths().iter().map(|p| p.file_stem().unwrap().to_string_lossy().into_owned()).collect();
+        assert_eq!(names[..4], PAPER_SCENES.map(String::from));
+    }
+}
