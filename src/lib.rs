@@ -39,6 +39,7 @@ pub use storage::{Loaded, Scratch, Sizes, Storage, StorageView};
 pub use storage::{HeapScratch, HeapStorage};
 pub mod bitframe;
 pub use bitframe::BitFrame;
+#[cfg(any(test, feature = "generate"))]
 pub mod generate;
 pub mod fixed;
 pub use fixed::Fx;
