@@ -42,7 +42,7 @@ fn main() {
     println!("cargo:rerun-if-changed=default-scenes.txt");
     let names = env::var("FIRMWARE_SCENES").unwrap_or_else(|_| fs::read_to_string("default-scenes.txt").expect("default-scenes.txt"));
     let mut list = String::new();
-    let mut sizes = Sizes { objects: 1, grids: 1, coords: 1, words: 1, rows: 0 };
+    let mut sizes = Sizes { objects: 1, lattices: 1, coords: 1, words: 1, rows: 0 };
     let mut effects = 0u8;
     for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));
@@ -71,12 +71,12 @@ fn main() {
         "/// The scenes embedded in this build (`FIRMWARE_SCENES`).\n\
          pub const SCENES: [(&str, &str); {count}] = [\n{list}];\n\
          /// Most primitives in an embedded scene.\npub const MAX_OBJECTS: usize = {};\n\
-         /// Most lattices (world + composites).\npub const MAX_GRIDS: usize = {};\n\
+         /// Most lattices (world + composites).\npub const MAX_LATTICES: usize = {};\n\
          /// Coordinate-list entries.\npub const MAX_COORDS: usize = {};\n\
          /// Words: cells + 1, references and the mailbox.\npub const MAX_WORDS: usize = {};\n\
          /// Render rows (dither carries, edge ids).\npub const MAX_ROWS: usize = {};\n\
          /// Effects compiled in: those the embedded scenes call for (`Effects` bits).\npub const EFFECTS: u8 = {effects};\n",
-        sizes.objects, sizes.grids, sizes.coords, sizes.words, sizes.rows
+        sizes.objects, sizes.lattices, sizes.coords, sizes.words, sizes.rows
     );
     fs::write(out.join("capacities.rs"), code).unwrap();
 }

@@ -81,7 +81,7 @@ impl<'m> Query<'m> {
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
-        scene.objects.len() + scene.groups.len()
+        scene.objects.len() + scene.composites.len()
     }
     /// Starts a new ray: every mailbox entry becomes unvisited.
     pub fn next_ray(&mut self) {

@@ -46,7 +46,7 @@ pub struct RandomScene {
     /// Number of primitives.
     pub objects: usize,
     /// Objects per composite (0: no composites).
-    pub group_size: usize,
+    pub composite_size: usize,
     /// Side of the cube the objects are scattered in (0: grows as the cube root of the count).
     pub spread: f64,
     /// Seed.
@@ -78,13 +78,13 @@ pub fn random_scene<R: Real>(b: &mut SceneBuilder<'_, R>, p: &RandomScene) -> Re
     let mirror = b.add_material(Material { ka: 0.1, kd: 0.5, ks: 0.4, kt: 0.0, ior: 1.0 })?;
     let glass = b.add_material(Material { ka: 0.05, kd: 0.1, ks: 0.1, kt: 0.7, ior: 1.5 })?;
     b.add_light(Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 })?;
-    let mut in_group = 0;
+    let mut in_composite = 0;
     for i in 0..p.objects {
-        if p.group_size > 0 && in_group == 0 {
+        if p.composite_size > 0 && in_composite == 0 {
             let c = Vec3::new(rng.range(0.0, side), rng.range(0.0, side), rng.range(0.0, side));
-            b.begin_group(Affine::translate(c))?;
+            b.begin_composite(Affine::translate(c))?;
         }
-        let center = if p.group_size > 0 {
+        let center = if p.composite_size > 0 {
             Vec3::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), rng.range(-1.5, 1.5))
         } else {
             Vec3::new(rng.range(0.0, side), rng.range(0.0, side), rng.range(0.0, side))
@@ -96,11 +96,11 @@ pub fn random_scene<R: Real>(b: &mut SceneBuilder<'_, R>, p: &RandomScene) -> Re
             _ => matte,
         };
         b.add_object(shape, t, m)?;
-        if p.group_size > 0 {
-            in_group += 1;
-            if in_group == p.group_size || i + 1 == p.objects {
-                b.end_group()?;
-                in_group = 0;
+        if p.composite_size > 0 {
+            in_composite += 1;
+            if in_composite == p.composite_size || i + 1 == p.objects {
+                b.end_composite()?;
+                in_composite = 0;
             }
         }
     }

@@ -11,35 +11,36 @@ extern crate std;
 #[cfg(feature = "alloc")]
 extern crate alloc;
 
-pub mod math;
+// In the order the data flows: numbers, geometry, the scene (text in, validated scene out),
+// the lattice over it, the storage that holds both, then tracing, sampling, dithering and the
+// tile loop that writes a display.
 pub mod scalar;
-pub mod scene;
-pub mod shape;
-
-pub use math::{Aabb, Affine, Ray, Vec3};
 pub use scalar::{F32Micro, F32MicroNewton, Real};
-pub use scene::{Scene, SceneBuilder, SceneError};
+pub mod fixed;
+pub use fixed::Fx;
+pub mod math;
+pub use math::{Aabb, Affine, Ray, Vec3};
+pub mod shape;
 pub use shape::Shape;
+pub mod scene;
+pub use scene::text::{parse, ParseError};
+pub use scene::{Scene, SceneBuilder, SceneError};
+#[cfg(any(test, feature = "generate"))]
+pub mod generate;
 pub mod accel;
-pub mod lattice;
 pub use accel::{Accelerator, BoundingBox, BruteForce, Hit, Query, Stats};
+pub mod lattice;
 pub use lattice::{Lattice, LatticeConfig, LatticeStorage};
-pub mod trace;
-pub use trace::{Effects, Tracer};
-pub mod dither;
-pub use dither::Dither;
-pub mod sample;
-pub mod render;
-pub use render::{render, Frame, Hooks, NoHooks, Sampling};
-pub mod parse;
-pub use parse::{parse, ParseError};
 pub mod storage;
 pub use storage::{Loaded, Scratch, Sizes, Storage, StorageView};
 #[cfg(feature = "alloc")]
 pub use storage::{HeapScratch, HeapStorage};
+pub mod trace;
+pub use trace::{Effects, Tracer};
+pub mod sample;
+pub mod dither;
+pub use dither::Dither;
+pub mod render;
+pub use render::{render, Frame, Hooks, NoHooks, Sampling};
 pub mod bitframe;
 pub use bitframe::BitFrame;
-#[cfg(any(test, feature = "generate"))]
-pub mod generate;
-pub mod fixed;
-pub use fixed::Fx;

@@ -1,16 +1,16 @@
 //! Storage: all memory a frame needs, in one place. [`Storage`] holds it in arrays whose
 //! capacities are const parameters (heapless style: firmware sizes them at build time);
-//! with the `alloc` feature, [`HeapStorage`] holds the same on the heap, sized at run time by
+//! with the `alloc` feature, `HeapStorage` holds the same on the heap, sized at run time by
 //! [`Sizes::of`]. Both lend a [`StorageView`] that erases the capacities, so the code that
 //! loads a scene, builds its lattice and hands the rest to the render is written once.
 //!
-//! The view is used up in the order the data flows: objects (the scene), then grids,
+//! The view is used up in the order the data flows: objects (the scene), then lattices,
 //! coordinate lists and the word pool (the lattice's cells and references), then what is
 //! left of the pool and the `i16` rows (the render's [`Scratch`]).
 
 use crate::accel::Query;
-use crate::lattice::{Grid, Lattice, LatticeConfig, LatticeError, LatticeStorage};
-use crate::parse::{parse, ParseError};
+use crate::lattice::{SubLattice, Lattice, LatticeConfig, LatticeError, LatticeStorage};
+use crate::scene::text::{parse, ParseError};
 use crate::render::Frame;
 use crate::scalar::Real;
 use crate::scene::{Object, Scene};
@@ -22,7 +22,7 @@ pub struct Sizes {
     /// Primitives.
     pub objects: usize,
     /// Lattices (world and sub-lattices).
-    pub grids: usize,
+    pub lattices: usize,
     /// Coordinate-list entries.
     pub coords: usize,
     /// `u32` words: the lattice's cells and references, then the render's mailbox (one per
@@ -40,7 +40,7 @@ impl Sizes {
         let lattice = cfg.map(|c| Lattice::plan(scene, c)).unwrap_or_default();
         Sizes {
             objects: scene.objects.len(),
-            grids: lattice.grids,
+            lattices: lattice.lattices,
             coords: lattice.coords,
             words: lattice.words() + Query::mailbox_len(scene),
             rows: frame.scratch_len(),
@@ -52,7 +52,7 @@ impl Sizes {
     pub fn bytes<R>(&self) -> usize {
         [
             self.objects.saturating_mul(size_of::<Object<R>>()),
-            self.grids.saturating_mul(size_of::<Grid<R>>()),
+            self.lattices.saturating_mul(size_of::<SubLattice<R>>()),
             self.coords.saturating_mul(size_of::<R>()),
             self.words.saturating_mul(4),
             self.rows.saturating_mul(2),
@@ -65,7 +65,7 @@ impl Sizes {
     pub fn max(self, o: Sizes) -> Sizes {
         Sizes {
             objects: self.objects.max(o.objects),
-            grids: self.grids.max(o.grids),
+            lattices: self.lattices.max(o.lattices),
             coords: self.coords.max(o.coords),
             words: self.words.max(o.words),
             rows: self.rows.max(o.rows),
@@ -79,13 +79,13 @@ impl Sizes {
 pub struct Storage<
     R,
     const OBJECTS: usize,
-    const GRIDS: usize,
+    const LATTICES: usize,
     const COORDS: usize,
     const WORDS: usize,
     const ROWS: usize,
 > {
     objects: [Object<R>; OBJECTS],
-    grids: [Grid<R>; GRIDS],
+    lattices: [SubLattice<R>; LATTICES],
     coords: [R; COORDS],
     words: [u32; WORDS],
     rows: [i16; ROWS],
@@ -98,7 +98,7 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
     pub fn new() -> Self {
         Storage {
             objects: [Object::default(); O],
-            grids: [Grid::EMPTY; G],
+            lattices: [SubLattice::EMPTY; G],
             coords: [R::ZERO; C],
             words: [0; W],
             rows: [0; S],
@@ -109,7 +109,7 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
     pub const fn sizes() -> Sizes {
         Sizes {
             objects: O,
-            grids: G,
+            lattices: G,
             coords: C,
             words: W,
             rows: S,
@@ -120,7 +120,7 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
     pub fn view(&mut self) -> StorageView<'_, R> {
         StorageView::new(
             &mut self.objects,
-            &mut self.grids,
+            &mut self.lattices,
             &mut self.coords,
             &mut self.words,
             &mut self.rows,
@@ -141,7 +141,7 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
 #[derive(Debug)]
 pub struct HeapStorage<R> {
     objects: alloc::vec::Vec<Object<R>>,
-    grids: alloc::vec::Vec<Grid<R>>,
+    lattices: alloc::vec::Vec<SubLattice<R>>,
     coords: alloc::vec::Vec<R>,
     words: alloc::vec::Vec<u32>,
     rows: alloc::vec::Vec<i16>,
@@ -154,7 +154,7 @@ impl<R: Real> HeapStorage<R> {
         use alloc::vec;
         HeapStorage {
             objects: vec![Object::default(); sizes.objects],
-            grids: vec![Grid::EMPTY; sizes.grids],
+            lattices: vec![SubLattice::EMPTY; sizes.lattices],
             coords: vec![R::ZERO; sizes.coords],
             words: vec![0; sizes.words],
             rows: vec![0; sizes.rows],
@@ -164,7 +164,7 @@ impl<R: Real> HeapStorage<R> {
     /// Bytes this storage occupies.
     pub fn bytes(&self) -> usize {
         size_of_val(&self.objects[..])
-            + size_of_val(&self.grids[..])
+            + size_of_val(&self.lattices[..])
             + size_of_val(&self.coords[..])
             + size_of_val(&self.words[..])
             + size_of_val(&self.rows[..])
@@ -174,7 +174,7 @@ impl<R: Real> HeapStorage<R> {
     pub fn view(&mut self) -> StorageView<'_, R> {
         StorageView::new(
             &mut self.objects,
-            &mut self.grids,
+            &mut self.lattices,
             &mut self.coords,
             &mut self.words,
             &mut self.rows,
@@ -182,7 +182,7 @@ impl<R: Real> HeapStorage<R> {
     }
 }
 
-/// Storage with its capacities erased: the slices of a [`Storage`] or [`HeapStorage`] (or
+/// Storage with its capacities erased: the slices of a [`Storage`] or `HeapStorage` (or
 /// any the caller owns), used up as a frame is set up.
 #[derive(Debug)]
 pub struct StorageView<'a, R> {
@@ -194,7 +194,7 @@ pub struct StorageView<'a, R> {
 /// render's scratch.
 #[derive(Debug)]
 pub struct FrameStorage<'a, R> {
-    grids: &'a mut [Grid<R>],
+    lattices: &'a mut [SubLattice<R>],
     coords: &'a mut [R],
     words: &'a mut [u32],
     rows: &'a mut [i16],
@@ -236,7 +236,7 @@ impl<'a, R: Real> StorageView<'a, R> {
     /// A view of caller-owned slices.
     pub fn new(
         objects: &'a mut [Object<R>],
-        grids: &'a mut [Grid<R>],
+        lattices: &'a mut [SubLattice<R>],
         coords: &'a mut [R],
         words: &'a mut [u32],
         rows: &'a mut [i16],
@@ -244,7 +244,7 @@ impl<'a, R: Real> StorageView<'a, R> {
         StorageView {
             objects,
             rest: FrameStorage {
-                grids,
+                lattices,
                 coords,
                 words,
                 rows,
@@ -284,7 +284,7 @@ impl<'a, R: Real> FrameStorage<'a, R> {
         cfg: &LatticeConfig,
     ) -> Result<(Lattice<'a, R>, Scratch<'a>), LatticeError> {
         let storage = LatticeStorage {
-            grids: self.grids,
+            lattices: self.lattices,
             coords: self.coords,
             words: self.words,
         };

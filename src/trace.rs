@@ -100,7 +100,7 @@ impl Effects {
         if scene.lights.iter().any(|l| matches!(l, Light::Point { .. })) {
             e = e | Self::POINT_LIGHTS;
         }
-        if !scene.groups.is_empty() {
+        if !scene.composites.is_empty() {
             e = e | Self::COMPOSITES;
         }
         e

@@ -93,26 +93,26 @@ proptest! {
 
     #[test]
     fn accelerators_agree_ray_by_ray_in_f64(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(3), Just(5)]) {
-        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        let p = RandomScene { objects: n, composite_size: group, spread: 0.0, seed };
         check::<f64>(&p, &LatticeConfig::default(), rays_per_scene())?;
     }
 
     #[test]
     fn accelerators_agree_ray_by_ray_in_f32(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(3), Just(5)]) {
-        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        let p = RandomScene { objects: n, composite_size: group, spread: 0.0, seed };
         check::<f32>(&p, &LatticeConfig::default(), rays_per_scene())?;
     }
 
     #[test]
     fn accelerators_agree_ray_by_ray_in_fixed_point(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(3), Just(5)]) {
-        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        let p = RandomScene { objects: n, composite_size: group, spread: 0.0, seed };
         check::<lattice_rt::Fx>(&p, &LatticeConfig::default(), rays_per_scene())?;
     }
 
     #[test]
     fn flat_and_adaptive_lattices_agree_too(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(4)]) {
         use lattice_rt::lattice::Spacing;
-        let p = RandomScene { objects: n, group_size: group, spread: 0.0, seed };
+        let p = RandomScene { objects: n, composite_size: group, spread: 0.0, seed };
         for (spacing, nested) in [(Spacing::Adaptive, true), (Spacing::Uniform, false), (Spacing::Adaptive, false)] {
             let cfg = LatticeConfig { spacing, nested, top: lattice_rt::lattice::Resolution::Auto { density: 8.0 }, ..LatticeConfig::default() };
             check::<f64>(&p, &cfg, 300)?;
@@ -124,7 +124,7 @@ proptest! {
     #[test]
     fn fine_and_coarse_lattices_agree_too(seed in any::<u64>(), n in 1usize..30, res in 1u16..12) {
         use lattice_rt::lattice::Resolution;
-        let p = RandomScene { objects: n, group_size: 4, spread: 0.0, seed };
+        let p = RandomScene { objects: n, composite_size: 4, spread: 0.0, seed };
         let cfg = LatticeConfig { top: Resolution::Uniform([res, res + 1, res.saturating_sub(1).max(1)]), sub: Resolution::Uniform([res; 3]), ..LatticeConfig::default() };
         check::<f64>(&p, &cfg, 200)?;
         check::<f32>(&p, &cfg, 200)?;
@@ -147,14 +147,14 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
         let c = Vec3::new((i % side) as f64 * 0.5, (i / side) as f64 * 0.5, 400.0);
         b.add_object(Shape::Sphere, Affine::translate(c).after(&Affine::scale(Vec3::new(0.2, 0.2, 0.2))), 0).unwrap();
     }
-    b.begin_group(Affine::translate(Vec3::new(3.0, 3.0, 20.0))).unwrap();
+    b.begin_composite(Affine::translate(Vec3::new(3.0, 3.0, 20.0))).unwrap();
     let span = (members as f64).cbrt().ceil().max(1.0);
     for _ in 0..members {
         let c = Vec3::new(rng.range(0.0, span), rng.range(0.0, span), rng.range(0.0, span));
         let (shape, t) = random_object(&mut rng, c, 0.3);
         b.add_object(shape, t, 0).unwrap();
     }
-    b.end_group().unwrap();
+    b.end_composite().unwrap();
     let scene = b.finish().unwrap();
     let cfg = LatticeConfig::default();
     let mut bufs = lattice_storage(&scene, &cfg);

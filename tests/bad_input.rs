@@ -4,7 +4,7 @@
 
 mod common;
 use common::*;
-use lattice_rt::parse::text_from_bytes;
+use lattice_rt::scene::text::text_from_bytes;
 use lattice_rt::scene::Object;
 use lattice_rt::{parse, Frame, Fx, LatticeConfig, Real, Tracer};
 

@@ -233,7 +233,7 @@ fn corners_faces_and_sub_lattices<R: Real>() {
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([4, 4, 4]), sub: Resolution::Uniform([2, 2, 2]), ..LatticeConfig::default() };
     let w = scene.world();
-    let g = scene.groups()[0].bounds;
+    let g = scene.composites()[0].bounds;
     let rays = [
         Ray::new(w.min, w.max - w.min),                                         // corner to corner
         Ray::new(Vec3::new(w.min.x, w.min.y, w.min.z), v::<R>(1.0, 1.0, 0.0)),   // along a face edge

@@ -144,7 +144,7 @@ fn comments_blank_lines_and_groups_parse() {
     let mut storage = vec![Object::<f64>::default(); 4];
     let scene = parse::<f64>(text, &mut storage).unwrap();
     assert_eq!(scene.objects().len(), 1);
-    assert_eq!(scene.groups().len(), 1);
+    assert_eq!(scene.composites().len(), 1);
 }
 
 #[test]

@@ -4,7 +4,7 @@ use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use lattice_rt::lattice::LatticeError;
-use lattice_rt::parse::ParseError;
+use lattice_rt::scene::text::ParseError;
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::storage::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
@@ -29,7 +29,7 @@ pub type Scalar = f32;
 include!(concat!(env!("OUT_DIR"), "/capacities.rs"));
 
 /// All memory a frame of any embedded scene needs, with the capacities build.rs computed.
-pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_GRIDS, MAX_COORDS, MAX_WORDS, MAX_ROWS>;
+pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_LATTICES, MAX_COORDS, MAX_WORDS, MAX_ROWS>;
 
 /// Why a scene could not be shown.
 #[derive(Debug)]

@@ -3,7 +3,7 @@
 //! a few rays in every scalar, so validation is checked against what the tracer needs.
 #![no_main]
 
-use lattice_rt::lattice::{Grid, LatticeSizes};
+use lattice_rt::lattice::SubLattice;
 use lattice_rt::scene::Object;
 use lattice_rt::{parse, Accelerator, BruteForce, Fx, Lattice, LatticeConfig, LatticeStorage, Query, Real};
 use libfuzzer_sys::fuzz_target;
@@ -17,16 +17,16 @@ fn check<R: Real>(text: &str) {
         }
         Ok(scene) => {
             let cfg = LatticeConfig::default();
-            let LatticeSizes { grids, coords, cells, refs } = Lattice::plan(&scene, &cfg);
-            if cells > 1 << 20 || refs > 1 << 20 {
+            let sizes = Lattice::plan(&scene, &cfg);
+            if sizes.words() > 1 << 20 {
                 return;
             }
-            let (mut g, mut c, mut ce, mut r) = (vec![Grid::EMPTY; grids], vec![R::ZERO; coords], vec![0; cells], vec![0; refs]);
-            let lat = Lattice::build(&scene, &cfg, LatticeStorage { grids: &mut g, coords: &mut c, cells: &mut ce, refs: &mut r }).unwrap();
+            let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; sizes.lattices], vec![R::ZERO; sizes.coords], vec![0; sizes.words()]);
+            let lat = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
             let mut mb = vec![0; Query::mailbox_len(&scene)];
             let mut q = Query::new(&mut mb);
             for (x, y) in [(1, 1), (7, 3), (15, 9)] {
-                let ray = scene.camera.ray(x, y, 16, 10);
+                let ray = scene.camera().ray(x, y, 16, 10);
                 let a = lat.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q);
                 let b = BruteForce.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q);
                 assert_eq!(a, b);

@@ -99,7 +99,7 @@ fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> Resul
     *storage = vec![Object::default(); n];
     let mut b = SceneBuilder::new(storage);
     if !clustered {
-        random_scene(&mut b, &RandomScene { objects: n, group_size: 0, spread: 0.0, seed: n as u64 })?;
+        random_scene(&mut b, &RandomScene { objects: n, composite_size: 0, spread: 0.0, seed: n as u64 })?;
     } else {
         let mut rng = Rng::new(7 + n as u64);
         let side = 6.0 * (n as f64).cbrt().max(2.0);
@@ -112,13 +112,13 @@ fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> Resul
             b.add_object(s, t, 0)?;
         }
         // The teapot: a composite of the other 90 % packed into a cube of side 2.
-        b.begin_group(lattice_rt::Affine::translate(Vec3::new(side * 0.8, side * 0.1, side * 0.8)))?;
+        b.begin_composite(lattice_rt::Affine::translate(Vec3::new(side * 0.8, side * 0.1, side * 0.8)))?;
         for _ in sparse..n {
             let c = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
             let (s, t) = random_object(&mut rng, c, 0.04);
             b.add_object(s, t, 0)?;
         }
-        b.end_group()?;
+        b.end_composite()?;
         b.camera.eye = Vec3::new(side * 0.5, side * 0.6, -side * 0.6);
         b.camera.look = Vec3::new(side * 0.8, side * 0.1, side * 0.8);
     }
@@ -184,7 +184,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     writeln!(md, "\nNested lattice against bounding box: {}. The paper: 2.01x to 2.70x.\n", ratios.iter().map(|(n, r, _)| format!("{n} {r:.2}x")).collect::<Vec<_>>().join(", "))?;
     // Scaling.
     let sizes: Vec<usize> = if quick { vec![10, 100, 1000] } else { vec![10, 100, 1_000, 10_000, 100_000] };
-    writeln!(md, "## Scaling\n\nGenerated scenes (random mixes of the four primitives in a cube growing with N; \"clustered\":\n10 % spread over a stadium, 90 % packed in one composite far from them). Nearest-hit queries\nfor camera rays (a 64x40 grid; fewer for the O(N) methods at large N). Bytes: lattice storage\n(grids, coordinate lists, cells, references); the bounding-box method keeps one box per object.\n")?;
+    writeln!(md, "## Scaling\n\nGenerated scenes (random mixes of the four primitives in a cube growing with N; \"clustered\":\n10 % spread over a stadium, 90 % packed in one composite far from them). Nearest-hit queries\nfor camera rays (a 64x40 grid; fewer for the O(N) methods at large N). Bytes: lattice storage\n(lattices, coordinate lists, cells, references); the bounding-box method keeps one box per object.\n")?;
     writeln!(md, "| scene | N | method | us/ray | object tests/ray | cells/ray | bytes | bytes/ref + bytes/cell |\n|---|---|---|---|---|---|---|---|")?;
     let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     let bar = crate::progress::bar(2 * sizes.len(), "generated scenes");

@@ -3,7 +3,7 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::lattice::LatticeSizes;
-use lattice_rt::parse::{object_count, text_from_bytes};
+use lattice_rt::scene::text::{object_count, text_from_bytes};
 use lattice_rt::scene::Object;
 use lattice_rt::{parse, Frame, HeapStorage, Lattice, LatticeConfig, Real, Scene, Sizes};
 use std::io::Read;

@@ -362,7 +362,7 @@ fn real_main() -> Result<()> {
             let out = pov::export(&s, if ids { pov::PovMode::Ids } else { pov::PovMode::Full }).map_err(|e| {
                 match e.downcast_ref::<pov::Unrepresentable>() {
                     Some(u) => {
-                        let (line, col, _) = lattice_rt::parse::object_statement(&text, u.object);
+                        let (line, col, _) = lattice_rt::scene::text::object_statement(&text, u.object);
                         anyhow::anyhow!("{}: line {line}, column {col}: cannot export {u}", scene.display())
                     }
                     None => e,

@@ -278,7 +278,7 @@ mod tests {
         // A generated random scene too.
         let mut storage = vec![Object::<f64>::default(); 30];
         let mut b = SceneBuilder::new(&mut storage);
-        random_scene(&mut b, &RandomScene { objects: 30, group_size: 0, spread: 0.0, seed: 42 }).unwrap();
+        random_scene(&mut b, &RandomScene { objects: 30, composite_size: 0, spread: 0.0, seed: 42 }).unwrap();
         let scene = b.finish().unwrap();
         let (agree, mean, far) = compare("random30", &scene);
         report.push_str(&format!("random30: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n", agree * 100.0, far * 100.0));

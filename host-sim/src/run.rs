@@ -218,13 +218,13 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     println!(
         "  objects {}, composites {}, materials {}, lights {}, depth {}",
         scene.objects().len(),
-        scene.groups().len(),
+        scene.composites().len(),
         scene.materials().len(),
         scene.lights().len(),
         scene.max_depth()
     );
     println!("  effects: {fx}");
-    for (i, g) in lattice.grids().iter().enumerate() {
+    for (i, g) in lattice.lattices().iter().enumerate() {
         let name = if i == 0 { "world lattice".to_string() } else { format!("sub-lattice {}", i - 1) };
         println!("  {name}: {} x {} x {} cells", g.n[0], g.n[1], g.n[2]);
     }

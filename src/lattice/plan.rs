@@ -1,0 +1,208 @@
+//! Planning a lattice: its resolution, where its planes go, and how much storage it needs.
+
+use super::{for_each_item, locate, Lattice};
+use crate::math::Aabb;
+use crate::scalar::Real;
+use crate::scene::Scene;
+
+/// How the coordinate lists of a lattice are chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Resolution {
+    /// Cost heuristic: about `density * items` cells in all, shaped like the box
+    /// (cells per axis proportional to the extent times the cube root of the item count).
+    Auto {
+        /// Target cells per item.
+        density: f64,
+    },
+    /// A fixed number of equal cells per axis.
+    Uniform([u16; 3]),
+}
+
+/// Where the planes of a coordinate list go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spacing {
+    /// Equal cells.
+    Uniform,
+    /// The paper's free coordinate lists `X(), Y(), Z()`: planes at quantiles of an even mix of
+    /// the items' box centres and a uniform spread along each axis, so crowded regions get
+    /// narrow cells while empty ones are not left with a few huge cells.
+    Adaptive,
+}
+
+/// Choices for building a lattice.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LatticeConfig {
+    /// Resolution of the world lattice.
+    pub top: Resolution,
+    /// Resolution of each composite's sub-lattice.
+    pub sub: Resolution,
+    /// Upper bound on cells per axis for [`Resolution::Auto`].
+    pub max_per_axis: u16,
+    /// Where the planes go.
+    pub spacing: Spacing,
+    /// Whether composites get sub-lattices (the paper's hierarchy); if not, their primitives
+    /// are listed in the world lattice like any other (a flat lattice).
+    pub nested: bool,
+}
+
+impl Default for LatticeConfig {
+    fn default() -> Self {
+        LatticeConfig {
+            top: Resolution::Auto { density: 2.0 },
+            sub: Resolution::Auto { density: 2.0 },
+            max_per_axis: 64,
+            spacing: Spacing::Uniform,
+            nested: true,
+        }
+    }
+}
+
+/// Most cells per axis of any lattice.
+pub const MAX_PER_AXIS: u16 = 1024;
+/// How much storage a scene's lattice needs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LatticeSizes {
+    /// Lattices (world and sub-lattices).
+    pub lattices: usize,
+    /// Coordinate-list entries.
+    pub coords: usize,
+    /// Cell entries (cells + 1).
+    pub cells: usize,
+    /// References.
+    pub refs: usize,
+}
+
+impl LatticeSizes {
+    /// Words of [`LatticeStorage::words`](super::LatticeStorage::words) the lattice takes: its cells and references.
+    pub fn words(&self) -> usize {
+        self.cells + self.refs
+    }
+}
+/// Cells per axis of lattice `g`.
+pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>) -> [u16; 3] {
+    let mut items = 0;
+    for_each_item(scene, cfg, g, |_, _| items += 1);
+    resolution(b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis)
+}
+
+pub(super) fn lattice_bounds<R: Real>(scene: &Scene<'_, R>, sub: usize) -> Aabb<R> {
+    if sub == 0 {
+        scene.world
+    } else {
+        scene.composites[sub - 1].bounds
+    }
+}
+
+fn resolution<R: Real>(b: &Aabb<R>, items: usize, res: Resolution, max_axis: u16) -> [u16; 3] {
+    match res {
+        Resolution::Uniform(n) => n.map(|v| v.clamp(1, MAX_PER_AXIS)),
+        Resolution::Auto { density } => {
+            let ext = [0, 1, 2].map(|a| (b.max.axis(a) - b.min.axis(a)).to_f64().max(0.0));
+            let longest = ext.iter().cloned().fold(0.0f64, f64::max);
+            if longest <= 0.0 {
+                return [1; 3];
+            }
+            // Cells ~ density * items; axes with a tiny extent are given at least one cell, so
+            // the volume of the others is used (a flat box does not get a huge cell count).
+            let floor = longest / max_axis as f64;
+            let vol: f64 = ext.iter().map(|e| e.max(floor)).product();
+            let k = libm::cbrt(density * items.max(1) as f64 / vol);
+            ext.map(|e| (libm::round(e * k) as u16).clamp(1, max_axis.min(MAX_PER_AXIS)))
+        }
+    }
+}
+
+/// Plane `i` of a uniform coordinate list of `n` cells over `[lo, hi]`, computed from the
+/// index (never accumulated); the last plane is exactly `hi`.
+fn uniform_coord<R: Real>(lo: R, hi: R, n: u16, i: usize) -> R {
+    if i == n as usize {
+        hi
+    } else {
+        lo + (hi - lo) / R::from_i32(n as i32) * R::from_i32(i as i32)
+    }
+}/// Writes the `n + 1` planes of axis `a` of lattice `g` (bounds `b`) into `out`.
+pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, b: &Aabb<R>, n: u16, out: &mut [R]) {
+    let (lo, hi) = (b.min.axis(a), b.max.axis(a));
+    match cfg.spacing {
+        Spacing::Uniform => {
+            for (i, c) in out.iter_mut().enumerate().take(n as usize + 1) {
+                *c = uniform_coord(lo, hi, n, i);
+            }
+        }
+        Spacing::Adaptive => adaptive_planes(scene, cfg, g, a, lo, hi, n, out),
+    }
+}
+
+/// Planes at quantiles of the box centres mixed with a uniform spread, from a histogram of
+/// 1024 bins (no allocation, no sorting). Out of line so its 4 KB histogram is only on the stack when used.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
+    const BINS: usize = 1024;
+    let (l, h) = (lo.to_f64(), hi.to_f64());
+    let width = (h - l).max(f64::MIN_POSITIVE);
+    let mut hist = [0u32; BINS];
+    let mut total = 0u32;
+    for_each_item(scene, cfg, g, |_, ib| {
+        let c = (ib.min.axis(a).to_f64() + ib.max.axis(a).to_f64()) * 0.5;
+        let bin = (((c - l) / width) * BINS as f64).clamp(0.0, (BINS - 1) as f64) as usize;
+        hist[bin] += 1;
+        total += 1;
+    });
+    out[0] = lo;
+    out[n as usize] = hi;
+    // Planes at quantiles of a half-and-half mixture of the box centres and a uniform spread:
+    // crowded regions get narrow cells without starving the empty ones.
+    let share = |bin: usize, below: u32| 0.5 * bin as f64 / BINS as f64 + 0.5 * below as f64 / total.max(1) as f64;
+    let (mut bin, mut below) = (0usize, 0u32);
+    for (i, plane) in out.iter_mut().enumerate().take(n as usize).skip(1) {
+        let target = i as f64 / n as f64;
+        while bin < BINS - 1 && share(bin + 1, below + hist[bin]) <= target {
+            below += hist[bin];
+            bin += 1;
+        }
+        // Interpolate inside the bin, where the mixture grows linearly.
+        let (a, b) = (share(bin, below), share(bin + 1, below + hist[bin]));
+        let frac = if b > a { ((target - a) / (b - a)).clamp(0.0, 1.0) } else { 0.0 };
+        *plane = R::from_f64(l + width * (bin as f64 + frac) / BINS as f64);
+    }
+    // Keep the list non-decreasing after rounding.
+    for i in 1..=n as usize {
+        if out[i] < out[i - 1] {
+            out[i] = out[i - 1];
+        }
+    }
+}
+
+/// Storage entries of the planes of one lattice and of the references to its cells.
+#[inline(never)]
+fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3]) -> usize {
+    let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
+    for (a, p) in planes.iter_mut().enumerate() {
+        axis_planes(scene, cfg, g, a, b, n[a], p);
+    }
+    let mut refs = 0;
+    for_each_item(scene, cfg, g, |_, ib| {
+        let mut count = 1usize;
+        for a in 0..3 {
+            let c = &planes[a][..n[a] as usize + 1];
+            count *= locate(c, ib.max.axis(a)) - locate(c, ib.min.axis(a)) + 1;
+        }
+        refs += count;
+    });
+    refs
+}
+impl<R: Real> Lattice<'_, R> {
+    /// Storage a scene needs with this configuration.
+    pub fn plan(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> LatticeSizes {
+        let lattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
+        let mut s = LatticeSizes { lattices, cells: 1, ..Default::default() };
+        for g in 0..lattices {
+            let b = lattice_bounds(scene, g);
+            let n = lattice_resolution(scene, cfg, g, &b);
+            s.coords += n.iter().map(|&v| v as usize + 1).sum::<usize>();
+            s.cells += n.iter().map(|&v| v as usize).product::<usize>();
+            s.refs += plan_refs(scene, cfg, g, &b, n);
+        }
+        s
+    }}

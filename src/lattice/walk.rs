@@ -1,0 +1,169 @@
+//! Walking a lattice: from cell to neighbouring cell by index arithmetic (3D-DDA), with an
+//! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
+
+use super::{locate, Lattice, SubLattice, MAX_NESTING, SUB_FLAG};
+use crate::accel::{offer, Hit, Query};
+use crate::math::Ray;
+use crate::scalar::Real;
+use crate::scene::Scene;
+
+impl<R: Real> Lattice<'_, R> {
+    /// Calls `visit(sub, cell_index, t_enter, t_exit)` for every cell of the world lattice the
+    /// ray enters, in order, without testing objects (for tests and statistics).
+    pub fn walk_cells(&self, ray: &Ray<R>, tmin: R, tmax: R, mut visit: impl FnMut([usize; 3], R, R)) {
+        let inv = Inverse::new(ray);
+        let Some((t0, t1)) = self.lattices[0].bounds.clip(ray, tmin, tmax) else { return };
+        let mut w = Walker::start(self, 0, ray, &inv, t0, t1);
+        let mut enter = t0;
+        loop {
+            let exit = w.exit();
+            visit(w.idx.map(|v| v as usize), enter, exit.min(t1));
+            enter = exit;
+            if !w.advance(self, ray, &inv) {
+                break;
+            }
+        }
+    }
+
+    pub(super) fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
+        let (t0, t1) = self.lattices[0].bounds.clip(ray, tmin, tmax)?;
+        q.next_ray();
+        let inv = Inverse::new(ray);
+        let mut best: Option<Hit<R>> = None;
+        let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
+        let mut depth = 1;
+        stack[0] = Some(Walker::start(self, 0, ray, &inv, t0, t1));
+        q.stats.cells_visited += 1;
+        while depth > 0 {
+            let Some(w) = stack[depth - 1].as_mut() else { break };
+            if w.ref_i < w.ref_end {
+                let item = self.refs[w.ref_i as usize];
+                w.ref_i += 1;
+                if item & SUB_FLAG == 0 {
+                    let i = item as usize;
+                    if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats) && any {
+                        return best;
+                    }
+                } else {
+                    let g = (item & !SUB_FLAG) as usize + 1;
+                    let limit = best.map_or(tmax, |b| b.t);
+                    if depth < MAX_NESTING && q.first_visit(self.objects + g - 1) {
+                        if let Some((a, b)) = self.lattices[g].bounds.clip(ray, tmin, limit) {
+                            stack[depth] = Some(Walker::start(self, g, ray, &inv, a, b));
+                            depth += 1;
+                            q.stats.cells_visited += 1;
+                        }
+                    }
+                }
+                continue;
+            }
+            // The cell is done: stop if the best hit lies before its exit, else step.
+            let done = best.is_some_and(|b| b.t < w.exit());
+            if done || !w.advance(self, ray, &inv) {
+                depth -= 1;
+            } else {
+                q.stats.cells_visited += 1;
+            }
+        }
+        best
+    }
+}
+
+/// Which axes a ray steps along (a zero component, +0.0 or -0.0, never steps).
+///
+/// Crossings are `(plane - o) / d`, one correctly rounded division, rather than a product with
+/// a precomputed reciprocal: the reciprocal of a small component is coarse in fixed point, and
+/// the division keeps every scalar's crossing within one rounding of the exact one.
+struct Inverse<R> {
+    moves: [bool; 3],
+    _r: core::marker::PhantomData<R>,
+}
+
+impl<R: Real> Inverse<R> {
+    fn new(ray: &Ray<R>) -> Self {
+        let d = [ray.dir.x, ray.dir.y, ray.dir.z];
+        Inverse { moves: d.map(|v| v != R::ZERO), _r: core::marker::PhantomData }
+    }
+}
+
+/// The state of a walk through one lattice (one entry of the explicit stack).
+#[derive(Clone, Copy, Debug)]
+struct Walker<R> {
+    sub: u16,
+    idx: [i32; 3],
+    step: [i32; 3],
+    t_next: [R; 3],
+    t_end: R,
+    ref_i: u32,
+    ref_end: u32,
+}
+
+impl<R: Real> Walker<R> {
+    fn start(l: &Lattice<'_, R>, sub: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> Self {
+        let g = &l.lattices[sub];
+        let p = ray.at(t0);
+        let mut w = Walker {
+            sub: sub as u16,
+            idx: [0; 3],
+            step: [0; 3],
+            t_next: [R::MAX; 3],
+            t_end: t1,
+            ref_i: 0,
+            ref_end: 0,
+        };
+        for a in 0..3 {
+            let c = l.coordinate_list(sub, a);
+            // With a zero direction component the coordinate is the origin's, exactly.
+            let x = if inv.moves[a] { p.axis(a) } else { ray.origin.axis(a) };
+            let i = locate(c, x);
+            w.idx[a] = i as i32;
+            if inv.moves[a] {
+                let forward = ray.dir.axis(a) > R::ZERO;
+                w.step[a] = if forward { 1 } else { -1 };
+                let plane = if forward { c[i + 1] } else { c[i] };
+                w.t_next[a] = (plane - ray.origin.axis(a)) / ray.dir.axis(a);
+            }
+        }
+        w.load_cell(l, g);
+        w
+    }
+
+    fn load_cell(&mut self, l: &Lattice<'_, R>, g: &SubLattice<R>) {
+        let (nx, ny) = (g.n[0] as usize, g.n[1] as usize);
+        let c = g.cell_start as usize + self.idx[0] as usize + nx * (self.idx[1] as usize + ny * self.idx[2] as usize);
+        self.ref_i = l.cells[c];
+        self.ref_end = l.cells[c + 1];
+    }
+
+    /// Parameter where the ray leaves the current cell.
+    #[inline]
+    fn exit(&self) -> R {
+        self.t_next[0].min(self.t_next[1]).min(self.t_next[2])
+    }
+
+    /// Steps to the neighbouring cell; false when the ray leaves the lattice or its range.
+    fn advance(&mut self, l: &Lattice<'_, R>, ray: &Ray<R>, inv: &Inverse<R>) -> bool {
+        // Tie rule: x before y before z (strict comparisons keep the earlier axis).
+        let mut a = 0;
+        if self.t_next[1] < self.t_next[a] {
+            a = 1;
+        }
+        if self.t_next[2] < self.t_next[a] {
+            a = 2;
+        }
+        if !inv.moves[a] || self.t_next[a] > self.t_end {
+            return false;
+        }
+        let g = &l.lattices[self.sub as usize];
+        let i = self.idx[a] + self.step[a];
+        if i < 0 || i >= g.n[a] as i32 {
+            return false;
+        }
+        self.idx[a] = i;
+        let c = l.coordinate_list(self.sub as usize, a);
+        let plane = if self.step[a] > 0 { c[i as usize + 1] } else { c[i as usize] };
+        self.t_next[a] = (plane - ray.origin.axis(a)) / ray.dir.axis(a);
+        self.load_cell(l, g);
+        true
+    }
+}

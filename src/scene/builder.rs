@@ -1,0 +1,416 @@
+//! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
+
+use super::error::SceneError;
+use super::model::{Camera, CameraDesc, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
+use crate::math::{Aabb, Affine, Vec3};
+use crate::scalar::Real;
+use crate::shape::Shape;
+use heapless::Vec;
+
+/// Builds and validates a [`Scene`] into caller-provided object storage.
+#[derive(Debug)]
+pub struct SceneBuilder<'a, R> {
+    storage: &'a mut [Object<R>],
+    len: usize,
+    composites: Vec<Composite<R>, MAX_COMPOSITES>,
+    materials: Vec<Material<R>, MAX_MATERIALS>,
+    lights: Vec<Light<R>, MAX_LIGHTS>,
+    open_composite: Option<(usize, Affine<f64>, Aabb<f64>)>,
+    /// Ambient intensity `Ia`.
+    pub ambient: f64,
+    /// Background gray.
+    pub background: f64,
+    /// Camera description.
+    pub camera: CameraDesc,
+    /// Maximum depth of the intersection tree.
+    pub max_depth: u8,
+}
+
+fn check_finite(vals: &[f64]) -> Result<(), SceneError> {
+    if vals.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SceneError::NotFinite)
+    }
+}
+
+/// Checks a number other than a coordinate against the scalar's range (`what` names it).
+pub fn check_value<R: Real>(what: &'static str, v: f64) -> Result<(), SceneError> {
+    check_finite(&[v])?;
+    let limit = value_limit::<R>(what);
+    if v.abs() < limit {
+        Ok(())
+    } else {
+        Err(SceneError::ValueOutOfRange { what, limit, scalar: R::NAME })
+    }
+}
+
+/// The largest magnitude of a shading number in `R`: coordinates' limit, or for the index of
+/// refraction its square root (refraction squares the ratio of indices).
+fn value_limit<R: Real>(what: &'static str) -> f64 {
+    if what == IOR {
+        libm::sqrt(R::LIMIT)
+    } else {
+        R::LIMIT
+    }
+}
+
+/// The name [`check_value`] uses for the index of refraction.
+pub const IOR: &str = "index of refraction";
+
+fn check_range<R: Real>(v: Vec3<f64>) -> Result<(), SceneError> {
+    check_finite(&[v.x, v.y, v.z])?;
+    if v.max_abs() < R::LIMIT {
+        Ok(())
+    } else {
+        Err(SceneError::OutOfRange { limit: R::LIMIT, scalar: R::NAME })
+    }
+}
+
+impl<'a, R: Real> SceneBuilder<'a, R> {
+    /// A builder storing objects in `storage` (its length is the object capacity).
+    pub fn new(storage: &'a mut [Object<R>]) -> Self {
+        SceneBuilder {
+            storage,
+            len: 0,
+            composites: Vec::new(),
+            materials: Vec::new(),
+            lights: Vec::new(),
+            open_composite: None,
+            ambient: 0.2,
+            background: 0.0,
+            camera: CameraDesc::default(),
+            max_depth: 5,
+        }
+    }
+
+    /// Number of objects so far.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether no object was added yet.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Adds a material and returns its index.
+    pub fn add_material(&mut self, m: Material<f64>) -> Result<u8, SceneError> {
+        check_finite(&[m.ka, m.kd, m.ks, m.kt, m.ior])?;
+        if m.ka < 0.0 || m.kd < 0.0 || m.ks < 0.0 || m.kt < 0.0 || m.ior < 1.0 {
+            return Err(SceneError::BadCoefficient);
+        }
+        for v in [m.ka, m.kd, m.ks, m.kt] {
+            check_value::<R>("coefficient", v)?;
+        }
+        check_value::<R>(IOR, m.ior)?;
+        let f = R::from_f64;
+        let conv = Material { ka: f(m.ka), kd: f(m.kd), ks: f(m.ks), kt: f(m.kt), ior: f(m.ior) };
+        self.materials.push(conv).map_err(|_| SceneError::TooManyMaterials)?;
+        Ok((self.materials.len() - 1) as u8)
+    }
+
+    /// Adds a light. A directional light's `dir` is the direction the light travels.
+    pub fn add_light(&mut self, l: Light<f64>) -> Result<(), SceneError> {
+        let conv = match l {
+            Light::Directional { to_light, intensity } => {
+                check_finite(&[to_light.x, to_light.y, to_light.z])?;
+                check_value::<R>("light intensity", intensity)?;
+                // A direction so short (subnormal) that normalising it overflows is as unusable
+                // as a zero one.
+                let unit = to_light.normalize();
+                if to_light.max_abs() == 0.0 || !is_unit(unit) {
+                    return Err(SceneError::DegenerateLight);
+                }
+                Light::Directional { to_light: unit.cast(), intensity: R::from_f64(intensity) }
+            }
+            Light::Point { pos, intensity } => {
+                check_range::<R>(pos)?;
+                check_value::<R>("light intensity", intensity)?;
+                Light::Point { pos: pos.cast(), intensity: R::from_f64(intensity) }
+            }
+        };
+        self.lights.push(conv).map_err(|_| SceneError::TooManyLights)
+    }
+
+    /// Opens a composite object placed by `t`; objects until [`SceneBuilder::end_composite`] belong to it.
+    pub fn begin_composite(&mut self, t: Affine<f64>) -> Result<(), SceneError> {
+        if self.open_composite.is_some() {
+            return Err(SceneError::NestedComposite);
+        }
+        if self.composites.is_full() {
+            return Err(SceneError::TooManyComposites);
+        }
+        checked_inverse(&t)?;
+        self.open_composite = Some((self.len, t, Aabb::empty()));
+        Ok(())
+    }
+
+    /// Closes the open composite object.
+    pub fn end_composite(&mut self) -> Result<(), SceneError> {
+        let (first, _, bounds) = self.open_composite.take().ok_or(SceneError::EndWithoutComposite)?;
+        if self.len == first {
+            return Err(SceneError::EmptyComposite);
+        }
+        // Object indices are below 2^31 (checked in `add_object`), so both fit in u32.
+        let g = Composite { first: first as u32, len: (self.len - first) as u32, bounds: bounds.cast_padded() };
+        self.composites.push(g).map_err(|_| SceneError::TooManyComposites)
+    }
+
+    /// Adds a primitive placed by `to_world` (inside an open composite, the composite's
+    /// transform is applied after it).
+    pub fn add_object(&mut self, shape: Shape<f64>, to_world: Affine<f64>, material: u8) -> Result<(), SceneError> {
+        // Lattice references keep the top bit for sub-lattices, so 2^31 objects at most.
+        if self.len >= self.storage.len() || self.len >= 1 << 31 {
+            return Err(SceneError::TooManyObjects { capacity: self.storage.len(), needed: self.len + 1 });
+        }
+        let place = match &self.open_composite {
+            Some((_, g, _)) => g.after(&to_world),
+            None => to_world,
+        };
+        // `place` is `to_world` after an invertible group transform: checking it covers both.
+        let inv = checked_inverse(&place)?;
+        let top = match shape {
+            Shape::Cone { top } => top,
+            _ => 0.0,
+        };
+        check_finite(&[top])?;
+        if top < 0.0 {
+            return Err(SceneError::NonPositiveSize);
+        }
+        let bounds = world_bounds(&shape, &place);
+        // The padded box is what the lattice registers: it must be in range too.
+        let padded = bounds.padded_for::<R>();
+        check_range::<R>(padded.min)?;
+        check_range::<R>(padded.max)?;
+        let material = material.min(self.materials.len().saturating_sub(1) as u8);
+        if self.materials.is_empty() {
+            self.add_material(Material::DEFAULT)?;
+        }
+        let composite = match &mut self.open_composite {
+            Some((_, _, gb)) => {
+                *gb = gb.union(&bounds);
+                self.composites.len() as u16
+            }
+            None => NO_COMPOSITE,
+        };
+        let shape = match shape {
+            Shape::Sphere => Shape::Sphere,
+            Shape::Cylinder => Shape::Cylinder,
+            Shape::Cone { top } => Shape::Cone { top: R::from_f64(top) },
+            Shape::Box => Shape::Box,
+        };
+        // Largest stretch of a direction into object space, rounded up to a power of two.
+        let m = &inv.m;
+        let stretch = (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(0.0, f64::max);
+        let largest = m.iter().flat_map(|r| r[..3].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
+        // An object so small that its inverse transform leaves f64's comfortable range is too
+        // small for any scene (its own coordinates would overflow).
+        if !(stretch < 1e200 && largest > 1e-200) {
+            return Err(SceneError::ObjectOutOfRange { object: self.len, reach: f64::INFINITY, limit: R::LIMIT, scalar: R::NAME });
+        }
+        let dir_scale = 1.0 / pow2_at_least(stretch);
+        let unscale = pow2_at_least(largest);
+        let mut scaled = inv;
+        scaled.m.iter_mut().flatten().for_each(|v| *v /= unscale);
+        scaled.m.iter_mut().for_each(|row| row[3] = 0.0);
+        let origin = Vec3::new(place.m[0][3], place.m[1][3], place.m[2][3]);
+        self.storage[self.len] = Object {
+            shape,
+            to_object: scaled.cast(),
+            origin: origin.cast(),
+            unscale: R::from_f64(unscale),
+            dir_factor: R::from_f64(unscale * dir_scale),
+            material,
+            composite,
+            bounds: bounds.cast_padded(),
+            dir_scale: R::from_f64(dir_scale),
+            inv_dir_scale: R::from_f64(1.0 / dir_scale),
+        };
+        self.len += 1;
+        Ok(())
+    }
+
+    /// Validates the whole and returns the scene.
+    pub fn finish(mut self) -> Result<Scene<'a, R>, SceneError> {
+        if self.open_composite.is_some() {
+            return Err(SceneError::UnclosedComposite);
+        }
+        if self.len == 0 {
+            return Err(SceneError::NoObjects);
+        }
+        if self.materials.is_empty() {
+            self.add_material(Material::DEFAULT)?;
+        }
+        let c = self.camera;
+        check_range::<R>(c.eye)?;
+        check_range::<R>(c.look)?;
+        check_finite(&[c.up.x, c.up.y, c.up.z, c.fov.0, c.fov.1])?;
+        check_value::<R>("ambient", self.ambient)?;
+        check_value::<R>("background", self.background)?;
+        if !(c.fov.0 > 0.0 && c.fov.0 < 180.0 && c.fov.1 > 0.0 && c.fov.1 < 180.0) {
+            return Err(SceneError::BadFieldOfView);
+        }
+        let forward = (c.look - c.eye).normalize();
+        let right = forward.cross(c.up);
+        if forward.max_abs() == 0.0 || right.length() < 1e-9 * c.up.length() || c.up.max_abs() == 0.0 {
+            return Err(SceneError::DegenerateCamera);
+        }
+        // Left-handed like POV-Ray: x right, y up, z into the screen, so right = up x forward.
+        let right = -right.normalize();
+        let up = forward.cross(right).normalize();
+        if !(is_unit(forward) && is_unit(right) && is_unit(up)) {
+            // Directions so short (subnormal) or long that normalising them overflowed.
+            return Err(SceneError::DegenerateCamera);
+        }
+        let tx = libm::tan(c.fov.0.to_radians_core() / 2.0);
+        let ty = libm::tan(c.fov.1.to_radians_core() / 2.0);
+        let camera =
+            Camera { eye: c.eye.cast(), forward: forward.cast(), right: (right * tx).cast(), up: (up * ty).cast() };
+        let objects: &'a [Object<R>] = &self.storage[..self.len];
+        let mut world = Aabb { min: camera.eye, max: camera.eye };
+        for o in objects {
+            world = world.union(&o.bounds);
+        }
+        check_range::<R>(world.min.cast())?;
+        check_range::<R>(world.max.cast())?;
+        // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
+        // coordinates never exceed those of the world box's corners in its space.
+        for (i, o) in objects.iter().enumerate() {
+            let inv = o.to_object.cast::<f64>();
+            let unscale = o.unscale.to_f64();
+            let reach = (0..8)
+                .map(|c| {
+                    let p = Vec3::new(
+                        if c & 1 == 0 { world.min.x } else { world.max.x },
+                        if c & 2 == 0 { world.min.y } else { world.max.y },
+                        if c & 4 == 0 { world.min.z } else { world.max.z },
+                    );
+                    (inv.vector(p.cast() - o.origin.cast()) * unscale).max_abs()
+                })
+                .fold(0.0, f64::max);
+            if reach >= R::LIMIT {
+                return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
+            }
+        }
+        let extent = world.extent();
+        for (i, o) in objects.iter().enumerate() {
+            let (size, smallest) = thickness(o, extent);
+            if size < smallest {
+                return Err(SceneError::ObjectTooThin { object: i, size, smallest, scalar: R::NAME });
+            }
+        }
+        let bound = brightness_bound(&self.materials, &self.lights, self.ambient, self.background);
+        if !(bound < R::LIMIT) {
+            return Err(SceneError::TooBright { bound, limit: R::LIMIT, scalar: R::NAME });
+        }
+        Ok(Scene {
+            objects,
+            composites: self.composites,
+            materials: self.materials,
+            lights: self.lights,
+            ambient: R::from_f64(self.ambient),
+            background: R::from_f64(self.background),
+            camera,
+            max_depth: self.max_depth,
+            world,
+        })
+    }
+}
+
+/// Whether `v` is finite and of length 1 (to rounding).
+fn is_unit(v: Vec3<f64>) -> bool {
+    (v.length() - 1.0).abs() < 1e-6
+}
+
+/// The inverse of a transform, refusing one whose entries overflowed (composition of huge
+/// factors) or that is singular.
+fn checked_inverse(t: &Affine<f64>) -> Result<Affine<f64>, SceneError> {
+    if t.m.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(SceneError::TransformOverflow);
+    }
+    t.inverse().ok_or(SceneError::SingularTransform)
+}
+
+/// An object's smallest width (its canonical primitive's narrowest width divided by the
+/// largest stretch of its world-to-object map), and the smallest width the scalar can trace
+/// there: twice the offset of secondary rays at the object's farthest point (a ray entering
+/// the object starts that far inside it, so it must stay in the inner half).
+fn thickness<R: Real>(o: &Object<R>, extent: R) -> (f64, f64) {
+    let m = o.to_object.cast::<f64>();
+    let unscale = o.unscale.to_f64();
+    let stretch = (0..3)
+        .map(|i| libm::sqrt(m.m[i][0] * m.m[i][0] + m.m[i][1] * m.m[i][1] + m.m[i][2] * m.m[i][2]))
+        .fold(0.0, f64::max)
+        * unscale;
+    // Narrowest width of the canonical primitive: sphere 2 (diameter), the others 1.
+    let width = if let Shape::Sphere = o.shape { 2.0 } else { 1.0 };
+    let far = o.bounds.min.max_abs().max(o.bounds.max.max_abs());
+    (width / stretch, 2.0 * R::offset(far, extent).to_f64())
+}
+
+/// The largest brightness one eye ray can sum in the intersection tree at the deepest depth
+/// the tracer supports: each node adds `Ia*Ka + Kd * sum |Ip|` (or the background) and passes
+/// `Ks + Kt` of its weight to its children (a ray that misses adds the background).
+fn brightness_bound<R: Real>(materials: &[Material<R>], lights: &[Light<R>], ambient: f64, background: f64) -> f64 {
+    let ip: f64 = lights
+        .iter()
+        .map(|l| match *l {
+            Light::Directional { intensity, .. } | Light::Point { intensity, .. } => intensity.to_f64().abs(),
+        })
+        .sum();
+    let bg = background.abs();
+    let mut below = materials.iter().map(|m| ambient.abs() * m.ka.to_f64() + m.kd.to_f64() * ip).fold(bg, f64::max);
+    for _ in 0..crate::trace::MAX_DEPTH {
+        below = materials
+            .iter()
+            .map(|m| ambient.abs() * m.ka.to_f64() + m.kd.to_f64() * ip + (m.ks.to_f64() + m.kt.to_f64()) * below)
+            .fold(bg, f64::max);
+    }
+    below
+}
+
+/// The smallest power of two at or above `x > 0` (without `log2`/`exp2`, which would bring
+/// libm's 4 KB table into the firmware).
+fn pow2_at_least(x: f64) -> f64 {
+    let mut p = 1.0;
+    while p < x && p < f64::MAX {
+        p *= 2.0;
+    }
+    while p * 0.5 >= x {
+        p *= 0.5;
+    }
+    p
+}
+
+trait ToRadians {
+    fn to_radians_core(self) -> f64;
+}
+impl ToRadians for f64 {
+    fn to_radians_core(self) -> f64 {
+        self * core::f64::consts::PI / 180.0
+    }
+}
+
+/// World box of a placed primitive: exact for spheres (an ellipsoid's extent along axis `i`
+/// is the length of row `i` of the linear part), the transformed corners otherwise.
+fn world_bounds(shape: &Shape<f64>, place: &Affine<f64>) -> Aabb<f64> {
+    let m = &place.m;
+    if let Shape::Sphere = shape {
+        let c = Vec3::new(m[0][3], m[1][3], m[2][3]);
+        let e = |i: usize| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2]);
+        let h = Vec3::new(e(0), e(1), e(2));
+        return Aabb { min: c - h, max: c + h };
+    }
+    let (lo, hi) = shape.bounds();
+    let mut b = Aabb::empty();
+    for i in 0..8 {
+        let p = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        b.include(place.point(p));
+    }
+    b
+}

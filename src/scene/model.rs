@@ -1,0 +1,286 @@
+//! The validated scene: objects, composites, materials, lights and the camera.
+
+use crate::math::{Aabb, Affine, Ray, Vec3};
+use crate::scalar::Real;
+use crate::shape::Shape;
+use heapless::Vec;
+
+/// Most materials a scene may define.
+pub const MAX_MATERIALS: usize = 16;
+/// Most lights a scene may define.
+pub const MAX_LIGHTS: usize = 4;
+/// Most composite objects (each gets a sub-lattice).
+pub const MAX_COMPOSITES: usize = 16;
+/// The composite index of an object that belongs to no composite.
+pub const NO_COMPOSITE: u16 = u16::MAX;
+
+/// A gray, wavelength-independent surface in the paper's terms (eq. 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material<R> {
+    /// Ambient coefficient `Ka` (multiplies the scene's `Ia`).
+    pub ka: R,
+    /// Diffuse coefficient `Kd`.
+    pub kd: R,
+    /// Mirror-reflection coefficient `Ks` (weight of `S`).
+    pub ks: R,
+    /// Transmission coefficient `Kt` (weight of `T`).
+    pub kt: R,
+    /// Index of refraction of the inside.
+    pub ior: R,
+}
+
+impl Material<f64> {
+    /// The material objects get when none is named: matte gray.
+    pub const DEFAULT: Self = Material { ka: 0.2, kd: 0.8, ks: 0.0, kt: 0.0, ior: 1.0 };
+}
+
+/// A light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light<R> {
+    /// The paper's planar light at infinite distance.
+    Directional {
+        /// Unit vector from the surface towards the light.
+        to_light: Vec3<R>,
+        /// Intensity `Ip`.
+        intensity: R,
+    },
+    /// A point light.
+    Point {
+        /// Position.
+        pos: Vec3<R>,
+        /// Intensity `Ip`.
+        intensity: R,
+    },
+}
+
+/// The camera as given in a scene (eye, look-at, up, field of view in degrees).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    /// Viewpoint `V`.
+    pub eye: Vec3<f64>,
+    /// Point looked at.
+    pub look: Vec3<f64>,
+    /// Up direction.
+    pub up: Vec3<f64>,
+    /// Horizontal and vertical field of view in degrees (the paper: 40 x 25).
+    pub fov: (f64, f64),
+}
+
+impl Default for CameraDesc {
+    fn default() -> Self {
+        CameraDesc {
+            eye: Vec3::new(0.0, 0.0, -10.0),
+            look: Vec3::zero(),
+            up: Vec3::new(0.0, 1.0, 0.0),
+            fov: (40.0, 25.0),
+        }
+    }
+}
+
+/// The camera reduced to what eye rays need.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera<R> {
+    /// Viewpoint.
+    pub eye: Vec3<R>,
+    /// Unit view direction.
+    pub forward: Vec3<R>,
+    /// Right vector scaled by `tan(fov_x / 2)`.
+    pub right: Vec3<R>,
+    /// Up vector scaled by `tan(fov_y / 2)`.
+    pub up: Vec3<R>,
+}
+
+impl<R: Real> Camera<R> {
+    /// The eye ray through the point `(sx, sy)` of a `w x h` window, in pixel units from the
+    /// top-left corner (pixel centres are at `i + 0.5`).
+    pub fn ray(&self, sx2: i32, sy2: i32, w2: i32, h2: i32) -> Ray<R> {
+        // Arguments are doubled coordinates so that pixel centres stay integers.
+        let u = R::from_i32(2 * sx2 - w2) / R::from_i32(w2);
+        let v = R::from_i32(h2 - 2 * sy2) / R::from_i32(h2);
+        Ray::new(self.eye, self.forward + self.right * u + self.up * v)
+    }
+}
+
+/// One primitive placed in the world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Object<R> {
+    /// The canonical primitive.
+    pub(crate) shape: Shape<R>,
+    /// World-to-object transform (the inverse of the placement) multiplied by the power of two
+    /// `1 / unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
+    /// full precision however large or small the object is (exact in floating point).
+    pub(crate) to_object: Affine<R>,
+    /// The world point at the object's origin: rays are taken relative to it before
+    /// `to_object` (whose translation is then zero), so a scene far from the world's origin
+    /// loses no precision to cancellation.
+    pub(crate) origin: Vec3<R>,
+    /// The power of two that `to_object`'s results are multiplied by to get object space.
+    pub(crate) unscale: R,
+    /// `unscale * dir_scale`: what `to_object`'s direction results are multiplied by.
+    pub(crate) dir_factor: R,
+    /// Index into the scene's materials.
+    pub(crate) material: u8,
+    /// Composite object it belongs to, or [`NO_COMPOSITE`].
+    pub(crate) composite: u16,
+    /// World-space bounding box, padded for the scalar's rounding.
+    pub(crate) bounds: Aabb<R>,
+    /// A power of two that object-space directions are multiplied by, so that they stay near
+    /// unit length however small or large the object is (exact in floating point).
+    pub(crate) dir_scale: R,
+    /// `1 / dir_scale`.
+    pub(crate) inv_dir_scale: R,
+}
+
+impl<R: Real> Default for Object<R> {
+    /// A placeholder (unit sphere at the origin) for filling storage arrays.
+    fn default() -> Self {
+        let z = Vec3::new(R::ZERO, R::ZERO, R::ZERO);
+        Object {
+            shape: Shape::Sphere,
+            to_object: Affine::identity(),
+            origin: z,
+            unscale: R::ONE,
+            dir_factor: R::ONE,
+            material: 0,
+            composite: NO_COMPOSITE,
+            bounds: Aabb { min: z, max: z },
+            dir_scale: R::ONE,
+            inv_dir_scale: R::ONE,
+        }
+    }
+}
+
+impl<R: Real> Object<R> {
+    /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` and the object-space normal.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
+        let r = Ray::new(
+            self.to_object.vector(ray.origin - self.origin) * self.unscale,
+            self.to_object.vector(ray.dir) * self.dir_factor,
+        );
+        // With the direction scaled by k, the object-space parameter is t / k. Multiplying by
+        // a power of two is exact in floating point but rounds in fixed point, so the range is
+        // checked on the world parameter: a hit exactly at `tmax` (a tie with the best hit so
+        // far) is then found whichever scalar runs.
+        // The object-space limit is widened by the scalar's padding so rounding cannot exclude a
+        // hit at exactly `tmax`, yet still prunes hits well beyond it.
+        let far = if tmax == R::MAX {
+            R::MAX
+        } else {
+            let f = tmax * self.inv_dir_scale;
+            f + (f.abs() + R::ONE) * R::pad_eps()
+        };
+        let (t, n) = self.shape.intersect(&r, tmin * self.inv_dir_scale, far)?;
+        let t = t * self.dir_scale;
+        (t > tmin && t <= tmax).then_some((t, n))
+    }
+    /// The canonical primitive.
+    pub fn shape(&self) -> Shape<R> {
+        self.shape
+    }
+    /// Index into the scene's materials.
+    pub fn material(&self) -> u8 {
+        self.material
+    }
+    /// Composite object it belongs to, or [`NO_COMPOSITE`].
+    pub fn composite(&self) -> u16 {
+        self.composite
+    }
+    /// World-space bounding box, padded for the scalar's rounding.
+    pub fn bounds(&self) -> Aabb<R> {
+        self.bounds
+    }
+    /// The world point at the object's origin.
+    pub fn origin(&self) -> Vec3<R> {
+        self.origin
+    }
+    /// The map from a world offset relative to [`Object::origin`] to object space (the
+    /// inverse of the placement), without the scaling the stored copy carries for precision.
+    pub fn world_to_object(&self) -> Affine<R> {
+        let mut t = self.to_object;
+        for row in t.m.iter_mut() {
+            for v in row.iter_mut() {
+                *v *= self.unscale;
+            }
+        }
+        t
+    }
+    /// Unit world-space normal from an object-space normal (inverse-transpose rule).
+    pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
+        self.to_object.transpose_vector(n_obj).normalize()
+    }
+}
+
+/// A composite object: a contiguous run of objects with a common box (gets a sub-lattice).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Composite<R> {
+    /// Index of its first object (as wide as object indices: a composite may start anywhere).
+    pub first: u32,
+    /// Number of objects (as wide as object indices: a composite may hold any number).
+    pub len: u32,
+    /// Union of its objects' boxes.
+    pub bounds: Aabb<R>,
+}
+
+/// A validated scene, ready to trace.
+#[derive(Debug)]
+pub struct Scene<'a, R> {
+    /// All primitives; the objects of a composite are contiguous.
+    pub(crate) objects: &'a [Object<R>],
+    /// Composite objects.
+    pub(crate) composites: Vec<Composite<R>, MAX_COMPOSITES>,
+    /// Materials.
+    pub(crate) materials: Vec<Material<R>, MAX_MATERIALS>,
+    /// Lights.
+    pub(crate) lights: Vec<Light<R>, MAX_LIGHTS>,
+    /// Ambient intensity `Ia`.
+    pub(crate) ambient: R,
+    /// Gray of rays that hit nothing (0 black .. 1 white).
+    pub(crate) background: R,
+    /// Camera.
+    pub(crate) camera: Camera<R>,
+    /// Maximum depth of the intersection tree (0: eye rays only).
+    pub(crate) max_depth: u8,
+    /// Box holding the viewpoint and every object (the paper's world range).
+    pub(crate) world: Aabb<R>,
+}
+
+impl<'a, R: Real> Scene<'a, R> {
+    /// All primitives; the objects of a composite are contiguous.
+    pub fn objects(&self) -> &'a [Object<R>] {
+        self.objects
+    }
+    /// Composite objects.
+    pub fn composites(&self) -> &[Composite<R>] {
+        &self.composites
+    }
+    /// Materials.
+    pub fn materials(&self) -> &[Material<R>] {
+        &self.materials
+    }
+    /// Lights.
+    pub fn lights(&self) -> &[Light<R>] {
+        &self.lights
+    }
+    /// Ambient intensity `Ia`.
+    pub fn ambient(&self) -> R {
+        self.ambient
+    }
+    /// Gray of rays that hit nothing (0 black .. 1 white).
+    pub fn background(&self) -> R {
+        self.background
+    }
+    /// Camera.
+    pub fn camera(&self) -> &Camera<R> {
+        &self.camera
+    }
+    /// Maximum depth of the intersection tree the scene asks for (0: eye rays only).
+    pub fn max_depth(&self) -> u8 {
+        self.max_depth
+    }
+    /// Box holding the viewpoint and every object (the paper's world range).
+    pub fn world(&self) -> Aabb<R> {
+        self.world
+    }
+}
+
