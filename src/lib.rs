@@ -32,7 +32,7 @@ pub use accel::{Accelerator, BoundingBox, BruteForce, Hit, Query, Stats};
 pub mod lattice;
 pub use lattice::{Lattice, LatticeConfig, LatticeStorage};
 pub mod storage;
-pub use storage::{Loaded, Scratch, Sizes, Storage, StorageView};
+pub use storage::{Buffers, Loaded, Scratch, Sizes, Storage, StorageView};
 #[cfg(feature = "alloc")]
 pub use storage::{HeapScratch, HeapStorage};
 pub mod trace;

@@ -73,22 +73,73 @@ impl Sizes {
     }
 }
 
-/// All memory a frame needs, with capacities fixed at compile time (see [`Sizes`] for what
-/// each holds). It is plain arrays: put it on the stack or in a `static`.
+/// All memory a frame needs (see [`Sizes`] for what each part holds), in whatever holds it:
+/// arrays ([`Storage`]) or, with the `alloc` feature, vectors (`HeapStorage`). One type, so
+/// lending the [`StorageView`] is written once.
 #[derive(Debug)]
-pub struct Storage<
+pub struct Buffers<O, L, C, W, S> {
+    objects: O,
+    lattices: L,
+    coords: C,
+    words: W,
+    rows: S,
+}
+
+/// All memory a frame needs, with capacities fixed at compile time. It is plain arrays: put
+/// it on the stack or in a `static`.
+pub type Storage<
     R,
     const OBJECTS: usize,
     const LATTICES: usize,
     const COORDS: usize,
     const WORDS: usize,
     const ROWS: usize,
-> {
-    objects: [Object<R>; OBJECTS],
-    lattices: [SubLattice<R>; LATTICES],
-    coords: [R; COORDS],
-    words: [u32; WORDS],
-    rows: [i16; ROWS],
+> = Buffers<[Object<R>; OBJECTS], [SubLattice<R>; LATTICES], [R; COORDS], [u32; WORDS], [i16; ROWS]>;
+
+/// All memory a frame needs, on the heap, sized at run time (the host's [`Storage`]).
+#[cfg(feature = "alloc")]
+pub type HeapStorage<R> = Buffers<
+    alloc::vec::Vec<Object<R>>,
+    alloc::vec::Vec<SubLattice<R>>,
+    alloc::vec::Vec<R>,
+    alloc::vec::Vec<u32>,
+    alloc::vec::Vec<i16>,
+>;
+
+impl<O, L, C, W, S> Buffers<O, L, C, W, S> {
+    /// The storage with its capacities erased.
+    pub fn view<R: Real>(&mut self) -> StorageView<'_, R>
+    where
+        O: AsMut<[Object<R>]>,
+        L: AsMut<[SubLattice<R>]>,
+        C: AsMut<[R]>,
+        W: AsMut<[u32]>,
+        S: AsMut<[i16]>,
+    {
+        StorageView::new(
+            self.objects.as_mut(),
+            self.lattices.as_mut(),
+            self.coords.as_mut(),
+            self.words.as_mut(),
+            self.rows.as_mut(),
+        )
+    }
+
+    /// Bytes this storage occupies.
+    pub fn bytes<R>(&self) -> usize
+    where
+        O: AsRef<[Object<R>]>,
+        L: AsRef<[SubLattice<R>]>,
+        C: AsRef<[R]>,
+        W: AsRef<[u32]>,
+        S: AsRef<[i16]>,
+    {
+        size_of_val(self.objects.as_ref())
+            + size_of_val(self.lattices.as_ref())
+            + size_of_val(self.coords.as_ref())
+            + size_of_val(self.words.as_ref())
+            + size_of_val(self.rows.as_ref())
+    }
 }
 
 impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, const S: usize>
@@ -96,7 +147,7 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
 {
     /// Empty storage.
     pub fn new() -> Self {
-        Storage {
+        Buffers {
             objects: [Object::default(); O],
             lattices: [SubLattice::EMPTY; G],
             coords: [R::ZERO; C],
@@ -115,17 +166,6 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
             rows: S,
         }
     }
-
-    /// The storage with its capacities erased.
-    pub fn view(&mut self) -> StorageView<'_, R> {
-        StorageView::new(
-            &mut self.objects,
-            &mut self.lattices,
-            &mut self.coords,
-            &mut self.words,
-            &mut self.rows,
-        )
-    }
 }
 
 impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, const S: usize>
@@ -136,49 +176,18 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
     }
 }
 
-/// All memory a frame needs, on the heap, sized at run time (the host's [`Storage`]).
-#[cfg(feature = "alloc")]
-#[derive(Debug)]
-pub struct HeapStorage<R> {
-    objects: alloc::vec::Vec<Object<R>>,
-    lattices: alloc::vec::Vec<SubLattice<R>>,
-    coords: alloc::vec::Vec<R>,
-    words: alloc::vec::Vec<u32>,
-    rows: alloc::vec::Vec<i16>,
-}
-
 #[cfg(feature = "alloc")]
 impl<R: Real> HeapStorage<R> {
     /// Storage of exactly `sizes`.
     pub fn new(sizes: Sizes) -> Self {
         use alloc::vec;
-        HeapStorage {
+        Buffers {
             objects: vec![Object::default(); sizes.objects],
             lattices: vec![SubLattice::EMPTY; sizes.lattices],
             coords: vec![R::ZERO; sizes.coords],
             words: vec![0; sizes.words],
             rows: vec![0; sizes.rows],
         }
-    }
-
-    /// Bytes this storage occupies.
-    pub fn bytes(&self) -> usize {
-        size_of_val(&self.objects[..])
-            + size_of_val(&self.lattices[..])
-            + size_of_val(&self.coords[..])
-            + size_of_val(&self.words[..])
-            + size_of_val(&self.rows[..])
-    }
-
-    /// The storage as a view.
-    pub fn view(&mut self) -> StorageView<'_, R> {
-        StorageView::new(
-            &mut self.objects,
-            &mut self.lattices,
-            &mut self.coords,
-            &mut self.words,
-            &mut self.rows,
-        )
     }
 }
 

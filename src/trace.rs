@@ -121,19 +121,19 @@ impl core::ops::Sub for Effects {
     }
 }
 
+impl Effects {
+    /// The pieces [`Display`](core::fmt::Display) and `defmt` write: the effects' names
+    /// separated by ", ", or "diffuse only".
+    fn words(self) -> impl Iterator<Item = &'static str> {
+        let names = Self::NAMES.iter().enumerate().filter(move |(i, _)| self.0 & (1 << i) != 0).map(|(_, n)| *n);
+        let none = names.clone().next().is_none().then_some("diffuse only");
+        names.enumerate().flat_map(|(k, n)| [if k == 0 { "" } else { ", " }, n]).chain(none)
+    }
+}
+
 impl core::fmt::Display for Effects {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let mut first = true;
-        for (i, name) in Self::NAMES.iter().enumerate() {
-            if self.0 & (1 << i) != 0 {
-                write!(f, "{}{name}", if first { "" } else { ", " })?;
-                first = false;
-            }
-        }
-        if first {
-            write!(f, "diffuse only")?;
-        }
-        Ok(())
+        self.words().try_for_each(|w| f.write_str(w))
     }
 }
 
@@ -141,16 +141,7 @@ impl core::fmt::Display for Effects {
 #[cfg(feature = "defmt")]
 impl defmt::Format for Effects {
     fn format(&self, f: defmt::Formatter<'_>) {
-        let mut first = true;
-        for (i, name) in Self::NAMES.iter().enumerate() {
-            if self.0 & (1 << i) != 0 {
-                defmt::write!(f, "{=str}{=str}", if first { "" } else { ", " }, name);
-                first = false;
-            }
-        }
-        if first {
-            defmt::write!(f, "diffuse only");
-        }
+        self.words().for_each(|w| defmt::write!(f, "{=str}", w));
     }
 }
 

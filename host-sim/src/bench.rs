@@ -4,13 +4,9 @@
 use crate::shared::median;
 use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
 use crate::run::render_band;
-use anyhow::{Context, Result};
-use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
-use embedded_graphics::pixelcolor::Rgb888;
-use embedded_graphics::prelude::*;
-use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
-use embedded_graphics::text::Text;
-use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
+use crate::output::write_atomic;
+use crate::shared::plot_link;
+use anyhow::Result;
 use lattice_rt::generate::{random_object, random_scene, RandomScene, Rng};
 use lattice_rt::lattice::{Resolution, Spacing};
 use lattice_rt::scene::Object;
@@ -263,58 +259,9 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
         let (t, tests, cells) = per_ray(&scene, &lat, &rays, runs);
         writeln!(md, "| {label} | {} | {:.3} | {tests:.2} | {cells:.1} | {} |", lat.cell_count(), t.as_secs_f64() * 1e6, lat.bytes())?;
     }
-    writeln!(md, "\n![time per ray against N](performance.png)")?;
-    std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
-    std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
-    draw_loglog(&series, plot)?;
+    writeln!(md, "\n![time per ray against N]({})", plot_link(out, plot))?;
+    crate::plot::loglog(plot, "Time per ray against scene size", "primitives N", "microseconds per ray", &series)?;
+    write_atomic(out, md.as_bytes())?;
     println!("wrote {} and {}", out.display(), plot.display());
     Ok(())
-}
-
-/// Time per ray against N on log-log axes, one line per method.
-fn draw_loglog(series: &[(String, Vec<(f64, f64)>)], path: &Path) -> Result<()> {
-    let (w, h) = (900i32, 520i32);
-    let (left, right, top, bottom) = (70, 260, 30, 50);
-    let mut d = SimulatorDisplay::<Rgb888>::new(Size::new(w as u32, h as u32));
-    Rectangle::new(Point::zero(), Size::new(w as u32, h as u32)).into_styled(PrimitiveStyle::with_fill(Rgb888::WHITE)).draw(&mut d)?;
-    let pts = series.iter().flat_map(|(_, v)| v.iter());
-    let (xmin, xmax) = pts.clone().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0.log10()), b.max(p.0.log10())));
-    let (ymin, ymax) = pts.fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1.log10()), b.max(p.1.log10())));
-    let (ymin, ymax) = (ymin.floor(), ymax.ceil());
-    let px = |x: f64| left + ((x.log10() - xmin) / (xmax - xmin).max(1e-9) * (w - left - right) as f64) as i32;
-    let py = |y: f64| h - bottom - ((y.log10() - ymin) / (ymax - ymin).max(1e-9) * (h - top - bottom) as f64) as i32;
-    let black = PrimitiveStyle::with_stroke(Rgb888::BLACK, 1);
-    let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
-    Line::new(Point::new(left, h - bottom), Point::new(w - right, h - bottom)).into_styled(black).draw(&mut d)?;
-    Line::new(Point::new(left, top), Point::new(left, h - bottom)).into_styled(black).draw(&mut d)?;
-    let mut e = xmin.ceil() as i32;
-    while e as f64 <= xmax {
-        let x = 10f64.powi(e);
-        Text::new(&format!("1e{e}"), Point::new(px(x) - 10, h - bottom + 14), text).draw(&mut d)?;
-        e += 1;
-    }
-    let mut e = ymin as i32;
-    while e as f64 <= ymax {
-        let y = 10f64.powi(e);
-        Text::new(&format!("1e{e}"), Point::new(left - 40, py(y) + 3), text).draw(&mut d)?;
-        e += 1;
-    }
-    Text::new("primitives N (log)", Point::new(left + 200, h - 12), text).draw(&mut d)?;
-    Text::new("microseconds per ray (log)", Point::new(left, 16), text).draw(&mut d)?;
-    let colours = [Rgb888::new(200, 30, 30), Rgb888::new(30, 60, 200), Rgb888::new(30, 140, 30), Rgb888::new(150, 100, 0), Rgb888::new(140, 40, 160), Rgb888::new(0, 140, 140), Rgb888::new(90, 90, 90), Rgb888::new(230, 120, 0), Rgb888::new(0, 0, 0)];
-    for (i, (label, v)) in series.iter().enumerate() {
-        let c = colours[i % colours.len()];
-        let style = PrimitiveStyle::with_stroke(c, if label.starts_with("clustered") { 1 } else { 2 });
-        for p in v.windows(2) {
-            Line::new(Point::new(px(p[0].0), py(p[0].1)), Point::new(px(p[1].0), py(p[1].1))).into_styled(style).draw(&mut d)?;
-        }
-        for p in v {
-            Circle::with_center(Point::new(px(p.0), py(p.1)), 5).into_styled(PrimitiveStyle::with_fill(c)).draw(&mut d)?;
-        }
-        Text::new(label, Point::new(w - right + 10, top + 14 * i as i32), MonoTextStyle::new(&FONT_6X10, c)).draw(&mut d)?;
-    }
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    d.to_rgb_output_image(&OutputSettingsBuilder::new().scale(1).build()).save_png(path).with_context(|| format!("cannot write {}", path.display()))
 }

@@ -10,6 +10,7 @@ mod pov;
 mod shared;
 mod progress;
 mod output;
+mod plot;
 mod run;
 mod tradeoff;
 
@@ -73,8 +74,8 @@ enum Command {
         /// Report to write.
         #[arg(long, default_value = "docs/performance.md")]
         out: PathBuf,
-        /// Plot to write.
-        #[arg(long, default_value = "docs/performance.png")]
+        /// Plot to write (SVG).
+        #[arg(long, default_value = "docs/performance.svg")]
         plot: PathBuf,
     },
     /// What accuracy costs in time: error against a 16-ray f64 reference and cost, one knob
@@ -91,8 +92,8 @@ enum Command {
         /// Report to write.
         #[arg(long, default_value = "docs/accuracy.md")]
         out: PathBuf,
-        /// Plot to write.
-        #[arg(long, default_value = "docs/accuracy.png")]
+        /// Plot to write (SVG).
+        #[arg(long, default_value = "docs/accuracy.svg")]
         plot: PathBuf,
         /// Instruction counts written by `host-sim firmware`.
         #[arg(long, default_value = "docs/firmware.csv")]

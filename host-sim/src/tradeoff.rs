@@ -5,13 +5,9 @@
 use crate::shared::median;
 use crate::run::render_text;
 use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
-use anyhow::{Context, Result};
-use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
-use embedded_graphics::pixelcolor::Rgb888;
-use embedded_graphics::prelude::*;
-use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
-use embedded_graphics::text::Text;
-use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
+use crate::output::write_atomic;
+use crate::shared::plot_link;
+use anyhow::Result;
 use lattice_rt::dither::Ditherer;
 use lattice_rt::{Dither, F32Micro, F32MicroNewton, Frame, Fx, LatticeConfig, Real, Sampling, Tracer};
 use std::collections::BTreeMap;
@@ -297,55 +293,10 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
             }
         }
     }
-    writeln!(md, "\n![error against cost](accuracy.png)")?;
-    std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
-    std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
-    draw_plot(&points, plot)?;
+    writeln!(md, "\n![error against cost]({})", plot_link(out, plot))?;
+    let title = "Error against cost, one knob at a time";
+    crate::plot::scatter(plot, title, "host ms per frame (median, mean over scenes)", "mean abs gray error (levels of 64)", &points)?;
+    write_atomic(out, md.as_bytes())?;
     println!("wrote {} and {}", out.display(), plot.display());
     Ok(())
-}
-
-/// Error against cost, one labelled dot per configuration, drawn with embedded-graphics.
-fn draw_plot(points: &[(String, &str, f64, f64)], path: &Path) -> Result<()> {
-    let (w, h) = (900i32, 560i32);
-    let (left, right, top, bottom) = (70, 330, 30, 50);
-    let mut d = SimulatorDisplay::<Rgb888>::new(Size::new(w as u32, h as u32));
-    Rectangle::new(Point::zero(), Size::new(w as u32, h as u32)).into_styled(PrimitiveStyle::with_fill(Rgb888::WHITE)).draw(&mut d)?;
-    let xmax = points.iter().map(|p| p.2).fold(0.0, f64::max) * 1.1;
-    let ymax = points.iter().map(|p| p.3).fold(0.0, f64::max) * 1.1;
-    let (pw, ph) = ((w - left - right) as f64, (h - top - bottom) as f64);
-    let px = |x: f64| left + (x / xmax * pw) as i32;
-    let py = |y: f64| h - bottom - (y / ymax * ph) as i32;
-    let black = PrimitiveStyle::with_stroke(Rgb888::BLACK, 1);
-    let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
-    Line::new(Point::new(left, h - bottom), Point::new(w - right, h - bottom)).into_styled(black).draw(&mut d)?;
-    Line::new(Point::new(left, top), Point::new(left, h - bottom)).into_styled(black).draw(&mut d)?;
-    for k in 0..=4 {
-        let (xv, yv) = (xmax * k as f64 / 4.0, ymax * k as f64 / 4.0);
-        Text::new(&format!("{xv:.1}"), Point::new(px(xv) - 10, h - bottom + 14), text).draw(&mut d)?;
-        Text::new(&format!("{yv:.2}"), Point::new(left - 40, py(yv) + 3), text).draw(&mut d)?;
-    }
-    Text::new("host ms per frame (median, mean over scenes)", Point::new(left + 60, h - 12), text).draw(&mut d)?;
-    Text::new("mean abs gray error (levels of 64) vs 16-ray f64 reference", Point::new(left, 16), text).draw(&mut d)?;
-    let colour = |k: &str| match k {
-        "scalar" => Rgb888::new(200, 30, 30),
-        "depth" => Rgb888::new(30, 120, 30),
-        "cutoff" => Rgb888::new(150, 100, 0),
-        "sampling" => Rgb888::new(30, 60, 200),
-        "dither" => Rgb888::new(140, 40, 160),
-        _ => Rgb888::BLACK,
-    };
-    for (i, (label, knob, x, y)) in points.iter().enumerate() {
-        let c = colour(knob);
-        Circle::with_center(Point::new(px(*x), py(*y)), 7).into_styled(PrimitiveStyle::with_fill(c)).draw(&mut d)?;
-        let tag = format!("{}", i + 1);
-        Text::new(&tag, Point::new(px(*x) + 5, py(*y) - 4), MonoTextStyle::new(&FONT_6X10, c)).draw(&mut d)?;
-        let legend = format!("{:2} {knob}: {label}", i + 1);
-        Text::new(&legend, Point::new(w - right + 10, top + 12 * i as i32), MonoTextStyle::new(&FONT_6X10, c)).draw(&mut d)?;
-    }
-    let settings = OutputSettingsBuilder::new().scale(1).build();
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    d.to_rgb_output_image(&settings).save_png(path).with_context(|| format!("cannot write {}", path.display()))
 }
