@@ -8,7 +8,7 @@
 
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
-use crate::scene::Scene;
+use crate::scene::{Culled, Scene, MAX_LIGHTS};
 
 /// The nearest intersection found for a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +45,9 @@ pub struct Stats {
     pub inside_tests: u64,
     /// Lattice cells entered (top level and sub-lattices).
     pub cells_visited: u64,
+    /// Eye-ray object tests skipped because the ray passes outside the object's window
+    /// ([`crate::scene::EyeWindow`]); not counted in `object_tests`.
+    pub culled: u64,
 }
 
 impl Stats {
@@ -56,6 +59,7 @@ impl Stats {
         self.object_tests += o.object_tests;
         self.inside_tests += o.inside_tests;
         self.cells_visited += o.cells_visited;
+        self.culled += o.culled;
     }
     /// All rays of every kind.
     pub fn total_rays(&self) -> u64 {
@@ -70,6 +74,13 @@ pub struct Query<'m> {
     pub stats: Stats,
     mailbox: &'m mut [u32],
     ray_id: u32,
+    /// The window position of the ray being traced when it is an eye ray (see
+    /// [`Query::set_eye_ray`]).
+    eye: Option<[i32; 2]>,
+    /// The object the last test that hit was made against.
+    last_hit: u32,
+    /// Per light, the object that last hid it ([`u32::MAX`]: none yet).
+    occluders: [u32; MAX_LIGHTS],
 }
 
 impl<'m> Query<'m> {
@@ -77,11 +88,37 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0 }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS] }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
         scene.objects.len() + scene.composites.len()
+    }
+    /// Declares the next ray traced an eye ray through window position `uv` (from
+    /// [`crate::scene::Camera::window_uv`]), or not one (`None`). The tracer keeps it for the
+    /// eye ray alone; objects whose window the eye ray misses are then not tested.
+    pub fn set_eye_ray(&mut self, uv: Option<[i32; 2]>) {
+        self.eye = uv;
+    }
+    /// The eye-ray window position, if the query is for an eye ray.
+    pub fn eye_ray(&self) -> Option<[i32; 2]> {
+        self.eye
+    }
+    /// The object that last hid light `l` from a shaded point, if any.
+    pub fn occluder(&self, l: usize) -> Option<u32> {
+        self.occluders.get(l).copied().filter(|&i| i != u32::MAX)
+    }
+    /// After an `occluded` query towards light `l`: remembers the occluder it found (the object
+    /// of its hit) if `hidden`, else forgets light `l`'s.
+    pub fn remember_occluder(&mut self, l: usize, hidden: bool) {
+        if let Some(o) = self.occluders.get_mut(l) {
+            *o = if hidden { self.last_hit } else { u32::MAX };
+        }
+    }
+    /// Forgets the remembered occluders (the render does so at every band of tiles, so a band's
+    /// work does not depend on the bands rendered before it, on whichever core or thread).
+    pub fn forget_occluders(&mut self) {
+        self.occluders = [u32::MAX; MAX_LIGHTS];
     }
     /// Starts a new ray: every mailbox entry becomes unvisited.
     pub fn next_ray(&mut self) {
@@ -115,12 +152,24 @@ pub fn offer<R: Real>(
     tmin: R,
     tmax: R,
     best: &mut Option<Hit<R>>,
-    stats: &mut Stats,
+    q: &mut Query<'_>,
 ) -> bool {
-    stats.object_tests += 1;
     let limit = best.map_or(tmax, |b| b.t);
-    match scene.objects[i].intersect(ray, tmin, limit) {
+    let o = &scene.objects[i];
+    let hit = match q.eye {
+        Some(uv) => match o.intersect_eye_ray(ray, uv, tmin, limit) {
+            Ok(hit) => hit,
+            Err(Culled) => {
+                q.stats.culled += 1;
+                return false;
+            }
+        },
+        None => o.intersect(ray, tmin, limit),
+    };
+    q.stats.object_tests += 1;
+    match hit {
         Some((t, n)) => {
+            q.last_hit = i as u32;
             let better = match best {
                 Some(b) => t < b.t || (t == b.t && (i as u32) < b.object),
                 None => true,
@@ -155,13 +204,13 @@ impl<R: Real> Accelerator<R> for BruteForce {
     fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>> {
         let mut best = None;
         for i in 0..scene.objects.len() {
-            offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats);
+            offer(scene, i, ray, tmin, tmax, &mut best, q);
         }
         best
     }
     fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool {
         let mut best = None;
-        (0..scene.objects.len()).any(|i| offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats))
+        (0..scene.objects.len()).any(|i| offer(scene, i, ray, tmin, tmax, &mut best, q))
     }
 }
 
@@ -231,7 +280,7 @@ impl BoundingBox {
         let mut best = None;
         for (i, o) in scene.objects.iter().enumerate() {
             q.stats.inside_tests += 1;
-            if frame.passes(&o.bounds) && offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats) && any {
+            if frame.passes(&o.bounds) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                 return best;
             }
         }

@@ -36,7 +36,7 @@ pub use storage::{Buffers, Loaded, Scratch, Sizes, Storage, StorageView};
 #[cfg(feature = "alloc")]
 pub use storage::{HeapScratch, HeapStorage};
 pub mod trace;
-pub use trace::{Effects, Tracer};
+pub use trace::{EyeRays, Effects, Tracer};
 pub mod sample;
 pub mod dither;
 pub use dither::Dither;

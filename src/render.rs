@@ -7,6 +7,7 @@ use crate::dither::{Dither, Ditherer, MAX_TILE};
 use crate::scalar::Real;
 pub use crate::sample::{level, Sampling};
 use crate::sample::Sampler;
+use crate::scene::Camera;
 use crate::storage::Scratch;
 use crate::trace::Tracer;
 use core::fmt;
@@ -146,7 +147,15 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     let total = (tiles_x * end.saturating_sub(first)) as u32;
     let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
+    // Remembered occluders are forgotten at every band of tiles, so a band renders the same
+    // whichever bands a core or thread rendered before it.
+    let mut band = usize::MAX;
     let mut shoot = |sx: usize, sy: usize| {
+        if sy / (4 * t) != band {
+            band = sy / (4 * t);
+            q.forget_occluders();
+        }
+        q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
         let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
         (v, id as u16)
     };

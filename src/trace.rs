@@ -14,7 +14,7 @@
 //! leaves the image bit for bit the same. Fixed point, whose absolute precision is the same
 //! everywhere, uses `offset_eps * extent`.
 
-use crate::accel::{Accelerator, Query, RayKind};
+use crate::accel::{Accelerator, BruteForce, Query, RayKind};
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::{Light, Scene};
@@ -214,6 +214,36 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     cutoff: R,
     /// Extent of the world box, the scale term of the self-intersection offset.
     scale: R,
+    /// How eye rays given a window position find their nearest hit.
+    eye_rays: EyeRays,
+}
+
+/// How eye rays find their nearest hit. Every eye ray starts at the eye, and each object knows
+/// its window on the image ([`crate::scene::EyeWindow`]), so for a scene of few objects
+/// testing every object's window beats walking the lattice; both give the same hit.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EyeRays {
+    /// Through the tracer's accelerator, skipping objects whose window misses the ray.
+    Accelerator,
+    /// Every object's window tested, and the exact test made only where the window holds the
+    /// ray: no walk at all.
+    Windows,
+}
+
+impl EyeRays {
+    /// Most objects for which [`EyeRays::Windows`] is the default: past that, a window test
+    /// per object costs more than the walk saves.
+    pub const WINDOWS_UP_TO: usize = 32;
+
+    /// The default for a scene: [`EyeRays::Windows`] up to [`EyeRays::WINDOWS_UP_TO`] objects.
+    pub fn for_scene<R: Real>(scene: &Scene<'_, R>) -> Self {
+        if scene.objects.len() <= Self::WINDOWS_UP_TO {
+            EyeRays::Windows
+        } else {
+            EyeRays::Accelerator
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -235,6 +265,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
             max_depth: scene.max_depth.min(MAX_DEPTH),
             cutoff: R::ZERO,
             scale: scene.world.extent(),
+            eye_rays: EyeRays::for_scene(scene),
         }
     }
 }
@@ -254,7 +285,18 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             max_depth: scene.max_depth.min(MAX_DEPTH),
             cutoff: R::ZERO,
             scale: scene.world.extent(),
+            eye_rays: EyeRays::for_scene(scene),
         })
+    }
+
+    /// How eye rays find their nearest hit.
+    pub fn eye_rays(&self) -> EyeRays {
+        self.eye_rays
+    }
+
+    /// Sets how eye rays find their nearest hit (the picture is the same either way).
+    pub fn set_eye_rays(&mut self, how: EyeRays) {
+        self.eye_rays = how;
     }
 
     /// The scene traced.
@@ -322,9 +364,25 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
         let _ = stack.push(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary });
         let mut total = R::ZERO;
+        // The eye ray's window position (if the caller gave one) serves the eye ray alone.
+        let eye_uv = q.eye_ray();
         while let Some(node) = stack.pop() {
             q.stats.rays[node.kind as usize] += 1;
-            let Some(hit) = self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q) else {
+            let found = match (node.depth, eye_uv) {
+                (0, Some(uv)) => {
+                    q.set_eye_ray(Some(uv));
+                    match self.eye_rays {
+                        EyeRays::Accelerator => self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
+                        EyeRays::Windows => BruteForce.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
+                    }
+                }
+                _ => {
+                    q.set_eye_ray(None);
+                    self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q)
+                }
+            };
+            q.set_eye_ray(None);
+            let Some(hit) = found else {
                 total += node.weight * scene.background;
                 continue;
             };
@@ -341,8 +399,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let outside = p + n * eps;
             let mut local = scene.ambient * m.ka;
             if m.kd > R::ZERO {
-                for light in scene.lights.iter() {
-                    local += self.direct(light, outside, n, m.kd, node.weight, q);
+                for (l, light) in scene.lights.iter().enumerate() {
+                    local += self.direct(l, light, outside, n, m.kd, node.weight, q);
                 }
             }
             total += node.weight * local;
@@ -373,7 +431,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// (with shadows on) blocked. When the term, times the weight of the node, is below the
     /// cutoff, the shadow ray is not traced and the light counts as visible: either answer is
     /// within the cutoff of the other.
-    fn direct(&self, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, weight: R, q: &mut Query<'_>) -> R {
+    #[allow(clippy::too_many_arguments)]
+    fn direct(&self, l: usize, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, weight: R, q: &mut Query<'_>) -> R {
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
@@ -392,7 +451,22 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let term = ip * kd * cos;
         if self.simulates(Effects::SHADOWS) && weight * term >= self.cutoff {
             q.stats.rays[RayKind::Shadow as usize] += 1;
-            if self.accel.occluded(self.scene, &Ray::new(from, to_light), R::ZERO, reach, q) {
+            let ray = Ray::new(from, to_light);
+            // Shadow-ray coherence: the object that last hid this light from a point is tried
+            // before the accelerator (the last shadow ray towards the light was hidden by it);
+            // neighbouring points in a shadow share their occluder.
+            // Occlusion is a yes-or-no question, so the answer is the accelerator's.
+            if let Some(o) = q.occluder(l).and_then(|i| self.scene.objects.get(i as usize)) {
+                q.stats.object_tests += 1;
+                if o.intersect(&ray, R::ZERO, reach).is_some() {
+                    return R::ZERO;
+                }
+            }
+            let hidden = self.accel.occluded(self.scene, &ray, R::ZERO, reach, q);
+            // Remembered only while the light stays hidden: a lit point forgets it, so points
+            // in the light pay no extra test.
+            q.remember_occluder(l, hidden);
+            if hidden {
                 return R::ZERO;
             }
         }

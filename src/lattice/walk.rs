@@ -41,7 +41,7 @@ impl<R: Real> Lattice<'_, R> {
                 w.ref_i += 1;
                 if item & SUB_FLAG == 0 {
                     let i = item as usize;
-                    if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, &mut q.stats) && any {
+                    if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                         return best;
                     }
                 } else {

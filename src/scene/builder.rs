@@ -1,7 +1,7 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::model::{Camera, CameraDesc, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
+use super::model::{Camera, CameraDesc, EyeWindow, EYE_MARGIN, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::Real;
 use crate::shape::Shape;
@@ -226,6 +226,9 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             bounds: bounds.cast_padded(),
             dir_scale: R::from_f64(dir_scale),
             inv_dir_scale: R::from_f64(1.0 / dir_scale),
+            // The camera is known at `finish`, which sets both.
+            eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
+            eye_window: WHOLE_PLANE,
         };
         self.len += 1;
         Ok(())
@@ -267,6 +270,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let ty = libm::tan(c.fov.1.to_radians_core() / 2.0);
         let camera =
             Camera { eye: c.eye.cast(), forward: forward.cast(), right: (right * tx).cast(), up: (up * ty).cast() };
+        for o in self.storage[..self.len].iter_mut() {
+            o.eye_local = o.to_object.vector(camera.eye - o.origin) * o.unscale;
+            o.eye_window = eye_window(&o.bounds, &camera);
+        }
         let objects: &'a [Object<R>] = &self.storage[..self.len];
         let mut world = Aabb { min: camera.eye, max: camera.eye };
         for o in objects {
@@ -316,6 +323,43 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             world,
         })
     }
+}
+
+/// The [`EyeWindow`] of a box: its eight corners projected through the camera's eye onto the
+/// window plane (in `f64`, from the camera's vectors as the scalar holds them), widened by
+/// [`EYE_MARGIN`]. The image of a box wholly in front of the eye is the convex hull of its
+/// corners' images, so every eye ray that meets the box passes inside.
+fn eye_window<R: Real>(b: &Aabb<R>, cam: &Camera<R>) -> EyeWindow {
+    let (f, r, u) = (cam.forward.cast::<f64>(), cam.right.cast::<f64>(), cam.up.cast::<f64>());
+    // Columns forward, right, up: a direction's coordinates (s, s u, s v) along them.
+    let to_window = Affine { m: [[f.x, r.x, u.x, 0.0], [f.y, r.y, u.y, 0.0], [f.z, r.z, u.z, 0.0]] };
+    let Some(from_eye) = to_window.inverse() else { return WHOLE_PLANE };
+    let (eye, min, max) = (cam.eye.cast::<f64>(), b.min.cast::<f64>(), b.max.cast::<f64>());
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for c in 0..8 {
+        let p = Vec3::new(
+            if c & 1 == 0 { min.x } else { max.x },
+            if c & 2 == 0 { min.y } else { max.y },
+            if c & 4 == 0 { min.z } else { max.z },
+        );
+        let k = from_eye.vector(p - eye);
+        // A corner on or behind the eye plane: the box's image is unbounded.
+        if !(k.x > 1e-6 * (p - eye).max_abs()) {
+            return WHOLE_PLANE;
+        }
+        for (a, w) in [k.y / k.x, k.z / k.x].into_iter().enumerate() {
+            lo[a] = lo[a].min(w);
+            hi[a] = hi[a].max(w);
+        }
+    }
+    // Rounded outwards; `as` saturates, so a window beyond the i32 range only widens.
+    let (below, above) = (|w: f64| libm::floor(w * 65536.0) as i32, |w: f64| libm::ceil(w * 65536.0) as i32);
+    [
+        below(lo[0]).saturating_sub(EYE_MARGIN),
+        above(hi[0]).saturating_add(EYE_MARGIN),
+        below(lo[1]).saturating_sub(EYE_MARGIN),
+        above(hi[1]).saturating_add(EYE_MARGIN),
+    ]
 }
 
 /// Whether `v` is finite and of length 1 (to rounding).

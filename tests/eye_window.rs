@@ -1,0 +1,82 @@
+//! Eye-ray windows skip work, never change a pixel: every eye ray traced with its window
+//! position (objects outside their window are not tested; with `EyeRays::Windows` no walk at
+//! all) gives the brightness and the object
+//! it gives without, in every scalar and accelerator, on the paper's scenes, the Whitted scene,
+//! generated scenes and cameras that sit inside or right beside an object.
+
+mod common;
+
+use common::{build_lattice, lattice_storage, scene_text, ACCELS};
+use lattice_rt::generate::{random_scene, RandomScene};
+use lattice_rt::scene::{Camera, Object};
+use lattice_rt::{parse, Accelerator, BoundingBox, BruteForce, EyeRays, Fx, LatticeConfig, Query, Real, Scene, SceneBuilder, Tracer};
+
+/// Traces every eye ray of a `w x h` frame (pixel centres and a quarter-pixel offset) with and
+/// without its window position; returns how many object tests the windows skipped.
+fn same_with_and_without<R: Real>(scene: &Scene<'_, R>, w: i32, h: i32, what: &str) -> u64 {
+    let mut st = lattice_storage(scene, &LatticeConfig::default());
+    let lat = build_lattice(scene, &LatticeConfig::default(), &mut st);
+    let mut culled = 0;
+    for accel in ACCELS {
+        let a: &dyn Accelerator<R> = match accel {
+            common::Accel::Lattice => &lat,
+            common::Accel::Bbox => &BoundingBox,
+            common::Accel::Brute => &BruteForce,
+        };
+        for how in [EyeRays::Accelerator, EyeRays::Windows] {
+            let mut tracer = Tracer::new(scene, a);
+            tracer.set_eye_rays(how);
+            let mut mb = vec![0; Query::mailbox_len(scene)];
+            let mut q = Query::new(&mut mb);
+            let (w4, h4) = (4 * w, 4 * h);
+            for sy in (1..h4).step_by(2) {
+                for sx in (1..w4).step_by(2) {
+                    let ray = scene.camera().ray(sx, sy, w4, h4);
+                    q.set_eye_ray(None);
+                    let plain = tracer.radiance_and_object(ray, &mut q);
+                    q.set_eye_ray(Some(Camera::<R>::window_uv(sx, sy, w4, h4)));
+                    let windowed = tracer.radiance_and_object(ray, &mut q);
+                    assert_eq!(plain, windowed, "{what}, {}, {accel:?}, {how:?}: eye ray ({sx}, {sy}) of ({w4}, {h4})", R::NAME);
+                }
+            }
+            culled += q.stats.culled;
+        }
+    }
+    culled
+}
+
+fn scenes_in<R: Real>() {
+    for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
+        let text = scene_text(name);
+        let mut storage = vec![Object::<R>::default(); 64];
+        let scene = parse::<R>(&text, &mut storage).unwrap();
+        let culled = same_with_and_without(&scene, 48, 24, name);
+        assert!(culled > 0, "{name}, {}: the windows skipped no test", R::NAME);
+    }
+}
+
+#[test]
+fn the_paper_scenes_render_the_same_with_windows_in_every_scalar() {
+    scenes_in::<f64>();
+    scenes_in::<f32>();
+    scenes_in::<Fx>();
+}
+
+#[test]
+fn generated_scenes_and_cameras_inside_or_beside_objects_render_the_same() {
+    let (mut built, mut culled) = (0, 0);
+    for seed in 0..6u64 {
+        for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0)), ((3.0, 0.0, 0.0), (-3.0, 0.5, 0.0))] {
+            let mut storage = vec![Object::<f64>::default(); 40];
+            let mut b = SceneBuilder::new(&mut storage);
+            random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
+            b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
+            b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
+            b.camera.fov = (70.0, 50.0);
+            let Ok(scene) = b.finish() else { continue };
+            built += 1;
+            culled += same_with_and_without(&scene, 32, 20, &format!("seed {seed}, eye {eye:?}"));
+        }
+    }
+    assert!(built >= 12 && culled > 0, "{built} scenes built, {culled} tests skipped");
+}
