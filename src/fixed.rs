@@ -93,10 +93,23 @@ impl Div for Fx {
                 }
             }
         } else {
-            let n = (a as u64) << FRAC;
-            let (q, r) = (n / b as u64, n % b as u64);
-            let q = if 2 * r >= b as u64 { q + 1 } else { q };
-            q.min(i32::MAX as u64) as u32
+            // A divisor of 2^23 or more: the quotient is below 2^24 and its 16 fraction bits
+            // come by restoring long division in base 2, in 32 bits (the remainder stays
+            // below the divisor, at most 2^31, so doubling it fits), not a 64-bit division.
+            let (mut q, mut r) = (a / b, a % b);
+            for _ in 0..FRAC {
+                r <<= 1;
+                q <<= 1;
+                if r >= b {
+                    r -= b;
+                    q |= 1;
+                }
+            }
+            if r >= b - r {
+                q + 1
+            } else {
+                q
+            }
         };
         let q = q.min(i32::MAX as u32) as i32;
         Fx(if neg { -q } else { q })
@@ -131,8 +144,10 @@ impl MulAssign for Fx {
 /// 64-bit operations, and this is several times faster than the same method on a `u64`.
 fn sqrt_q16(raw: u32) -> u32 {
     let (mut root, mut rem) = (0u32, 0u32);
-    // The radicand's 24 digit pairs: `raw`'s 16 from the top, then the 8 zero pairs of `<< 16`.
-    for i in (0..24).rev() {
+    // The radicand's 24 digit pairs: `raw`'s 16 from the top, then the 8 zero pairs of `<< 16`;
+    // leading zero pairs leave root and remainder at zero, so they are skipped.
+    let top = 8 + (32 - raw.leading_zeros()).div_ceil(2);
+    for i in (0..top).rev() {
         let pair = if i >= 8 { (raw >> (2 * (i - 8))) & 3 } else { 0 };
         rem = (rem << 2) | pair;
         let trial = (root << 2) | 1;

@@ -12,6 +12,14 @@ use lattice_rt::{render, Effects, LatticeConfig, Real, Stats, Tracer};
 
 pub use crate::frame::{FRAME, HEIGHT, WIDTH};
 
+/// The frame the firmware renders: [`FRAME`], or with the `exact-sampling` feature one eye ray
+/// per pixel.
+pub const RENDERED: lattice_rt::Frame = if cfg!(feature = "exact-sampling") {
+    lattice_rt::Frame { sampling: lattice_rt::Sampling::Center, ..FRAME }
+} else {
+    FRAME
+};
+
 /// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).
 #[cfg(feature = "scalar-fixed")]
 pub type Scalar = lattice_rt::Fx;
@@ -86,7 +94,7 @@ pub struct Report {
     pub lattice_bytes: usize,
 }
 
-/// Parses `text`, builds its lattice and renders [`FRAME`] into `target`, tile by tile.
+/// Parses `text`, builds its lattice and renders [`RENDERED`] into `target`, tile by tile.
 pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     text: &'t str,
     st: &mut Storage<R>,
@@ -98,7 +106,7 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     if cfg!(feature = "effects-all") {
         tracer.set_effects(Effects::ALL);
     }
-    let stats = render(&tracer, &FRAME, target, &mut scratch, hooks).map_err(AppError::Render)?;
+    let stats = render(&tracer, &RENDERED, target, &mut scratch, hooks).map_err(AppError::Render)?;
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes() })
 }
 

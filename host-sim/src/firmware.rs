@@ -5,7 +5,6 @@
 use crate::run::render_text;
 use crate::load::read;
 use anyhow::{bail, Context, Result};
-use lattice_rt::Frame;
 use object::{Object, ObjectSection, SectionFlags};
 use std::fmt::Write as _;
 use std::io::Read;
@@ -226,10 +225,15 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
     Ok(run)
 }
 
+/// The frame the boards render, from the file the firmware compiles.
+#[path = "../../firmware/src/frame.rs"]
+#[allow(dead_code)]
+mod board_frame;
+
 /// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R`.
 fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str) -> Result<Vec<u8>> {
     let path = scenes.join(format!("{name}.scene"));
-    Ok(render_text::<R>(&path, &read(&path)?, &Frame::new(128, 64), |_| {})?.bits)
+    Ok(render_text::<R>(&path, &read(&path)?, &board_frame::FRAME, |_| {})?.bits)
 }
 
 /// [`host_frame_in`] for a scalar named as in [`SCALARS`].

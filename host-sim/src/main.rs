@@ -214,6 +214,9 @@ pub enum SamplingArg {
     Edges,
     /// One ray per pixel, four at object edges and where neighbours differ by 16 of 64 levels.
     EdgesContrast,
+    /// Adaptive sub-sampling (the boards' default): every second pixel traced, the rest
+    /// filled in where the traced pixels around hit one object and differ by at most 4 levels.
+    Adaptive,
 }
 
 impl SamplingArg {
@@ -225,6 +228,7 @@ impl SamplingArg {
             SamplingArg::Four => Sampling::Grid2x2,
             SamplingArg::Edges => Sampling::Edges { contrast: u8::MAX },
             SamplingArg::EdgesContrast => Sampling::Edges { contrast: 16 },
+            SamplingArg::Adaptive => Sampling::Adaptive { contrast: 4 },
         }
     }
 }

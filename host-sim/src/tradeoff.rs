@@ -55,6 +55,9 @@ fn configs() -> Vec<Config> {
     for c in [16u8, 24] {
         v.push(Config { knob: "sampling", label: format!("edges + contrast >= {c}: 4 rays there"), sampling: Sampling::Edges { contrast: c }, ..base.clone() });
     }
+    for c in [2u8, 4, 8] {
+        v.push(Config { knob: "sampling", label: format!("adaptive, contrast <= {c}: every 2nd pixel traced, the rest filled"), sampling: Sampling::Adaptive { contrast: c }, ..base.clone() });
+    }
     v.push(Config { knob: "dither", label: "floyd-steinberg".into(), dither: Dither::FloydSteinberg, ..base.clone() });
     v.push(Config { knob: "dither", label: "atkinson".into(), dither: Dither::Atkinson, ..base.clone() });
     v
