@@ -291,7 +291,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
             failures.push(format!("{name}: the panel shows no picture: {e}"));
             continue;
         }
-        let want = host_frame(&scenes_dir, name, PICO_SCALAR)?;
+        let want = host_frame(&scenes_dir, name, PICO_SCALAR, false)?;
         save_frame(&frame.pixels, &frames_dir.join(format!("{name}.png")))?;
         if want == frame.pixels {
             passed += 1;

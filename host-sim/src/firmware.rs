@@ -62,6 +62,17 @@ fn variants() -> Vec<Variant> {
             what: format!("Cortex-M0+, {scalar}, only the chair embedded"),
         });
     }
+    // What adaptive sub-sampling saves: the same build tracing one eye ray per pixel.
+    v.push(Variant {
+        name: "qemu-m0-fixed-exact".into(),
+        target: "thumbv6m-none-eabi",
+        features: "qemu,scalar-fixed,exact-sampling".into(),
+        bin: "qemu",
+        machine: Some("mps2-an385"),
+        scenes: None,
+        scalar: "fixed",
+        what: "Cortex-M0+, fixed, all five scenes, one eye ray per pixel (exact-sampling) instead of adaptive sub-sampling".into(),
+    });
     // What the effect set saves: every effect forced in, and the matte paper scenes with their
     // derived set against every effect (the same scenes, so the difference is the effect code).
     for (name, scenes, features, what) in [
@@ -230,19 +241,24 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
 #[allow(dead_code)]
 mod board_frame;
 
-/// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R`.
-fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str) -> Result<Vec<u8>> {
+/// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R` (`exact`: one
+/// eye ray per pixel, as the `exact-sampling` feature renders).
+fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str, exact: bool) -> Result<Vec<u8>> {
     let path = scenes.join(format!("{name}.scene"));
-    Ok(render_text::<R>(&path, &read(&path)?, &board_frame::FRAME, |_| {})?.bits)
+    let mut frame = board_frame::FRAME;
+    if exact {
+        frame.sampling = lattice_rt::Sampling::Center;
+    }
+    Ok(render_text::<R>(&path, &read(&path)?, &frame, |_| {})?.bits)
 }
 
 /// [`host_frame_in`] for a scalar named as in [`SCALARS`].
-pub fn host_frame(scenes: &Path, name: &str, scalar: &str) -> Result<Vec<u8>> {
+pub fn host_frame(scenes: &Path, name: &str, scalar: &str, exact: bool) -> Result<Vec<u8>> {
     match scalar {
-        "fixed" => host_frame_in::<lattice_rt::Fx>(scenes, name),
-        "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(scenes, name),
-        "f32-micromath-newton" => host_frame_in::<lattice_rt::F32MicroNewton>(scenes, name),
-        _ => host_frame_in::<f32>(scenes, name),
+        "fixed" => host_frame_in::<lattice_rt::Fx>(scenes, name, exact),
+        "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(scenes, name, exact),
+        "f32-micromath-newton" => host_frame_in::<lattice_rt::F32MicroNewton>(scenes, name, exact),
+        _ => host_frame_in::<f32>(scenes, name, exact),
     }
 }
 
@@ -289,7 +305,7 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
             failed += 1;
         }
         for s in &r.scenes {
-            let want = host_frame(&scenes_dir, &s.name, v.scalar)?;
+            let want = host_frame(&scenes_dir, &s.name, v.scalar, v.features.contains("exact-sampling"))?;
             let same = want == s.rows;
             if same {
                 passed += 1;
