@@ -224,6 +224,9 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EyeRays {
+    /// Through the tracer's accelerator like any other ray, windows unused (the paper's
+    /// methods as they were, for comparing them).
+    Plain,
     /// Through the tracer's accelerator, skipping objects whose window misses the ray.
     Accelerator,
     /// Every object's window tested, and the exact test made only where the window holds the
@@ -369,11 +372,11 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         while let Some(node) = stack.pop() {
             q.stats.rays[node.kind as usize] += 1;
             let found = match (node.depth, eye_uv) {
-                (0, Some(uv)) => {
+                (0, Some(uv)) if self.eye_rays != EyeRays::Plain => {
                     q.set_eye_ray(Some(uv));
                     match self.eye_rays {
-                        EyeRays::Accelerator => self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
                         EyeRays::Windows => BruteForce.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
+                        _ => self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
                     }
                 }
                 _ => {

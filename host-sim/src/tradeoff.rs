@@ -296,6 +296,18 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
             }
         }
     }
+    if let (Some(one), Some(a)) = (find("f64, 1 ray"), find("adaptive, contrast <= 4")) {
+        let err = |t: &Tally| t.abs_sum / t.pixels.max(1) as f64;
+        writeln!(
+            md,
+            "- adaptive sub-sampling (the boards' default, contrast 4): mean gray error {:.3} against {:.3} with one ray per pixel ({:+.1} %), at {:.2}x the host time and {:.2}x the rays.",
+            err(a),
+            err(one),
+            100.0 * (err(a) / err(one) - 1.0),
+            a.time.as_secs_f64() / one.time.as_secs_f64(),
+            a.rays as f64 / one.rays as f64
+        )?;
+    }
     writeln!(md, "\n![error against cost]({})", plot_link(out, plot))?;
     let title = "Error against cost, one knob at a time";
     crate::plot::scatter(plot, title, "host ms per frame (median, mean over scenes)", "mean abs gray error (levels of 64)", &points)?;
