@@ -115,6 +115,12 @@ impl<'m> Query<'m> {
             *o = if hidden { self.last_hit } else { u32::MAX };
         }
     }
+    /// Remembers `occluder` as what hides light `l` (`None`: the light is not hidden, forget).
+    pub fn set_occluder(&mut self, l: usize, occluder: Option<u32>) {
+        if let Some(o) = self.occluders.get_mut(l) {
+            *o = occluder.unwrap_or(u32::MAX);
+        }
+    }
     /// Forgets the remembered occluders (the render does so at every band of tiles, so a band's
     /// work does not depend on the bands rendered before it, on whichever core or thread).
     pub fn forget_occluders(&mut self) {

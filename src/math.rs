@@ -133,6 +133,17 @@ pub struct Aabb<R> {
 }
 
 impl<R: Real> Aabb<R> {
+    /// The eight corners (corner `c` takes `max` on axis `a` where bit `a` of `c` is set).
+    pub fn corners(&self) -> [Vec3<R>; 8] {
+        let (lo, hi) = (self.min, self.max);
+        core::array::from_fn(|c| {
+            Vec3::new(
+                if c & 1 == 0 { lo.x } else { hi.x },
+                if c & 2 == 0 { lo.y } else { hi.y },
+                if c & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+    }
     /// The empty box (min above max), the identity of [`Aabb::union`].
     pub fn empty() -> Self {
         Aabb { min: Vec3::new(R::MAX, R::MAX, R::MAX), max: Vec3::new(-R::MAX, -R::MAX, -R::MAX) }

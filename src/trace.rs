@@ -230,7 +230,8 @@ pub enum EyeRays {
     /// Through the tracer's accelerator, skipping objects whose window misses the ray.
     Accelerator,
     /// Every object's window tested, and the exact test made only where the window holds the
-    /// ray: no walk at all.
+    /// ray: no walk at all. Shadow rays towards the first light, when it is directional, do
+    /// the same with the objects' shadow windows ([`crate::scene::ShadowWindow`]).
     Windows,
 }
 
@@ -465,14 +466,43 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                     return R::ZERO;
                 }
             }
-            let hidden = self.accel.occluded(self.scene, &ray, R::ZERO, reach, q);
-            // Remembered only while the light stays hidden: a lit point forgets it, so points
-            // in the light pay no extra test.
-            q.remember_occluder(l, hidden);
+            let hidden = match self.scene.shadow_basis {
+                // Towards the first light, when it is directional, a small scene's shadow rays
+                // test the objects whose shadow window holds the ray, with no walk.
+                Some((a, b)) if l == 0 && self.eye_rays == EyeRays::Windows => {
+                    let found = self.shadow_by_windows(&ray, [from.dot(a), from.dot(b)], reach, q);
+                    q.set_occluder(l, found);
+                    found.is_some()
+                }
+                _ => {
+                    let hidden = self.accel.occluded(self.scene, &ray, R::ZERO, reach, q);
+                    // Remembered only while the light stays hidden: a lit point forgets it, so
+                    // points in the light pay no extra test.
+                    q.remember_occluder(l, hidden);
+                    hidden
+                }
+            };
             if hidden {
                 return R::ZERO;
             }
         }
         term
+    }
+
+    /// The first object (in index order) whose shadow window holds the shadow ray's position
+    /// `w` across the light and which the ray hits within `reach`.
+    fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, q: &mut Query<'_>) -> Option<u32> {
+        for (i, o) in self.scene.objects.iter().enumerate() {
+            let sw = &o.shadow_window;
+            if w[0] < sw[0] || w[0] > sw[1] || w[1] < sw[2] || w[1] > sw[3] {
+                q.stats.culled += 1;
+                continue;
+            }
+            q.stats.object_tests += 1;
+            if o.intersect(ray, R::ZERO, reach).is_some() {
+                return Some(i as u32);
+            }
+        }
+        None
     }
 }

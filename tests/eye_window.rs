@@ -1,6 +1,6 @@
 //! Eye-ray windows skip work, never change a pixel: every eye ray traced with its window
 //! position (objects outside their window are not tested; with `EyeRays::Windows` no walk at
-//! all) gives the brightness and the object
+//! all, for shadow rays towards a directional light too) gives the brightness and the object
 //! it gives without, in every scalar and accelerator, on the paper's scenes, the Whitted scene,
 //! generated scenes and cameras that sit inside or right beside an object.
 
@@ -23,6 +23,11 @@ fn same_with_and_without<R: Real>(scene: &Scene<'_, R>, w: i32, h: i32, what: &s
             common::Accel::Bbox => &BoundingBox,
             common::Accel::Brute => &BruteForce,
         };
+        // The reference: the accelerator alone, no window of any kind.
+        let mut reference = Tracer::new(scene, a);
+        reference.set_eye_rays(EyeRays::Plain);
+        let mut mb0 = vec![0; Query::mailbox_len(scene)];
+        let mut q0 = Query::new(&mut mb0);
         for how in [EyeRays::Accelerator, EyeRays::Windows] {
             let mut tracer = Tracer::new(scene, a);
             tracer.set_eye_rays(how);
@@ -32,11 +37,15 @@ fn same_with_and_without<R: Real>(scene: &Scene<'_, R>, w: i32, h: i32, what: &s
             for sy in (1..h4).step_by(2) {
                 for sx in (1..w4).step_by(2) {
                     let ray = scene.camera().ray(sx, sy, w4, h4);
+                    let plain = reference.radiance_and_object(ray, &mut q0);
+                    // Without the eye ray's window position only shadow windows act.
                     q.set_eye_ray(None);
-                    let plain = tracer.radiance_and_object(ray, &mut q);
+                    let shadows_only = tracer.radiance_and_object(ray, &mut q);
                     q.set_eye_ray(Some(Camera::<R>::window_uv(sx, sy, w4, h4)));
                     let windowed = tracer.radiance_and_object(ray, &mut q);
-                    assert_eq!(plain, windowed, "{what}, {}, {accel:?}, {how:?}: eye ray ({sx}, {sy}) of ({w4}, {h4})", R::NAME);
+                    let at = format!("{what}, {}, {accel:?}, {how:?}: eye ray ({sx}, {sy}) of ({w4}, {h4})", R::NAME);
+                    assert_eq!(plain, shadows_only, "{at}, shadow windows");
+                    assert_eq!(plain, windowed, "{at}");
                 }
             }
             culled += q.stats.culled;

@@ -1,7 +1,7 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::model::{Camera, CameraDesc, EyeWindow, EYE_MARGIN, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
+use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::Real;
 use crate::shape::Shape;
@@ -229,6 +229,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             // The camera is known at `finish`, which sets both.
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             eye_window: WHOLE_PLANE,
+            shadow_window: shadow_whole_plane(),
         };
         self.len += 1;
         Ok(())
@@ -270,15 +271,24 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let ty = libm::tan(c.fov.1.to_radians_core() / 2.0);
         let camera =
             Camera { eye: c.eye.cast(), forward: forward.cast(), right: (right * tx).cast(), up: (up * ty).cast() };
+        let mut world = Aabb { min: camera.eye, max: camera.eye };
+        for o in &self.storage[..self.len] {
+            world = world.union(&o.bounds);
+        }
+        let shadow_basis = shadow_basis(&self.lights);
+        // A point's light-window position is two dot products in R: widen every window by what
+        // their rounding can reach anywhere in the world (the scalar's padding at its corners).
+        let reach = world.min.max_abs().max(world.max.max_abs()).to_f64();
+        let margin = R::pad_eps().to_f64() * (1.0 + reach);
         for o in self.storage[..self.len].iter_mut() {
             o.eye_local = o.to_object.vector(camera.eye - o.origin) * o.unscale;
             o.eye_window = eye_window(&o.bounds, &camera);
+            o.shadow_window = match shadow_basis {
+                Some((a, b)) => shadow_window(&o.bounds, a.cast(), b.cast(), margin),
+                None => shadow_whole_plane(),
+            };
         }
         let objects: &'a [Object<R>] = &self.storage[..self.len];
-        let mut world = Aabb { min: camera.eye, max: camera.eye };
-        for o in objects {
-            world = world.union(&o.bounds);
-        }
         check_range::<R>(world.min.cast())?;
         check_range::<R>(world.max.cast())?;
         // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
@@ -286,15 +296,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         for (i, o) in objects.iter().enumerate() {
             let inv = o.to_object.cast::<f64>();
             let unscale = o.unscale.to_f64();
-            let reach = (0..8)
-                .map(|c| {
-                    let p = Vec3::new(
-                        if c & 1 == 0 { world.min.x } else { world.max.x },
-                        if c & 2 == 0 { world.min.y } else { world.max.y },
-                        if c & 4 == 0 { world.min.z } else { world.max.z },
-                    );
-                    (inv.vector(p.cast() - o.origin.cast()) * unscale).max_abs()
-                })
+            let reach = world
+                .corners()
+                .into_iter()
+                .map(|p| (inv.vector(p.cast() - o.origin.cast()) * unscale).max_abs())
                 .fold(0.0, f64::max);
             if reach >= R::LIMIT {
                 return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
@@ -321,6 +326,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             camera,
             max_depth: self.max_depth,
             world,
+            shadow_basis,
         })
     }
 }
@@ -336,12 +342,7 @@ fn eye_window<R: Real>(b: &Aabb<R>, cam: &Camera<R>) -> EyeWindow {
     let Some(from_eye) = to_window.inverse() else { return WHOLE_PLANE };
     let (eye, min, max) = (cam.eye.cast::<f64>(), b.min.cast::<f64>(), b.max.cast::<f64>());
     let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-    for c in 0..8 {
-        let p = Vec3::new(
-            if c & 1 == 0 { min.x } else { max.x },
-            if c & 2 == 0 { min.y } else { max.y },
-            if c & 4 == 0 { min.z } else { max.z },
-        );
+    for p in (Aabb { min, max }).corners() {
         let k = from_eye.vector(p - eye);
         // A corner on or behind the eye plane: the box's image is unbounded.
         if !(k.x > 1e-6 * (p - eye).max_abs()) {
@@ -360,6 +361,35 @@ fn eye_window<R: Real>(b: &Aabb<R>, cam: &Camera<R>) -> EyeWindow {
         below(lo[1]).saturating_sub(EYE_MARGIN),
         above(hi[1]).saturating_add(EYE_MARGIN),
     ]
+}
+
+/// Two unit vectors across the first light when it is directional (in the scalar, as the
+/// tracer projects with them): shadow rays towards it are parallel, so each object's shadow
+/// window is a rectangle in their plane.
+fn shadow_basis<R: Real>(lights: &[Light<R>]) -> Option<(Vec3<R>, Vec3<R>)> {
+    let Some(Light::Directional { to_light, .. }) = lights.first() else { return None };
+    let l = to_light.cast::<f64>().normalize();
+    let helper = if l.x.abs() < 0.9 { Vec3::new(1.0, 0.0, 0.0) } else { Vec3::new(0.0, 1.0, 0.0) };
+    let a = l.cross(helper).normalize();
+    let b = l.cross(a).normalize();
+    Some((a.cast(), b.cast()))
+}
+
+/// The [`ShadowWindow`] of a box: its corners' coordinates along `a` and `b` (the basis as
+/// the scalar holds it, in `f64`), widened by `margin`.
+fn shadow_window<R: Real>(b: &Aabb<R>, x: Vec3<f64>, y: Vec3<f64>, margin: f64) -> ShadowWindow<R> {
+    let (min, max) = (b.min.cast::<f64>(), b.max.cast::<f64>());
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for p in (Aabb { min, max }).corners() {
+        for (k, w) in [p.dot(x), p.dot(y)].into_iter().enumerate() {
+            lo[k] = lo[k].min(w);
+            hi[k] = hi[k].max(w);
+        }
+    }
+    // Rounded outwards into the scalar (beyond its range the window is unbounded there).
+    let down = |w: f64| R::from_f64(w - margin - (w.abs() + 1.0) * R::pad_eps().to_f64());
+    let up = |w: f64| R::from_f64(w + margin + (w.abs() + 1.0) * R::pad_eps().to_f64());
+    [down(lo[0]), up(hi[0]), down(lo[1]), up(hi[1])]
 }
 
 /// Whether `v` is finite and of length 1 (to rounding).

@@ -147,6 +147,19 @@ pub struct Object<R> {
     pub(crate) eye_local: Vec3<R>,
     /// The part of the image the object can appear in, as an [`EyeWindow`].
     pub(crate) eye_window: EyeWindow,
+    /// Where a shadow ray towards the scene's first light can meet it, as a [`ShadowWindow`].
+    pub(crate) shadow_window: ShadowWindow<R>,
+}
+
+/// Where shadow rays towards the scene's first light (when it is directional, so its rays are
+/// parallel) can meet an object: `[a_lo, a_hi, b_lo, b_hi]`, the object's padded box projected
+/// along the light onto the plane of [`Scene::shadow_basis`], widened by the rounding of that
+/// projection. A shadow ray whose origin projects outside cannot hit the object.
+pub type ShadowWindow<R> = [R; 4];
+
+/// The shadow window that culls nothing.
+pub fn shadow_whole_plane<R: Real>() -> ShadowWindow<R> {
+    [-R::MAX, R::MAX, -R::MAX, R::MAX]
 }
 
 /// Where on the image an object can appear: `[u_lo, u_hi, v_lo, v_hi]` in units of 2^-16 of
@@ -186,6 +199,7 @@ impl<R: Real> Default for Object<R> {
             inv_dir_scale: R::ONE,
             eye_local: z,
             eye_window: WHOLE_PLANE,
+            shadow_window: shadow_whole_plane(),
         }
     }
 }
@@ -299,6 +313,8 @@ pub struct Scene<'a, R> {
     pub(crate) max_depth: u8,
     /// Box holding the viewpoint and every object (the paper's world range).
     pub(crate) world: Aabb<R>,
+    /// Two unit vectors across the first light, when it is directional (see [`ShadowWindow`]).
+    pub(crate) shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
 }
 
 impl<'a, R: Real> Scene<'a, R> {
