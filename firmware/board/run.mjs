@@ -11,14 +11,20 @@
 // rp2040js has no SSI flash model, so the run starts at boot2 (PC = 0x10000000) with the
 // bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2.
 //
+// With --profile FILE it also samples the program counter every 97th instruction of the first
+// frame (while the LED is lit) and writes the counts as JSON pairs [pc, samples].
+//
 // Usage: node run.mjs --uf2 FILE --bootrom FILE --rtt ADDR --log FILE
-//                     [--frames N] [--max-cycles N] [--no-display] [--until-ms T]
+//                     [--frames N] [--max-cycles N] [--no-display] [--until-ms T] [--profile FILE]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { RP2040, GPIOPinState } from 'rp2040js';
 import { Ssd1306 } from './ssd1306.mjs';
 
 const FLASH = 0x10000000;
 const LED_PIN = 25;
+// Every how many instructions --profile samples the program counter (a prime, so no loop of
+// the renderer beats in step with it).
+const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
   const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null };
@@ -36,6 +42,7 @@ function parseArgs(argv) {
     else if (a === '--max-cycles') o.maxCycles = Number(next());
     else if (a === '--until-ms') o.untilMs = Number(next());
     else if (a === '--no-display') o.display = false;
+    else if (a === '--profile') o.profile = next();
     else throw new Error(`unknown argument ${a}`);
   }
   for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
@@ -204,6 +211,7 @@ function main() {
   core.SP = mcu.readUint32(0);
   core.PC = FLASH;
 
+  const profile = opt.profile ? new Map() : null;
   const untilNanos = opt.untilMs === null ? Infinity : opt.untilMs * 1e6;
   const nanosPerCycle = () => 1e9 / mcu.clkSys;
   let nextPoll = 0;
@@ -223,6 +231,10 @@ function main() {
       idleNanos += dt;
       if (mcu.clock.nanos >= untilNanos) nextPoll = 0; // time is up while asleep: check now
     } else {
+      if (profile && ledOn && frames.length === 0 && instructions % PROFILE_EVERY === 0) {
+        const pc = core.PC >>> 0;
+        profile.set(pc, (profile.get(pc) || 0) + 1);
+      }
       const c = core.executeInstruction();
       mcu.clock.tick(c * nanosPerCycle());
       instructions++;
@@ -241,6 +253,7 @@ function main() {
   }
   rtt.poll();
   rtt.save(opt.log);
+  if (profile) writeFileSync(opt.profile, JSON.stringify([...profile.entries()]));
   emit({
     event: 'end',
     ok,

@@ -154,7 +154,9 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
         .args(["--max-cycles", &(MAX_CYCLES_PER_FRAME * frames.max(1) as u64).to_string()])
         .stdin(Stdio::null())
         .stdout(Stdio::piped());
-    if !display {
+    if display {
+        cmd.arg("--profile").arg(work.join("profile.json"));
+    } else {
         cmd.args(["--no-display", "--until-ms", "2500"]);
     }
     let mut child = cmd.spawn().context("cannot run node (Node.js 18 or newer is needed)")?;
@@ -325,7 +327,8 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
 
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms };
-    let md = report(&summary, &rows, flash, static_ram, &bare, &scenes)?;
+    let profile = profile_shares(&elf, &frames_dir.join("profile.json"))?;
+    let md = report(&summary, &rows, flash, static_ram, &bare, &scenes, &profile)?;
     crate::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     for f in &failures {
@@ -338,6 +341,45 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     Ok(())
 }
 
+/// Most functions the profile lists; the rest are summed into one row.
+const PROFILE_ROWS: usize = 16;
+
+/// The shares of a PC-sample profile (`profile.json` from `run.mjs --profile`) by function,
+/// largest first: the symbols of `elf` (demangled, hashes dropped), code below the flash
+/// `bootrom`, anything else `(no symbol)`.
+fn profile_shares(elf: &Path, samples: &Path) -> Result<Vec<(String, f64)>> {
+    use object::{Object as _, ObjectSymbol as _, SymbolKind};
+    let text = std::fs::read_to_string(samples).with_context(|| format!("cannot read {}", samples.display()))?;
+    let pairs: Vec<(u64, u64)> = serde_json::from_str(&text).with_context(|| format!("{} is not a profile", samples.display()))?;
+    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+    let file = object::File::parse(&*bytes)?;
+    let mut syms: Vec<(u64, u64, String)> = file
+        .symbols()
+        .filter(|s| s.kind() == SymbolKind::Text && s.size() > 0)
+        .filter_map(|s| Some(((s.address() & !1), s.size(), format!("{:#}", rustc_demangle::demangle(s.name().ok()?)))))
+        .collect();
+    syms.sort();
+    let mut by_name: std::collections::HashMap<String, u64> = Default::default();
+    let total: u64 = pairs.iter().map(|p| p.1).sum();
+    for (pc, n) in pairs {
+        let i = syms.partition_point(|s| s.0 <= pc);
+        let name = match i.checked_sub(1).map(|i| &syms[i]) {
+            Some((a, size, name)) if pc < a + size => name.clone(),
+            _ if pc < 0x1000_0000 => "(bootrom)".into(),
+            _ => "(no symbol)".into(),
+        };
+        *by_name.entry(name).or_default() += n;
+    }
+    let mut rows: Vec<(String, f64)> = by_name.into_iter().map(|(k, v)| (k, v as f64 / total.max(1) as f64)).collect();
+    rows.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    if rows.len() > PROFILE_ROWS {
+        let rest: f64 = rows[PROFILE_ROWS..].iter().map(|r| r.1).sum();
+        rows.truncate(PROFILE_ROWS);
+        rows.push(("(everything else)".into(), rest));
+    }
+    Ok(rows)
+}
+
 /// Clock and time of the run with the display.
 struct Summary {
     clk_hz: f64,
@@ -346,7 +388,8 @@ struct Summary {
 }
 
 /// docs/board.md.
-fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &BoardRun, scenes: &[String]) -> Result<String> {
+#[allow(clippy::too_many_arguments)]
+fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &BoardRun, scenes: &[String], profile: &[(String, f64)]) -> Result<String> {
     let mut md = String::new();
     let mhz = s.clk_hz / 1e6;
     writeln!(md, "# The Pico image on an emulated board\n")?;
@@ -388,6 +431,17 @@ fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &Bo
     writeln!(md, "board time, of which {:.2} s the core slept in `wfi` between scenes (skipped, not emulated).\n", s.idle_ms / 1e3)?;
     writeln!(md, "With no display on the bus the firmware logs `{NO_DISPLAY_MESSAGE} ...`, blinks the LED and")?;
     writeln!(md, "retries every second ({} LED changes in {:.1} s of emulated time, no panic).\n", bare.led_toggles, bare.emulated_ms / 1e3)?;
+    if let (Some(first), false) = (scenes.first(), profile.is_empty()) {
+        writeln!(md, "## Where the {first} frame's time goes\n")?;
+        writeln!(md, "The program counter sampled every 97th instruction of the first frame (the {first}, LED on to")?;
+        writeln!(md, "LED off), each sample credited to the function whose code holds it (`object` reads the ELF's")?;
+        writeln!(md, "symbols): shares of instructions, with code the compiler inlined counted in its caller.\n")?;
+        writeln!(md, "| share | function |\n|---:|---|")?;
+        for (name, share) in profile {
+            writeln!(md, "| {:.1} % | `{name}` |", share * 100.0)?;
+        }
+        writeln!(md)?;
+    }
     writeln!(md, "## What the emulator does not model\n")?;
     writeln!(md, "- **I2C bus timing.** The model acknowledges each byte at once, so the cycles above leave out the")?;
     writeln!(md, "  time the bus takes: at 400 kHz every byte, address bytes included, is 9 bit times: the *I2C")?;
