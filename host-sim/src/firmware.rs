@@ -239,7 +239,7 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
 /// The frame the boards render, from the file the firmware compiles.
 #[path = "../../firmware/src/frame.rs"]
 #[allow(dead_code)]
-mod board_frame;
+pub mod board_frame;
 
 /// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R` (`exact`: one
 /// eye ray per pixel, as the `exact-sampling` feature renders).

@@ -9,6 +9,7 @@ mod load;
 mod pov;
 mod shared;
 mod progress;
+mod orbit;
 mod output;
 mod plot;
 mod run;
@@ -140,6 +141,30 @@ enum Command {
         /// Use the image already built instead of running `cargo pico-build`.
         #[arg(long)]
         no_build: bool,
+    },
+    /// The camera circles a scene (around the vertical line through the point it looks at):
+    /// the frames as the Pico renders and shows them (128x64, fixed point, its sampling and
+    /// dither), as an animated GIF.
+    Orbit {
+        /// Scene file.
+        scene: PathBuf,
+        /// GIF to write.
+        #[arg(short, long, default_value = "out/orbit.gif")]
+        output: PathBuf,
+        /// Frames per turn.
+        #[arg(long, default_value_t = 36)]
+        frames: u32,
+    },
+    /// Flicker of each dither while the camera orbits the scenes: docs/motion.md.
+    Motion {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Frames per turn.
+        #[arg(long, default_value_t = 36)]
+        frames: u32,
+        /// Report to write.
+        #[arg(long, default_value = "docs/motion.md")]
+        out: PathBuf,
     },
     /// Build the Pico image and write it as a UF2 file, for flashing without a probe: hold
     /// BOOTSEL while plugging the Pico in and copy the file onto the RPI-RP2 drive.
@@ -381,6 +406,8 @@ fn real_main() -> Result<()> {
         Some(Command::Effects { scenes, runs, out, firmware_csv }) => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
         Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
         Some(Command::Board { out, frames, no_build }) => board::board_cmd(&std::env::current_dir()?, &out, &frames, no_build),
+        Some(Command::Orbit { scene, output, frames }) => orbit::orbit_cmd(&scene, &output, frames),
+        Some(Command::Motion { scenes, frames, out }) => orbit::motion_cmd(&default_scenes(scenes), frames, &out),
         Some(Command::Uf2 { output }) => board::uf2_cmd(&std::env::current_dir()?, &output),
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),

@@ -66,6 +66,20 @@ pub struct CameraDesc {
     pub fov: (f64, f64),
 }
 
+impl CameraDesc {
+    /// The camera moved `turn` of a full circle (0..1) around the vertical line through the
+    /// point it looks at (the line along `up`): the eye keeps its height and distance, and still
+    /// looks at `look`. Frames of an orbit.
+    pub fn orbit(&self, turn: f64) -> CameraDesc {
+        let (sin, cos) = libm::sincos(turn * 2.0 * core::f64::consts::PI);
+        let axis = self.up.normalize();
+        let v = self.eye - self.look;
+        // Rodrigues' rotation of the eye's offset about the axis.
+        let rotated = v * cos + axis.cross(v) * sin + axis * (axis.dot(v) * (1.0 - cos));
+        CameraDesc { eye: self.look + rotated, ..*self }
+    }
+}
+
 impl Default for CameraDesc {
     fn default() -> Self {
         CameraDesc {

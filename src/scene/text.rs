@@ -7,7 +7,7 @@
 
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
-use super::{check_value, Light, Material, Object, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
+use super::{check_value, CameraDesc, Light, Material, Object, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
 use crate::shape::Shape;
 use crate::trace::MAX_DEPTH;
 use core::fmt;
@@ -700,6 +700,16 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
 /// render that follows it needs the stack.
 #[inline(never)]
 pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Result<Scene<'a, R>, ParseError<'t>> {
+    parse_with(text, storage, |_| {})
+}
+
+/// [`parse`], with the camera the text describes changed by `camera` before the scene is
+/// validated (the frames of an orbit: [`CameraDesc::orbit`]).
+pub fn parse_with<'a, 't, R: Real>(
+    text: &'t str,
+    storage: &'a mut [Object<R>],
+    camera: impl FnOnce(&mut CameraDesc),
+) -> Result<Scene<'a, R>, ParseError<'t>> {
     let mut p = Parser {
         text,
         b: SceneBuilder::<R>::new(storage),
@@ -716,6 +726,7 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
         let Some((kcol, key)) = w.next() else { continue };
         p.statement(&mut Statement { lineno, kcol, key, w })?;
     }
+    camera(&mut p.b.camera);
     p.finish(last_line)
 }
 
