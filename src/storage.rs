@@ -10,10 +10,10 @@
 
 use crate::accel::Query;
 use crate::lattice::{SubLattice, Lattice, LatticeConfig, LatticeError, LatticeStorage};
-use crate::scene::text::{parse, ParseError};
+use crate::scene::text::{parse_with, ParseError};
 use crate::render::Frame;
 use crate::scalar::Real;
-use crate::scene::{Object, Scene};
+use crate::scene::{CameraDesc, Object, Scene};
 use core::fmt;
 
 /// How much of each kind of storage a scene and a frame need.
@@ -268,8 +268,19 @@ impl<'a, R: Real> StorageView<'a, R> {
         text: &'t str,
         cfg: &LatticeConfig,
     ) -> Result<Loaded<'a, R>, LoadError<'t>> {
+        self.load_with(text, cfg, |_| {})
+    }
+
+    /// [`StorageView::load`] with the scene's camera changed by `camera` before validation
+    /// (an orbit's frames: [`crate::scene::CameraDesc::orbit`]).
+    pub fn load_with<'t>(
+        self,
+        text: &'t str,
+        cfg: &LatticeConfig,
+        camera: impl FnOnce(&mut CameraDesc),
+    ) -> Result<Loaded<'a, R>, LoadError<'t>> {
         let (objects, rest) = self.split();
-        let scene = parse::<R>(text, objects).map_err(LoadError::Parse)?;
+        let scene = parse_with::<R>(text, objects, camera).map_err(LoadError::Parse)?;
         let (lattice, scratch) = rest.lattice(&scene, cfg).map_err(LoadError::Lattice)?;
         Ok(Loaded {
             scene,

@@ -10,7 +10,7 @@ use lattice_rt::storage::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::{render, Effects, LatticeConfig, Real, Stats, Tracer};
 
-pub use crate::frame::{FRAME, HEIGHT, WIDTH};
+pub use crate::frame::{FRAME, HEIGHT, ORBIT_FRAMES, WIDTH};
 
 /// The frame the firmware renders: [`FRAME`], or with the `exact-sampling` feature one eye ray
 /// per pixel.
@@ -101,7 +101,20 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     target: &mut D,
     hooks: &mut impl Hooks,
 ) -> Result<Report, AppError<'t, D::Error>> {
-    let Loaded { scene, lattice, mut scratch } = st.view().load(text, &LatticeConfig::default())?;
+    render_scene_at(text, st, target, hooks, 0.0)
+}
+
+/// [`render_scene`] with the camera moved `turn` of a circle around the point it looks at
+/// (`CameraDesc::orbit`; 0 is the scene's own camera).
+pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+    text: &'t str,
+    st: &mut Storage<R>,
+    target: &mut D,
+    hooks: &mut impl Hooks,
+    turn: f64,
+) -> Result<Report, AppError<'t, D::Error>> {
+    let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(turn);
+    let Loaded { scene, lattice, mut scratch } = st.view().load_with(text, &LatticeConfig::default(), at)?;
     let mut tracer = Tracer::<_, _, EFFECTS>::compiled(&scene, &lattice).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
         tracer.set_effects(Effects::ALL);

@@ -23,3 +23,6 @@ pub const FRAME: Frame = Frame {
     sampling: SAMPLING,
     rows: (0, u16::MAX),
 };
+
+/// Frames per turn of the camera in orbit mode (the firmware's `orbit` feature, `host-sim orbit`).
+pub const ORBIT_FRAMES: u32 = 36;

@@ -9,7 +9,8 @@
 //!
 //! `host-sim uf2` is the first half alone: the UF2 file to drag onto a Pico in BOOTSEL mode.
 
-use crate::firmware::{elf_sizes, host_frame};
+use crate::firmware::{board_frame, elf_sizes, host_frame};
+use board_frame::ORBIT_FRAMES;
 use anyhow::{bail, Context, Result};
 use lattice_rt::BitFrame;
 use object::{Object, ObjectSymbol};
@@ -48,6 +49,28 @@ pub fn build_pico(root: &Path) -> Result<PathBuf> {
         bail!("`cargo pico-build` failed (it links with flip-link: `cargo install flip-link`)");
     }
     Ok(pico_elf(root))
+}
+
+/// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).
+const ORBIT_CHECKED: usize = 4;
+
+/// Builds the Pico image in orbit mode (`--features orbit`) with the chair alone, beside the
+/// default image (its own target folder).
+fn build_pico_orbit(root: &Path) -> Result<PathBuf> {
+    eprintln!("building the Pico image in orbit mode (cargo pico-build --features orbit, the chair alone)");
+    let dir = root.join("firmware/target/orbit");
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .args(["pico-build", "--features", "orbit", "--target-dir"])
+        .arg(&dir)
+        .env("FIRMWARE_SCENES", "chair")
+        .env_remove("RUSTFLAGS")
+        .status()
+        .context("cannot run cargo")?;
+    if !status.success() {
+        bail!("`cargo pico-build --features orbit` failed");
+    }
+    Ok(dir.join("thumbv6m-none-eabi/release/pico"))
 }
 
 /// Writes `elf` as a UF2 file for the RP2040's BOOTSEL drive (via a temporary file, so a failed
@@ -326,9 +349,34 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         ));
     }
 
+    // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
+    let orbit_elf = if no_build { root.join("firmware/target/orbit/thumbv6m-none-eabi/release/pico") } else { build_pico_orbit(root)? };
+    let orbit_dir = frames_dir.join("orbit");
+    std::fs::create_dir_all(&orbit_dir).with_context(|| format!("cannot create {}", orbit_dir.display()))?;
+    let orbit_uf2 = orbit_dir.join("lattice-rt-pico-orbit.uf2");
+    write_uf2(&orbit_elf, &orbit_uf2)?;
+    eprintln!("running {} ({ORBIT_CHECKED} frames of the chair's orbit)", orbit_uf2.display());
+    let orun = run_emulator(root, &orbit_elf, &orbit_uf2, &bootrom, ORBIT_CHECKED, true, &orbit_dir)?;
+    let chair = scenes_dir.join("chair.scene");
+    let want = crate::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &crate::load::read(&chair)?, ORBIT_FRAMES, &board_frame::FRAME)?;
+    if orun.frames.len() < ORBIT_CHECKED {
+        failures.push(format!("orbit mode: {} of {ORBIT_CHECKED} frames shown ({})", orun.frames.len(), orun.reason));
+    }
+    let mut orbit_same = 0;
+    for (i, f) in orun.frames.iter().enumerate() {
+        save_frame(&f.pixels, &orbit_dir.join(format!("chair-{i}.png")))?;
+        if want.get(i) == Some(&f.pixels) {
+            passed += 1;
+            orbit_same += 1;
+        } else {
+            failures.push(format!("orbit mode: frame {i} of the chair differs from host-sim (see {}/chair-{i}.png)", orbit_dir.display()));
+        }
+    }
+
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms };
     let profile = profile_shares(&elf, &frames_dir.join("profile.json"))?;
-    let md = report(&summary, &rows, flash, static_ram, &bare, &scenes, &profile)?;
+    let mut md = report(&summary, &rows, flash, static_ram, &bare, &scenes, &profile)?;
+    md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     crate::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     for f in &failures {
@@ -378,6 +426,21 @@ fn profile_shares(elf: &Path, samples: &Path) -> Result<Vec<(String, f64)>> {
         rows.push(("(everything else)".into(), rest));
     }
     Ok(rows)
+}
+
+/// The orbit-mode section of docs/board.md (`same`: frames bit-identical to host-sim's).
+fn orbit_report(frames: &[PanelFrame], same: usize, clk_hz: f64) -> Result<String> {
+    let mut md = String::new();
+    writeln!(md, "\n## Orbit mode\n")?;
+    writeln!(md, "The image built with `--features orbit` circles the camera around each scene, {ORBIT_FRAMES} frames per")?;
+    writeln!(md, "turn (`host-sim orbit` draws the same frames as a GIF). Built with the chair alone and run like the")?;
+    writeln!(md, "image above, {same} of its first {} frames were bit-identical to host-sim's orbit. A frame here is", frames.len())?;
+    writeln!(md, "whole: the scene parsed for the new camera, its lattice and windows built, every tile traced and sent.\n")?;
+    writeln!(md, "| frame | cycles | frames per second at {:.0} MHz |\n|---:|---:|---:|", clk_hz / 1e6)?;
+    for (i, f) in frames.iter().enumerate() {
+        writeln!(md, "| {i} | {:.1} M | {:.2} |", f.cycles as f64 / 1e6, clk_hz / f.cycles.max(1) as f64)?;
+    }
+    Ok(md)
 }
 
 /// Clock and time of the run with the display.

@@ -152,7 +152,7 @@ enum Command {
         #[arg(short, long, default_value = "out/orbit.gif")]
         output: PathBuf,
         /// Frames per turn.
-        #[arg(long, default_value_t = 36)]
+        #[arg(long, default_value_t = firmware::board_frame::ORBIT_FRAMES)]
         frames: u32,
     },
     /// Flicker of each dither while the camera orbits the scenes: docs/motion.md.

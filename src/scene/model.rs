@@ -71,6 +71,10 @@ impl CameraDesc {
     /// point it looks at (the line along `up`): the eye keeps its height and distance, and still
     /// looks at `look`. Frames of an orbit.
     pub fn orbit(&self, turn: f64) -> CameraDesc {
+        if turn == 0.0 {
+            // Exactly the scene's camera (look + (eye - look) may round).
+            return *self;
+        }
         let (sin, cos) = libm::sincos(turn * 2.0 * core::f64::consts::PI);
         let axis = self.up.normalize();
         let v = self.eye - self.look;

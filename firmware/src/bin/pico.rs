@@ -18,7 +18,9 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-use firmware::app::{render_scene, Scalar, Storage, HEIGHT, SCENES, WIDTH};
+#[cfg(feature = "orbit")]
+use firmware::app::ORBIT_FRAMES;
+use firmware::app::{render_scene_at, Scalar, Storage, HEIGHT, SCENES, WIDTH};
 use firmware::stack;
 use hal::fugit::RateExtU32;
 use hal::Clock;
@@ -195,11 +197,35 @@ fn main() -> ! {
     let mut target = PageTiles { display };
     let mut st = Storage::<Scalar>::new();
     defmt::info!("lattice-rt on the Pico: {} scenes, {}x{}, {} MHz", SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz());
+    #[cfg(feature = "orbit")]
+    loop {
+        // Orbit mode: the camera circles each scene, frame after frame, for one turn.
+        for (name, text) in SCENES {
+            let t0 = timer.get_counter();
+            for i in 0..ORBIT_FRAMES {
+                let _ = led.set_high();
+                let result = render_scene_at(text, &mut st, &mut target, &mut NoHooks, i as f64 / ORBIT_FRAMES as f64);
+                let _ = led.set_low();
+                if let Err(e) = result {
+                    defmt::error!("{}: orbit frame {}: {}", name, i, e);
+                    break;
+                }
+            }
+            let us = (timer.get_counter() - t0).to_micros().max(1);
+            let centi_fps = ORBIT_FRAMES as u64 * 100_000_000 / us;
+            defmt::info!(
+                "{}: orbit of {} frames in {} ms: {}.{=u64:02} frames per second, stack high-water {} B",
+                name, ORBIT_FRAMES, us / 1000, centi_fps / 100, centi_fps % 100, stack::high_water()
+            );
+            sleep_ms(&mut alarm, PAUSE_MS);
+        }
+    }
+    #[cfg(not(feature = "orbit"))]
     loop {
         for (name, text) in SCENES {
             let t0 = timer.get_counter();
             let _ = led.set_high();
-            let result = render_scene(text, &mut st, &mut target, &mut NoHooks);
+            let result = render_scene_at(text, &mut st, &mut target, &mut NoHooks, 0.0);
             let _ = led.set_low();
             match result {
                 Ok(r) => {
