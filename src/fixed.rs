@@ -92,6 +92,10 @@ impl Div for Fx {
                     q
                 }
             }
+        } else if b.is_power_of_two() {
+            // A power of two (an eye ray's window size): a rounded shift, the same quotient.
+            let s = b.trailing_zeros() - FRAC;
+            (a >> s) + ((a >> (s - 1)) & 1)
         } else {
             // A divisor of 2^23 or more: the quotient is below 2^24 and its 16 fraction bits
             // come by restoring long division in base 2, in 32 bits (the remainder stays
@@ -284,6 +288,20 @@ mod tests {
             let q = q.min(i32::MAX as i64);
             let want = if (a < 0) != (b < 0) { -q } else { q } as i32;
             assert_eq!((Fx(a) / Fx(b)).0, want, "{a} / {b}");
+        }
+    }
+
+    #[test]
+    fn divide_by_large_powers_of_two_matches_the_wide_quotient() {
+        for k in 23..31 {
+            for a in [0, 1, 3, 0x7f, 0x80, 0x81, 0xffff, 0x1_0000, 0x12_3456, 0x7fff_ffff, -1, -0x80, -0x81, -0x7fff_ffff] {
+                for b in [1i32 << k, -(1i32 << k)] {
+                    let (n, d) = ((a as i64).abs() << 16, (b as i64).abs());
+                    let q = if (n % d) * 2 >= d { n / d + 1 } else { n / d };
+                    let want = if (a < 0) != (b < 0) { -q } else { q } as i32;
+                    assert_eq!((Fx(a) / Fx(b)).0, want, "{a} / {b}");
+                }
+            }
         }
     }
 

@@ -41,6 +41,6 @@ pub mod sample;
 pub mod dither;
 pub use dither::Dither;
 pub mod render;
-pub use render::{render, Frame, Hooks, NoHooks, Sampling};
+pub use render::{render, render_share, Frame, Hooks, NoHooks, Sampling, Share};
 pub mod bitframe;
 pub use bitframe::BitFrame;

@@ -35,6 +35,32 @@ pub struct Frame {
     pub rows: (u16, u16),
 }
 
+/// One core's share of a frame's tiles ([`render_share`]): tile `(tx, ty)` belongs to share `(tx + ty) % of`, a
+/// checkerboard for two, so each share holds as much of every part of the picture as the
+/// others. Shares rendered apart give the pixels of the whole frame when its bands are
+/// independent ([`Frame::bands_independent`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Share {
+    /// Which share, `0..of`.
+    pub index: u8,
+    /// How many shares the frame is split into (1: the whole frame).
+    pub of: u8,
+}
+
+impl Share {
+    /// The whole frame.
+    pub const ALL: Share = Share { index: 0, of: 1 };
+
+    /// Whether tile `(tx, ty)` is in this share.
+    pub fn holds(self, tx: usize, ty: usize) -> bool {
+        (tx + ty) % self.of.max(1) as usize == self.index as usize
+    }
+
+    fn valid(self) -> bool {
+        self.index < self.of
+    }
+}
+
 impl Frame {
     /// A frame with 8x8 tiles, Bayer dithering and one ray per pixel.
     pub fn new(width: u16, height: u16) -> Self {
@@ -92,6 +118,9 @@ pub enum RenderError<E> {
         /// Entries needed.
         needed: usize,
     },
+    /// The share is not one of its frame's (`index >= of`), or the frame's tiles depend on
+    /// each other (error diffusion, edge sampling) and cannot be shared out.
+    BadShare,
 }
 
 impl<E: fmt::Debug> fmt::Display for RenderError<E> {
@@ -106,22 +135,36 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
+            RenderError::BadShare => write!(f, "tile share out of range, or the dithering carries error from tile to tile"),
         }
     }
 }
 
 /// Renders a frame tile by tile into `target`, returning the statistics.
 ///
-/// Kept out of line so the firmware report can check that nothing it calls uses floating point
-/// when the scalar is fixed point.
-///
 /// `scratch` comes from the storage the scene was loaded into ([`crate::storage`]); its rows
 /// must hold [`Frame::scratch_len`] entries (none for Bayer or patterning with one ray per
 /// pixel).
-#[inline(never)]
 pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
+    target: &mut D,
+    scratch: &mut Scratch<'_>,
+    hooks: &mut impl Hooks,
+) -> Result<Stats, RenderError<D::Error>> {
+    render_share(tracer, frame, Share::ALL, target, scratch, hooks)
+}
+
+/// [`render`] of one share of the frame's tiles (one core's, when cores split a frame; the
+/// frame stays what the picture is, the share says which of its tiles this call draws).
+///
+/// Kept out of line so the firmware report can check that nothing it calls uses floating point
+/// when the scalar is fixed point.
+#[inline(never)]
+pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+    tracer: &Tracer<'_, '_, R, A, E>,
+    frame: &Frame,
+    share: Share,
     target: &mut D,
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
@@ -134,6 +177,9 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     if frame.edges() && !cfg!(feature = "edge-sampling") {
         return Err(RenderError::EdgesNotCompiled);
     }
+    if !share.valid() || (share.of > 1 && !frame.bands_independent()) {
+        return Err(RenderError::BadShare);
+    }
     let (w, h) = (frame.width as usize, frame.height as usize);
     let too_small = || RenderError::ScratchTooSmall { needed: frame.scratch_len() };
     let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or_else(too_small)?;
@@ -144,27 +190,24 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
     let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
-    let total = (tiles_x * end.saturating_sub(first)) as u32;
+    let total = (first..end).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>() as u32;
+    let mut done = 0;
     let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
-    // Remembered occluders are forgotten at every band of tiles, so a band renders the same
-    // whichever bands a core or thread rendered before it.
-    let mut band = usize::MAX;
-    let mut shoot = |sx: usize, sy: usize| {
-        if sy / (4 * t) != band {
-            band = sy / (4 * t);
-            q.forget_occluders();
-        }
-        q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
-        let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
-        (v, id as u16)
-    };
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     for ty in first..end {
         dither.next_band();
         sampler.next_band();
-        for tx in 0..tiles_x {
+        // Remembered occluders are forgotten at every band of tiles, so a band renders the same
+        // whichever bands a core or thread rendered before it.
+        q.forget_occluders();
+        let mut shoot = |sx: usize, sy: usize| {
+            q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
+            let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
+            (v, id as u16)
+        };
+        for tx in (0..tiles_x).filter(|&tx| share.holds(tx, ty)) {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
             sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels);
@@ -172,7 +215,8 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
             target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
-            if !hooks.progress(((ty - first) * tiles_x + tx + 1) as u32, total) {
+            done += 1;
+            if !hooks.progress(done, total) {
                 return Err(RenderError::Cancelled);
             }
         }

@@ -216,6 +216,8 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     scale: R,
     /// How eye rays given a window position find their nearest hit.
     eye_rays: EyeRays,
+    /// Whether a shadow ray first tries the object that last hid its light.
+    coherence: bool,
 }
 
 /// How eye rays find their nearest hit. Every eye ray starts at the eye, and each object knows
@@ -271,6 +273,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
             cutoff: R::ZERO,
             scale: scene.world.extent(),
             eye_rays: EyeRays::for_scene(scene),
+            coherence: true,
         }
     }
 }
@@ -291,6 +294,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             cutoff: R::ZERO,
             scale: scene.world.extent(),
             eye_rays: EyeRays::for_scene(scene),
+            coherence: true,
         })
     }
 
@@ -302,6 +306,17 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// Sets how eye rays find their nearest hit (the picture is the same either way).
     pub fn set_eye_rays(&mut self, how: EyeRays) {
         self.eye_rays = how;
+    }
+
+    /// Whether shadow rays try the object that last hid their light first (on by default).
+    pub fn shadow_coherence(&self) -> bool {
+        self.coherence
+    }
+
+    /// Switches shadow-ray coherence (the picture is the same either way; off is the paper's
+    /// method as it was, for comparing).
+    pub fn set_shadow_coherence(&mut self, on: bool) {
+        self.coherence = on;
     }
 
     /// The scene traced.
@@ -461,7 +476,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             // before the accelerator (the last shadow ray towards the light was hidden by it);
             // neighbouring points in a shadow share their occluder.
             // Occlusion is a yes-or-no question, so the answer is the accelerator's.
-            if let Some(o) = q.occluder(l).and_then(|i| self.scene.objects.get(i as usize)) {
+            let last = if self.coherence { q.occluder(l) } else { None };
+            if let Some(o) = last.and_then(|i| self.scene.objects.get(i as usize)) {
                 q.stats.object_tests += 1;
                 if o.intersect(&ray, R::ZERO, reach).is_some() {
                     return R::ZERO;

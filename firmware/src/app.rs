@@ -8,9 +8,9 @@ use lattice_rt::scene::text::ParseError;
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::storage::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
-use lattice_rt::{render, Effects, LatticeConfig, Real, Stats, Tracer};
+use lattice_rt::{render_share, Effects, Frame, LatticeConfig, Real, Share, Stats, Tracer};
 
-pub use crate::frame::{FRAME, HEIGHT, ORBIT_FRAMES, WIDTH};
+pub use crate::frame::{Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
 /// The frame the firmware renders: [`FRAME`], or with the `exact-sampling` feature one eye ray
 /// per pixel.
@@ -76,6 +76,7 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Render(RenderError::Cancelled) => defmt::write!(f, "render cancelled"),
             AppError::Render(RenderError::BadTile) => defmt::write!(f, "bad tile size"),
             AppError::Render(RenderError::EdgesNotCompiled) => defmt::write!(f, "edge sampling not compiled in"),
+            AppError::Render(RenderError::BadShare) => defmt::write!(f, "bad tile share"),
             AppError::Render(RenderError::ScratchTooSmall { needed }) => {
                 defmt::write!(f, "scratch storage too small: {} entries needed", needed)
             }
@@ -101,25 +102,57 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     target: &mut D,
     hooks: &mut impl Hooks,
 ) -> Result<Report, AppError<'t, D::Error>> {
-    render_scene_at(text, st, target, hooks, 0.0)
+    render_scene_at(text, st, target, hooks, &Shot::default(), |_| {})
 }
 
-/// [`render_scene`] with the camera moved `turn` of a circle around the point it looks at
-/// (`CameraDesc::orbit`; 0 is the scene's own camera).
+/// What one frame shows and how it is traced.
+#[derive(Clone, Copy, Debug)]
+pub struct Shot {
+    /// The camera moved this much of a circle around the point it looks at
+    /// (`CameraDesc::orbit`; 0 is the scene's own camera).
+    pub turn: f64,
+    /// The levers switched on ([`TUNING`]: all; the `ladder` image steps through [`LADDER`]).
+    pub tuning: Tuning,
+}
+
+impl Default for Shot {
+    fn default() -> Self {
+        Shot { turn: 0.0, tuning: Tuning { sampling: RENDERED.sampling, ..TUNING } }
+    }
+}
+
+/// [`render_scene`] for a [`Shot`]: the frame is rendered in [`SHARES`] tile shares, one after
+/// the other; `mark(i)` is called as share `i` starts, and `mark(SHARES)` when the last is done
+/// (to time each core's share where one core renders them all).
 pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     text: &'t str,
     st: &mut Storage<R>,
     target: &mut D,
     hooks: &mut impl Hooks,
-    turn: f64,
+    shot: &Shot,
+    mut mark: impl FnMut(u8),
 ) -> Result<Report, AppError<'t, D::Error>> {
-    let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(turn);
+    let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
     let Loaded { scene, lattice, mut scratch } = st.view().load_with(text, &LatticeConfig::default(), at)?;
     let mut tracer = Tracer::<_, _, EFFECTS>::compiled(&scene, &lattice).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
         tracer.set_effects(Effects::ALL);
     }
-    let stats = render(&tracer, &RENDERED, target, &mut scratch, hooks).map_err(AppError::Render)?;
+    if let Some(how) = shot.tuning.eye_rays {
+        tracer.set_eye_rays(how);
+    }
+    tracer.set_shadow_coherence(shot.tuning.shadow_coherence);
+    let tuned = Frame { sampling: shot.tuning.sampling, ..RENDERED };
+    // Every image but the ladder renders the constant RENDERED, whose sizes the compiler folds
+    // into the render loop (a division by the window's size becomes a shift).
+    let frame = if cfg!(feature = "ladder") { &tuned } else { &RENDERED };
+    let mut stats = Stats::default();
+    for index in 0..SHARES {
+        mark(index);
+        let share = Share { index, of: SHARES };
+        stats.add(&render_share(&tracer, frame, share, target, &mut scratch, hooks).map_err(AppError::Render)?);
+    }
+    mark(SHARES);
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes() })
 }
 

@@ -1,7 +1,7 @@
 //! The frame every board renders (also read by `build.rs`, which sizes the storage for it).
 
 use lattice_rt::render::Sampling;
-use lattice_rt::{Dither, Frame};
+use lattice_rt::{Dither, EyeRays, Frame};
 
 /// Display width (SSD1306 128x64).
 pub const WIDTH: u16 = 128;
@@ -26,3 +26,33 @@ pub const FRAME: Frame = Frame {
 
 /// Frames per turn of the camera in orbit mode (the firmware's `orbit` feature, `host-sim orbit`).
 pub const ORBIT_FRAMES: u32 = 36;
+
+/// How a frame is traced: the real-time levers that can be switched at run time, so one image
+/// measures them one by one (the `ladder` feature) with every frame still checked against
+/// host-sim.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tuning {
+    /// How eye rays find their hit (`None`: the scene's default, `EyeRays::for_scene`).
+    pub eye_rays: Option<EyeRays>,
+    /// Shadow rays try the object that last hid their light first.
+    pub shadow_coherence: bool,
+    /// Eye rays per pixel.
+    pub sampling: Sampling,
+}
+
+/// What the boards run: every lever on.
+pub const TUNING: Tuning = Tuning { eye_rays: None, shadow_coherence: true, sampling: SAMPLING };
+
+/// The ladder of the real-time work, from the paper's method to what the boards run, one lever
+/// added per rung (docs/board.md, written by `host-sim board` from the `ladder` image).
+pub const LADDER: [(&str, Tuning); 5] = [
+    ("the paper's nested lattice, one ray per pixel", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: false, sampling: Sampling::Center }),
+    ("+ shadow rays try the last occluder first", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, sampling: Sampling::Center }),
+    ("+ eye windows: the walk skips objects whose window misses the eye ray", Tuning { eye_rays: Some(EyeRays::Accelerator), shadow_coherence: true, sampling: Sampling::Center }),
+    ("+ eye rays and first-light shadow rays by windows alone, no walk", Tuning { eye_rays: Some(EyeRays::Windows), shadow_coherence: true, sampling: Sampling::Center }),
+    ("+ adaptive sub-sampling (the boards' default)", TUNING),
+];
+
+/// Tile shares a frame is rendered in (`Share`): one per RP2040 core. Where only one core runs
+/// (the emulator), core 0 renders both, one after the other, and logs each share's time.
+pub const SHARES: u8 = 2;

@@ -10,7 +10,7 @@
 //! `host-sim uf2` is the first half alone: the UF2 file to drag onto a Pico in BOOTSEL mode.
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
-use board_frame::ORBIT_FRAMES;
+use board_frame::{LADDER, ORBIT_FRAMES};
 use anyhow::{bail, Context, Result};
 use lattice_rt::BitFrame;
 use object::{Object, ObjectSymbol};
@@ -33,7 +33,7 @@ const NO_DISPLAY_MESSAGE: &str = "no SSD1306 answers on I2C0";
 
 /// Where the image `cargo pico-build` writes.
 fn pico_elf(root: &Path) -> PathBuf {
-    root.join("firmware/target/thumbv6m-none-eabi/release/pico")
+    pico_elf_in(&root.join("firmware/target"))
 }
 
 /// Builds the Pico image with the repository's own alias, so it is the image `cargo pico` flashes.
@@ -54,23 +54,28 @@ pub fn build_pico(root: &Path) -> Result<PathBuf> {
 /// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).
 const ORBIT_CHECKED: usize = 4;
 
-/// Builds the Pico image in orbit mode (`--features orbit`) with the chair alone, beside the
-/// default image (its own target folder).
-fn build_pico_orbit(root: &Path) -> Result<PathBuf> {
-    eprintln!("building the Pico image in orbit mode (cargo pico-build --features orbit, the chair alone)");
-    let dir = root.join("firmware/target/orbit");
+/// Builds the Pico image with an extra `feature` and the chair alone, beside the default image
+/// (its own target folder, `firmware/target/<feature>`).
+fn build_pico_with(root: &Path, feature: &str) -> Result<PathBuf> {
+    eprintln!("building the Pico image with `{feature}` (cargo pico-build --features {feature}, the chair alone)");
+    let dir = root.join("firmware/target").join(feature);
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .current_dir(root)
-        .args(["pico-build", "--features", "orbit", "--target-dir"])
+        .args(["pico-build", "--features", feature, "--target-dir"])
         .arg(&dir)
         .env("FIRMWARE_SCENES", "chair")
         .env_remove("RUSTFLAGS")
         .status()
         .context("cannot run cargo")?;
     if !status.success() {
-        bail!("`cargo pico-build --features orbit` failed");
+        bail!("`cargo pico-build --features {feature}` failed");
     }
-    Ok(dir.join("thumbv6m-none-eabi/release/pico"))
+    Ok(pico_elf_in(&dir))
+}
+
+/// The image in target folder `dir`.
+fn pico_elf_in(dir: &Path) -> PathBuf {
+    dir.join("thumbv6m-none-eabi/release/pico")
 }
 
 /// Writes `elf` as a UF2 file for the RP2040's BOOTSEL drive (via a temporary file, so a failed
@@ -350,7 +355,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
 
     // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
-    let orbit_elf = if no_build { root.join("firmware/target/orbit/thumbv6m-none-eabi/release/pico") } else { build_pico_orbit(root)? };
+    let orbit_elf = if no_build { pico_elf_in(&root.join("firmware/target/orbit")) } else { build_pico_with(root, "orbit")? };
     let orbit_dir = frames_dir.join("orbit");
     std::fs::create_dir_all(&orbit_dir).with_context(|| format!("cannot create {}", orbit_dir.display()))?;
     let orbit_uf2 = orbit_dir.join("lattice-rt-pico-orbit.uf2");
@@ -373,10 +378,38 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         }
     }
 
+    // The ladder: the chair once per rung, each frame bit for bit against host-sim's.
+    let ladder_elf = if no_build { pico_elf_in(&root.join("firmware/target/ladder")) } else { build_pico_with(root, "ladder")? };
+    let ladder_dir = frames_dir.join("ladder");
+    std::fs::create_dir_all(&ladder_dir).with_context(|| format!("cannot create {}", ladder_dir.display()))?;
+    let ladder_uf2 = ladder_dir.join("lattice-rt-pico-ladder.uf2");
+    write_uf2(&ladder_elf, &ladder_uf2)?;
+    eprintln!("running {} (the chair once per rung of the ladder)", ladder_uf2.display());
+    let lrun = run_emulator(root, &ladder_elf, &ladder_uf2, &bootrom, LADDER.len(), true, &ladder_dir)?;
+    if lrun.frames.len() < LADDER.len() {
+        failures.push(format!("ladder: {} of {} frames shown ({})", lrun.frames.len(), LADDER.len(), lrun.reason));
+    }
+    let mut rungs = Vec::new();
+    for (i, f) in lrun.frames.iter().enumerate() {
+        let Some((what, tuning)) = LADDER.get(i) else { break };
+        save_frame(&f.pixels, &ladder_dir.join(format!("chair-{i}.png")))?;
+        let want = ladder_frame(&chair, tuning)?;
+        if want == f.pixels {
+            passed += 1;
+        } else {
+            failures.push(format!("ladder rung {i} ({what}): the chair differs from host-sim (see {}/chair-{i}.png)", ladder_dir.display()));
+        }
+        match logged_rung(&lrun.log, i) {
+            Some((shares, tests)) => rungs.push(Rung { what, frame: f, shares, tests }),
+            None => failures.push(format!("ladder rung {i}: the device logged no share times")),
+        }
+    }
+
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms };
     let profile = profile_shares(&elf, &frames_dir.join("profile.json"))?;
     let mut md = report(&summary, &rows, flash, static_ram, &bare, &scenes, &profile)?;
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
+    md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
     crate::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     for f in &failures {
@@ -439,6 +472,80 @@ fn orbit_report(frames: &[PanelFrame], same: usize, clk_hz: f64) -> Result<Strin
     writeln!(md, "| frame | cycles | frames per second at {:.0} MHz |\n|---:|---:|---:|", clk_hz / 1e6)?;
     for (i, f) in frames.iter().enumerate() {
         writeln!(md, "| {i} | {:.1} M | {:.2} |", f.cycles as f64 / 1e6, clk_hz / f.cycles.max(1) as f64)?;
+    }
+    Ok(md)
+}
+
+/// One rung of the ladder as the board ran it.
+struct Rung<'f> {
+    what: &'static str,
+    frame: &'f PanelFrame,
+    /// Microseconds of each tile share, as the device logged them.
+    shares: [u64; 2],
+    /// Object tests of the frame, as the device logged them.
+    tests: u64,
+}
+
+/// The host's frame of the chair traced with a rung's levers.
+fn ladder_frame(chair: &Path, tuning: &board_frame::Tuning) -> Result<Vec<u8>> {
+    let frame = lattice_rt::Frame { sampling: tuning.sampling, ..board_frame::FRAME };
+    let text = crate::load::read(chair)?;
+    Ok(crate::run::render_text::<lattice_rt::Fx>(chair, &text, &frame, |t| {
+        if let Some(how) = tuning.eye_rays {
+            t.set_eye_rays(how);
+        }
+        t.set_shadow_coherence(tuning.shadow_coherence);
+    })?
+    .bits)
+}
+
+/// The tile shares' microseconds and the object tests the ladder image logged for rung `i`.
+fn logged_rung(log: &[LogLine], i: usize) -> Option<([u64; 2], u64)> {
+    let line = log.iter().find(|l| l.text.starts_with(&format!("ladder {i}:")))?;
+    let rest = line.text.split("shares ").nth(1)?;
+    // "A us and B us, object tests T, ..."
+    let mut nums = rest.split(|c: char| !c.is_ascii_digit()).filter(|w| !w.is_empty()).map(|w| w.parse::<u64>().ok());
+    Some(([nums.next()??, nums.next()??], nums.next()??))
+}
+
+/// The ladder section of docs/board.md.
+fn ladder_report(rungs: &[Rung<'_>], clk_hz: f64) -> Result<String> {
+    let mut md = String::new();
+    let mhz = clk_hz / 1e6;
+    writeln!(md, "\n## The ladder: what each lever gave\n")?;
+    writeln!(md, "The image built with `--features ladder` (the chair alone) renders the chair once per rung of")?;
+    writeln!(md, "`LADDER` (`firmware/src/frame.rs`), from the paper's method to what the boards run, each rung")?;
+    writeln!(md, "switching one more lever on at run time; every frame is checked bit for bit against host-sim's")?;
+    writeln!(md, "render with the same levers. *Tiles* are cycles from the first byte of the first tile on the")?;
+    writeln!(md, "bus to the LED going out, as above (target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz).")?;
+    writeln!(md, "The frame is traced in two tile shares, a checkerboard of tiles, one per RP2040 core. rp2040js")?;
+    writeln!(md, "runs core 0 only, so core 0 renders both shares one after the other and times each with the")?;
+    writeln!(md, "RP2040 timer (1 us, {mhz:.0} cycles); *two cores* is the larger share's cycles, what the frame")?;
+    writeln!(md, "would take with each core rendering its own share (set-up and the display's I2C traffic not")?;
+    writeln!(md, "included; core 1 is not emulated, so this is the method, not a measurement of two cores).\n")?;
+    writeln!(md, "| rung | tiles: cycles | instructions | object tests | share 0 | share 1 | two cores | fps at {mhz:.0} MHz, one core / two |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|")?;
+    let mut first = None;
+    for r in rungs {
+        let f = r.frame;
+        let tiles = f.cycles - f.setup_cycles;
+        let base = *first.get_or_insert(tiles);
+        let [a, b] = r.shares.map(|us| us as f64 * mhz);
+        let two = a.max(b);
+        writeln!(
+            md,
+            "| {} | {:.1} M ({:.1}x) | {:.1} M | {} | {:.1} M | {:.1} M | {:.1} M | {:.2} / {:.2} |",
+            r.what,
+            tiles as f64 / 1e6,
+            base as f64 / tiles.max(1) as f64,
+            (f.instructions - f.setup_instructions) as f64 / 1e6,
+            r.tests,
+            a / 1e6,
+            b / 1e6,
+            two / 1e6,
+            clk_hz / f.cycles.max(1) as f64,
+            clk_hz / (f.setup_cycles as f64 + two).max(1.0),
+        )?;
     }
     Ok(md)
 }

@@ -375,7 +375,7 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     // No floating point per ray in the fixed-point build.
     if let Some(v) = variants.iter().find(|v| v.name == "qemu-m0-fixed") {
         let (reached, setup) = float_audit(&elf_path(root, v))?;
-        writeln!(md, "\n## Fixed point uses no floating point per ray\n\nChecked on the disassembly of `{}` (call graph from `llvm-objdump`): soft-float routines\nreachable from `lattice_rt::render::render`: {}.", v.name, if reached.is_empty() { "none".to_string() } else { reached.join(", ") })?;
+        writeln!(md, "\n## Fixed point uses no floating point per ray\n\nChecked on the disassembly of `{}` (call graph from `llvm-objdump`): soft-float routines\nreachable from `lattice_rt::render::render_share`: {}.", v.name, if reached.is_empty() { "none".to_string() } else { reached.join(", ") })?;
         writeln!(md, "Functions that do call soft-float routines (scene set-up: parsing, transforms, lattice\nresolution, reports): {}.", setup.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", "))?;
         if reached.is_empty() {
             passed += 1;
@@ -435,7 +435,7 @@ fn call_graph(elf: &Path) -> Result<std::collections::HashMap<String, std::colle
     Ok(graph)
 }
 
-/// Soft-float routines reachable from the renderer (`lattice_rt::render::render`), with the
+/// Soft-float routines reachable from the renderer (`lattice_rt::render::render_share` and `render`), with the
 /// path that reaches each, and all soft-float call sites outside it (set-up code).
 pub fn float_audit(elf: &Path) -> Result<(Vec<String>, Vec<String>)> {
     let graph = call_graph(elf)?;

@@ -18,9 +18,12 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
+#[cfg(feature = "ladder")]
+use firmware::app::LADDER;
 #[cfg(feature = "orbit")]
 use firmware::app::ORBIT_FRAMES;
-use firmware::app::{render_scene_at, Scalar, Storage, HEIGHT, SCENES, WIDTH};
+use firmware::app::{render_scene_at, Scalar, Shot, Storage, HEIGHT, SCENES, SHARES, WIDTH};
+#[cfg(not(feature = "ladder"))]
 use firmware::stack;
 use hal::fugit::RateExtU32;
 use hal::Clock;
@@ -197,16 +200,46 @@ fn main() -> ! {
     let mut target = PageTiles { display };
     let mut st = Storage::<Scalar>::new();
     defmt::info!("lattice-rt on the Pico: {} scenes, {}x{}, {} MHz", SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz());
-    #[cfg(feature = "orbit")]
+    // One frame: the LED lit while it renders, each tile share timed.
+    let mut show = |text: &'static str, shot: &Shot| {
+        let mut shares = [0u64; SHARES as usize];
+        let t0 = timer.get_counter();
+        let mut t = t0;
+        let _ = led.set_high();
+        let result = render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, |i| {
+            // Share i starts: share i - 1 took the time since the last mark.
+            let now = timer.get_counter();
+            if let Some(prev) = (i as usize).checked_sub(1).and_then(|p| shares.get_mut(p)) {
+                *prev = (now - t).to_micros();
+            }
+            t = now;
+        });
+        let _ = led.set_low();
+        result.map(|r| (r, (timer.get_counter() - t0).to_micros(), shares))
+    };
+    #[cfg(feature = "ladder")]
+    loop {
+        // The ladder: the first scene once per rung, from the paper's method to the default.
+        let (name, text) = SCENES[0];
+        for (rung, (what, tuning)) in LADDER.iter().enumerate() {
+            match show(text, &Shot { turn: 0.0, tuning: *tuning }) {
+                Ok((r, us, shares)) => defmt::info!(
+                    "ladder {}: {}: {} us, shares {} us and {} us, object tests {}, cells {} ({})",
+                    rung, name, us, shares[0], shares[1], r.stats.object_tests, r.stats.cells_visited, what
+                ),
+                Err(e) => defmt::error!("ladder {}: {}: {}", rung, name, e),
+            }
+        }
+        sleep_ms(&mut alarm, PAUSE_MS);
+    }
+    #[cfg(all(feature = "orbit", not(feature = "ladder")))]
     loop {
         // Orbit mode: the camera circles each scene, frame after frame, for one turn.
         for (name, text) in SCENES {
             let t0 = timer.get_counter();
             for i in 0..ORBIT_FRAMES {
-                let _ = led.set_high();
-                let result = render_scene_at(text, &mut st, &mut target, &mut NoHooks, i as f64 / ORBIT_FRAMES as f64);
-                let _ = led.set_low();
-                if let Err(e) = result {
+                let shot = Shot { turn: i as f64 / ORBIT_FRAMES as f64, ..Shot::default() };
+                if let Err(e) = show(text, &shot) {
                     defmt::error!("{}: orbit frame {}: {}", name, i, e);
                     break;
                 }
@@ -220,20 +253,15 @@ fn main() -> ! {
             sleep_ms(&mut alarm, PAUSE_MS);
         }
     }
-    #[cfg(not(feature = "orbit"))]
+    #[cfg(not(any(feature = "orbit", feature = "ladder")))]
     loop {
         for (name, text) in SCENES {
-            let t0 = timer.get_counter();
-            let _ = led.set_high();
-            let result = render_scene_at(text, &mut st, &mut target, &mut NoHooks, 0.0);
-            let _ = led.set_low();
-            match result {
-                Ok(r) => {
-                    let ms = (timer.get_counter() - t0).to_millis();
+            match show(text, &Shot::default()) {
+                Ok((r, us, shares)) => {
                     let s = r.stats;
                     defmt::info!(
-                        "{}: {} ms, rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
-                        name, ms, s.total_rays(), s.rays[1], s.rays[2], s.rays[3], s.object_tests, s.cells_visited,
+                        "{}: {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
+                        name, us / 1000, shares[0], shares[1], s.total_rays(), s.rays[1], s.rays[2], s.rays[3], s.object_tests, s.cells_visited,
                         r.lattice_bytes, stack::high_water()
                     );
                 }

@@ -1,0 +1,98 @@
+//! A frame split into tile shares (one per core) gives, share by share, the pixels of the whole
+//! frame; frames whose tiles depend on each other refuse to be split. Switching shadow-ray
+//! coherence off (the paper's method as it was) changes work, never a pixel.
+
+mod common;
+use common::*;
+use lattice_rt::render::RenderError;
+use lattice_rt::scene::Object;
+use lattice_rt::{parse, render, render_share, BitFrame, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
+
+/// Renders `name` into a fresh 1-bit frame for each frame in `frames`, all into one bitmap.
+fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
+    let text = scene_text(name);
+    let mut storage = vec![Object::<R>::default(); 64];
+    let scene = parse::<R>(&text, &mut storage).unwrap();
+    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
+    let mut tracer = Tracer::new(&scene, &lat);
+    tracer.set_shadow_coherence(coherence);
+    let (w, h) = (frames[0].0.width as u32, frames[0].0.height as u32);
+    let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+    let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+    let mut stats = Stats::default();
+    for (f, share) in frames {
+        let mut scratch = HeapScratch::new(&scene, f);
+        let s = render_share(&tracer, f, *share, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
+        stats.object_tests += s.object_tests;
+        stats.rays[0] += s.rays[0];
+    }
+    (bits, stats)
+}
+
+fn shares_of(frame: Frame, of: u8) -> Vec<(Frame, Share)> {
+    (0..of).map(|index| (frame, Share { index, of })).collect()
+}
+
+#[test]
+fn shares_rendered_apart_give_the_whole_frame() {
+    for name in ["chair", "spheres", "whitted"] {
+        for sampling in [Sampling::Center, Sampling::Adaptive { contrast: 4 }] {
+            // 100x60: the last tile column and row are partial.
+            let frame = Frame { sampling, ..Frame::new(100, 60) };
+            let (whole, ws) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
+            for of in [2, 3] {
+                let (split, ss) = render_into::<Fx>(name, &shares_of(frame, of), true);
+                assert_eq!(whole, split, "{name}, {sampling:?}, {of} shares");
+                assert_eq!(ws.rays[0], ss.rays[0], "{name}, {sampling:?}: every eye ray traced once");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_share_holds_a_checkerboard_of_tiles() {
+    let (a, b) = (Share { index: 0, of: 2 }, Share { index: 1, of: 2 });
+    for ty in 0..8 {
+        for tx in 0..16 {
+            assert!(a.holds(tx, ty) != b.holds(tx, ty));
+            assert_eq!(a.holds(tx, ty), (tx + ty) % 2 == 0);
+        }
+    }
+    assert!(Share::ALL.holds(5, 3));
+}
+
+#[test]
+fn frames_that_carry_error_between_tiles_or_bad_shares_are_refused() {
+    let text = scene_text("chair");
+    let mut storage = vec![Object::<f64>::default(); 64];
+    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let tracer = Tracer::new(&scene, &lattice_rt::BruteForce);
+    let mut bits = vec![0u8; BitFrame::bytes(64, 32)];
+    let mut target = BitFrame::new(64, 32, &mut bits).unwrap();
+    let refused = [
+        (Frame { dither: Dither::FloydSteinberg, ..Frame::new(64, 32) }, Share { index: 0, of: 2 }),
+        (Frame::new(64, 32), Share { index: 2, of: 2 }),
+        (Frame::new(64, 32), Share { index: 0, of: 0 }),
+    ];
+    for (f, share) in refused {
+        let mut scratch = HeapScratch::new(&scene, &f);
+        let r = render_share(&tracer, &f, share, &mut target, &mut scratch.scratch(), &mut NoHooks);
+        assert!(matches!(r, Err(RenderError::BadShare)), "{f:?}, {share:?}: {r:?}");
+    }
+    // Error diffusion over the whole frame is fine.
+    let f = Frame { dither: Dither::FloydSteinberg, ..Frame::new(64, 32) };
+    let mut scratch = HeapScratch::new(&scene, &f);
+    assert!(render(&tracer, &f, &mut target, &mut scratch.scratch(), &mut NoHooks).is_ok());
+}
+
+#[test]
+fn shadow_coherence_changes_work_not_pixels() {
+    for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
+        let frame = Frame::new(96, 48);
+        let (with, ws) = render_into::<f64>(name, &[(frame, Share::ALL)], true);
+        let (without, wo) = render_into::<f64>(name, &[(frame, Share::ALL)], false);
+        assert_eq!(with, without, "{name}");
+        assert!(ws.object_tests <= wo.object_tests, "{name}: {} tests with coherence, {} without", ws.object_tests, wo.object_tests);
+    }
+}
