@@ -266,9 +266,47 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
         let (t, tests, cells) = per_ray(&scene, &lat, &rays, runs);
         writeln!(md, "| {label} | {} | {:.3} | {tests:.2} | {cells:.1} | {} |", lat.cell_count(), t.as_secs_f64() * 1e6, lat.bytes())?;
     }
-    writeln!(md, "\n![time per ray against N]({})", plot_link(out, plot))?;
+    writeln!(md, "\n![time per ray against N]({})\n", plot_link(out, plot))?;
+    md.push_str(&against_povray(quick, runs)?);
     crate::plot::loglog(plot, "Time per ray against scene size", "primitives N", "microseconds per ray", &series)?;
     write_atomic(out, md.as_bytes())?;
     println!("wrote {} and {}", out.display(), plot.display());
     Ok(())
+}
+
+/// The POV-Ray section: the paper scenes and generated scenes of 100, 1 000 and 10 000
+/// primitives (1 000 at most with `quick`), random and clustered, with and without shadows.
+fn against_povray(quick: bool, runs: usize) -> Result<String> {
+    if !crate::versus::available() {
+        eprintln!("povray is not installed: the POV-Ray comparison is left out (apt-get install povray)");
+        return Ok("## Against POV-Ray 3.7\n\nLeft out: `povray` was not installed when this was written.\n".into());
+    }
+    let work = Path::new("target/povray-bench");
+    let cfg = LatticeConfig::default();
+    let mut rows = Vec::new();
+    let sizes: &[usize] = if quick { &[100, 1000] } else { &[100, 1000, 10_000] };
+    let bar = crate::progress::bar(PAPER.len() + 2 * sizes.len(), "against POV-Ray");
+    for (name, ..) in PAPER {
+        let path = Path::new("scenes").join(format!("{name}.scene"));
+        let text = read(&path)?;
+        let mut storage = object_storage::<f64>(&text)?;
+        let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
+        let mut bufs = lattice_storage(&scene, &cfg)?;
+        let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+        rows.extend(crate::versus::compare(name, &scene, &lattice, runs, work)?);
+        bar.inc(1);
+    }
+    for clustered in [false, true] {
+        for &n in sizes {
+            let mut storage = Vec::new();
+            let scene = generated(n, clustered, &mut storage)?;
+            let mut bufs = lattice_storage(&scene, &cfg)?;
+            let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+            let name = format!("{} {n}", if clustered { "clustered" } else { "random" });
+            rows.extend(crate::versus::compare(&name, &scene, &lattice, runs, work)?);
+            bar.inc(1);
+            crate::progress::log(&bar, format_args!("  {name} against POV-Ray done"));
+        }
+    }
+    crate::versus::section(&rows, runs)
 }

@@ -14,6 +14,7 @@ mod output;
 mod plot;
 mod run;
 mod tradeoff;
+mod versus;
 
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand, ValueEnum};
