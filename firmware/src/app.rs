@@ -93,6 +93,8 @@ pub struct Report {
     pub objects: usize,
     /// Bytes of the built lattice.
     pub lattice_bytes: usize,
+    /// Microseconds each tile share took (by the clock given to [`render_scene_at`]).
+    pub share_us: [u64; 2],
 }
 
 /// Parses `text`, builds its lattice and renders [`RENDERED`] into `target`, tile by tile.
@@ -102,7 +104,8 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     target: &mut D,
     hooks: &mut impl Hooks,
 ) -> Result<Report, AppError<'t, D::Error>> {
-    render_scene_at(text, st, target, hooks, &Shot::default(), |_| {})
+    let mut second = ShareMemory::new();
+    render_scene_at(text, st, target, hooks, &Shot::default(), &mut OneCore, &mut second, &|| 0)
 }
 
 /// What one frame shows and how it is traced.
@@ -121,16 +124,61 @@ impl Default for Shot {
     }
 }
 
-/// [`render_scene`] for a [`Shot`]: the frame is rendered in [`SHARES`] tile shares, one after
-/// the other; `mark(i)` is called as share `i` starts, and `mark(SHARES)` when the last is done
-/// (to time each core's share where one core renders them all).
+/// Runs two pieces of work, on two cores where there are two.
+pub trait Cores {
+    /// Runs `there` on the other core while `here` runs on this one and returns when both are
+    /// done; with one core, `here` and then `there`.
+    fn join(&mut self, there: &mut (dyn FnMut() + Send), here: &mut dyn FnMut());
+}
+
+/// One core does all the work: [`Cores::join`] runs both pieces in turn.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct OneCore;
+
+impl Cores for OneCore {
+    fn join(&mut self, there: &mut (dyn FnMut() + Send), here: &mut dyn FnMut()) {
+        here();
+        there();
+    }
+}
+
+/// Pixels in [`RENDERED`].
+const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
+
+/// The memory of the second tile share: its own query scratch and a 1-bit frame its tiles are
+/// drawn into (the display is core 0's), sent to the display when the share is done.
+pub struct ShareMemory {
+    mailbox: [u32; MAX_OBJECTS + MAX_LATTICES],
+    rows: [i16; MAX_ROWS],
+    bits: [u8; PIXELS / 8],
+}
+
+impl ShareMemory {
+    /// Zeroed memory.
+    pub const fn new() -> Self {
+        ShareMemory { mailbox: [0; MAX_OBJECTS + MAX_LATTICES], rows: [0; MAX_ROWS], bits: [0; PIXELS / 8] }
+    }
+}
+
+impl Default for ShareMemory {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// [`render_scene`] for a [`Shot`], in [`SHARES`] tile shares: share 0 drawn straight to
+/// `target` by this core, share 1 traced by `cores`' other core into `second`'s frame and sent
+/// to `target` after. `now` reads a microsecond clock (from either core) to time each share.
+#[allow(clippy::too_many_arguments)]
 pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     text: &'t str,
     st: &mut Storage<R>,
     target: &mut D,
     hooks: &mut impl Hooks,
     shot: &Shot,
-    mut mark: impl FnMut(u8),
+    cores: &mut impl Cores,
+    second: &mut ShareMemory,
+    now: &(dyn Fn() -> u64 + Sync),
 ) -> Result<Report, AppError<'t, D::Error>> {
     let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
     let Loaded { scene, lattice, mut scratch } = st.view().load_with(text, &LatticeConfig::default(), at)?;
@@ -144,16 +192,68 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     tracer.set_shadow_coherence(shot.tuning.shadow_coherence);
     let tuned = Frame { sampling: shot.tuning.sampling, ..RENDERED };
     // Every image but the ladder renders the constant RENDERED, whose sizes the compiler folds
-    // into the render loop (a division by the window's size becomes a shift).
-    let frame = if cfg!(feature = "ladder") { &tuned } else { &RENDERED };
-    let mut stats = Stats::default();
-    for index in 0..SHARES {
-        mark(index);
-        let share = Share { index, of: SHARES };
-        stats.add(&render_share(&tracer, frame, share, target, &mut scratch, hooks).map_err(AppError::Render)?);
+    // into the render loop (a division by the window's size becomes a shift); named in each
+    // closure below, so that no call passes it through a closure's captures.
+    let pick = |tuned| if cfg!(feature = "ladder") { tuned } else { &RENDERED };
+    let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
+    let tracer = &tracer;
+    let ShareMemory { mailbox, rows, bits } = second;
+    let (mut there_result, mut here_result) = (None, None);
+    let mut times = [0u64; 2];
+    let [there_us, here_us] = &mut times;
+    cores.join(
+        &mut || {
+            let t0 = now();
+            let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
+            let result = match lattice_rt::BitFrame::wrap(WIDTH as u32, HEIGHT as u32, &mut bits[..]) {
+                Some(mut frame_bits) => render_share(tracer, pick(&tuned), other, &mut frame_bits, &mut scratch, &mut lattice_rt::NoHooks),
+                None => Err(RenderError::BadTile),
+            };
+            there_result = Some(result);
+            *there_us = now() - t0;
+        },
+        &mut || {
+            let t0 = now();
+            here_result = Some(render_share(tracer, pick(&tuned), first, target, &mut scratch, hooks));
+            *here_us = now() - t0;
+        },
+    );
+    let mut stats = here_result.unwrap_or(Err(RenderError::Cancelled)).map_err(AppError::Render)?;
+    let more = there_result.unwrap_or(Err(RenderError::Cancelled));
+    stats.add(&more.map_err(|e| AppError::Render(widen(e)))?);
+    send_share(bits, pick(&tuned), other, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
+    Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
+}
+
+/// An error of a render into memory (which cannot fail to draw) as one of any target.
+fn widen<E>(e: RenderError<core::convert::Infallible>) -> RenderError<E> {
+    match e {
+        RenderError::Draw(never) => match never {},
+        RenderError::Cancelled => RenderError::Cancelled,
+        RenderError::BadTile => RenderError::BadTile,
+        RenderError::EdgesNotCompiled => RenderError::EdgesNotCompiled,
+        RenderError::ScratchTooSmall { needed } => RenderError::ScratchTooSmall { needed },
+        RenderError::BadShare => RenderError::BadShare,
     }
-    mark(SHARES);
-    Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes() })
+}
+
+/// Sends the tiles of `share`, drawn into the 1-bit frame `bits`, to `target`, one tile at a time.
+fn send_share<D: DrawTarget<Color = BinaryColor>>(bits: &mut [u8], frame: &Frame, share: Share, target: &mut D) -> Result<(), D::Error> {
+    use embedded_graphics_core::geometry::{Point, Size};
+    use embedded_graphics_core::primitives::Rectangle;
+    let Some(drawn) = lattice_rt::BitFrame::wrap(frame.width as u32, frame.height as u32, bits) else { return Ok(()) };
+    let t = frame.tile as usize;
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    for ty in 0..h.div_ceil(t) {
+        for tx in (0..w.div_ceil(t)).filter(|&tx| share.holds(tx, ty)) {
+            let (x0, y0) = (tx * t, ty * t);
+            let (tw, th) = (t.min(w - x0), t.min(h - y0));
+            let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
+            let pixels = (0..tw * th).map(|i| BinaryColor::from(drawn.get((x0 + i % tw) as u32, (y0 + i / tw) as u32)));
+            target.fill_contiguous(&area, pixels)?;
+        }
+    }
+    Ok(())
 }
 
 impl<'t, E> From<LoadError<'t>> for AppError<'t, E> {

@@ -22,7 +22,7 @@ use embedded_graphics_core::Pixel;
 use firmware::app::LADDER;
 #[cfg(feature = "orbit")]
 use firmware::app::ORBIT_FRAMES;
-use firmware::app::{render_scene_at, Scalar, Shot, Storage, HEIGHT, SCENES, SHARES, WIDTH};
+use firmware::app::{render_scene_at, Cores, OneCore, Scalar, ShareMemory, Shot, Storage, HEIGHT, SCENES, WIDTH};
 #[cfg(not(feature = "ladder"))]
 use firmware::stack;
 use hal::fugit::RateExtU32;
@@ -118,6 +118,55 @@ where
     }
 }
 
+/// Core 1's stack (32 KiB; a frame's tracing needs well under half of it).
+static CORE1_STACK: hal::multicore::Stack<8192> = hal::multicore::Stack::new();
+
+/// Core 1: runs each job core 0 sends through the SIO FIFO and answers when it is done.
+fn core1_main() {
+    // SAFETY: core 1 uses only the SIO FIFO's core-1 side, which no other code on core 1 touches.
+    #[allow(unsafe_code)]
+    let pac = unsafe { pac::Peripherals::steal() };
+    let mut sio = hal::Sio::new(pac.SIO);
+    loop {
+        let job = sio.fifo.read_blocking() as usize as *mut &mut (dyn FnMut() + Send);
+        // SAFETY: core 0 sent the address of a job it keeps alive, and does not touch, until
+        // this core answers below (`TwoCores::join`).
+        #[allow(unsafe_code)]
+        unsafe {
+            (*job)()
+        };
+        sio.fifo.write_blocking(1);
+    }
+}
+
+/// Whether the inter-core FIFO behaves as the RP2040's does: its sticky error flags (WOF, ROE)
+/// clear when written and room is there (RDY). rp2040js has no FIFO and reads every bit as 1.
+fn fifo_answers() -> bool {
+    // SAFETY: core 1 is still in the bootrom, so nothing else uses the FIFO; writing FIFO_ST
+    // only clears its two error flags.
+    #[allow(unsafe_code)]
+    let sio = unsafe { &*pac::SIO::ptr() };
+    sio.fifo_st().write(|w| w.wof().clear_bit_by_one().roe().clear_bit_by_one());
+    let st = sio.fifo_st().read();
+    st.rdy().bit_is_set() && st.wof().bit_is_clear() && st.roe().bit_is_clear()
+}
+
+/// Both RP2040 cores: core 1 runs the other piece of work (see [`core1_main`]).
+struct TwoCores {
+    fifo: hal::sio::SioFifo,
+}
+
+impl Cores for TwoCores {
+    fn join(&mut self, there: &mut (dyn FnMut() + Send), here: &mut dyn FnMut()) {
+        let mut job: &mut (dyn FnMut() + Send) = there;
+        // Core 1 gets the address of `job` (a pointer to the closure and its vtable); both live
+        // on this stack until core 1's answer has come back.
+        self.fifo.write_blocking(&mut job as *mut &mut (dyn FnMut() + Send) as usize as u32);
+        here();
+        let _ = self.fifo.read_blocking();
+    }
+}
+
 /// The pause between two scenes.
 const PAUSE_MS: u32 = 3000;
 
@@ -200,22 +249,33 @@ fn main() -> ! {
     let mut target = PageTiles { display };
     let mut st = Storage::<Scalar>::new();
     defmt::info!("lattice-rt on the Pico: {} scenes, {}x{}, {} MHz", SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz());
-    // One frame: the LED lit while it renders, each tile share timed.
+    // Core 1 renders the second tile share of every frame where the SIO FIFO answers; in
+    // rp2040js, which has none, core 0 renders both shares: the same code and frames.
+    let mut second = ShareMemory::new();
+    let mut fifo = sio.fifo;
+    let mut one = OneCore;
+    let mut two = None;
+    if fifo_answers() {
+        let mut mc = hal::multicore::Multicore::new(&mut pac.PSM, &mut pac.PPB, &mut fifo);
+        let cores = mc.cores();
+        match CORE1_STACK.take().map(|stack| cores[1].spawn(stack, core1_main)) {
+            Some(Ok(())) => two = Some(TwoCores { fifo }),
+            Some(Err(e)) => defmt::error!("core 1 did not start ({}): rendering on core 0 alone", e),
+            None => defmt::error!("core 1's stack is taken: rendering on core 0 alone"),
+        }
+    }
+    defmt::info!("rendering on {} core(s)", if two.is_some() { 2 } else { 1 });
+    let now = || timer.get_counter().ticks();
+    // One frame: the LED lit while it renders.
     let mut show = |text: &'static str, shot: &Shot| {
-        let mut shares = [0u64; SHARES as usize];
         let t0 = timer.get_counter();
-        let mut t = t0;
         let _ = led.set_high();
-        let result = render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, |i| {
-            // Share i starts: share i - 1 took the time since the last mark.
-            let now = timer.get_counter();
-            if let Some(prev) = (i as usize).checked_sub(1).and_then(|p| shares.get_mut(p)) {
-                *prev = (now - t).to_micros();
-            }
-            t = now;
-        });
+        let result = match two.as_mut() {
+            Some(cores) => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, cores, &mut second, &now),
+            None => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, &mut one, &mut second, &now),
+        };
         let _ = led.set_low();
-        result.map(|r| (r, (timer.get_counter() - t0).to_micros(), shares))
+        result.map(|r| (r, (timer.get_counter() - t0).to_micros(), r.share_us))
     };
     #[cfg(feature = "ladder")]
     loop {
