@@ -73,6 +73,19 @@ fn build_pico_with(root: &Path, feature: &str) -> Result<PathBuf> {
     Ok(pico_elf_in(&dir))
 }
 
+/// Builds (unless `no_build`) the image with `feature` and the chair alone, writes its UF2 file
+/// into `frames_dir/<feature>` and runs it for `frames` frames; returns the run and that folder.
+fn run_variant(root: &Path, no_build: bool, feature: &str, frames_dir: &Path, bootrom: &Path, frames: usize) -> Result<(BoardRun, PathBuf)> {
+    let elf = if no_build { pico_elf_in(&root.join("firmware/target").join(feature)) } else { build_pico_with(root, feature)? };
+    let dir = frames_dir.join(feature);
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let uf2 = dir.join(format!("lattice-rt-pico-{feature}.uf2"));
+    write_uf2(&elf, &uf2)?;
+    eprintln!("running {} ({frames} frames of the chair)", uf2.display());
+    let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir)?;
+    Ok((run, dir))
+}
+
 /// The image in target folder `dir`.
 fn pico_elf_in(dir: &Path) -> PathBuf {
     dir.join("thumbv6m-none-eabi/release/pico")
@@ -355,13 +368,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
 
     // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
-    let orbit_elf = if no_build { pico_elf_in(&root.join("firmware/target/orbit")) } else { build_pico_with(root, "orbit")? };
-    let orbit_dir = frames_dir.join("orbit");
-    std::fs::create_dir_all(&orbit_dir).with_context(|| format!("cannot create {}", orbit_dir.display()))?;
-    let orbit_uf2 = orbit_dir.join("lattice-rt-pico-orbit.uf2");
-    write_uf2(&orbit_elf, &orbit_uf2)?;
-    eprintln!("running {} ({ORBIT_CHECKED} frames of the chair's orbit)", orbit_uf2.display());
-    let orun = run_emulator(root, &orbit_elf, &orbit_uf2, &bootrom, ORBIT_CHECKED, true, &orbit_dir)?;
+    let (orun, orbit_dir) = run_variant(root, no_build, "orbit", frames_dir, &bootrom, ORBIT_CHECKED)?;
     let chair = scenes_dir.join("chair.scene");
     let want = crate::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &crate::load::read(&chair)?, ORBIT_FRAMES, &board_frame::FRAME)?;
     if orun.frames.len() < ORBIT_CHECKED {
@@ -379,13 +386,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
 
     // The ladder: the chair once per rung, each frame bit for bit against host-sim's.
-    let ladder_elf = if no_build { pico_elf_in(&root.join("firmware/target/ladder")) } else { build_pico_with(root, "ladder")? };
-    let ladder_dir = frames_dir.join("ladder");
-    std::fs::create_dir_all(&ladder_dir).with_context(|| format!("cannot create {}", ladder_dir.display()))?;
-    let ladder_uf2 = ladder_dir.join("lattice-rt-pico-ladder.uf2");
-    write_uf2(&ladder_elf, &ladder_uf2)?;
-    eprintln!("running {} (the chair once per rung of the ladder)", ladder_uf2.display());
-    let lrun = run_emulator(root, &ladder_elf, &ladder_uf2, &bootrom, LADDER.len(), true, &ladder_dir)?;
+    let (lrun, ladder_dir) = run_variant(root, no_build, "ladder", frames_dir, &bootrom, LADDER.len())?;
     if lrun.frames.len() < LADDER.len() {
         failures.push(format!("ladder: {} of {} frames shown ({})", lrun.frames.len(), LADDER.len(), lrun.reason));
     }

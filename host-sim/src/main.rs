@@ -64,8 +64,9 @@ enum Command {
         #[arg(short, long, default_value = "out/scene.pov")]
         output: PathBuf,
     },
-    /// The paper's Table 1 reproduced, scaling to 100 000 primitives, and the lattice's
-    /// resolution choice against a sweep: docs/performance.md and a log-log plot.
+    /// The paper's Table 1 reproduced, scaling to 100 000 primitives, the lattice's resolution
+    /// choice against a sweep, and host-sim against POV-Ray (when `povray` is installed):
+    /// docs/performance.md and a log-log plot.
     Bench {
         /// A short run for CI (N up to 1 000, one timed run).
         #[arg(long)]
