@@ -21,14 +21,26 @@ use std::{env, fs, path::PathBuf};
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let pico = env::var_os("CARGO_FEATURE_PICO").is_some();
-    let src = if pico { "../memory.x" } else { "qemu/memory.x" };
+    let pico2 = env::var_os("CARGO_FEATURE_PICO2").is_some();
+    let target = env::var("TARGET").unwrap_or_default();
+    let m33 = target.starts_with("thumbv8m");
+    let src = match (pico, pico2, m33) {
+        (true, _, _) => "../memory.x",
+        (_, true, _) => "pico2/memory.x",
+        (_, _, true) => "qemu-an505/memory.x",
+        _ => "qemu/memory.x",
+    };
     fs::copy(src, out.join("memory.x")).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
-    println!("cargo:rerun-if-changed=../memory.x");
-    println!("cargo:rerun-if-changed=qemu/memory.x");
+    for map in ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x"] {
+        println!("cargo:rerun-if-changed={map}");
+    }
+    // The core's name in the firmware's reports.
+    let core = if m33 { "m33" } else if target.starts_with("thumbv7em") { "m4f" } else { "m0" };
+    println!("cargo:rustc-env=FIRMWARE_CORE={core}");
     println!("cargo:rerun-if-env-changed=FIRMWARE_SCENES");
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
-    if pico {
+    if pico || pico2 {
         println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
     }
     // defmt drops everything below `error` unless DEFMT_LOG says otherwise; the repository's

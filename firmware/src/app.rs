@@ -65,7 +65,7 @@ impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
 
 /// Logged by defmt without `core::fmt`: the core's errors derive `defmt::Format` (its `defmt`
 /// feature); only the display's own error goes through `Debug`.
-#[cfg(feature = "pico")]
+#[cfg(feature = "rp")]
 impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
     fn format(&self, f: defmt::Formatter<'_>) {
         match self {

@@ -12,8 +12,6 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// SysTick runs at the mps2 boards' 25 MHz; under `-icount shift=0` one instruction is 1 ns.
-const INSTRUCTIONS_PER_TICK: u64 = 40;
 
 /// One firmware build.
 struct Variant {
@@ -33,11 +31,13 @@ pub const SCALARS: [(&str, &str); 4] =
 
 fn variants() -> Vec<Variant> {
     let mut v = Vec::new();
-    for (board, target, machine, core) in [
-        ("m0", "thumbv6m-none-eabi", "mps2-an385", "Cortex-M0+ (thumbv6m, run on QEMU's Cortex-M3 board)"),
-        ("m4f", "thumbv7em-none-eabihf", "mps2-an386", "Cortex-M4F (thumbv7em-none-eabihf)"),
+    for (board, target, machine, core, scalars) in [
+        ("m0", "thumbv6m-none-eabi", "mps2-an385", "Cortex-M0+ (thumbv6m, run on QEMU's Cortex-M3 board)", &SCALARS[..]),
+        ("m4f", "thumbv7em-none-eabihf", "mps2-an386", "Cortex-M4F (thumbv7em-none-eabihf)", &SCALARS[..]),
+        // The Pico 2's core, in the Pico 2's scalar.
+        ("m33", "thumbv8m.main-none-eabihf", "mps2-an505", "Cortex-M33 (thumbv8m.main-none-eabihf, the Pico 2's core)", &SCALARS[..1]),
     ] {
-        for (scalar, feature) in SCALARS {
+        for &(scalar, feature) in scalars {
             v.push(Variant {
                 name: format!("qemu-{board}-{scalar}"),
                 target,
@@ -101,6 +101,16 @@ fn variants() -> Vec<Variant> {
         scalar: "fixed",
         what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes (run on an emulated board by `host-sim board`: docs/board.md)".into(),
     });
+    v.push(Variant {
+        name: "pico2".into(),
+        target: "thumbv8m.main-none-eabihf",
+        features: "pico2".into(),
+        bin: "pico",
+        machine: None,
+        scenes: None,
+        scalar: "f32",
+        what: "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32)".into(),
+    });
     v
 }
 
@@ -155,6 +165,8 @@ pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
 /// What one QEMU run printed.
 #[derive(Default)]
 struct Run {
+    /// Instructions per SysTick tick, from the firmware's calibration loop (`CALIBRATE`).
+    per_tick: u64,
     scenes: Vec<SceneRun>,
     stack: u64,
     statics: u64,
@@ -164,6 +176,8 @@ struct Run {
 struct SceneRun {
     name: String,
     ticks: u64,
+    /// Ticks from the first tile to the last (both shares).
+    tiles: u64,
     rays: u64,
     stack_so_far: u64,
     rows: Vec<u8>,
@@ -214,6 +228,7 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
             run.scenes.push(SceneRun {
                 name: rest.split_whitespace().next().unwrap_or("").to_string(),
                 ticks: field(line, "ticks"),
+                tiles: field(line, "tiles"),
                 rays: field(line, "rays"),
                 stack_so_far: field(line, "stack_so_far"),
                 rows: Vec::new(),
@@ -223,12 +238,18 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
                 let bytes = (0..hex.len() / 2).filter_map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).ok());
                 s.rows.extend(bytes);
             }
+        } else if line.starts_with("CALIBRATE ") {
+            let ticks = field(line, "ticks").max(1);
+            run.per_tick = (field(line, "instructions") + ticks / 2) / ticks;
         } else if line.starts_with("RAM ") {
             run.stack = field(line, "stack_high_water");
             run.statics = field(line, "static");
         } else if line.starts_with("ERROR") || line.starts_with("PANIC") || line.starts_with("HARDFAULT") {
             run.errors.push(line.to_string());
         }
+    }
+    if run.per_tick == 0 && run.errors.is_empty() {
+        run.errors.push("no CALIBRATE line: instructions per tick unknown".into());
     }
     if !status.success() && run.errors.is_empty() {
         run.errors.push(format!("QEMU exited with {status}"));
@@ -317,7 +338,7 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
             identical.insert((v.name.clone(), s.name.clone()), same);
         }
     }
-    writeln!(md, "## Instructions per frame (QEMU, `-icount shift=0`)\n\nSysTick ticks x {INSTRUCTIONS_PER_TICK} (25 MHz SysTick, 1 ns per instruction): deterministic, the same on\nany machine. Every frame below was checked bit for bit against host-sim in the same scalar.\n")?;
+    writeln!(md, "## Instructions per frame (QEMU, `-icount shift=0`)\n\nSysTick ticks x instructions per tick (1 ns per instruction; the firmware times a loop of known\nlength: 40 on the an385/an386's 25 MHz SysTick, 50 on the an505's 20 MHz): deterministic, the same on\nany machine. Every frame below was checked bit for bit against host-sim in the same scalar.\n")?;
     let mut header = String::from("| scene | rays |");
     let mut rule = String::from("|---|---|");
     let cols: Vec<&Variant> = variants.iter().filter(|v| v.machine.is_some() && v.scenes.is_none() && !v.features.contains("effects-all")).collect();
@@ -334,15 +355,16 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
         let mut row = format!("| {scene} | {rays} |");
         for (v, r) in &runs {
             if let Some(s) = r.scenes.iter().find(|s| &s.name == scene) {
-                let board = if v.target.starts_with("thumbv6m") { "m0" } else { "m4f" };
+                let board = v.name.trim_start_matches("qemu-").split('-').next().unwrap_or("");
                 let flash = elf_sizes(&elf_path(root, v)).map(|f| f.0).unwrap_or(0);
-                csv.push_str(&format!("{scene},{},{board},{},{},{},{flash}\n", v.scalar, s.ticks * INSTRUCTIONS_PER_TICK, s.rays, v.name));
+                csv.push_str(&format!("{scene},{},{board},{},{},{},{flash}\n", v.scalar, s.ticks * r.per_tick, s.rays, v.name));
             }
         }
         for v in &cols {
+            let per_tick = runs.iter().find(|(w, _)| w.name == v.name).map_or(0, |(_, r)| r.per_tick);
             match find(&v.name, scene) {
                 Some(s) => {
-                    let ins = s.ticks * INSTRUCTIONS_PER_TICK;
+                    let ins = s.ticks * per_tick;
                     let ok = if identical.get(&(v.name.clone(), scene.clone())) == Some(&true) { "" } else { " (frame differs!)" };
                     row.push_str(&format!(" {:.1} M{ok} |", ins as f64 / 1e6));
 
@@ -352,11 +374,16 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
         }
         writeln!(md, "{row}")?;
     }
+    // Instructions of `scene`'s frame in `variant` (SysTick ticks x that run's calibration),
+    // and of its tiles alone (the frame without parsing and set-up).
+    let per_tick = |variant: &str| runs.iter().find(|(v, _)| v.name == variant).map_or(0, |(_, r)| r.per_tick);
+    let instructions = |variant: &str, scene: &str| find(variant, scene).map(|s| s.ticks * per_tick(variant));
+    let tile_instructions = |variant: &str, scene: &str| find(variant, scene).map(|s| s.tiles * per_tick(variant));
     let ratio = |a: &str, b: &str| -> Option<f64> {
         let (mut x, mut y) = (0u64, 0u64);
         for scene in &names {
-            x += find(a, scene)?.ticks;
-            y += find(b, scene)?.ticks;
+            x += instructions(a, scene)?;
+            y += instructions(b, scene)?;
         }
         Some(x as f64 / y.max(1) as f64)
     };
@@ -365,6 +392,24 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     }
     if let Some(r) = ratio("qemu-m0-f32", "qemu-m4f-f32") {
         writeln!(md, "The M0 build needs {r:.2}x the instructions of the M4F build in f32 (no FPU against an FPU).")?;
+    }
+    if let Some(r) = ratio("qemu-m33-f32", "qemu-m4f-f32") {
+        writeln!(md, "The M33 build (the Pico 2's core) needs {r:.2}x the instructions of the M4F build in f32.")?;
+    }
+    // The Pico 2's targets: instructions per frame on one core, f32.
+    let m33 = "qemu-m33-f32";
+    if find(m33, "chair").is_some() {
+        writeln!(md, "\n### The Pico 2's core (`{m33}`: the Pico 2's code on QEMU's mps2-an505)\n\n| scene | whole frame | tiles alone | target (whole frame) | frames per second at 150 MHz, one core, one instruction per cycle |\n|---|---|---|---|---|")?;
+        for scene in &names {
+            let (Some(all), Some(tiles)) = (instructions(m33, scene), tile_instructions(m33, scene)) else { continue };
+            let target = match scene.as_str() {
+                "chair" => "5 M",
+                "whitted" => "25 M",
+                _ => "",
+            };
+            writeln!(md, "| {scene} | {:.2} M | {:.2} M | {target} | {:.1} |", all as f64 / 1e6, tiles as f64 / 1e6, 150e6 / all.max(1) as f64)?;
+        }
+        writeln!(md, "\nThe whole frame is what `render_scene` does per frame: parse the scene text, build the lattice,\ntrace the tiles and send them; tiles alone is the part from the first tile to the last.")?;
     }
     for scalar in ["f32", "fixed"] {
         let name = format!("qemu-m0-{scalar}-chair");

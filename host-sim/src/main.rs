@@ -168,12 +168,16 @@ enum Command {
         #[arg(long, default_value = "docs/motion.md")]
         out: PathBuf,
     },
-    /// Build the Pico image and write it as a UF2 file, for flashing without a probe: hold
-    /// BOOTSEL while plugging the Pico in and copy the file onto the RPI-RP2 drive.
+    /// Build the Pico (or Pico 2) image and write it as a UF2 file, for flashing without a
+    /// probe: hold BOOTSEL while plugging the board in and copy the file onto the drive it
+    /// shows (RPI-RP2 for the Pico, RP2350 for the Pico 2).
     Uf2 {
-        /// UF2 file to write.
-        #[arg(short, long, default_value = "out/lattice-rt-pico.uf2")]
-        output: PathBuf,
+        /// The board: pico (RP2040, fixed point) or pico2 (RP2350, f32).
+        #[arg(long, value_enum, default_value = "pico")]
+        board: board::Board,
+        /// UF2 file to write [default: out/lattice-rt-<board>.uf2].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
 }
 
@@ -410,7 +414,7 @@ fn real_main() -> Result<()> {
         Some(Command::Board { out, frames, no_build }) => board::board_cmd(&std::env::current_dir()?, &out, &frames, no_build),
         Some(Command::Orbit { scene, output, frames }) => orbit::orbit_cmd(&scene, &output, frames),
         Some(Command::Motion { scenes, frames, out }) => orbit::motion_cmd(&default_scenes(scenes), frames, &out),
-        Some(Command::Uf2 { output }) => board::uf2_cmd(&std::env::current_dir()?, &output),
+        Some(Command::Uf2 { board, output }) => board::uf2_cmd(&std::env::current_dir()?, board, output.as_deref()),
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),
             Scalar::F32 => run::stats_cmd::<f32>(&a),

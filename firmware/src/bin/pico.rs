@@ -1,4 +1,5 @@
-//! Raspberry Pi Pico + SSD1306 128x64 OLED on I2C: renders the embedded scenes in turn, tile by
+//! Raspberry Pi Pico (RP2040, `--features pico`, fixed point) or Pico 2 (RP2350, Cortex-M33
+//! with an FPU, `--features pico2`, f32) + SSD1306 128x64 OLED on I2C: renders the embedded scenes in turn, tile by
 //! tile straight to the display (each 8x8 tile is one SSD1306 page high, so it is sent as eight
 //! column bytes; no framebuffer), and logs per-frame time and statistics over defmt-rtt.
 //!
@@ -8,7 +9,10 @@
 //! `host-sim board` runs this image in an RP2040 emulator and relies on that LED protocol.
 //!
 //! Wiring (change it here, in `Wiring` below, and nowhere else): SDA on GP4, SCL on GP5,
-//! display address 0x3C, VCC on 3V3(OUT), GND on GND.
+//! display address 0x3C, VCC on 3V3(OUT), GND on GND; the two boards share the pin-out.
+//!
+//! The two boards differ only in what their HALs name differently (boot block, timer, its
+//! interrupt); each difference is one `cfg` below.
 #![no_std]
 #![no_main]
 
@@ -32,15 +36,57 @@ use hal::pac::interrupt;
 use embedded_hal::digital::OutputPin;
 use lattice_rt::NoHooks;
 use panic_probe as _;
+#[cfg(feature = "pico")]
 use rp2040_hal as hal;
+#[cfg(feature = "pico2")]
+use rp235x_hal as hal;
 use ssd1306::mode::BasicMode;
 use ssd1306::prelude::*;
 use ssd1306::{I2CDisplayInterface, Ssd1306};
 
+#[cfg(all(feature = "pico", feature = "pico2"))]
+compile_error!("choose one board: `pico` (RP2040) or `pico2` (RP2350)");
+
 /// The second-stage bootloader for the Pico's W25Q080 flash.
+#[cfg(feature = "pico")]
 #[link_section = ".boot2"]
 #[used]
 pub static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+
+/// The RP2350's image definition: the boot ROM starts a secure Arm image from it.
+#[cfg(feature = "pico2")]
+#[link_section = ".start_block"]
+#[used]
+pub static IMAGE_DEF: hal::block::ImageDef = hal::block::ImageDef::secure_exe();
+
+/// What `picotool info` shows about the Pico 2 image.
+#[cfg(feature = "pico2")]
+#[link_section = ".bi_entries"]
+#[used]
+pub static PICOTOOL_ENTRIES: [hal::binary_info::EntryAddr; 4] = [
+    hal::binary_info::rp_cargo_bin_name!(),
+    hal::binary_info::rp_cargo_version!(),
+    hal::binary_info::rp_program_description!(c"lattice-rt: a lattice ray tracer on an SSD1306"),
+    hal::binary_info::rp_cargo_homepage_url!(),
+];
+
+/// The board's name in the log.
+#[cfg(feature = "pico")]
+const BOARD: &str = "Pico (RP2040)";
+/// The board's name in the log.
+#[cfg(feature = "pico2")]
+const BOARD: &str = "Pico 2 (RP2350)";
+
+/// The timer alarm the firmware sleeps on, and its interrupt.
+#[cfg(feature = "pico")]
+type Alarm0 = hal::timer::Alarm0;
+#[cfg(feature = "pico")]
+const ALARM_IRQ: pac::Interrupt = pac::Interrupt::TIMER_IRQ_0;
+/// The timer alarm the firmware sleeps on, and its interrupt.
+#[cfg(feature = "pico2")]
+type Alarm0 = hal::timer::Alarm0<hal::timer::CopyableTimer0>;
+#[cfg(feature = "pico2")]
+const ALARM_IRQ: pac::Interrupt = pac::Interrupt::TIMER0_IRQ_0;
 
 /// The Pico's crystal.
 const XTAL_FREQ_HZ: u32 = 12_000_000;
@@ -173,8 +219,8 @@ const PAUSE_MS: u32 = 3000;
 /// Sleeps (`wfi`) until `alarm` has run `ms` milliseconds, instead of spinning: the core draws
 /// less power, and an emulator skips the idle time. The check and the `wfi` run with interrupts
 /// masked, so an alarm that fires between them still ends the `wfi` (a pending interrupt wakes
-/// the core whatever PRIMASK says); [`TIMER_IRQ_0`] then clears it.
-fn sleep_ms(alarm: &mut hal::timer::Alarm0, ms: u32) {
+/// the core whatever PRIMASK says); the alarm's interrupt handler then clears it.
+fn sleep_ms(alarm: &mut Alarm0, ms: u32) {
     use hal::timer::Alarm;
     if alarm.schedule(hal::fugit::MicrosDurationU32::millis(ms)).is_err() {
         return;
@@ -184,7 +230,7 @@ fn sleep_ms(alarm: &mut hal::timer::Alarm0, ms: u32) {
     // enabling it cannot break any critical section or data the main loop holds.
     #[allow(unsafe_code)]
     unsafe {
-        pac::NVIC::unmask(pac::Interrupt::TIMER_IRQ_0)
+        cortex_m::peripheral::NVIC::unmask(ALARM_IRQ)
     };
     while !cortex_m::interrupt::free(|_| {
         let done = alarm.finished();
@@ -193,11 +239,12 @@ fn sleep_ms(alarm: &mut hal::timer::Alarm0, ms: u32) {
         }
         done
     }) {}
-    pac::NVIC::mask(pac::Interrupt::TIMER_IRQ_0);
+    cortex_m::peripheral::NVIC::mask(ALARM_IRQ);
     alarm.disable_interrupt();
 }
 
 /// Alarm 0 has fired: clear its interrupt (the main loop only needed to wake up).
+#[cfg(feature = "pico")]
 #[interrupt]
 fn TIMER_IRQ_0() {
     // SAFETY: a write-1-to-clear of alarm 0's bit in TIMER.INTR; no other code writes INTR
@@ -205,6 +252,17 @@ fn TIMER_IRQ_0() {
     #[allow(unsafe_code)]
     unsafe {
         (*pac::TIMER::ptr()).intr().write(|w| w.alarm_0().clear_bit_by_one())
+    };
+}
+
+/// Alarm 0 of TIMER0 has fired: clear its interrupt (the main loop only needed to wake up).
+#[cfg(feature = "pico2")]
+#[interrupt]
+fn TIMER0_IRQ_0() {
+    // SAFETY: as for the Pico's handler, on TIMER0.INTR.
+    #[allow(unsafe_code)]
+    unsafe {
+        (*pac::TIMER0::ptr()).intr().write(|w| w.alarm_0().clear_bit_by_one())
     };
 }
 
@@ -231,7 +289,10 @@ fn main() -> ! {
     let i2c = hal::I2C::i2c0(pac.I2C0, sda, scl, I2C_HZ.Hz(), &mut pac.RESETS, &clocks.system_clock);
     let interface = I2CDisplayInterface::new(CheckedI2c(i2c)); // address 0x3C; new_alternate_address() for 0x3D
     let mut led = pins.gpio25.into_push_pull_output();
+    #[cfg(feature = "pico")]
     let mut timer = hal::Timer::new(pac.TIMER, &mut pac.RESETS, &clocks);
+    #[cfg(feature = "pico2")]
+    let mut timer = hal::Timer::new_timer0(pac.TIMER0, &mut pac.RESETS, &clocks);
     let Some(mut alarm) = timer.alarm_0() else {
         defmt::panic!("timer alarm 0 is taken");
     };
@@ -248,7 +309,7 @@ fn main() -> ! {
     }
     let mut target = PageTiles { display };
     let mut st = Storage::<Scalar>::new();
-    defmt::info!("lattice-rt on the Pico: {} scenes, {}x{}, {} MHz", SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz());
+    defmt::info!("lattice-rt on the {}: {} scenes, {}x{}, {} MHz", BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz());
     // Core 1 renders the second tile share of every frame where the SIO FIFO answers; in
     // rp2040js, which has none, core 0 renders both shares: the same code and frames.
     let mut second = ShareMemory::new();

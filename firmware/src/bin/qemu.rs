@@ -2,9 +2,12 @@
 //! (Cortex-M4F, thumbv7em-none-eabihf). Each frame goes out over semihosting as hex rows with
 //! its statistics; the exit code says whether every scene rendered.
 //!
+//! Also the Cortex-M33 build (thumbv8m.main-none-eabihf, the Pico 2's core) on mps2-an505.
+//!
 //! Run with `-icount shift=0`: every instruction then takes 1 ns of virtual time, and SysTick,
-//! clocked at the board's 25 MHz, ticks once per 40 instructions, so the reported tick counts
-//! are deterministic instruction counts / 40.
+//! clocked at the board's rate, ticks once per so many instructions; the `CALIBRATE` line gives
+//! that rate (ticks over a loop of known length), so the reported tick counts convert to
+//! deterministic instruction counts.
 #![no_std]
 #![no_main]
 
@@ -14,7 +17,7 @@ use cortex_m::interrupt::{free, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
-use firmware::app::{render_scene, Scalar, Storage, FRAME, SCENES};
+use firmware::app::{render_scene_at, OneCore, Scalar, ShareMemory, Shot, Storage, FRAME, SCENES};
 use firmware::stack;
 use lattice_rt::{BitFrame, NoHooks};
 
@@ -27,25 +30,14 @@ fn SysTick() {
 }
 
 /// SysTick ticks since start (wraps counted by the exception).
-fn ticks(syst: &cortex_m::peripheral::SYST) -> u64 {
+fn ticks() -> u64 {
     loop {
         let w0 = free(|cs| WRAPS.borrow(cs).get());
         let cur = cortex_m::peripheral::SYST::get_current();
         let w1 = free(|cs| WRAPS.borrow(cs).get());
-        if w0 == w1 && !syst.has_wrapped_peek() {
+        if w0 == w1 && !cortex_m::peripheral::SCB::is_pendst_pending() {
             return w0 as u64 * (RELOAD as u64 + 1) + (RELOAD - cur) as u64;
         }
-    }
-}
-
-trait PeekWrap {
-    fn has_wrapped_peek(&self) -> bool;
-}
-impl PeekWrap for cortex_m::peripheral::SYST {
-    /// Whether a wrap is pending whose exception has not run yet (reading COUNTFLAG clears it,
-    /// so this only looks at the pending bit of the exception).
-    fn has_wrapped_peek(&self) -> bool {
-        cortex_m::peripheral::SCB::is_pendst_pending()
     }
 }
 
@@ -56,6 +48,18 @@ impl fmt::Display for Hex<'_> {
     }
 }
 
+/// Instructions in the calibration loop.
+const CALIBRATE_INSTRUCTIONS: u32 = 4_000_000;
+
+/// Runs `n` iterations of a two-instruction loop (`subs`, `bne`): 2n instructions.
+fn spin(n: u32) {
+    // SAFETY: the loop only counts r0 down to zero; it touches no memory and no stack.
+    #[allow(unsafe_code)]
+    unsafe {
+        core::arch::asm!("2:", "subs r0, #1", "bne 2b", inout("r0") n => _, options(nomem, nostack))
+    };
+}
+
 #[entry]
 fn main() -> ! {
     let mut cp = cortex_m::Peripherals::take().unwrap();
@@ -64,21 +68,28 @@ fn main() -> ! {
     cp.SYST.clear_current();
     cp.SYST.enable_interrupt();
     cp.SYST.enable_counter();
-    let board = if cfg!(target_feature = "dsp") { "m4f" } else { "m0" };
+    let board = env!("FIRMWARE_CORE");
     hprintln!("BOARD {} scalar {} size {}x{}", board, <Scalar as lattice_rt::Real>::NAME, FRAME.width, FRAME.height);
+    // SysTick's clock differs between the machines (25 MHz on the an385/an386, 20 MHz on the
+    // an505): a loop of exactly CALIBRATE_INSTRUCTIONS instructions tells the host the rate.
+    let t0 = ticks();
+    spin(CALIBRATE_INSTRUCTIONS / 2);
+    hprintln!("CALIBRATE instructions {} ticks {}", CALIBRATE_INSTRUCTIONS, ticks() - t0);
     let mut st = Storage::<Scalar>::new();
+    let mut second = ShareMemory::new();
     let mut bits = [0u8; BitFrame::bytes(FRAME.width as u32, FRAME.height as u32)];
     let mut failed = false;
     for (name, text) in SCENES {
         let mut frame = BitFrame::new(FRAME.width as u32, FRAME.height as u32, &mut bits).unwrap();
-        let t0 = ticks(&cp.SYST);
-        match render_scene(text, &mut st, &mut frame, &mut NoHooks) {
+        let t0 = ticks();
+        let shot = Shot::default();
+        match render_scene_at(text, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks) {
             Ok(r) => {
-                let t = ticks(&cp.SYST) - t0;
+                let t = ticks() - t0;
                 let s = r.stats;
                 hprintln!(
-                    "SCENE {} ticks {} rays {} primary {} shadow {} reflection {} refraction {} tests {} cells {} objects {} lattice_bytes {} stack_so_far {}",
-                    name, t, s.total_rays(), s.rays[0], s.rays[1], s.rays[2], s.rays[3], s.object_tests,
+                    "SCENE {} ticks {} tiles {} rays {} primary {} shadow {} reflection {} refraction {} tests {} cells {} objects {} lattice_bytes {} stack_so_far {}",
+                    name, t, r.share_us[0] + r.share_us[1], s.total_rays(), s.rays[0], s.rays[1], s.rays[2], s.rays[3], s.object_tests,
                     s.cells_visited, r.objects, r.lattice_bytes, stack::high_water()
                 );
                 for row in frame.raster().chunks(FRAME.width as usize / 8) {
