@@ -117,6 +117,41 @@ impl Real for f64 {
     }
 }
 
+/// Square root of an `f32`, correctly rounded (IEEE 754), so every way below gives the same bits:
+/// on an Arm core with a hardware FPU (the `eabihf` targets: Cortex-M4F, M7, M33) the FPU's own
+/// `vsqrt.f32`, one instruction instead of libm's software loop; elsewhere libm.
+#[inline]
+fn sqrt_f32(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        let r: u32;
+        // Stable Rust cannot name FPU registers on these targets (its `vfp2` feature is not
+        // seen as enabled), so the value goes through a core register and s0, which is saved
+        // and restored around it.
+        // SAFETY: the block leaves every register but `r` as it found it (s0 is pushed and
+        // popped), touches no memory but the 4 bytes it pushes, and every eabihf target has the
+        // single-precision FPU `vsqrt.f32` needs.
+        #[allow(unsafe_code)]
+        unsafe {
+            core::arch::asm!(
+                "vpush {{s0}}",
+                "vmov s0, {x}",
+                "vsqrt.f32 s0, s0",
+                "vmov {r}, s0",
+                "vpop {{s0}}",
+                x = in(reg) x.to_bits(),
+                r = lateout(reg) r,
+                options(pure, nomem, preserves_flags)
+            )
+        };
+        f32::from_bits(r)
+    }
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    {
+        libm::sqrtf(x)
+    }
+}
+
 impl Real for f32 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
@@ -134,7 +169,7 @@ impl Real for f32 {
         self as f64
     }
     fn sqrt(self) -> Self {
-        libm::sqrtf(self)
+        sqrt_f32(self)
     }
     fn offset_eps() -> Self {
         3e-6

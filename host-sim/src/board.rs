@@ -101,7 +101,11 @@ pub fn build_board(root: &Path, board: Board) -> Result<PathBuf> {
     if !status.success() {
         bail!("`cargo {alias}` failed (it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target());
     }
-    Ok(root.join("firmware/target").join(board.target()).join("release/pico"))
+    let profile = match board {
+        Board::Pico => "release",
+        Board::Pico2 => "speed",
+    };
+    Ok(root.join("firmware/target").join(board.target()).join(profile).join("pico"))
 }
 
 /// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).

@@ -17,6 +17,8 @@ use std::time::{Duration, Instant};
 struct Variant {
     name: String,
     target: &'static str,
+    /// Cargo profile: `release`, or `speed` (opt-level 3) for the boards with flash to spare.
+    profile: &'static str,
     features: String,
     bin: &'static str,
     machine: Option<&'static str>,
@@ -41,6 +43,7 @@ fn variants() -> Vec<Variant> {
             v.push(Variant {
                 name: format!("qemu-{board}-{scalar}"),
                 target,
+                profile: if board == "m33" { "speed" } else { "release" },
                 features: ["qemu", feature].iter().filter(|f| !f.is_empty()).cloned().collect::<Vec<_>>().join(","),
                 bin: "qemu",
                 machine: Some(machine),
@@ -54,6 +57,7 @@ fn variants() -> Vec<Variant> {
         v.push(Variant {
             name: format!("qemu-m0-{scalar}-chair"),
             target: "thumbv6m-none-eabi",
+            profile: "release",
             features: format!("qemu,{feature}").trim_end_matches(',').to_string(),
             bin: "qemu",
             machine: Some("mps2-an385"),
@@ -66,6 +70,7 @@ fn variants() -> Vec<Variant> {
     v.push(Variant {
         name: "qemu-m0-fixed-exact".into(),
         target: "thumbv6m-none-eabi",
+        profile: "release",
         features: "qemu,scalar-fixed,exact-sampling".into(),
         bin: "qemu",
         machine: Some("mps2-an385"),
@@ -83,6 +88,7 @@ fn variants() -> Vec<Variant> {
         v.push(Variant {
             name: name.into(),
             target: "thumbv6m-none-eabi",
+            profile: "release",
             features: features.into(),
             bin: "qemu",
             machine: Some("mps2-an385"),
@@ -94,6 +100,7 @@ fn variants() -> Vec<Variant> {
     v.push(Variant {
         name: "pico".into(),
         target: "thumbv6m-none-eabi",
+        profile: "release",
         features: "pico".into(),
         bin: "pico",
         machine: None,
@@ -104,6 +111,7 @@ fn variants() -> Vec<Variant> {
     v.push(Variant {
         name: "pico2".into(),
         target: "thumbv8m.main-none-eabihf",
+        profile: "speed",
         features: "pico2".into(),
         bin: "pico",
         machine: None,
@@ -119,13 +127,13 @@ fn target_dir(root: &Path, v: &Variant) -> PathBuf {
 }
 
 fn elf_path(root: &Path, v: &Variant) -> PathBuf {
-    target_dir(root, v).join(v.target).join("release").join(v.bin)
+    target_dir(root, v).join(v.target).join(v.profile).join(v.bin)
 }
 
 fn build(root: &Path, v: &Variant) -> Result<()> {
     let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cmd.current_dir(root.join("firmware"))
-        .args(["build", "--release", "--features", &v.features, "--bin", v.bin, "--target", v.target, "--target-dir"])
+        .args(["build", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target, "--target-dir"])
         .arg(target_dir(root, v))
         .env_remove("RUSTFLAGS");
     match v.scenes {
