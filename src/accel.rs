@@ -81,6 +81,9 @@ pub struct Query<'m> {
     last_hit: u32,
     /// Per light, the object that last hid it ([`u32::MAX`]: none yet).
     occluders: [u32; MAX_LIGHTS],
+    /// The objects (bit `i`: object `i`) whose eye window meets the current tile; the others
+    /// cannot be hit by its eye rays (see [`Query::set_eye_candidates`]).
+    eye_candidates: u64,
 }
 
 impl<'m> Query<'m> {
@@ -88,7 +91,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS] }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -99,6 +102,17 @@ impl<'m> Query<'m> {
     /// eye ray alone; objects whose window the eye ray misses are then not tested.
     pub fn set_eye_ray(&mut self, uv: Option<[i32; 2]>) {
         self.eye = uv;
+    }
+    /// Declares which objects the eye rays to come can hit at all (bit `i`: object `i`; from
+    /// [`crate::scene::Scene::eye_candidates`] for the tile being rendered): tracing by
+    /// windows then tests only these, and counts the others as culled, as their windows would
+    /// have culled them ray by ray. `u64::MAX` (the default) holds every object.
+    pub fn set_eye_candidates(&mut self, objects: u64) {
+        self.eye_candidates = objects;
+    }
+    /// The objects eye rays can hit (see [`Query::set_eye_candidates`]).
+    pub fn eye_candidates(&self) -> u64 {
+        self.eye_candidates
     }
     /// The eye-ray window position, if the query is for an eye ray.
     pub fn eye_ray(&self) -> Option<[i32; 2]> {

@@ -202,14 +202,20 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
         // Remembered occluders are forgotten at every band of tiles, so a band renders the same
         // whichever bands a core or thread rendered before it.
         q.forget_occluders();
-        let mut shoot = |sx: usize, sy: usize| {
-            q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
-            let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
-            (v, id as u16)
-        };
         for tx in (0..tiles_x).filter(|&tx| share.holds(tx, ty)) {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
+            // The objects this tile's eye rays can hit: those whose window meets the tile's
+            // (widened by a block on each side, beyond any ray the sampler shoots in the tile).
+            let m = 4 * block as i32;
+            let (sx, sy) = ([4 * x0 as i32 - m, 4 * (x0 + tw) as i32 + m], [4 * y0 as i32 - m, 4 * (y0 + th) as i32 + m]);
+            let (lo, hi) = (Camera::<R>::window_uv(sx[0], sy[1], w4, h4), Camera::<R>::window_uv(sx[1], sy[0], w4, h4));
+            q.set_eye_candidates(tracer.scene().eye_candidates([lo[0], hi[0]], [lo[1], hi[1]]));
+            let mut shoot = |sx: usize, sy: usize| {
+                q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
+                let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
+                (v, id as u16)
+            };
             sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels);
             dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);

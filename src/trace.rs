@@ -253,6 +253,27 @@ impl EyeRays {
     }
 }
 
+/// The nearest hit of an eye ray among the objects whose windows hold it: the tile's
+/// candidates ([`Query::eye_candidates`]) in index order, each window checked again for the ray
+/// itself (as [`BruteForce`] would check every object's); objects that are no candidates are
+/// counted as culled, as their windows would have culled them.
+fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query<'_>) -> Option<crate::accel::Hit<R>> {
+    let n = scene.objects.len();
+    if n > 64 {
+        return BruteForce.nearest(scene, ray, R::ZERO, R::MAX, q);
+    }
+    let all = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
+    let mut left = q.eye_candidates() & all;
+    q.stats.culled += u64::from(n as u32 - left.count_ones());
+    let mut best = None;
+    while left != 0 {
+        let i = left.trailing_zeros() as usize;
+        left &= left - 1;
+        crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, q);
+    }
+    best
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Node<R> {
     ray: Ray<R>,
@@ -392,7 +413,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 (0, Some(uv)) if self.eye_rays != EyeRays::Plain => {
                     q.set_eye_ray(Some(uv));
                     match self.eye_rays {
-                        EyeRays::Windows => BruteForce.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
+                        EyeRays::Windows => nearest_by_windows(scene, &node.ray, q),
                         _ => self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
                     }
                 }

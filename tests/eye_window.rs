@@ -89,3 +89,49 @@ fn generated_scenes_and_cameras_inside_or_beside_objects_render_the_same() {
     }
     assert!(built >= 12 && culled > 0, "{built} scenes built, {culled} tests skipped");
 }
+
+/// A render checks each tile's eye rays only against the objects whose window meets the tile
+/// (`Scene::eye_candidates`). Every object left out must be one whose window culls every eye
+/// ray through the tile, and frames rendered so must equal those whose eye rays check every
+/// object's window one by one (`EyeRays::Accelerator` over brute force).
+#[test]
+fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
+    let (mut checked, mut left_out) = (0, 0);
+    for seed in 0..4u64 {
+        for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0))] {
+            let mut storage = vec![Object::<f64>::default(); 40];
+            let mut b = SceneBuilder::new(&mut storage);
+            random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
+            b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
+            b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
+            b.camera.fov = (70.0, 50.0);
+            let Ok(scene) = b.finish() else { continue };
+            // 8x8 tiles of a 48x32 frame, every quarter-pixel ray position in each.
+            let (w4, h4) = (4 * 48, 4 * 32);
+            for (tx, ty) in (0..6).flat_map(|tx| (0..4).map(move |ty| (tx, ty))) {
+                let (sx, sy) = ([32 * tx, 32 * tx + 32], [32 * ty, 32 * ty + 32]);
+                let (lo, hi) = (Camera::<f64>::window_uv(sx[0], sy[1], w4, h4), Camera::<f64>::window_uv(sx[1], sy[0], w4, h4));
+                let mask = scene.eye_candidates([lo[0], hi[0]], [lo[1], hi[1]]);
+                for (i, o) in scene.objects().iter().enumerate().filter(|&(i, _)| mask & (1 << i) == 0) {
+                    left_out += 1;
+                    for y in sy[0]..=sy[1] {
+                        for x in sx[0]..=sx[1] {
+                            let ray = scene.camera().ray(x, y, w4, h4);
+                            let uv = Camera::<f64>::window_uv(x, y, w4, h4);
+                            assert!(o.intersect_eye_ray(&ray, uv, 0.0, f64::MAX).is_err(), "seed {seed}, eye {eye:?}: object {i} left out of tile ({tx}, {ty}) but not culled at ({x}, {y})");
+                        }
+                    }
+                }
+            }
+            for frame in [lattice_rt::Frame::new(48, 32), lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4 }, ..lattice_rt::Frame::new(37, 21) }] {
+                let mut by_tiles = Tracer::new(&scene, &BruteForce);
+                by_tiles.set_eye_rays(EyeRays::Windows);
+                let mut by_rays = Tracer::new(&scene, &BruteForce);
+                by_rays.set_eye_rays(EyeRays::Accelerator);
+                assert_eq!(common::render_tracer(&by_tiles, &frame).0, common::render_tracer(&by_rays, &frame).0, "seed {seed}, eye {eye:?}, {}x{}", frame.width, frame.height);
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 8 && left_out > 0, "{checked} frames checked, {left_out} objects left out of tiles");
+}

@@ -336,6 +336,23 @@ pub struct Scene<'a, R> {
 }
 
 impl<'a, R: Real> Scene<'a, R> {
+    /// The objects (bit `i`: object `i`, for the first 64) whose eye window meets the window
+    /// rectangle `u` x `v` (2^-16 units, inclusive bounds, see [`EyeWindow`]): an eye ray
+    /// through that rectangle can hit no other. Objects past the 64th are always included.
+    pub fn eye_candidates(&self, u: [i32; 2], v: [i32; 2]) -> u64 {
+        let mut mask = 0u64;
+        for (i, o) in self.objects.iter().enumerate().take(64) {
+            let w = &o.eye_window;
+            if w[0] <= u[1] && u[0] <= w[1] && w[2] <= v[1] && v[0] <= w[3] {
+                mask |= 1 << i;
+            }
+        }
+        if self.objects.len() > 64 {
+            u64::MAX
+        } else {
+            mask
+        }
+    }
     /// All primitives; the objects of a composite are contiguous.
     pub fn objects(&self) -> &'a [Object<R>] {
         self.objects
