@@ -7,6 +7,7 @@
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
+use embedded_graphics_core::primitives::{PointsIter, Rectangle};
 use embedded_graphics_core::Pixel;
 
 /// A 1-bit frame; `On` pixels are stored as 1 (PBM black).
@@ -108,5 +109,53 @@ impl DrawTarget for BitFrame<'_> {
             }
         }
         Ok(())
+    }
+
+    /// A whole rectangle inside the frame (a tile) goes row by row with no per-pixel bounds
+    /// checks; one reaching outside goes pixel by pixel through [`DrawTarget::draw_iter`].
+    fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Self::Error> {
+        let (x0, y0) = (area.top_left.x, area.top_left.y);
+        let (w, h) = (area.size.width, area.size.height);
+        let inside = x0 >= 0 && y0 >= 0 && (x0 as u32).checked_add(w).is_some_and(|x1| x1 <= self.width) && (y0 as u32).checked_add(h).is_some_and(|y1| y1 <= self.height);
+        if !inside {
+            return self.draw_iter(area.points().zip(colors).map(|(p, c)| Pixel(p, c)));
+        }
+        let stride = (self.width as usize).div_ceil(8);
+        let mut colors = colors.into_iter();
+        for y in y0 as usize..y0 as usize + h as usize {
+            let row = &mut self.bits[y * stride..(y + 1) * stride];
+            for x in x0 as usize..x0 as usize + w as usize {
+                let Some(c) = colors.next() else { return Ok(()) };
+                let m = 0x80u8 >> (x % 8);
+                if c.is_on() {
+                    row[x / 8] |= m;
+                } else {
+                    row[x / 8] &= !m;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use embedded_graphics_core::geometry::Point;
+
+    /// Filling a rectangle, inside the frame or reaching out of it, sets the bits that drawing
+    /// its pixels one by one sets.
+    #[test]
+    fn fill_contiguous_is_draw_iter() {
+        for (x, y, w, h) in [(0, 0, 8, 8), (8, 16, 8, 8), (3, 5, 7, 3), (20, 10, 8, 8), (-3, -2, 6, 5), (0, 0, 21, 13), (0, 0, 0, 4)] {
+            let area = Rectangle::new(Point::new(x, y), Size::new(w, h));
+            let colors = (0..w * h).map(|i| BinaryColor::from((i * 7 + i / 3) % 5 < 2));
+            let (mut a, mut b) = ([0x5au8; 3 * 13], [0x5au8; 3 * 13]);
+            let mut fa = BitFrame::wrap(21, 13, &mut a).unwrap();
+            fa.fill_contiguous(&area, colors.clone()).unwrap();
+            let mut fb = BitFrame::wrap(21, 13, &mut b).unwrap();
+            fb.draw_iter(area.points().zip(colors).map(|(p, c)| Pixel(p, c))).unwrap();
+            assert_eq!(a, b, "area ({x}, {y}) {w}x{h}");
+        }
     }
 }

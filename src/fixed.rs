@@ -209,6 +209,14 @@ impl Real for Fx {
     fn is_finite(self) -> bool {
         true
     }
+    fn floor_clamped(self, max: u8) -> u8 {
+        // `from_i32(k)` is exactly `k << FRAC`, so the bisection's answer is the integer part.
+        if self.0 < 0 {
+            0
+        } else {
+            (self.0 >> FRAC).min(i32::from(max)) as u8
+        }
+    }
 }
 
 #[cfg(test)]

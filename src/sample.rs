@@ -37,19 +37,7 @@ pub enum Sampling {
 
 /// Gray level (0..=64) of a brightness in `[0, 1]`, rounded to nearest.
 pub fn level<R: Real>(v: R) -> u8 {
-    let l = v * R::from_i32(LEVELS as i32) + R::HALF;
-    // Bisection over the 65 levels: no float-to-int conversion the scalar may not have.
-    let mut lo = 0u8;
-    let mut hi = LEVELS + 1;
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        if R::from_i32(mid as i32) <= l {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
+    (v * R::from_i32(LEVELS as i32) + R::HALF).floor_clamped(LEVELS)
 }
 
 /// Samples tiles in the render's order (tile rows top to bottom, tiles left to right).

@@ -85,6 +85,21 @@ pub trait Real:
     fn pad_eps() -> Self;
     /// Whether the value is finite (always true for fixed point).
     fn is_finite(self) -> bool;
+    /// The largest integer `k` in `0..=max` with `k <= self` (0 when there is none: below 0,
+    /// or NaN). The default bisects with comparisons alone (no float-to-int conversion the
+    /// scalar may not have); the built-in scalars convert directly, to the same answer.
+    fn floor_clamped(self, max: u8) -> u8 {
+        let (mut lo, mut hi) = (0u16, u16::from(max) + 1);
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if Self::from_i32(i32::from(mid)) <= self {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo as u8
+    }
 }
 
 impl Real for f64 {
@@ -114,6 +129,16 @@ impl Real for f64 {
     }
     fn is_finite(self) -> bool {
         f64::is_finite(self)
+    }
+    fn floor_clamped(self, max: u8) -> u8 {
+        // `as` truncates towards zero, which is the floor from 0 up; NaN fails `>=`.
+        if !(self >= 0.0) {
+            0
+        } else if self >= f64::from(max) {
+            max
+        } else {
+            self as u8
+        }
     }
 }
 
@@ -180,11 +205,48 @@ impl Real for f32 {
     fn is_finite(self) -> bool {
         f32::is_finite(self)
     }
+    fn floor_clamped(self, max: u8) -> u8 {
+        // As for f64.
+        if !(self >= 0.0) {
+            0
+        } else if self >= f32::from(max) {
+            max
+        } else {
+            self as u8
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::Real;
+
+    /// The comparison-only bisection the trait's default does, as the reference.
+    fn bisect<R: Real>(x: R, max: u8) -> u8 {
+        (0..=max).rev().find(|&k| R::from_i32(k as i32) <= x).unwrap_or(0)
+    }
+
+    fn floor_clamped_matches_bisection<R: Real>() {
+        let mut values = std::vec![f64::NAN, f64::NEG_INFINITY, f64::INFINITY, -1e9, 1e9, -0.0, 0.0];
+        for i in -300..=70 * 64 {
+            let x = i as f64 / 64.0;
+            values.extend([x, x - 1e-7, x + 1e-7, x - 1.0 / 65536.0]);
+        }
+        for v in values {
+            let x = R::from_f64(v);
+            for max in [0, 1, 64, 255] {
+                assert_eq!(x.floor_clamped(max), bisect(x, max), "{} {v} (max {max})", R::NAME);
+            }
+        }
+    }
+
+    #[test]
+    fn floor_clamped_is_the_bisection_in_every_scalar() {
+        floor_clamped_matches_bisection::<f64>();
+        floor_clamped_matches_bisection::<f32>();
+        floor_clamped_matches_bisection::<crate::Fx>();
+        floor_clamped_matches_bisection::<crate::F32Micro>();
+    }
 
     fn generic_min_max<R: Real>() {
         let two = R::from_f64(2.0);
