@@ -71,18 +71,24 @@ fn the_paper_scenes_render_the_same_with_windows_in_every_scalar() {
     scenes_in::<Fx>();
 }
 
+/// A random scene of 40 objects (4 per composite) seen from `eye` towards `look`, or `None`
+/// if the camera is refused.
+fn generated(storage: &mut [Object<f64>], seed: u64, eye: (f64, f64, f64), look: (f64, f64, f64)) -> Option<Scene<'_, f64>> {
+    let mut b = SceneBuilder::new(storage);
+    random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
+    b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
+    b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
+    b.camera.fov = (70.0, 50.0);
+    b.finish().ok()
+}
+
 #[test]
 fn generated_scenes_and_cameras_inside_or_beside_objects_render_the_same() {
     let (mut built, mut culled) = (0, 0);
     for seed in 0..6u64 {
         for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0)), ((3.0, 0.0, 0.0), (-3.0, 0.5, 0.0))] {
             let mut storage = vec![Object::<f64>::default(); 40];
-            let mut b = SceneBuilder::new(&mut storage);
-            random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
-            b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
-            b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
-            b.camera.fov = (70.0, 50.0);
-            let Ok(scene) = b.finish() else { continue };
+            let Some(scene) = generated(&mut storage, seed, eye, look) else { continue };
             built += 1;
             culled += same_with_and_without(&scene, 32, 20, &format!("seed {seed}, eye {eye:?}"));
         }
@@ -100,12 +106,7 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
     for seed in 0..4u64 {
         for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0))] {
             let mut storage = vec![Object::<f64>::default(); 40];
-            let mut b = SceneBuilder::new(&mut storage);
-            random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
-            b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
-            b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
-            b.camera.fov = (70.0, 50.0);
-            let Ok(scene) = b.finish() else { continue };
+            let Some(scene) = generated(&mut storage, seed, eye, look) else { continue };
             // 8x8 tiles of a 48x32 frame, every quarter-pixel ray position in each.
             let (w4, h4) = (4 * 48, 4 * 32);
             for (tx, ty) in (0..6).flat_map(|tx| (0..4).map(move |ty| (tx, ty))) {
