@@ -1,6 +1,8 @@
 //! Turning gray levels (0..=64, the paper's 65 levels) into 1-bit pixels.
 //!
 //! * [`Dither::Bayer`]: ordered dither with the 8x8 Bayer matrix, one gray per pixel;
+//! * [`Dither::BlueNoise`]: ordered dither with a 16x16 blue-noise mask (void-and-cluster,
+//!   made at build time), one gray per pixel: no regular texture, no error carried;
 //! * [`Dither::Pattern`]: the paper's bit-map patterning: one traced sample per NxN block,
 //!   shown as the NxN dot pattern of its level (N = 8 gives the paper's 65 levels);
 //! * [`Dither::FloydSteinberg`] and [`Dither::Atkinson`]: error diffusion, run in tile order
@@ -21,6 +23,8 @@ pub const LEVELS: u8 = 64;
 pub enum Dither {
     /// 8x8 Bayer ordered dither, one sample per pixel.
     Bayer,
+    /// Ordered dither with a 16x16 void-and-cluster blue-noise mask, one sample per pixel.
+    BlueNoise,
     /// The paper's patterning: one sample per NxN block (N = 2, 4 or 8).
     Pattern(u8),
     /// Floyd-Steinberg error diffusion.
@@ -65,6 +69,45 @@ pub fn ordered(level: u8, x: u32, y: u32, n: u8) -> BinaryColor {
     let shift = 64 / cells;
     let t = BAYER8[(y % n) as usize][(x % n) as usize] as u32 / shift;
     BinaryColor::from(q > t)
+}
+
+// BLUE_NOISE and GAMMA, made by the crate's build.rs.
+include!(concat!(env!("OUT_DIR"), "/display.rs"));
+
+/// Ordered dither of one pixel against the blue-noise mask: of the mask's 256 ranks, the lowest
+/// `level * 4` are on (so level 32 lights half the pixels, 0 none and 64 all).
+pub fn blue_noise(level: u8, x: u32, y: u32) -> BinaryColor {
+    let rank = BLUE_NOISE[(y % 16) as usize][(x % 16) as usize] as u32;
+    BinaryColor::from(rank < level.min(LEVELS) as u32 * 4)
+}
+
+/// A tone curve applied to gray levels before dithering: level `l` of 64 shows as
+/// `64 * (l / 64)^(gamma / 10)`, rounded (tables made at build time). Below 10 it lifts dark
+/// grays, above 10 it deepens them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tone {
+    /// The exponent in tenths, 5..=20 (10: unchanged).
+    pub gamma_tenths: u8,
+}
+
+impl Tone {
+    /// Levels unchanged.
+    pub const LINEAR: Tone = Tone { gamma_tenths: 10 };
+    /// Exponents the tables hold, in tenths.
+    pub const RANGE: core::ops::RangeInclusive<u8> = 5..=20;
+
+    /// Whether the curve changes any level.
+    pub fn is_linear(self) -> bool {
+        self.gamma_tenths == 10 || !Self::RANGE.contains(&self.gamma_tenths)
+    }
+
+    /// Level `l` (0..=64) through the curve; exponents outside [`Tone::RANGE`] leave it unchanged.
+    pub fn apply(self, l: u8) -> u8 {
+        match GAMMA.get(self.gamma_tenths.wrapping_sub(*Self::RANGE.start()) as usize) {
+            Some(curve) if !self.is_linear() => curve[l.min(LEVELS) as usize],
+            _ => l,
+        }
+    }
 }
 
 /// (dx, dy, weight) of an error-diffusion kernel and its divisor.
@@ -209,7 +252,8 @@ impl<'c> Ditherer<'c> {
                 let n = if self.mode == Dither::Bayer { 8 } else { self.mode.block() };
                 for y in 0..h {
                     for x in 0..w {
-                        out[y * w + x] = ordered(levels[y * w + x], (x0 + x) as u32, (y0 + y) as u32, n);
+                        let (l, gx, gy) = (levels[y * w + x], (x0 + x) as u32, (y0 + y) as u32);
+                        out[y * w + x] = if self.mode == Dither::BlueNoise { blue_noise(l, gx, gy) } else { ordered(l, gx, gy, n) };
                     }
                 }
             }
@@ -252,6 +296,42 @@ mod tests {
              #.#.#.#.\n\
              ........\n"
         );
+    }
+
+    #[test]
+    fn blue_noise_mask_holds_every_rank_once_and_lights_level_quarters() {
+        let mut seen = [false; 256];
+        BLUE_NOISE.iter().flatten().for_each(|&r| seen[r as usize] = true);
+        assert!(seen.iter().all(|&s| s));
+        for level in [0u8, 16, 32, 48, 64] {
+            let on = (0..256).filter(|&i| blue_noise(level, i % 16, i / 16).is_on()).count();
+            assert_eq!(on, level as usize * 4);
+        }
+    }
+
+    #[test]
+    fn blue_noise_half_gray_has_no_clumps() {
+        // Blue noise spreads the dots: at half gray few 2x2 squares are all on or all off (white
+        // noise makes about one in eight solid).
+        let solid = (0..256)
+            .filter(|&i| {
+                let (x, y) = (i % 16, i / 16);
+                let px = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)].map(|(a, b)| blue_noise(32, a, b).is_on());
+                px.iter().all(|&p| p) || px.iter().all(|&p| !p)
+            })
+            .count();
+        assert!(solid < 256 / 16, "{solid} solid 2x2 squares of 256");
+    }
+
+    #[test]
+    fn tone_curves_fix_the_ends_and_bend_the_middle() {
+        for g in Tone::RANGE {
+            let t = Tone { gamma_tenths: g };
+            assert_eq!((t.apply(0), t.apply(64)), (0, 64));
+            let mid = t.apply(32);
+            assert!((g < 10 && mid > 32) || (g == 10 && mid == 32) || (g > 10 && mid < 32), "gamma {g}: {mid}");
+        }
+        assert_eq!(Tone { gamma_tenths: 30 }.apply(17), 17);
     }
 
     #[test]

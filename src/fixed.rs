@@ -188,6 +188,17 @@ impl Real for Fx {
     fn to_f64(self) -> f64 {
         self.0 as f64 / ONE_RAW as f64
     }
+    fn depth_key(self) -> u16 {
+        // A float of the raw value, integers only: 5 bits of exponent (the leading one's
+        // place), 11 of mantissa.
+        if self.0 <= 0 {
+            return 0;
+        }
+        let raw = self.0 as u32;
+        let lz = raw.leading_zeros();
+        let mantissa = ((raw << lz) >> 20) & 0x7ff;
+        (((31 - lz) << 11) | mantissa) as u16
+    }
     fn sqrt(self) -> Self {
         if self.0 <= 0 {
             return Fx(0);

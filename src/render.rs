@@ -1,11 +1,19 @@
 //! Tiles: the frame is rendered one small tile at a time into a fixed buffer, dithered and
 //! handed to an `embedded_graphics` draw target in one `fill_contiguous` call. No full-frame
 //! buffer exists; between tiles a hook reports progress and may cancel.
+//!
+//! A frame can also be rendered **progressively** ([`render_pass`]), the paper's patterning
+//! turned into time: pass 8 traces one ray per 8x8 block and shows it as the block, passes 4
+//! and 2 add the rays that make 4x4 and 2x2 blocks, and pass 1 completes the frame with the
+//! frame's own sampling. Every ray a pass traces on the 2x2 grid is kept ([`Traced`]) and
+//! reused by the passes after it, so no ray is traced twice and the last pass draws exactly the
+//! frame [`render`] draws.
 
 use crate::accel::{Accelerator, Query, Stats};
-use crate::dither::{Dither, Ditherer, MAX_TILE};
+use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
+use crate::outline::Outline;
 use crate::scalar::Real;
-pub use crate::sample::{level, Sampling};
+pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
 use crate::scene::Camera;
 use crate::storage::Scratch;
@@ -33,6 +41,11 @@ pub struct Frame {
     /// rendered apart give the same pixels as the whole when the dithering carries nothing
     /// between tiles ([`Frame::bands_independent`]): that is how a host renders in parallel.
     pub rows: (u16, u16),
+    /// Tone curve applied to the gray levels before dithering.
+    pub tone: Tone,
+    /// Silhouette lines ([`crate::outline`]): the farther pixel of two neighbours that hit
+    /// different objects is drawn black.
+    pub outline: bool,
 }
 
 /// One core's share of a frame's tiles ([`render_share`]): tile `(tx, ty)` belongs to share `(tx + ty) % of`, a
@@ -64,20 +77,54 @@ impl Share {
 impl Frame {
     /// A frame with 8x8 tiles, Bayer dithering and one ray per pixel.
     pub fn new(width: u16, height: u16) -> Self {
-        Frame { width, height, tile: 8, dither: Dither::Bayer, sampling: Sampling::Center, rows: (0, u16::MAX) }
+        Frame {
+            width,
+            height,
+            tile: 8,
+            dither: Dither::Bayer,
+            sampling: Sampling::Center,
+            rows: (0, u16::MAX),
+            tone: Tone::LINEAR,
+            outline: false,
+        }
     }
 
     /// Whether bands of tile rows can be rendered apart and give the same pixels: true unless
-    /// error diffusion or edge detection carries state from one tile row to the next.
+    /// error diffusion, edge detection or the outline carries state from one tile row to the
+    /// next.
     pub fn bands_independent(&self) -> bool {
-        !self.dither.diffuses() && !self.edges()
+        !self.dither.diffuses() && !self.edges() && !self.outline
     }
 
-    /// Entries of `i16` scratch storage [`render`] needs: error-diffusion carries and the
-    /// object ids of the row above the current band for edge detection.
+    /// Entries of `i16` scratch storage [`render`] needs: error-diffusion carries, the object
+    /// ids of the row above the current band for edge detection, and the objects and depths of
+    /// that row for the outline.
     pub fn scratch_len(&self) -> usize {
         let w = self.width as usize;
-        Ditherer::rows_len(self.dither, w) + Sampler::rows_len(self.sampling, self.dither.block(), w)
+        Ditherer::rows_len(self.dither, w) + Sampler::rows_len(self.sampling, self.dither.block(), w) + self.outline_len()
+    }
+
+    fn outline_len(&self) -> usize {
+        if self.outline {
+            Outline::rows_len(self.width as usize)
+        } else {
+            0
+        }
+    }
+
+    /// Whether the frame can be rendered progressively ([`render_pass`]): its tiles are a
+    /// multiple of 8 pixels (whole 8x8 blocks) and its dither shows one ray per pixel.
+    pub fn progressive(&self) -> bool {
+        self.tile.is_multiple_of(8) && self.dither.block() == 1
+    }
+
+    /// Entries of [`Traced`] storage a progressive render of `share` needs: one per pixel of
+    /// the 2x2 grid of each of its tiles.
+    pub fn traced_len(&self, share: Share) -> usize {
+        let t = self.tile as usize;
+        let (tiles_x, tiles_y) = ((self.width as usize).div_ceil(t), (self.height as usize).div_ceil(t));
+        let tiles = (0..tiles_y).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>();
+        tiles * (t / 2) * (t / 2)
     }
 
     fn edges(&self) -> bool {
@@ -119,8 +166,12 @@ pub enum RenderError<E> {
         needed: usize,
     },
     /// The share is not one of its frame's (`index >= of`), or the frame's tiles depend on
-    /// each other (error diffusion, edge sampling) and cannot be shared out.
+    /// each other (error diffusion, edge sampling, the outline) and cannot be shared out.
     BadShare,
+    /// A progressive pass was asked of a frame that cannot be rendered progressively
+    /// ([`Frame::progressive`]), or the pass is not 8, 4, 2 or 1, or the [`Traced`] storage is
+    /// shorter than [`Frame::traced_len`].
+    NotProgressive,
 }
 
 impl<E: fmt::Debug> fmt::Display for RenderError<E> {
@@ -135,7 +186,8 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
-            RenderError::BadShare => write!(f, "tile share out of range, or the dithering carries error from tile to tile"),
+            RenderError::BadShare => write!(f, "tile share out of range, or the frame carries state from tile to tile (error diffusion, edge sampling, outline)"),
+            RenderError::NotProgressive => write!(f, "progressive passes need tiles of a multiple of 8, one ray per pixel, a pass of 8, 4, 2 or 1 and room for the traced samples"),
         }
     }
 }
@@ -169,6 +221,55 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
+    render_tiles(tracer, frame, share, None, target, scratch, hooks)
+}
+
+/// What a progressive render keeps of one ray it traced on the 2x2 grid: its gray level and
+/// what it hit ([`render_pass`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Traced {
+    /// Gray level (0..=64).
+    pub level: u8,
+    /// Object hit (modulo 2^16).
+    pub object: u16,
+    /// Depth key of the hit.
+    pub depth: u16,
+}
+
+/// One pass of a progressive frame ([`Frame::progressive`]) over one share of its tiles: pass
+/// 8, 4 or 2 shows one ray per block of that side (the ray through the block's top-left pixel,
+/// traced now or by an earlier pass), pass 1 the finished frame, which is the frame [`render`]
+/// draws. Run the passes in the order 8, 4, 2, 1 with the same `traced` storage (at least
+/// [`Frame::traced_len`] entries; the rays each pass traces are kept there for the next).
+/// Returns the statistics of this pass alone.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+    tracer: &Tracer<'_, '_, R, A, E>,
+    frame: &Frame,
+    share: Share,
+    pass: u8,
+    traced: &mut [Traced],
+    target: &mut D,
+    scratch: &mut Scratch<'_>,
+    hooks: &mut impl Hooks,
+) -> Result<Stats, RenderError<D::Error>> {
+    if !frame.progressive() || ![8, 4, 2, 1].contains(&pass) || traced.len() < frame.traced_len(share) {
+        return Err(RenderError::NotProgressive);
+    }
+    render_tiles(tracer, frame, share, Some((pass, traced)), target, scratch, hooks)
+}
+
+/// The tile loop of [`render_share`] and [`render_pass`].
+fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+    tracer: &Tracer<'_, '_, R, A, E>,
+    frame: &Frame,
+    share: Share,
+    mut pass: Option<(u8, &mut [Traced])>,
+    target: &mut D,
+    scratch: &mut Scratch<'_>,
+    hooks: &mut impl Hooks,
+) -> Result<Stats, RenderError<D::Error>> {
     let t = frame.tile as usize;
     let block = frame.dither.block() as usize;
     if t == 0 || t > MAX_TILE || !t.is_multiple_of(block) {
@@ -183,22 +284,31 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
     let (w, h) = (frame.width as usize, frame.height as usize);
     let too_small = || RenderError::ScratchTooSmall { needed: frame.scratch_len() };
     let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or_else(too_small)?;
-    let (carries, above) = rows.split_at_mut(Ditherer::rows_len(frame.dither, w));
+    let (carries, rest) = rows.split_at_mut(Ditherer::rows_len(frame.dither, w));
+    let (outline_rows, above) = rest.split_at_mut(frame.outline_len());
     let mut dither = Ditherer::new(frame.dither, w, carries).ok_or_else(too_small)?;
     let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
+    let mut outline = if frame.outline { Some(Outline::new(outline_rows, w).ok_or_else(too_small)?) } else { None };
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
     let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
     let total = (first..end).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>() as u32;
+    // Tiles of this share before the band range: their traced samples come first.
+    let skipped = (0..first.min(tiles_y)).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>();
+    let per_tile = (t / 2) * (t / 2);
     let mut done = 0;
     let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
+    let mut hits = Hits::new();
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     for ty in first..end {
         dither.next_band();
         sampler.next_band();
+        if let Some(o) = outline.as_mut() {
+            o.next_band();
+        }
         // Remembered occluders are forgotten at every band of tiles, so a band renders the same
         // whichever bands a core or thread rendered before it.
         q.forget_occluders();
@@ -211,14 +321,27 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
             let (sx, sy) = ([4 * x0 as i32 - m, 4 * (x0 + tw) as i32 + m], [4 * y0 as i32 - m, 4 * (y0 + th) as i32 + m]);
             let (lo, hi) = (Camera::<R>::window_uv(sx[0], sy[1], w4, h4), Camera::<R>::window_uv(sx[1], sy[0], w4, h4));
             q.set_eye_candidates(tracer.scene().eye_candidates([lo[0], hi[0]], [lo[1], hi[1]]));
-            let mut shoot = |sx: usize, sy: usize| {
+            let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
-                let (v, id) = tracer.radiance_and_object(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
-                (v, id as u16)
+                let (v, id, depth) = tracer.eye_sample(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
+                (v, id as u16, depth.depth_key())
             };
-            sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels);
-            dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
+            match pass.as_mut() {
+                None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels, &mut hits),
+                Some((n, traced)) => {
+                    let k = skipped + done as usize;
+                    let kept = &mut traced[k * per_tile..(k + 1) * per_tile];
+                    progressive_tile(&mut sampler, *n as usize, x0, y0, tw, th, t, kept, &mut shoot, &mut levels, &mut hits);
+                }
+            }
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
+            if !frame.tone.is_linear() {
+                levels[..tw * th].iter_mut().for_each(|l| *l = frame.tone.apply(*l));
+            }
+            if let Some(o) = outline.as_mut() {
+                o.tile(x0, y0, tw, th, &hits, &mut levels[..tw * th]);
+            }
+            dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
             target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
             done += 1;
@@ -228,4 +351,61 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
         }
     }
     Ok(q.stats)
+}
+
+/// One tile of a progressive pass `n` (8, 4, 2 or 1); `kept` holds the tile's rays on the
+/// 2x2 grid (tile side `t`), `(t / 2)^2` of them, pixel `(x, y)` at `(y / 2) * (t / 2) + x / 2`.
+#[allow(clippy::too_many_arguments)]
+fn progressive_tile<R: Real>(
+    sampler: &mut Sampler<'_>,
+    n: usize,
+    x0: usize,
+    y0: usize,
+    tw: usize,
+    th: usize,
+    t: usize,
+    kept: &mut [Traced],
+    shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+    levels: &mut [u8; MAX_TILE * MAX_TILE],
+    hits: &mut Hits,
+) {
+    let at = |x: usize, y: usize| (y / 2) * (t / 2) + x / 2;
+    let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
+    if n == 1 {
+        // The frame's own sampling, with the rays of the 2x2 grid taken from the earlier
+        // passes: a level l comes back as the brightness l / 64, whose level is l again.
+        let sixty_fourth = R::ONE / R::from_i32(64);
+        let mut reuse = |sx: usize, sy: usize| -> Shot<R> {
+            let (x, y) = ((sx / 4).wrapping_sub(x0), (sy / 4).wrapping_sub(y0));
+            if sx % 4 == 2 && sy % 4 == 2 && x % 2 == 0 && y % 2 == 0 && x < tw && y < th {
+                let k = kept[at(x, y)];
+                (R::from_i32(k.level as i32) * sixty_fourth, k.object, k.depth)
+            } else {
+                shoot(sx, sy)
+            }
+        };
+        return sampler.tile(x0, y0, tw, th, &mut reuse, levels, hits);
+    }
+    for by in (0..th).step_by(n) {
+        for bx in (0..tw).step_by(n) {
+            // Rays on the grid of twice this pass's side were traced by an earlier pass.
+            let earlier = n < 8 && bx % (2 * n) == 0 && by % (2 * n) == 0;
+            let k = if earlier {
+                kept[at(bx, by)]
+            } else {
+                let (cx, cy) = centre(bx, by);
+                let (v, object, depth) = shoot(cx, cy);
+                let k = Traced { level: level(v), object, depth };
+                kept[at(bx, by)] = k;
+                k
+            };
+            for y in by..(by + n).min(th) {
+                for x in bx..(bx + n).min(tw) {
+                    levels[y * tw + x] = k.level;
+                    hits.object[y * tw + x] = k.object;
+                    hits.depth[y * tw + x] = k.depth;
+                }
+            }
+        }
+    }
 }

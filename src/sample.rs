@@ -35,6 +35,33 @@ pub enum Sampling {
     },
 }
 
+/// What one eye ray brings back: brightness, the object it hit (modulo 2^16: ids only need to
+/// differ between neighbours) and a key of its distance ([`Real::depth_key`]).
+pub type Shot<R> = (R, u16, u16);
+
+/// Per pixel of a tile (row-major, the tile's width), what its eye ray hit: the object and the
+/// depth key of the hit. Filled by [`Sampler::tile`]; the outline reads it.
+#[derive(Clone, Copy, Debug)]
+pub struct Hits {
+    /// Object id (modulo 2^16; `NO_OBJECT as u16` for the background).
+    pub object: [u16; MAX_TILE * MAX_TILE],
+    /// Depth key of the hit (`u16::MAX`-like for the background: larger than any hit's).
+    pub depth: [u16; MAX_TILE * MAX_TILE],
+}
+
+impl Hits {
+    /// Nothing hit yet.
+    pub const fn new() -> Self {
+        Hits { object: [NO_OBJECT as u16; MAX_TILE * MAX_TILE], depth: [u16::MAX; MAX_TILE * MAX_TILE] }
+    }
+}
+
+impl Default for Hits {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// Gray level (0..=64) of a brightness in `[0, 1]`, rounded to nearest.
 pub fn level<R: Real>(v: R) -> u8 {
     (v * R::from_i32(LEVELS as i32) + R::HALF).floor_clamped(LEVELS)
@@ -83,41 +110,42 @@ impl<'r> Sampler<'r> {
         self.left = [NO_OBJECT as u16; MAX_TILE];
     }
 
-    /// Gray levels of the `tw x th` tile at `(x0, y0)` into `levels` (row-major). `shoot(sx,
-    /// sy)` traces the eye ray through `(sx / 4, sy / 4)` pixels from the top-left corner
-    /// and returns its brightness and the object it hit (modulo 2^16: ids only need to differ
-    /// between neighbours).
+    /// Gray levels of the `tw x th` tile at `(x0, y0)` into `levels` (row-major), and what
+    /// each pixel's ray hit into `hits`. `shoot(sx, sy)` traces the eye ray through
+    /// `(sx / 4, sy / 4)` pixels from the top-left corner.
+    #[allow(clippy::too_many_arguments)]
     pub fn tile<R: Real>(
         &mut self,
         x0: usize,
         y0: usize,
         tw: usize,
         th: usize,
-        shoot: &mut impl FnMut(usize, usize) -> (R, u16),
+        shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
         levels: &mut [u8; MAX_TILE * MAX_TILE],
+        hits: &mut Hits,
     ) {
         let block = self.block;
         if let (Sampling::Adaptive { contrast }, 1) = (self.mode, block) {
-            return adaptive(x0, y0, tw, th, contrast, shoot, levels);
+            return adaptive(x0, y0, tw, th, contrast, shoot, levels, hits);
         }
-        let mut ids = [NO_OBJECT as u16; MAX_TILE * MAX_TILE];
         // One ray per block through the block's centre; Grid2x2 takes four per pixel.
         for by in (0..th).step_by(block) {
             for bx in (0..tw).step_by(block) {
                 let (cx, cy) = (4 * (x0 + bx) + 2 * block, 4 * (y0 + by) + 2 * block);
-                let (v, id) = if self.mode == Sampling::Grid2x2 && block == 1 { grid2x2(shoot, cx, cy) } else { shoot(cx, cy) };
+                let (v, id, depth) = if self.mode == Sampling::Grid2x2 && block == 1 { grid2x2(shoot, cx, cy) } else { shoot(cx, cy) };
                 let l = level(v);
                 for y in by..(by + block).min(th) {
                     for x in bx..(bx + block).min(tw) {
                         levels[y * tw + x] = l;
-                        ids[y * tw + x] = id;
+                        hits.object[y * tw + x] = id;
+                        hits.depth[y * tw + x] = depth;
                     }
                 }
             }
         }
         // Without the feature the branch is a constant false and its code is not linked.
         if cfg!(feature = "edge-sampling") && self.edges {
-            self.refine_edges(x0, y0, tw, th, shoot, levels, &ids);
+            self.refine_edges(x0, y0, tw, th, shoot, levels, &hits.object);
         }
     }
 
@@ -132,7 +160,7 @@ impl<'r> Sampler<'r> {
         y0: usize,
         tw: usize,
         th: usize,
-        shoot: &mut impl FnMut(usize, usize) -> (R, u16),
+        shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
         levels: &mut [u8; MAX_TILE * MAX_TILE],
         ids: &[u16; MAX_TILE * MAX_TILE],
     ) {
@@ -180,24 +208,29 @@ fn traced(i: usize, n: usize) -> bool {
 
 /// [`Sampling::Adaptive`] over one tile: the first pass traces the pixels of traced rows and
 /// columns, the second fills or traces each other pixel from its two or four traced
-/// neighbours (they are one pixel away: traced lines are at most two apart).
+/// neighbours (they are one pixel away: traced lines are at most two apart). A filled pixel
+/// takes the object of its neighbours and the nearest of their depths.
+#[allow(clippy::too_many_arguments)]
 fn adaptive<R: Real>(
     x0: usize,
     y0: usize,
     tw: usize,
     th: usize,
     contrast: u8,
-    shoot: &mut impl FnMut(usize, usize) -> (R, u16),
+    shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
+    hits: &mut Hits,
 ) {
-    let mut ids = [NO_OBJECT as u16; MAX_TILE * MAX_TILE];
+    let ids = &mut hits.object;
+    let depths = &mut hits.depth;
     let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
     for y in (0..th).filter(|&y| traced(y, th)) {
         for x in (0..tw).filter(|&x| traced(x, tw)) {
             let (cx, cy) = centre(x, y);
-            let (v, id) = shoot(cx, cy);
+            let (v, id, depth) = shoot(cx, cy);
             levels[y * tw + x] = level(v);
             ids[y * tw + x] = id;
+            depths[y * tw + x] = depth;
         }
     }
     for y in 0..th {
@@ -210,7 +243,7 @@ fn adaptive<R: Real>(
             let ys = if traced(y, th) { [y, y] } else { [y - 1, y + 1] };
             let at = |i: usize| (xs[i % 2], ys[i / 2]);
             let first = ids[ys[0] * tw + xs[0]];
-            let (mut lo, mut hi, mut sum, mut same) = (u8::MAX, 0u8, 0u32, true);
+            let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
             for i in 0..4 {
                 let (nx, ny) = at(i);
                 let l = levels[ny * tw + nx];
@@ -218,28 +251,31 @@ fn adaptive<R: Real>(
                 hi = hi.max(l);
                 sum += l as u32;
                 same &= ids[ny * tw + nx] == first;
+                near = near.min(depths[ny * tw + nx]);
             }
-            levels[y * tw + x] = if same && hi - lo <= contrast {
-                ((sum + 2) / 4) as u8
+            let i = y * tw + x;
+            if same && hi - lo <= contrast {
+                (levels[i], ids[i], depths[i]) = (((sum + 2) / 4) as u8, first, near);
             } else {
                 let (cx, cy) = centre(x, y);
-                level(shoot(cx, cy).0)
-            };
+                let (v, id, depth) = shoot(cx, cy);
+                (levels[i], ids[i], depths[i]) = (level(v), id, depth);
+            }
         }
     }
 }
 
 /// The mean of four eye rays on a 2x2 grid around the pixel centre `(cx, cy)` (quarter-pixel
-/// units), and the object the first of them hit.
-fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize) -> (R, u16), cx: usize, cy: usize) -> (R, u16) {
+/// units), with the object and depth the first of them hit.
+fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize) -> Shot<R>, cx: usize, cy: usize) -> Shot<R> {
     let mut sum = R::ZERO;
-    let mut first = NO_OBJECT as u16;
+    let mut first = (NO_OBJECT as u16, u16::MAX);
     for (k, (dx, dy)) in [(0, 0), (2, 0), (0, 2), (2, 2)].into_iter().enumerate() {
-        let (v, id) = shoot(cx - 1 + dx, cy - 1 + dy);
+        let (v, id, depth) = shoot(cx - 1 + dx, cy - 1 + dy);
         sum += v;
         if k == 0 {
-            first = id;
+            first = (id, depth);
         }
     }
-    (sum * (R::HALF * R::HALF), first)
+    (sum * (R::HALF * R::HALF), first.0, first.1)
 }

@@ -85,6 +85,13 @@ pub trait Real:
     fn pad_eps() -> Self;
     /// Whether the value is finite (always true for fixed point).
     fn is_finite(self) -> bool;
+    /// A 16-bit key that orders distances: `a <= b` gives `a.depth_key() <= b.depth_key()`
+    /// (0 for zero, negatives and NaN). Coarse (about 1 % steps) but enough to tell which of
+    /// two neighbouring pixels' hits is farther. The default goes through `f32`'s bits, whose
+    /// order is the order of the non-negative values.
+    fn depth_key(self) -> u16 {
+        f32_key(self.to_f64() as f32)
+    }
     /// The largest integer `k` in `0..=max` with `k <= self` (0 when there is none: below 0,
     /// or NaN). The default bisects with comparisons alone (no float-to-int conversion the
     /// scalar may not have); the built-in scalars convert directly, to the same answer.
@@ -99,6 +106,15 @@ pub trait Real:
             }
         }
         lo as u8
+    }
+}
+
+/// [`Real::depth_key`] of an `f32`: its top 16 bits (sign, exponent, 7 mantissa bits).
+fn f32_key(v: f32) -> u16 {
+    if v > 0.0 {
+        (v.to_bits() >> 16) as u16
+    } else {
+        0
     }
 }
 
@@ -196,6 +212,9 @@ impl Real for f32 {
     fn sqrt(self) -> Self {
         sqrt_f32(self)
     }
+    fn depth_key(self) -> u16 {
+        f32_key(self)
+    }
     fn offset_eps() -> Self {
         3e-6
     }
@@ -246,6 +265,26 @@ mod tests {
         floor_clamped_matches_bisection::<f32>();
         floor_clamped_matches_bisection::<crate::Fx>();
         floor_clamped_matches_bisection::<crate::F32Micro>();
+    }
+
+    fn depth_keys_keep_order<R: Real>() {
+        let mut values: std::vec::Vec<f64> = (0..2000).map(|i| 1.013f64.powi(i) * 1e-3).filter(|v| *v < R::LIMIT).collect();
+        values.extend([0.0, -1.0]);
+        values.sort_by(f64::total_cmp);
+        let keys: std::vec::Vec<u16> = values.iter().map(|&v| R::from_f64(v).depth_key()).collect();
+        assert!(keys.windows(2).all(|k| k[0] <= k[1]), "{} keys out of order", R::NAME);
+        // Distances 3 % apart get different keys from 1/100 to 100 units.
+        let differ = |a: f64| R::from_f64(a).depth_key() < R::from_f64(a * 1.03).depth_key();
+        assert!([0.01, 0.1, 1.0, 10.0, 100.0].into_iter().all(differ), "{}", R::NAME);
+        assert!(R::MAX.depth_key() > R::from_f64(1000.0).depth_key());
+    }
+
+    #[test]
+    fn depth_keys_order_distances_in_every_scalar() {
+        depth_keys_keep_order::<f64>();
+        depth_keys_keep_order::<f32>();
+        depth_keys_keep_order::<crate::Fx>();
+        depth_keys_keep_order::<crate::F32Micro>();
     }
 
     fn generic_min_max<R: Real>() {
@@ -338,6 +377,9 @@ macro_rules! f32_with_sqrt {
             }
             fn sqrt(self) -> Self {
                 $name(($sqrt)(self.0))
+            }
+            fn depth_key(self) -> u16 {
+                f32_key(self.0)
             }
             fn offset_eps() -> Self {
                 $name(<f32 as Real>::offset_eps())

@@ -398,7 +398,15 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
 
     /// Brightness along an eye ray and the object the eye ray hits ([`NO_OBJECT`] if none).
     pub fn radiance_and_object(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u32) {
+        let (v, object, _) = self.eye_sample(eye, q);
+        (v, object)
+    }
+
+    /// Brightness along an eye ray, the object it hits ([`NO_OBJECT`] if none) and how far
+    /// along the ray (in units of its direction's length; `R::MAX` if it hits nothing).
+    pub fn eye_sample(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u32, R) {
         let mut first = NO_OBJECT;
+        let mut depth = R::MAX;
         let scene = self.scene;
         // Depth-first, each node pushes at most two children and `max_depth <= MAX_DEPTH`, so at
         // most `MAX_DEPTH + 2` nodes wait: no push below can fail.
@@ -429,6 +437,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             };
             if node.depth == 0 {
                 first = hit.object;
+                depth = hit.t;
             }
             let obj = &scene.objects[hit.object as usize];
             let m = scene.materials[obj.material as usize];
@@ -465,7 +474,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection));
             }
         }
-        (total.max(R::ZERO).min(R::ONE), first)
+        (total.max(R::ZERO).min(R::ONE), first, depth)
     }
 
     /// `Ip * Kd * max(0, L.N)` for one light, or zero if the light is behind the surface or
