@@ -77,6 +77,7 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Render(RenderError::BadTile) => defmt::write!(f, "bad tile size"),
             AppError::Render(RenderError::EdgesNotCompiled) => defmt::write!(f, "edge sampling not compiled in"),
             AppError::Render(RenderError::BadShare) => defmt::write!(f, "bad tile share"),
+            AppError::Render(RenderError::NotProgressive) => defmt::write!(f, "frame cannot be rendered progressively"),
             AppError::Render(RenderError::ScratchTooSmall { needed }) => {
                 defmt::write!(f, "scratch storage too small: {} entries needed", needed)
             }
@@ -234,6 +235,7 @@ fn widen<E>(e: RenderError<core::convert::Infallible>) -> RenderError<E> {
         RenderError::EdgesNotCompiled => RenderError::EdgesNotCompiled,
         RenderError::ScratchTooSmall { needed } => RenderError::ScratchTooSmall { needed },
         RenderError::BadShare => RenderError::BadShare,
+        RenderError::NotProgressive => RenderError::NotProgressive,
     }
 }
 

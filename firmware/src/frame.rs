@@ -1,7 +1,7 @@
 //! The frame every board renders (also read by `build.rs`, which sizes the storage for it).
 
 use lattice_rt::render::Sampling;
-use lattice_rt::{Dither, EyeRays, Frame};
+use lattice_rt::{Dither, EyeRays, Frame, Tone};
 
 /// Display width (SSD1306 128x64).
 pub const WIDTH: u16 = 128;
@@ -14,14 +14,19 @@ pub const HEIGHT: u16 = 64;
 /// (`app::RENDERED`).
 pub const SAMPLING: Sampling = Sampling::Adaptive { contrast: 4 };
 
-/// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), Bayer dither.
+/// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), blue-noise
+/// ordered dither: of the dithers whose tiles the two cores can share out, the one that scores
+/// best in `host-sim display` (docs/display.md; error diffusion scores higher but carries error
+/// from tile to tile, so one core would have to render every tile).
 pub const FRAME: Frame = Frame {
     width: WIDTH,
     height: HEIGHT,
     tile: 8,
-    dither: Dither::Bayer,
+    dither: Dither::BlueNoise,
     sampling: SAMPLING,
     rows: (0, u16::MAX),
+    tone: Tone::LINEAR,
+    outline: false,
 };
 
 /// Frames per turn of the camera in orbit mode (the firmware's `orbit` feature, `host-sim orbit`).

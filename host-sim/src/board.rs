@@ -625,7 +625,7 @@ fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &Bo
     writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, flip-link), writes its UF2 file, runs that")?;
     writeln!(md, "file on [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 (core 0 of an RP2040, the B1 bootrom)")?;
     writeln!(md, "with an SSD1306 model on I2C0, decodes the defmt log, and requires every frame the panel shows to")?;
-    writeln!(md, "be bit-identical to host-sim's render of the scene (128x64, fixed point, Bayer). Scenes embedded:")?;
+    writeln!(md, "be bit-identical to host-sim's render of the scene (128x64, fixed point, blue-noise dither). Scenes embedded:")?;
     writeln!(md, "{}.\n", scenes.join(", "))?;
     writeln!(md, "## Per frame\n")?;
     writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;

@@ -295,7 +295,7 @@ pub fn host_frame(scenes: &Path, name: &str, scalar: &str, exact: bool) -> Resul
 pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     let (mut passed, mut failed) = (0, 0);
     let mut md = String::new();
-    writeln!(md, "# Firmware budgets\n\nWritten by `cargo run --release -p host-sim -- firmware` (also run by `.ci/run`).\nFrames are 128x64, lattice, Bayer dither, each scene's own effects and depth.\n")?;
+    writeln!(md, "# Firmware budgets\n\nWritten by `cargo run --release -p host-sim -- firmware` (also run by `.ci/run`).\nFrames are 128x64, lattice, blue-noise dither, each scene's own effects and depth.\n")?;
     writeln!(md, "## Builds\n\n| variant | what | flash bytes | static RAM | stack high-water | RAM total |\n|---|---|---|---|---|---|")?;
     let variants = variants();
     let mut runs = Vec::new();

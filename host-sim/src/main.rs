@@ -3,6 +3,7 @@
 
 mod bench;
 mod board;
+mod display;
 mod effects;
 mod firmware;
 mod load;
@@ -101,6 +102,19 @@ enum Command {
         /// Instruction counts written by `host-sim firmware`.
         #[arg(long, default_value = "docs/firmware.csv")]
         firmware_csv: PathBuf,
+    },
+    /// What the 1-bit display shows: every dither with and without silhouette lines and
+    /// through several tone curves, measured against the reference gray image after a low-pass
+    /// (mean error, SSIM); contact sheets per scene and the progressive passes: docs/display.md.
+    Display {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Report to write.
+        #[arg(long, default_value = "docs/display.md")]
+        out: PathBuf,
+        /// Folder for the contact sheets.
+        #[arg(long, default_value = "docs/images")]
+        images: PathBuf,
     },
     /// What simulating only the effects a scene calls for saves (rays, time, instructions,
     /// flash), and what the contribution cutoff saves and changes.
@@ -218,6 +232,8 @@ pub enum DitherArg {
     Fs,
     /// Atkinson error diffusion.
     Atkinson,
+    /// Ordered dither with a 16x16 blue-noise (void-and-cluster) mask, one ray per pixel.
+    BlueNoise,
 }
 
 impl DitherArg {
@@ -230,6 +246,7 @@ impl DitherArg {
             DitherArg::Pattern2 => Dither::Pattern(2),
             DitherArg::Fs => Dither::FloydSteinberg,
             DitherArg::Atkinson => Dither::Atkinson,
+            DitherArg::BlueNoise => Dither::BlueNoise,
         }
     }
 }
@@ -303,8 +320,8 @@ pub struct RenderArgs {
     /// Image size.
     #[arg(long, default_value = "128x64", value_parser = parse_size)]
     pub size: (u16, u16),
-    /// Dithering mode.
-    #[arg(long, value_enum, default_value_t = DitherArg::Bayer)]
+    /// Dithering mode (the default scores best in `host-sim display`, docs/display.md).
+    #[arg(long, value_enum, default_value_t = DitherArg::Fs)]
     pub dither: DitherArg,
     /// Eye rays per pixel.
     #[arg(long, value_enum, default_value_t = SamplingArg::One)]
@@ -333,6 +350,13 @@ pub struct RenderArgs {
     /// World lattice resolution, overriding the automatic choice.
     #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
     pub cells: Option<[u16; 3]>,
+    /// Draw silhouette lines (the farther pixel where neighbours hit different objects is black).
+    #[arg(long)]
+    pub outline: bool,
+    /// Tone curve before dithering: gray levels raised to the power GAMMA/10 (5 to 20; 10 leaves
+    /// them unchanged).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u8).range(5..=20))]
+    pub gamma: u8,
 }
 
 /// Options of `stats`.
@@ -385,6 +409,7 @@ fn real_main() -> Result<()> {
                 Scalar::Fixed => run::render_cmd::<lattice_rt::Fx>(&a),
             }
         }
+        Some(Command::Display { scenes, out, images }) => display::display_cmd(&default_scenes(scenes), &out, &images),
         Some(Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv }) => {
             tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv)
         }

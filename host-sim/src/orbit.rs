@@ -101,7 +101,7 @@ pub fn motion_cmd(scenes: &[std::path::PathBuf], frames: u32, out: &Path) -> Res
     if !(2..=3600).contains(&frames) {
         bail!("--frames must be from 2 to 3600");
     }
-    let dithers = [("bayer", Dither::Bayer), ("pattern 4x4", Dither::Pattern(4)), ("floyd-steinberg", Dither::FloydSteinberg), ("atkinson", Dither::Atkinson)];
+    let dithers = [("bayer", Dither::Bayer), ("blue noise", Dither::BlueNoise), ("pattern 4x4", Dither::Pattern(4)), ("floyd-steinberg", Dither::FloydSteinberg), ("atkinson", Dither::Atkinson)];
     let mut md = String::new();
     writeln!(md, "# Dithers in motion\n")?;
     writeln!(md, "Written by `cargo run --release -p host-sim -- motion` ({frames} frames per turn of the orbit that")?;

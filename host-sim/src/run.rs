@@ -181,7 +181,14 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let text = read(&a.scene)?;
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
-    let frame = Frame { tile: a.tile, dither: a.dither.mode(), sampling: a.sampling.mode(), ..Frame::new(a.size.0, a.size.1) };
+    let frame = Frame {
+        tile: a.tile,
+        dither: a.dither.mode(),
+        sampling: a.sampling.mode(),
+        outline: a.outline,
+        tone: lattice_rt::Tone { gamma_tenths: a.gamma },
+        ..Frame::new(a.size.0, a.size.1)
+    };
     let mut out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true, true)?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
     // Every output under a temporary name first: if one cannot be written, none is left.

@@ -93,7 +93,7 @@ fn shoot(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Result<Shot> {
 }
 
 /// Gray levels (0..=64, as reals) of `n x n` f64 rays per pixel, averaged.
-fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f64>> {
+pub fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f64>> {
     let mut storage = object_storage::<f64>(text)?;
     let scene = parse_scene::<f64>(path, text, &mut storage)?;
     let cfg = LatticeConfig::default();
