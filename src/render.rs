@@ -115,13 +115,13 @@ impl Frame {
     /// Whether the frame can be rendered progressively ([`render_pass`]): its tiles are a
     /// multiple of 8 pixels (whole 8x8 blocks) and its dither shows one ray per pixel.
     pub fn progressive(&self) -> bool {
-        self.tile.is_multiple_of(8) && self.dither.block() == 1
+        self.tile > 0 && self.tile as usize <= MAX_TILE && self.tile.is_multiple_of(8) && self.dither.block() == 1
     }
 
     /// Entries of [`Traced`] storage a progressive render of `share` needs: one per pixel of
     /// the 2x2 grid of each of its tiles.
     pub fn traced_len(&self, share: Share) -> usize {
-        let t = self.tile as usize;
+        let t = (self.tile as usize).max(1);
         let (tiles_x, tiles_y) = ((self.width as usize).div_ceil(t), (self.height as usize).div_ceil(t));
         let tiles = (0..tiles_y).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>();
         tiles * (t / 2) * (t / 2)

@@ -88,6 +88,8 @@ fn frames_that_cannot_be_progressive_are_refused() {
     for (frame, pass, room) in [
         (Frame { dither: Dither::Pattern(4), ..Frame::new(64, 32) }, 8u8, true),
         (Frame { tile: 4, ..Frame::new(64, 32) }, 8, true),
+        (Frame { tile: 0, ..Frame::new(64, 32) }, 8, true),
+        (Frame { tile: 24, ..Frame::new(64, 32) }, 8, true),
         (Frame::new(64, 32), 3, true),
         (Frame::new(64, 32), 8, false),
     ] {
