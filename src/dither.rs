@@ -248,12 +248,21 @@ impl<'c> Ditherer<'c> {
     pub fn tile(&mut self, x0: usize, y0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
         match self.carry.as_mut() {
             Some(c) => c.tile(self.mode, x0, w, h, levels, out),
+            None if self.mode == Dither::BlueNoise => {
+                // Row by row against the mask's row (the same pixels as `blue_noise`).
+                for ((row, px), y) in levels.chunks(w).zip(out.chunks_mut(w)).take(h).zip(y0..) {
+                    let mask = &BLUE_NOISE[y % 16];
+                    for ((&l, o), x) in row.iter().zip(px.iter_mut()).zip(x0..) {
+                        *o = BinaryColor::from((mask[x % 16] as u32) < l.min(LEVELS) as u32 * 4);
+                    }
+                }
+            }
             None => {
                 let n = if self.mode == Dither::Bayer { 8 } else { self.mode.block() };
                 for y in 0..h {
                     for x in 0..w {
                         let (l, gx, gy) = (levels[y * w + x], (x0 + x) as u32, (y0 + y) as u32);
-                        out[y * w + x] = if self.mode == Dither::BlueNoise { blue_noise(l, gx, gy) } else { ordered(l, gx, gy, n) };
+                        out[y * w + x] = ordered(l, gx, gy, n);
                     }
                 }
             }
@@ -267,6 +276,21 @@ mod tests {
 
     fn art(w: usize, px: &[BinaryColor]) -> std::string::String {
         px.chunks(w).map(|r| r.iter().map(|c| if c.is_on() { '#' } else { '.' }).collect::<std::string::String>() + "\n").collect()
+    }
+
+    #[test]
+    fn blue_noise_tiles_are_the_mask_pixel_by_pixel() {
+        // A tile anywhere in the frame (partial tiles too) shows exactly what `blue_noise` gives
+        // each of its pixels.
+        let mut d = Ditherer::new(Dither::BlueNoise, 40, &mut []).unwrap();
+        for (x0, y0, w, h) in [(0, 0, 8, 8), (8, 16, 8, 8), (24, 5, 16, 11), (33, 7, 7, 3)] {
+            let levels: std::vec::Vec<u8> = (0..w * h).map(|i| ((i * 37 + x0 * 5 + y0) % 65) as u8).collect();
+            let mut out = [BinaryColor::Off; MAX_TILE * MAX_TILE];
+            d.tile(x0, y0, w, h, &levels, &mut out);
+            for (i, &l) in levels.iter().enumerate() {
+                assert_eq!(out[i], blue_noise(l, (x0 + i % w) as u32, (y0 + i / w) as u32), "tile at ({x0}, {y0}), pixel {i}");
+            }
+        }
     }
 
     #[test]

@@ -65,8 +65,27 @@ impl Share {
     pub const ALL: Share = Share { index: 0, of: 1 };
 
     /// Whether tile `(tx, ty)` is in this share.
-    pub fn holds(self, tx: usize, ty: usize) -> bool {
-        (tx + ty) % self.of.max(1) as usize == self.index as usize
+    pub const fn holds(self, tx: usize, ty: usize) -> bool {
+        let of = if self.of == 0 { 1 } else { self.of as usize };
+        (tx + ty) % of == self.index as usize
+    }
+
+    /// How many of the tiles in tile rows `rows.0..rows.1` of a frame `tiles_x` tiles wide
+    /// this share holds (in the order the render visits them).
+    pub const fn tiles_in(self, tiles_x: usize, rows: (usize, usize)) -> usize {
+        let mut n = 0;
+        let mut ty = rows.0;
+        while ty < rows.1 {
+            let mut tx = 0;
+            while tx < tiles_x {
+                if self.holds(tx, ty) {
+                    n += 1;
+                }
+                tx += 1;
+            }
+            ty += 1;
+        }
+        n
     }
 
     fn valid(self) -> bool {
@@ -120,11 +139,10 @@ impl Frame {
 
     /// Entries of [`Traced`] storage a progressive render of `share` needs: one per pixel of
     /// the 2x2 grid of each of its tiles.
-    pub fn traced_len(&self, share: Share) -> usize {
-        let t = (self.tile as usize).max(1);
+    pub const fn traced_len(&self, share: Share) -> usize {
+        let t = if self.tile == 0 { 1 } else { self.tile as usize };
         let (tiles_x, tiles_y) = ((self.width as usize).div_ceil(t), (self.height as usize).div_ceil(t));
-        let tiles = (0..tiles_y).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>();
-        tiles * (t / 2) * (t / 2)
+        share.tiles_in(tiles_x, (0, tiles_y)) * (t / 2) * (t / 2)
     }
 
     fn edges(&self) -> bool {
@@ -293,9 +311,9 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
     let (first, end) = (frame.rows.0 as usize, (frame.rows.1 as usize).min(tiles_y));
-    let total = (first..end).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>() as u32;
+    let total = share.tiles_in(tiles_x, (first, end)) as u32;
     // Tiles of this share before the band range: their traced samples come first.
-    let skipped = (0..first.min(tiles_y)).map(|ty| (0..tiles_x).filter(|&tx| share.holds(tx, ty)).count()).sum::<usize>();
+    let skipped = share.tiles_in(tiles_x, (0, first.min(tiles_y)));
     let per_tile = (t / 2) * (t / 2);
     let mut done = 0;
     let cam = tracer.scene().camera();
@@ -324,14 +342,16 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
                 let (v, id, depth) = tracer.eye_sample(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
-                (v, id as u16, depth.depth_key())
+                // Only the outline reads depths: a frame without it keys none.
+                (v, id as u16, if frame.outline { depth.depth_key() } else { u16::MAX })
             };
             match pass.as_mut() {
                 None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels, &mut hits),
                 Some((n, traced)) => {
                     let k = skipped + done as usize;
                     let kept = &mut traced[k * per_tile..(k + 1) * per_tile];
-                    progressive_tile(&mut sampler, *n as usize, x0, y0, tw, th, t, kept, &mut shoot, &mut levels, &mut hits);
+                    let at = Block { x0, y0, tw, th, t };
+                    progressive_tile(&mut sampler, *n as usize, at, kept, &mut shoot, &mut levels, &mut hits, outline.is_some());
                 }
             }
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
@@ -353,21 +373,29 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     Ok(q.stats)
 }
 
-/// One tile of a progressive pass `n` (8, 4, 2 or 1); `kept` holds the tile's rays on the
-/// 2x2 grid (tile side `t`), `(t / 2)^2` of them, pixel `(x, y)` at `(y / 2) * (t / 2) + x / 2`.
-#[allow(clippy::too_many_arguments)]
-fn progressive_tile<R: Real>(
-    sampler: &mut Sampler<'_>,
-    n: usize,
+/// Where a tile lies: its top-left pixel, its size and the frame's tile side.
+#[derive(Clone, Copy)]
+struct Block {
     x0: usize,
     y0: usize,
     tw: usize,
     th: usize,
     t: usize,
+}
+
+/// One tile of a progressive pass `n` (8, 4, 2 or 1); `kept` holds the tile's rays on the
+/// 2x2 grid (tile side `t`), `(t / 2)^2` of them, pixel `(x, y)` at `(y / 2) * (t / 2) + x / 2`.
+/// The blocks of passes 8, 4 and 2 fill `hits` (what the outline reads) only with `keep_hits`.
+#[allow(clippy::too_many_arguments)]
+fn progressive_tile<R: Real>(
+    sampler: &mut Sampler<'_>,
+    n: usize,
+    Block { x0, y0, tw, th, t }: Block,
     kept: &mut [Traced],
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
     hits: &mut Hits,
+    keep_hits: bool,
 ) {
     let at = |x: usize, y: usize| (y / 2) * (t / 2) + x / 2;
     let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
@@ -387,6 +415,7 @@ fn progressive_tile<R: Real>(
         return sampler.tile(x0, y0, tw, th, &mut reuse, levels, hits);
     }
     for by in (0..th).step_by(n) {
+        let rows = by..(by + n).min(th);
         for bx in (0..tw).step_by(n) {
             // Rays on the grid of twice this pass's side were traced by an earlier pass.
             let earlier = n < 8 && bx % (2 * n) == 0 && by % (2 * n) == 0;
@@ -399,11 +428,13 @@ fn progressive_tile<R: Real>(
                 kept[at(bx, by)] = k;
                 k
             };
-            for y in by..(by + n).min(th) {
-                for x in bx..(bx + n).min(tw) {
-                    levels[y * tw + x] = k.level;
-                    hits.object[y * tw + x] = k.object;
-                    hits.depth[y * tw + x] = k.depth;
+            let cols = bx..(bx + n).min(tw);
+            for y in rows.clone() {
+                let row = y * tw;
+                levels[row + cols.start..row + cols.end].fill(k.level);
+                if keep_hits {
+                    hits.object[row + cols.start..row + cols.end].fill(k.object);
+                    hits.depth[row + cols.start..row + cols.end].fill(k.depth);
                 }
             }
         }

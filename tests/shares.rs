@@ -96,3 +96,21 @@ fn shadow_coherence_changes_work_not_pixels() {
         assert!(ws.object_tests <= wo.object_tests, "{name}: {} tests with coherence, {} without", ws.object_tests, wo.object_tests);
     }
 }
+
+#[test]
+fn shares_count_their_tiles_as_the_checkerboard_holds_them() {
+    for of in 1..=3u8 {
+        for index in 0..of {
+            let share = Share { index, of };
+            for (tiles_x, rows) in [(16, (0, 8)), (5, (2, 7)), (1, (0, 1)), (7, (3, 3))] {
+                let counted = (rows.0..rows.1).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).filter(|&(tx, ty)| share.holds(tx, ty)).count();
+                assert_eq!(share.tiles_in(tiles_x, rows), counted, "share {index} of {of}, {tiles_x} tiles wide, rows {rows:?}");
+            }
+        }
+    }
+    // The 128x64 board frame in 8x8 tiles: 64 tiles a share, 16 kept rays a tile.
+    let frame = Frame::new(128, 64);
+    assert_eq!(frame.traced_len(Share { index: 0, of: 2 }), 64 * 16);
+    assert_eq!(frame.traced_len(Share { index: 1, of: 2 }), 64 * 16);
+    assert_eq!(frame.traced_len(Share::ALL), 128 * 16);
+}

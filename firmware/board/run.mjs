@@ -12,10 +12,12 @@
 // bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2.
 //
 // With --profile FILE it also samples the program counter every 97th instruction of the first
-// frame (while the LED is lit) and writes the counts as JSON pairs [pc, samples].
+// frame (--profile-frames N: of the first N frames; while the LED is lit) and writes the counts
+// as JSON pairs [pc, samples].
 //
 // Usage: node run.mjs --uf2 FILE --bootrom FILE --rtt ADDR --log FILE
 //                     [--frames N] [--max-cycles N] [--no-display] [--until-ms T] [--profile FILE]
+//                     [--profile-frames N]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { RP2040, GPIOPinState } from 'rp2040js';
 import { Ssd1306 } from './ssd1306.mjs';
@@ -27,7 +29,7 @@ const LED_PIN = 25;
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1 };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -43,6 +45,7 @@ function parseArgs(argv) {
     else if (a === '--until-ms') o.untilMs = Number(next());
     else if (a === '--no-display') o.display = false;
     else if (a === '--profile') o.profile = next();
+    else if (a === '--profile-frames') o.profileFrames = Number(next());
     else throw new Error(`unknown argument ${a}`);
   }
   for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
@@ -231,7 +234,7 @@ function main() {
       idleNanos += dt;
       if (mcu.clock.nanos >= untilNanos) nextPoll = 0; // time is up while asleep: check now
     } else {
-      if (profile && ledOn && frames.length === 0 && instructions % PROFILE_EVERY === 0) {
+      if (profile && ledOn && frames.length < opt.profileFrames && instructions % PROFILE_EVERY === 0) {
         const pc = core.PC >>> 0;
         profile.set(pc, (profile.get(pc) || 0) + 1);
       }

@@ -8,7 +8,7 @@ use lattice_rt::scene::text::ParseError;
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::storage::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
-use lattice_rt::{render_share, Effects, Frame, LatticeConfig, Real, Share, Stats, Tracer};
+use lattice_rt::{render_pass, render_share, Effects, Frame, LatticeConfig, Real, Share, Stats, Traced, Tracer};
 
 pub use crate::frame::{Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
@@ -94,9 +94,24 @@ pub struct Report {
     pub objects: usize,
     /// Bytes of the built lattice.
     pub lattice_bytes: usize,
-    /// Microseconds each tile share took (by the clock given to [`render_scene_at`]).
+    /// Time each tile share took, all passes together (in the units of the clock given to
+    /// [`render_scene_at`]).
     pub share_us: [u64; 2],
 }
+
+/// The passes a frame is shown in: with the `progressive` feature 8, 4, 2 and 1 (`render_pass`:
+/// one ray per 8x8 block first, the finished frame last, no ray traced twice); otherwise one,
+/// `0`, the frame drawn at once (`render_share`).
+pub const PASSES: &[u8] = if cfg!(feature = "progressive") { &[8, 4, 2, 1] } else { &[0] };
+
+/// Entries of [`Traced`] storage each tile share keeps between passes (none without the
+/// `progressive` feature).
+pub const TRACED: usize = if cfg!(feature = "progressive") {
+    let (a, b) = (RENDERED.traced_len(Share { index: 0, of: SHARES }), RENDERED.traced_len(Share { index: 1, of: SHARES }));
+    if a > b { a } else { b }
+} else {
+    0
+};
 
 /// Parses `text`, builds its lattice and renders [`RENDERED`] into `target`, tile by tile.
 pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
@@ -106,7 +121,7 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     hooks: &mut impl Hooks,
 ) -> Result<Report, AppError<'t, D::Error>> {
     let mut second = ShareMemory::new();
-    render_scene_at(text, st, target, hooks, &Shot::default(), &mut OneCore, &mut second, &|| 0)
+    render_scene_at(text, st, target, hooks, &Shot::default(), &mut OneCore, &mut second, &|| 0, &mut |_| {})
 }
 
 /// What one frame shows and how it is traced.
@@ -147,17 +162,20 @@ impl Cores for OneCore {
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
 
 /// The memory of the second tile share: its own query scratch and a 1-bit frame its tiles are
-/// drawn into (the display is core 0's), sent to the display when the share is done.
+/// drawn into (the display is core 0's), sent to the display when the share is done; and the
+/// rays both shares keep between progressive passes ([`TRACED`] each).
 pub struct ShareMemory {
     mailbox: [u32; MAX_OBJECTS + MAX_LATTICES],
     rows: [i16; MAX_ROWS],
     bits: [u8; PIXELS / 8],
+    traced: [[Traced; TRACED]; 2],
 }
 
 impl ShareMemory {
     /// Zeroed memory.
     pub const fn new() -> Self {
-        ShareMemory { mailbox: [0; MAX_OBJECTS + MAX_LATTICES], rows: [0; MAX_ROWS], bits: [0; PIXELS / 8] }
+        const NONE: Traced = Traced { level: 0, object: 0, depth: 0 };
+        ShareMemory { mailbox: [0; MAX_OBJECTS + MAX_LATTICES], rows: [0; MAX_ROWS], bits: [0; PIXELS / 8], traced: [[NONE; TRACED]; 2] }
     }
 }
 
@@ -169,7 +187,8 @@ impl Default for ShareMemory {
 
 /// [`render_scene`] for a [`Shot`], in [`SHARES`] tile shares: share 0 drawn straight to
 /// `target` by this core, share 1 traced by `cores`' other core into `second`'s frame and sent
-/// to `target` after. `now` reads a microsecond clock (from either core) to time each share.
+/// to `target` after. `now` reads a clock (from either core) to time each share. The frame is
+/// shown in [`PASSES`]; `shown` is called with each pass once it is on `target`.
 #[allow(clippy::too_many_arguments)]
 pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     text: &'t str,
@@ -180,6 +199,7 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     cores: &mut impl Cores,
     second: &mut ShareMemory,
     now: &(dyn Fn() -> u64 + Sync),
+    shown: &mut dyn FnMut(u8),
 ) -> Result<Report, AppError<'t, D::Error>> {
     let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
     let Loaded { scene, lattice, mut scratch } = st.view().load_with(text, &LatticeConfig::default(), at)?;
@@ -198,32 +218,60 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     let pick = |tuned| if cfg!(feature = "ladder") { tuned } else { &RENDERED };
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
-    let ShareMemory { mailbox, rows, bits } = second;
-    let (mut there_result, mut here_result) = (None, None);
+    let ShareMemory { mailbox, rows, bits, traced } = second;
+    let [traced_here, traced_there] = traced;
+    let mut stats = Stats::default();
     let mut times = [0u64; 2];
-    let [there_us, here_us] = &mut times;
-    cores.join(
-        &mut || {
-            let t0 = now();
-            let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-            let result = match lattice_rt::BitFrame::wrap(WIDTH as u32, HEIGHT as u32, &mut bits[..]) {
-                Some(mut frame_bits) => render_share(tracer, pick(&tuned), other, &mut frame_bits, &mut scratch, &mut lattice_rt::NoHooks),
-                None => Err(RenderError::BadTile),
-            };
-            there_result = Some(result);
-            *there_us = now() - t0;
-        },
-        &mut || {
-            let t0 = now();
-            here_result = Some(render_share(tracer, pick(&tuned), first, target, &mut scratch, hooks));
-            *here_us = now() - t0;
-        },
-    );
-    let mut stats = here_result.unwrap_or(Err(RenderError::Cancelled)).map_err(AppError::Render)?;
-    let more = there_result.unwrap_or(Err(RenderError::Cancelled));
-    stats.add(&more.map_err(|e| AppError::Render(widen(e)))?);
-    send_share(bits, pick(&tuned), other, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
+    for &pass in PASSES {
+        let (mut there_result, mut here_result) = (None, None);
+        let [there_us, here_us] = &mut times;
+        cores.join(
+            &mut || {
+                let t0 = now();
+                let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
+                let result = match lattice_rt::BitFrame::wrap(WIDTH as u32, HEIGHT as u32, &mut bits[..]) {
+                    Some(mut frame_bits) => {
+                        draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], &mut frame_bits, &mut scratch, &mut lattice_rt::NoHooks)
+                    }
+                    None => Err(RenderError::BadTile),
+                };
+                there_result = Some(result);
+                *there_us += now() - t0;
+            },
+            &mut || {
+                let t0 = now();
+                here_result = Some(draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks));
+                *here_us += now() - t0;
+            },
+        );
+        stats.add(&here_result.unwrap_or(Err(RenderError::Cancelled)).map_err(AppError::Render)?);
+        let more = there_result.unwrap_or(Err(RenderError::Cancelled));
+        stats.add(&more.map_err(|e| AppError::Render(widen(e)))?);
+        send_share(bits, pick(&tuned), other, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
+        shown(pass);
+    }
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
+}
+
+/// One share of a frame: pass `pass` of a progressive frame (`render_pass`), or with pass 0 the
+/// whole frame at once (`render_share`).
+#[allow(clippy::too_many_arguments)]
+fn draw<R: Real, D: DrawTarget<Color = BinaryColor>>(
+    tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
+    frame: &Frame,
+    share: Share,
+    pass: u8,
+    traced: &mut [Traced],
+    target: &mut D,
+    scratch: &mut lattice_rt::Scratch<'_>,
+    hooks: &mut impl Hooks,
+) -> Result<Stats, RenderError<D::Error>> {
+    // A build without the `progressive` feature links no pass code at all.
+    if cfg!(feature = "progressive") && pass != 0 {
+        render_pass(tracer, frame, share, pass, traced, target, scratch, hooks)
+    } else {
+        render_share(tracer, frame, share, target, scratch, hooks)
+    }
 }
 
 /// An error of a render into memory (which cannot fail to draw) as one of any target.
@@ -244,15 +292,25 @@ fn send_share<D: DrawTarget<Color = BinaryColor>>(bits: &mut [u8], frame: &Frame
     use embedded_graphics_core::geometry::{Point, Size};
     use embedded_graphics_core::primitives::Rectangle;
     let Some(drawn) = lattice_rt::BitFrame::wrap(frame.width as u32, frame.height as u32, bits) else { return Ok(()) };
+    let raster = drawn.raster();
     let t = frame.tile as usize;
     let (w, h) = (frame.width as usize, frame.height as usize);
+    let stride = w.div_ceil(8);
+    let mut tile = [BinaryColor::Off; lattice_rt::dither::MAX_TILE * lattice_rt::dither::MAX_TILE];
     for ty in 0..h.div_ceil(t) {
         for tx in (0..w.div_ceil(t)).filter(|&tx| share.holds(tx, ty)) {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
+            // The tile's pixels, row by row, from the packed rows (no division per pixel).
+            let mut i = 0;
+            for row in raster[y0 * stride..].chunks(stride).take(th) {
+                for x in x0..x0 + tw {
+                    tile[i] = BinaryColor::from(row[x / 8] & (0x80 >> (x % 8)) != 0);
+                    i += 1;
+                }
+            }
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
-            let pixels = (0..tw * th).map(|i| BinaryColor::from(drawn.get((x0 + i % tw) as u32, (y0 + i / tw) as u32)));
-            target.fill_contiguous(&area, pixels)?;
+            target.fill_contiguous(&area, tile[..i].iter().copied())?;
         }
     }
     Ok(())

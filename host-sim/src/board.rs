@@ -111,34 +111,35 @@ pub fn build_board(root: &Path, board: Board) -> Result<PathBuf> {
 /// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).
 const ORBIT_CHECKED: usize = 4;
 
-/// Builds the Pico image with an extra `feature` and the chair alone, beside the default image
-/// (its own target folder, `firmware/target/<feature>`).
-fn build_pico_with(root: &Path, feature: &str) -> Result<PathBuf> {
-    eprintln!("building the Pico image with `{feature}` (cargo pico-build --features {feature}, the chair alone)");
+/// Builds the Pico image with an extra `feature` beside the default image (its own target
+/// folder, `firmware/target/<feature>`), with the chair alone or (`all_scenes`) the scenes of
+/// the default image.
+fn build_pico_with(root: &Path, feature: &str, all_scenes: bool) -> Result<PathBuf> {
+    let which = if all_scenes { "the default scenes" } else { "the chair alone" };
+    eprintln!("building the Pico image with `{feature}` (cargo pico-build --features {feature}, {which})");
     let dir = root.join("firmware/target").join(feature);
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(root)
-        .args(["pico-build", "--features", feature, "--target-dir"])
-        .arg(&dir)
-        .env("FIRMWARE_SCENES", "chair")
-        .env_remove("RUSTFLAGS")
-        .status()
-        .context("cannot run cargo")?;
+    let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    cmd.current_dir(root).args(["pico-build", "--features", feature, "--target-dir"]).arg(&dir).env_remove("RUSTFLAGS");
+    if !all_scenes {
+        cmd.env("FIRMWARE_SCENES", "chair");
+    }
+    let status = cmd.status().context("cannot run cargo")?;
     if !status.success() {
         bail!("`cargo pico-build --features {feature}` failed");
     }
     Ok(pico_elf_in(&dir))
 }
 
-/// Builds (unless `no_build`) the image with `feature` and the chair alone, writes its UF2 file
-/// into `frames_dir/<feature>` and runs it for `frames` frames; returns the run and that folder.
-fn run_variant(root: &Path, no_build: bool, feature: &str, frames_dir: &Path, bootrom: &Path, frames: usize) -> Result<(BoardRun, PathBuf)> {
-    let elf = if no_build { pico_elf_in(&root.join("firmware/target").join(feature)) } else { build_pico_with(root, feature)? };
+/// Builds (unless `no_build`) the image with `feature` and the chair alone (or `all_scenes`),
+/// writes its UF2 file into `frames_dir/<feature>` and runs it for `frames` frames; returns the
+/// run and that folder.
+fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, frames_dir: &Path, bootrom: &Path, frames: usize) -> Result<(BoardRun, PathBuf)> {
+    let elf = if no_build { pico_elf_in(&root.join("firmware/target").join(feature)) } else { build_pico_with(root, feature, all_scenes)? };
     let dir = frames_dir.join(feature);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let uf2 = dir.join(format!("lattice-rt-pico-{feature}.uf2"));
     write_uf2(&elf, &uf2)?;
-    eprintln!("running {} ({frames} frames of the chair)", uf2.display());
+    eprintln!("running {} ({frames} frames)", uf2.display());
     let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir)?;
     Ok((run, dir))
 }
@@ -421,7 +422,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
 
     // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
-    let (orun, orbit_dir) = run_variant(root, no_build, "orbit", frames_dir, &bootrom, ORBIT_CHECKED)?;
+    let (orun, orbit_dir) = run_variant(root, no_build, "orbit", false, frames_dir, &bootrom, ORBIT_CHECKED)?;
     let chair = scenes_dir.join("chair.scene");
     let want = crate::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &crate::load::read(&chair)?, ORBIT_FRAMES, &board_frame::FRAME)?;
     if orun.frames.len() < ORBIT_CHECKED {
@@ -439,7 +440,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
 
     // The ladder: the chair once per rung, each frame bit for bit against host-sim's.
-    let (lrun, ladder_dir) = run_variant(root, no_build, "ladder", frames_dir, &bootrom, LADDER.len())?;
+    let (lrun, ladder_dir) = run_variant(root, no_build, "ladder", false, frames_dir, &bootrom, LADDER.len())?;
     if lrun.frames.len() < LADDER.len() {
         failures.push(format!("ladder: {} of {} frames shown ({})", lrun.frames.len(), LADDER.len(), lrun.reason));
     }
@@ -459,11 +460,40 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         }
     }
 
+    // Progressive mode: every scene in four passes, each pass bit for bit against host-sim's.
+    let passes = 4;
+    let (prun, prog_dir) = run_variant(root, no_build, "progressive", true, frames_dir, &bootrom, passes * scenes.len())?;
+    if prun.frames.len() < passes * scenes.len() {
+        failures.push(format!("progressive mode: {} of {} passes shown ({})", prun.frames.len(), passes * scenes.len(), prun.reason));
+    }
+    let mut progressive = Vec::new();
+    for (name, shown) in scenes.iter().zip(prun.frames.chunks(passes)) {
+        let path = scenes_dir.join(format!("{name}.scene"));
+        let want = crate::run::progressive_passes::<lattice_rt::Fx>(&path, &crate::load::read(&path)?, &board_frame::FRAME)?;
+        let mut same = 0;
+        for (f, p) in shown.iter().zip(&want) {
+            let file = prog_dir.join(format!("{name}-pass{}.png", p.pass));
+            save_frame(&f.pixels, &file)?;
+            if f.pixels == p.bits {
+                same += 1;
+                passed += 1;
+            } else {
+                failures.push(format!("progressive mode: pass {} of {name} differs from host-sim (see {})", p.pass, file.display()));
+            }
+        }
+        let rays: Vec<u64> = want.iter().map(|p| p.stats.rays[0]).collect();
+        if let (Some(plain), true) = (rows.iter().find(|r| &r.name == name), shown.len() == passes) {
+            progressive.push(ProgressiveRow { name: name.clone(), passes: shown, rays, plain: &plain.frame, same });
+        }
+        eprintln!("  {name}: {same} of {} passes bit-identical to host-sim", shown.len());
+    }
+
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms };
     let profile = profile_shares(&elf, &frames_dir.join("profile.json"))?;
     let mut md = report(&summary, &rows, flash, static_ram, &bare, &scenes, &profile)?;
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
+    md.push_str(&progressive_report(&progressive, run.clk_sys_hz)?);
     crate::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     for f in &failures {
@@ -527,6 +557,59 @@ fn orbit_report(frames: &[PanelFrame], same: usize, clk_hz: f64) -> Result<Strin
     for (i, f) in frames.iter().enumerate() {
         writeln!(md, "| {i} | {:.1} M | {:.2} |", f.cycles as f64 / 1e6, clk_hz / f.cycles.max(1) as f64)?;
     }
+    Ok(md)
+}
+
+/// One scene of the progressive image as the board ran it.
+struct ProgressiveRow<'f> {
+    name: String,
+    /// The four passes the panel showed (8, 4, 2, 1).
+    passes: &'f [PanelFrame],
+    /// Eye rays host-sim traced in each pass.
+    rays: Vec<u64>,
+    /// The same scene's frame in the default (plain) image.
+    plain: &'f PanelFrame,
+    /// Passes bit-identical to host-sim's.
+    same: usize,
+}
+
+/// The progressive section of docs/board.md.
+fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String> {
+    let mut md = String::new();
+    let mhz = clk_hz / 1e6;
+    writeln!(md, "\n## Progressive frames\n")?;
+    writeln!(md, "The image built with `--features progressive` (the default scenes) shows every frame in four")?;
+    writeln!(md, "passes (`render_pass`): one traced ray per 8x8 block, then 4x4, 2x2 and the finished frame,")?;
+    writeln!(md, "each pass reusing every ray traced before it, so no eye ray is traced twice. The display is")?;
+    writeln!(md, "updated after each pass (both tile shares of the pass), and the LED goes out for a moment as")?;
+    writeln!(md, "each pass reaches the panel; every pass the panel showed is checked bit for bit against")?;
+    writeln!(md, "host-sim's (`host-sim display` draws the same passes). *At* is cycles from the LED going on")?;
+    writeln!(md, "(set-up included) to the pass on the panel; *plain* is the same scene's frame in the default")?;
+    writeln!(md, "image above, and *cost* the whole progressive frame against it (target: at most 1.05x).\n")?;
+    writeln!(md, "| scene | passes identical | pass 8 at | pass 4 at | pass 2 at | finished at | plain | cost | first picture: share of the plain frame's time | eye rays per pass | I2C bytes |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|")?;
+    for r in rows {
+        let mut at = 0u64;
+        let cumulative: Vec<u64> = r.passes.iter().map(|f| {
+            at += f.cycles;
+            at
+        }).collect();
+        let total = *cumulative.last().unwrap_or(&0);
+        writeln!(
+            md,
+            "| {} | {} of {} | {} | {:.3} | {:.1} % | {} | {} |",
+            r.name,
+            r.same,
+            r.passes.len(),
+            cumulative.iter().chain([&r.plain.cycles]).map(|c| format!("{:.1} M", *c as f64 / 1e6)).collect::<Vec<_>>().join(" | "),
+            total as f64 / r.plain.cycles.max(1) as f64,
+            100.0 * cumulative.first().copied().unwrap_or(0) as f64 / r.plain.cycles.max(1) as f64,
+            r.rays.iter().map(u64::to_string).collect::<Vec<_>>().join(" / "),
+            r.passes.iter().map(|f| f.i2c_bytes).sum::<u64>(),
+        )?;
+    }
+    writeln!(md, "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The I2C bytes are four frames' worth: at 400 kHz", 1e3 / mhz)?;
+    writeln!(md, "each pass's page bytes take about 57.6 ms on the bus, which the emulator does not model.")?;
     Ok(md)
 }
 

@@ -7,19 +7,18 @@
 
 use crate::load::read;
 use crate::output::write_atomic;
-use crate::run::render_text;
+use crate::run::{progressive_passes, render_text};
 use crate::tradeoff::reference;
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Gray8;
 use embedded_graphics::prelude::*;
 use embedded_graphics::text::{Baseline, Text};
 use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
-use lattice_rt::render::RenderError;
-use lattice_rt::{render_pass, BitFrame, Dither, Frame, Fx, HeapScratch, NoHooks, Sampling, Share, Stats, Tone, Traced};
+use lattice_rt::{Dither, Frame, Fx, Sampling, Tone};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// The dithers compared, with their report names.
 const DITHERS: [(&str, Dither); 4] =
@@ -108,31 +107,6 @@ fn measure(bits: &[u8], reference: &[f64], w: usize, h: usize, sigma: f64) -> (f
     let (a, b) = (blur(&unpack(bits, w, h), w, h, sigma), blur(reference, w, h, sigma));
     let mae = a.iter().zip(&b).map(|(p, q)| (p - q).abs()).sum::<f64>() / (w * h) as f64;
     (mae, ssim(&a, &b, w, h))
-}
-
-/// The passes of a progressive frame (8, 4, 2, 1): each pass's 1-bit frame, statistics and time.
-fn progressive(path: &Path, text: &str, frame: &Frame) -> Result<Vec<(Vec<u8>, Stats, Duration)>> {
-    let mut storage = crate::load::object_storage::<Fx>(text)?;
-    let scene = crate::load::parse_scene::<Fx>(path, text, &mut storage)?;
-    let cfg = lattice_rt::LatticeConfig::default();
-    let mut bufs = crate::load::lattice_storage(&scene, &cfg)?;
-    let lattice = crate::load::build_lattice(&mut bufs, &scene, &cfg)?;
-    let tracer = lattice_rt::Tracer::new(&scene, &lattice);
-    let (w, h) = (frame.width as u32, frame.height as u32);
-    let mut scratch = HeapScratch::new(&scene, frame);
-    let mut traced = vec![Traced::default(); frame.traced_len(Share::ALL)];
-    let mut out = Vec::new();
-    for pass in [8u8, 4, 2, 1] {
-        let mut bits = vec![0u8; BitFrame::bytes(w, h)];
-        let mut target = BitFrame::new(w, h, &mut bits).expect("sized");
-        let start = Instant::now();
-        let stats = render_pass(&tracer, frame, Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut NoHooks).map_err(|e| match e {
-            RenderError::Draw(never) => match never {},
-            other => anyhow!("{other}"),
-        })?;
-        out.push((bits, stats, start.elapsed()));
-    }
-    Ok(out)
 }
 
 /// Draws 1-bit frames and gray images into one labelled gray sheet.
@@ -264,20 +238,20 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
     for (s, path) in scenes.iter().enumerate() {
         let text = read(path)?;
         let frame = best.frame(w, h);
-        let passes = progressive(path, &text, &frame)?;
+        let passes = progressive_passes::<Fx>(path, &text, &frame)?;
         let plain = render_text::<Fx>(path, &text, &frame, |_| {})?;
-        let same = passes.last().is_some_and(|p| p.0 == plain.bits);
+        let same = passes.last().is_some_and(|p| p.bits == plain.bits);
         if !same {
             anyhow::bail!("{}: the last progressive pass differs from the plain frame", names[s]);
         }
-        let total: u64 = passes.iter().map(|p| p.1.rays[0]).sum();
+        let total: u64 = passes.iter().map(|p| p.stats.rays[0]).sum();
         let mut cells = Vec::new();
-        for (k, (bits, stats, _)) in passes.iter().enumerate() {
-            let (_, sim) = measure(bits, &references[s], wu, hu, SIGMAS[0]);
-            cells.push(format!("{} rays, SSIM {sim:.2}", stats.rays[0]));
-            strip.place(k as u32, s as u32, &format!("{} pass {}", names[s], [8, 4, 2, 1][k]), wu, &unpack(bits, wu, hu));
+        for (k, p) in passes.iter().enumerate() {
+            let (_, sim) = measure(&p.bits, &references[s], wu, hu, SIGMAS[0]);
+            cells.push(format!("{} rays, SSIM {sim:.2}", p.stats.rays[0]));
+            strip.place(k as u32, s as u32, &format!("{} pass {}", names[s], p.pass), wu, &unpack(&p.bits, wu, hu));
         }
-        let time: Duration = passes.iter().map(|p| p.2).sum();
+        let time: Duration = passes.iter().map(|p| p.elapsed).sum();
         prog_rows.push(format!(
             "| {} | {} | {} / {} | {} | {:.2} / {:.2} |",
             names[s],

@@ -78,6 +78,18 @@ fn variants() -> Vec<Variant> {
         scalar: "fixed",
         what: "Cortex-M0+, fixed, all five scenes, one eye ray per pixel (exact-sampling) instead of adaptive sub-sampling".into(),
     });
+    // What a progressive frame costs: the same build showing each frame in four passes.
+    v.push(Variant {
+        name: "qemu-m0-fixed-progressive".into(),
+        target: "thumbv6m-none-eabi",
+        profile: "release",
+        features: "qemu,scalar-fixed,progressive".into(),
+        bin: "qemu",
+        machine: Some("mps2-an385"),
+        scenes: None,
+        scalar: "fixed",
+        what: "Cortex-M0+, fixed, all five scenes, each frame in four progressive passes (8x8, 4x4, 2x2 blocks, then the frame; the last pass is the frame checked)".into(),
+    });
     // What the effect set saves: every effect forced in, and the matte paper scenes with their
     // derived set against every effect (the same scenes, so the difference is the effect code).
     for (name, scenes, features, what) in [
@@ -404,6 +416,13 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     }
     if let Some(r) = ratio("qemu-m33-f32", "qemu-m4f-f32") {
         writeln!(md, "The M33 build (the Pico 2's core, built with the `speed` profile: opt-level 3) needs {r:.2}x the instructions of the M4F build (opt-level \"s\") in f32.")?;
+    }
+    if let Some(r) = ratio("qemu-m0-fixed-progressive", "qemu-m0-fixed") {
+        let each: Vec<String> = names
+            .iter()
+            .filter_map(|scene| Some(format!("{scene} {:.3}x", instructions("qemu-m0-fixed-progressive", scene)? as f64 / instructions("qemu-m0-fixed", scene)?.max(1) as f64)))
+            .collect();
+        writeln!(md, "A progressive frame (four passes, the display updated after each) needs {r:.3}x the instructions of the plain frame over all scenes ({}; target: at most 1.05x).", each.join(", "))?;
     }
     // The Pico 2's targets: instructions per frame on one core, f32.
     let m33 = "qemu-m33-f32";

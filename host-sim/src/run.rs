@@ -111,6 +111,24 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
 }
 
 
+/// Parses scene text, builds its default lattice and hands `work` a tracer on it, after `tune`
+/// has adjusted the tracer (depth, cutoff, effects, eye rays).
+pub fn with_tracer<R: Real, T>(
+    path: &Path,
+    text: &str,
+    tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>),
+    work: impl FnOnce(&lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>) -> Result<T>,
+) -> Result<T> {
+    let mut storage = object_storage::<R>(text)?;
+    let scene = parse_scene::<R>(path, text, &mut storage)?;
+    let cfg = LatticeConfig::default();
+    let mut bufs = lattice_storage(&scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+    let mut tracer = lattice_rt::Tracer::new(&scene, &lattice);
+    tune(&mut tracer);
+    work(&tracer)
+}
+
 /// Parses scene text, builds its default lattice and renders `frame` on one core, after
 /// `tune` has adjusted the tracer (depth, cutoff, effects).
 pub fn render_text<R: Real>(
@@ -119,14 +137,42 @@ pub fn render_text<R: Real>(
     frame: &lattice_rt::Frame,
     tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>),
 ) -> Result<Rendered> {
-    let mut storage = object_storage::<R>(text)?;
-    let scene = parse_scene::<R>(path, text, &mut storage)?;
-    let cfg = LatticeConfig::default();
-    let mut bufs = lattice_storage(&scene, &cfg)?;
-    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
-    let mut tracer = lattice_rt::Tracer::new(&scene, &lattice);
-    tune(&mut tracer);
-    render_band(&tracer, frame, false)
+    with_tracer(path, text, tune, |tracer| render_band(tracer, frame, false))
+}
+
+/// One pass of a progressive frame as the panel shows it once the pass is drawn.
+pub struct Pass {
+    /// The pass: 8, 4, 2 or 1 (the finished frame).
+    pub pass: u8,
+    /// Packed 1-bit frame.
+    pub bits: Vec<u8>,
+    /// Work counted by the core in this pass alone.
+    pub stats: Stats,
+    /// Wall time of the pass.
+    pub elapsed: Duration,
+}
+
+/// The passes of a progressive frame (8, 4, 2, 1; `render_pass`) of scene text with its default
+/// lattice, in scalar `R`.
+pub fn progressive_passes<R: Real>(path: &Path, text: &str, frame: &Frame) -> Result<Vec<Pass>> {
+    with_tracer::<R, _>(path, text, |_| {}, |tracer| {
+        let (w, h) = (frame.width as u32, frame.height as u32);
+        let mut scratch = HeapScratch::new(tracer.scene(), frame);
+        let mut traced = vec![lattice_rt::Traced::default(); frame.traced_len(lattice_rt::Share::ALL)];
+        let mut out = Vec::new();
+        for pass in [8u8, 4, 2, 1] {
+            let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+            let mut target = BitFrame::new(w, h, &mut bits).expect("sized");
+            let start = Instant::now();
+            let stats = lattice_rt::render_pass(tracer, frame, lattice_rt::Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut lattice_rt::NoHooks)
+                .map_err(|e| match e {
+                    RenderError::Draw(never) => match never {},
+                    other => anyhow!("{other}"),
+                })?;
+            out.push(Pass { pass, bits, stats, elapsed: start.elapsed() });
+        }
+        Ok(out)
+    })
 }
 
 /// Renders with the accelerator chosen by `accel` (building the lattice when needed).

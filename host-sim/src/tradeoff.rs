@@ -4,12 +4,12 @@
 
 use crate::shared::median;
 use crate::run::render_text;
-use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
+use crate::load::read;
 use crate::output::write_atomic;
 use crate::shared::plot_link;
 use anyhow::Result;
 use lattice_rt::dither::Ditherer;
-use lattice_rt::{Dither, F32Micro, F32MicroNewton, Frame, Fx, LatticeConfig, Real, Sampling, Tracer};
+use lattice_rt::{Dither, F32Micro, F32MicroNewton, Frame, Fx, Real, Sampling};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -94,29 +94,26 @@ fn shoot(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Result<Shot> {
 
 /// Gray levels (0..=64, as reals) of `n x n` f64 rays per pixel, averaged.
 pub fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f64>> {
-    let mut storage = object_storage::<f64>(text)?;
-    let scene = parse_scene::<f64>(path, text, &mut storage)?;
-    let cfg = LatticeConfig::default();
-    let mut bufs = lattice_storage(&scene, &cfg)?;
-    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
-    let tracer = Tracer::new(&scene, &lattice);
-    let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(&scene)];
-    let mut q = lattice_rt::Query::new(&mut mb);
-    let (ws, hs) = (2 * n * w as usize, 2 * n * h as usize);
-    let mut out = Vec::with_capacity(w as usize * h as usize);
-    for y in 0..h as usize {
-        for x in 0..w as usize {
-            let mut sum = 0.0;
-            for j in 0..n {
-                for i in 0..n {
-                    let ray = scene.camera().ray((2 * n * x + 2 * i + 1) as i32, (2 * n * y + 2 * j + 1) as i32, ws as i32, hs as i32);
-                    sum += tracer.radiance(ray, &mut q);
+    crate::run::with_tracer::<f64, _>(path, text, |_| {}, |tracer| {
+        let scene = tracer.scene();
+        let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(scene)];
+        let mut q = lattice_rt::Query::new(&mut mb);
+        let (ws, hs) = (2 * n * w as usize, 2 * n * h as usize);
+        let mut out = Vec::with_capacity(w as usize * h as usize);
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                let mut sum = 0.0;
+                for j in 0..n {
+                    for i in 0..n {
+                        let ray = scene.camera().ray((2 * n * x + 2 * i + 1) as i32, (2 * n * y + 2 * j + 1) as i32, ws as i32, hs as i32);
+                        sum += tracer.radiance(ray, &mut q);
+                    }
                 }
+                out.push(sum / (n * n) as f64 * 64.0);
             }
-            out.push(sum / (n * n) as f64 * 64.0);
         }
-    }
-    Ok(out)
+        Ok(out)
+    })
 }
 
 /// The reference dithered the way a configuration dithers (ordered per pixel, or error

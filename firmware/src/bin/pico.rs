@@ -4,7 +4,8 @@
 //! column bytes; no framebuffer), and logs per-frame time and statistics over defmt-rtt.
 //!
 //! The on-board LED (GP25) is lit while a frame is being rendered and goes out when the frame is
-//! on the display; between scenes the core sleeps (`wfi`) until a timer alarm. With no display
+//! on the display (with the `progressive` feature, a frame is shown in four passes and the LED
+//! goes out for a moment as each of the first three reaches the display); between scenes the core sleeps (`wfi`) until a timer alarm. With no display
 //! answering, the log says so and the LED blinks quickly while the firmware retries every second.
 //! `host-sim board` runs this image in an RP2040 emulator and relies on that LED protocol.
 //!
@@ -121,9 +122,12 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
         }
         // One byte per column, bit k = row k of the page (LSB on top).
         let mut cols = [0u8; 16];
-        for (i, c) in colors.into_iter().take(w * h).enumerate() {
-            if c.is_on() {
-                cols[i % w] |= 1 << (i / w);
+        let mut colors = colors.into_iter();
+        for bit in (0..h).map(|y| 1u8 << y) {
+            for col in cols[..w].iter_mut() {
+                if colors.next().is_some_and(|c| c.is_on()) {
+                    *col |= bit;
+                }
             }
         }
         // `set_draw_area` takes pixel coordinates (it divides rows by 8 into pages itself).
@@ -327,13 +331,21 @@ fn main() -> ! {
     }
     defmt::info!("rendering on {} core(s)", if two.is_some() { 2 } else { 1 });
     let now = || timer.get_counter().ticks();
-    // One frame: the LED lit while it renders.
+    // One frame: the LED lit while it renders. A progressive frame (the `progressive` feature)
+    // puts it out for a moment as each pass but the last reaches the display, so the LED goes
+    // out once per picture the panel shows.
     let mut show = |text: &'static str, shot: &Shot| {
         let t0 = timer.get_counter();
         let _ = led.set_high();
+        let mut shown = |pass: u8| {
+            if pass > 1 {
+                let _ = led.set_low();
+                let _ = led.set_high();
+            }
+        };
         let result = match two.as_mut() {
-            Some(cores) => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, cores, &mut second, &now),
-            None => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, &mut one, &mut second, &now),
+            Some(cores) => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, cores, &mut second, &now, &mut shown),
+            None => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, &mut one, &mut second, &now, &mut shown),
         };
         let _ = led.set_low();
         result.map(|r| (r, (timer.get_counter() - t0).to_micros(), r.share_us))

@@ -83,7 +83,7 @@ fn main() -> ! {
         let mut frame = BitFrame::new(FRAME.width as u32, FRAME.height as u32, &mut bits).unwrap();
         let t0 = ticks();
         let shot = Shot::default();
-        match render_scene_at(text, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks) {
+        match render_scene_at(text, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks, &mut |_| {}) {
             Ok(r) => {
                 let t = ticks() - t0;
                 let s = r.stats;
