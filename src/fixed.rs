@@ -199,6 +199,16 @@ impl Real for Fx {
         let mantissa = ((raw << lz) >> 20) & 0x7ff;
         (((31 - lz) << 11) | mantissa) as u16
     }
+    fn div_pow2(self, k: u32) -> Self {
+        // Division rounds half away from zero: a rounded shift of the magnitude.
+        let k = k.min(14);
+        if k == 0 {
+            return self;
+        }
+        let a = self.0.unsigned_abs();
+        let q = ((a >> k) + ((a >> (k - 1)) & 1)) as i32;
+        Fx(if self.0 < 0 { -q } else { q })
+    }
     fn sqrt(self) -> Self {
         if self.0 <= 0 {
             return Fx(0);
@@ -307,6 +317,25 @@ mod tests {
             let q = q.min(i32::MAX as i64);
             let want = if (a < 0) != (b < 0) { -q } else { q } as i32;
             assert_eq!((Fx(a) / Fx(b)).0, want, "{a} / {b}");
+        }
+    }
+
+    #[test]
+    fn div_pow2_is_the_division_by_the_power_of_two() {
+        let mut x = 0x1234_5678u64;
+        for _ in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let a = ((x as i32) >> (x % 31) as i32).max(-i32::MAX);
+            for k in 0..=14 {
+                assert_eq!(Fx(a).div_pow2(k), Fx(a) / Fx::from_i32(1 << k), "{a} / 2^{k}");
+            }
+        }
+        for a in [0, 1, -1, 0x7fff_ffff, -0x7fff_ffff, 0x8000, -0x8000, 0x4000, -0x4000, 0xc000, -0xc000] {
+            for k in 0..=14 {
+                assert_eq!(Fx(a).div_pow2(k), Fx(a) / Fx::from_i32(1 << k), "{a} / 2^{k}");
+            }
         }
     }
 

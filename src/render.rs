@@ -351,7 +351,14 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                     let k = skipped + done as usize;
                     let kept = &mut traced[k * per_tile..(k + 1) * per_tile];
                     let at = Block { x0, y0, tw, th, t };
-                    progressive_tile(&mut sampler, *n as usize, at, kept, &mut shoot, &mut levels, &mut hits, outline.is_some());
+                    // Each preview side is a constant in its own copy of the loop (no division).
+                    let keep = outline.is_some();
+                    match *n {
+                        8 => preview_tile::<R, 8>(at, kept, &mut shoot, &mut levels, &mut hits, keep),
+                        4 => preview_tile::<R, 4>(at, kept, &mut shoot, &mut levels, &mut hits, keep),
+                        2 => preview_tile::<R, 2>(at, kept, &mut shoot, &mut levels, &mut hits, keep),
+                        _ => finish_tile(&mut sampler, at, kept, &mut shoot, &mut levels, &mut hits),
+                    }
                 }
             }
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
@@ -383,13 +390,41 @@ struct Block {
     t: usize,
 }
 
-/// One tile of a progressive pass `n` (8, 4, 2 or 1); `kept` holds the tile's rays on the
-/// 2x2 grid (tile side `t`), `(t / 2)^2` of them, pixel `(x, y)` at `(y / 2) * (t / 2) + x / 2`.
-/// The blocks of passes 8, 4 and 2 fill `hits` (what the outline reads) only with `keep_hits`.
-#[allow(clippy::too_many_arguments)]
-fn progressive_tile<R: Real>(
+/// Where the ray through pixel `(x, y)` of a tile of side `t` is kept: one entry per pixel of
+/// the tile's 2x2 grid, `(t / 2)^2` of them.
+fn kept_at(t: usize, x: usize, y: usize) -> usize {
+    (y / 2) * (t / 2) + x / 2
+}
+
+/// One tile of the last progressive pass: the frame's own sampling, with the rays of the 2x2
+/// grid taken from the earlier passes (`kept`): a level l comes back as the brightness l / 64,
+/// whose level is l again.
+fn finish_tile<R: Real>(
     sampler: &mut Sampler<'_>,
-    n: usize,
+    Block { x0, y0, tw, th, t }: Block,
+    kept: &[Traced],
+    shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+    levels: &mut [u8; MAX_TILE * MAX_TILE],
+    hits: &mut Hits,
+) {
+    let sixty_fourth = R::ONE / R::from_i32(64);
+    let mut reuse = |sx: usize, sy: usize| -> Shot<R> {
+        let (x, y) = ((sx / 4).wrapping_sub(x0), (sy / 4).wrapping_sub(y0));
+        if sx % 4 == 2 && sy % 4 == 2 && x % 2 == 0 && y % 2 == 0 && x < tw && y < th {
+            let k = kept[kept_at(t, x, y)];
+            (R::from_i32(k.level as i32) * sixty_fourth, k.object, k.depth)
+        } else {
+            shoot(sx, sy)
+        }
+    };
+    sampler.tile(x0, y0, tw, th, &mut reuse, levels, hits)
+}
+
+/// One tile of preview pass `N` (8, 4 or 2): one ray per `N`x`N` block, through its top-left
+/// pixel, traced now unless an earlier pass traced it (it lies on the grid of side `2N`), and
+/// kept in `kept` for the passes after. The blocks fill `hits` (what the outline reads) only
+/// with `keep_hits`.
+fn preview_tile<R: Real, const N: usize>(
     Block { x0, y0, tw, th, t }: Block,
     kept: &mut [Traced],
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
@@ -397,38 +432,18 @@ fn progressive_tile<R: Real>(
     hits: &mut Hits,
     keep_hits: bool,
 ) {
-    let at = |x: usize, y: usize| (y / 2) * (t / 2) + x / 2;
-    let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
-    if n == 1 {
-        // The frame's own sampling, with the rays of the 2x2 grid taken from the earlier
-        // passes: a level l comes back as the brightness l / 64, whose level is l again.
-        let sixty_fourth = R::ONE / R::from_i32(64);
-        let mut reuse = |sx: usize, sy: usize| -> Shot<R> {
-            let (x, y) = ((sx / 4).wrapping_sub(x0), (sy / 4).wrapping_sub(y0));
-            if sx % 4 == 2 && sy % 4 == 2 && x % 2 == 0 && y % 2 == 0 && x < tw && y < th {
-                let k = kept[at(x, y)];
-                (R::from_i32(k.level as i32) * sixty_fourth, k.object, k.depth)
+    for by in (0..th).step_by(N) {
+        let rows = by..(by + N).min(th);
+        for bx in (0..tw).step_by(N) {
+            let k = if N < 8 && bx % (2 * N) == 0 && by % (2 * N) == 0 {
+                kept[kept_at(t, bx, by)]
             } else {
-                shoot(sx, sy)
-            }
-        };
-        return sampler.tile(x0, y0, tw, th, &mut reuse, levels, hits);
-    }
-    for by in (0..th).step_by(n) {
-        let rows = by..(by + n).min(th);
-        for bx in (0..tw).step_by(n) {
-            // Rays on the grid of twice this pass's side were traced by an earlier pass.
-            let earlier = n < 8 && bx % (2 * n) == 0 && by % (2 * n) == 0;
-            let k = if earlier {
-                kept[at(bx, by)]
-            } else {
-                let (cx, cy) = centre(bx, by);
-                let (v, object, depth) = shoot(cx, cy);
+                let (v, object, depth) = shoot(4 * (x0 + bx) + 2, 4 * (y0 + by) + 2);
                 let k = Traced { level: level(v), object, depth };
-                kept[at(bx, by)] = k;
+                kept[kept_at(t, bx, by)] = k;
                 k
             };
-            let cols = bx..(bx + n).min(tw);
+            let cols = bx..(bx + N).min(tw);
             for y in rows.clone() {
                 let row = y * tw;
                 levels[row + cols.start..row + cols.end].fill(k.level);

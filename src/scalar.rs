@@ -92,6 +92,11 @@ pub trait Real:
     fn depth_key(self) -> u16 {
         f32_key(self.to_f64() as f32)
     }
+    /// `self / 2^k` for `k` in `0..=14`: the same value as dividing by `from_i32(1 << k)`, which
+    /// is what the default does; fixed point shifts instead of dividing.
+    fn div_pow2(self, k: u32) -> Self {
+        self / Self::from_i32(1 << k.min(14))
+    }
     /// The largest integer `k` in `0..=max` with `k <= self` (0 when there is none: below 0,
     /// or NaN). The default bisects with comparisons alone (no float-to-int conversion the
     /// scalar may not have); the built-in scalars convert directly, to the same answer.

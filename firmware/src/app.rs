@@ -253,8 +253,9 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
 }
 
-/// One share of a frame: pass `pass` of a progressive frame (`render_pass`), or with pass 0 the
-/// whole frame at once (`render_share`).
+/// One share of a frame: pass `pass` of a progressive frame (`render_pass`), or, in a build
+/// without the `progressive` feature (whose only pass is 0), the whole frame at once
+/// (`render_share`).
 #[allow(clippy::too_many_arguments)]
 fn draw<R: Real, D: DrawTarget<Color = BinaryColor>>(
     tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
@@ -266,8 +267,10 @@ fn draw<R: Real, D: DrawTarget<Color = BinaryColor>>(
     scratch: &mut lattice_rt::Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
-    // A build without the `progressive` feature links no pass code at all.
-    if cfg!(feature = "progressive") && pass != 0 {
+    // A build without the `progressive` feature links no pass code at all, and one with it
+    // renders through `render_pass` alone (one caller of the tile loop, so the compiler still
+    // folds the constant frame's sizes into it).
+    if cfg!(feature = "progressive") {
         render_pass(tracer, frame, share, pass, traced, target, scratch, hooks)
     } else {
         render_share(tracer, frame, share, target, scratch, hooks)

@@ -126,9 +126,20 @@ impl<R: Real> Camera<R> {
     /// top-left corner (pixel centres are at `i + 0.5`).
     pub fn ray(&self, sx2: i32, sy2: i32, w2: i32, h2: i32) -> Ray<R> {
         // Arguments are doubled coordinates so that pixel centres stay integers.
-        let u = R::from_i32(2 * sx2 - w2) / R::from_i32(w2);
-        let v = R::from_i32(h2 - 2 * sy2) / R::from_i32(h2);
+        let u = ratio::<R>(2 * sx2 - w2, w2);
+        let v = ratio::<R>(h2 - 2 * sy2, h2);
         Ray::new(self.eye, self.forward + self.right * u + self.up * v)
+    }
+}
+
+/// `n / d` in `R`, as `from_i32(n) / from_i32(d)`; a window side that is a power of two (up to
+/// 2^14, as every board's is) divides by [`Real::div_pow2`], the same value without a division.
+#[inline]
+fn ratio<R: Real>(n: i32, d: i32) -> R {
+    if d > 0 && d <= 1 << 14 && d & (d - 1) == 0 {
+        R::from_i32(n).div_pow2(d.trailing_zeros())
+    } else {
+        R::from_i32(n) / R::from_i32(d)
     }
 }
 
