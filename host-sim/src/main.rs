@@ -350,9 +350,11 @@ pub struct RenderArgs {
     /// World lattice resolution, overriding the automatic choice.
     #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
     pub cells: Option<[u16; 3]>,
-    /// Draw silhouette lines (the farther pixel where neighbours hit different objects is black).
+    /// Leave out the silhouette lines. By default the farther pixel where neighbours hit
+    /// different objects is drawn black: without them thin parts of the same gray as what lies
+    /// behind (the chair's legs on its floor) vanish in a 1-bit frame (docs/display.md).
     #[arg(long)]
-    pub outline: bool,
+    pub no_outline: bool,
     /// Tone curve before dithering: gray levels raised to the power GAMMA/10 (5 to 20; 10 leaves
     /// them unchanged).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u8).range(5..=20))]

@@ -231,7 +231,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
         tile: a.tile,
         dither: a.dither.mode(),
         sampling: a.sampling.mode(),
-        outline: a.outline,
+        outline: !a.no_outline,
         tone: lattice_rt::Tone { gamma_tenths: a.gamma },
         ..Frame::new(a.size.0, a.size.1)
     };
