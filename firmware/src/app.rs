@@ -299,21 +299,14 @@ fn send_share<D: DrawTarget<Color = BinaryColor>>(bits: &mut [u8], frame: &Frame
     let t = frame.tile as usize;
     let (w, h) = (frame.width as usize, frame.height as usize);
     let stride = w.div_ceil(8);
-    let mut tile = [BinaryColor::Off; lattice_rt::dither::MAX_TILE * lattice_rt::dither::MAX_TILE];
     for ty in 0..h.div_ceil(t) {
         for tx in (0..w.div_ceil(t)).filter(|&tx| share.holds(tx, ty)) {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
-            // The tile's pixels, row by row, from the packed rows (no division per pixel).
-            let mut i = 0;
-            for row in raster[y0 * stride..].chunks(stride).take(th) {
-                for x in x0..x0 + tw {
-                    tile[i] = BinaryColor::from(row[x / 8] & (0x80 >> (x % 8)) != 0);
-                    i += 1;
-                }
-            }
+            let rows = raster[y0 * stride..].chunks(stride).take(th);
+            let pixels = rows.flat_map(|row| (x0..x0 + tw).map(move |x| BinaryColor::from(row[x / 8] & (0x80 >> (x % 8)) != 0)));
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
-            target.fill_contiguous(&area, tile[..i].iter().copied())?;
+            target.fill_contiguous(&area, pixels)?;
         }
     }
     Ok(())
