@@ -22,17 +22,19 @@ fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let pico = env::var_os("CARGO_FEATURE_PICO").is_some();
     let pico2 = env::var_os("CARGO_FEATURE_PICO2").is_some();
+    let microbit = env::var_os("CARGO_FEATURE_MICROBIT").is_some();
     let target = env::var("TARGET").unwrap_or_default();
     let m33 = target.starts_with("thumbv8m");
-    let src = match (pico, pico2, m33) {
-        (true, _, _) => "../memory.x",
-        (_, true, _) => "pico2/memory.x",
-        (_, _, true) => "qemu-an505/memory.x",
+    let src = match (pico, pico2, m33, microbit) {
+        (true, _, _, _) => "../memory.x",
+        (_, true, _, _) => "pico2/memory.x",
+        (_, _, true, _) => "qemu-an505/memory.x",
+        (_, _, _, true) => "microbit/memory.x",
         _ => "qemu/memory.x",
     };
     fs::copy(src, out.join("memory.x")).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
-    for map in ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x"] {
+    for map in ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x", "microbit/memory.x"] {
         println!("cargo:rerun-if-changed={map}");
     }
     // The core's name in the firmware's reports.
