@@ -11,7 +11,7 @@
 
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
-use crate::outline::Outline;
+use crate::outline::Apron;
 use crate::scalar::Real;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
@@ -108,27 +108,18 @@ impl Frame {
         }
     }
 
-    /// Whether bands of tile rows can be rendered apart and give the same pixels: true unless
-    /// error diffusion, edge detection or the outline carries state from one tile row to the
-    /// next.
+    /// Whether bands of tile rows (and tile shares) can be rendered apart and give the same
+    /// pixels: true unless error diffusion or edge detection carries state from one tile row to
+    /// the next (the outline does not: each tile traces its own apron, [`crate::outline`]).
     pub fn bands_independent(&self) -> bool {
-        !self.dither.diffuses() && !self.edges() && !self.outline
+        !self.dither.diffuses() && !self.edges()
     }
 
-    /// Entries of `i16` scratch storage [`render`] needs: error-diffusion carries, the object
-    /// ids of the row above the current band for edge detection, and the objects and depths of
-    /// that row for the outline.
+    /// Entries of `i16` scratch storage [`render`] needs: error-diffusion carries and the
+    /// object ids of the row above the current band for edge detection.
     pub fn scratch_len(&self) -> usize {
         let w = self.width as usize;
-        Ditherer::rows_len(self.dither, w) + Sampler::rows_len(self.sampling, self.dither.block(), w) + self.outline_len()
-    }
-
-    fn outline_len(&self) -> usize {
-        if self.outline {
-            Outline::rows_len(self.width as usize)
-        } else {
-            0
-        }
+        Ditherer::rows_len(self.dither, w) + Sampler::rows_len(self.sampling, self.dither.block(), w)
     }
 
     /// Whether the frame can be rendered progressively ([`render_pass`]): its tiles are a
@@ -184,7 +175,7 @@ pub enum RenderError<E> {
         needed: usize,
     },
     /// The share is not one of its frame's (`index >= of`), or the frame's tiles depend on
-    /// each other (error diffusion, edge sampling, the outline) and cannot be shared out.
+    /// each other (error diffusion, edge sampling) and cannot be shared out.
     BadShare,
     /// A progressive pass was asked of a frame that cannot be rendered progressively
     /// ([`Frame::progressive`]), or the pass is not 8, 4, 2 or 1, or the [`Traced`] storage is
@@ -204,7 +195,7 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
-            RenderError::BadShare => write!(f, "tile share out of range, or the frame carries state from tile to tile (error diffusion, edge sampling, outline)"),
+            RenderError::BadShare => write!(f, "tile share out of range, or the frame carries state from tile to tile (error diffusion, edge sampling)"),
             RenderError::NotProgressive => write!(f, "progressive passes need tiles of a multiple of 8, one ray per pixel, a pass of 8, 4, 2 or 1 and room for the traced samples"),
         }
     }
@@ -302,11 +293,11 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let (w, h) = (frame.width as usize, frame.height as usize);
     let too_small = || RenderError::ScratchTooSmall { needed: frame.scratch_len() };
     let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or_else(too_small)?;
-    let (carries, rest) = rows.split_at_mut(Ditherer::rows_len(frame.dither, w));
-    let (outline_rows, above) = rest.split_at_mut(frame.outline_len());
+    let (carries, above) = rows.split_at_mut(Ditherer::rows_len(frame.dither, w));
     let mut dither = Ditherer::new(frame.dither, w, carries).ok_or_else(too_small)?;
     let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
-    let mut outline = if frame.outline { Some(Outline::new(outline_rows, w).ok_or_else(too_small)?) } else { None };
+    // The outline is drawn on finished frames: a progressive frame's last pass, not its previews.
+    let outline = frame.outline && pass.as_ref().is_none_or(|(n, _)| *n == 1);
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
     let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
@@ -324,9 +315,6 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     for ty in first..end {
         dither.next_band();
         sampler.next_band();
-        if let Some(o) = outline.as_mut() {
-            o.next_band();
-        }
         // Remembered occluders are forgotten at every band of tiles, so a band renders the same
         // whichever bands a core or thread rendered before it.
         q.forget_occluders();
@@ -352,11 +340,10 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                     let kept = &mut traced[k * per_tile..(k + 1) * per_tile];
                     let at = Block { x0, y0, tw, th, t };
                     // Each preview side is a constant in its own copy of the loop (no division).
-                    let keep = outline.is_some();
                     match *n {
-                        8 => preview_tile::<R, 8>(at, kept, &mut shoot, &mut levels, &mut hits, keep),
-                        4 => preview_tile::<R, 4>(at, kept, &mut shoot, &mut levels, &mut hits, keep),
-                        2 => preview_tile::<R, 2>(at, kept, &mut shoot, &mut levels, &mut hits, keep),
+                        8 => preview_tile::<R, 8>(at, kept, &mut shoot, &mut levels),
+                        4 => preview_tile::<R, 4>(at, kept, &mut shoot, &mut levels),
+                        2 => preview_tile::<R, 2>(at, kept, &mut shoot, &mut levels),
                         _ => finish_tile(&mut sampler, at, kept, &mut shoot, &mut levels, &mut hits),
                     }
                 }
@@ -365,8 +352,24 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
             if !frame.tone.is_linear() {
                 levels[..tw * th].iter_mut().for_each(|l| *l = frame.tone.apply(*l));
             }
-            if let Some(o) = outline.as_mut() {
-                o.tile(x0, y0, tw, th, &hits, &mut levels[..tw * th]);
+            if outline {
+                // The apron: what the eye rays through the column left of the tile and the row
+                // above it hit (the tile's eye candidates cover them: they are a pixel away).
+                let mut probe = |x: usize, y: usize| -> (u16, u16) {
+                    let (sx, sy) = (4 * x as i32 + 2, 4 * y as i32 + 2);
+                    q.set_eye_ray(Some(Camera::<R>::window_uv(sx, sy, w4, h4)));
+                    let (id, depth) = tracer.eye_hit(cam.ray(sx, sy, w4, h4), &mut q);
+                    (id as u16, depth.depth_key())
+                };
+                let (mut left, mut up) = ([(0u16, 0u16); MAX_TILE], [(0u16, 0u16); MAX_TILE]);
+                if x0 > 0 {
+                    (0..th).for_each(|y| left[y] = probe(x0 - 1, y0 + y));
+                }
+                if y0 > 0 {
+                    (0..tw).for_each(|x| up[x] = probe(x0 + x, y0 - 1));
+                }
+                let apron = Apron { left: (x0 > 0).then_some(&left[..th]), up: (y0 > 0).then_some(&up[..tw]) };
+                crate::outline::tile(tw, th, &hits, apron, &mut levels[..tw * th]);
             }
             dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
@@ -422,15 +425,12 @@ fn finish_tile<R: Real>(
 
 /// One tile of preview pass `N` (8, 4 or 2): one ray per `N`x`N` block, through its top-left
 /// pixel, traced now unless an earlier pass traced it (it lies on the grid of side `2N`), and
-/// kept in `kept` for the passes after. The blocks fill `hits` (what the outline reads) only
-/// with `keep_hits`.
+/// kept in `kept` for the passes after.
 fn preview_tile<R: Real, const N: usize>(
     Block { x0, y0, tw, th, t }: Block,
     kept: &mut [Traced],
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
-    hits: &mut Hits,
-    keep_hits: bool,
 ) {
     for by in (0..th).step_by(N) {
         let rows = by..(by + N).min(th);
@@ -447,10 +447,6 @@ fn preview_tile<R: Real, const N: usize>(
             for y in rows.clone() {
                 let row = y * tw;
                 levels[row + cols.start..row + cols.end].fill(k.level);
-                if keep_hits {
-                    hits.object[row + cols.start..row + cols.end].fill(k.object);
-                    hits.depth[row + cols.start..row + cols.end].fill(k.depth);
-                }
             }
         }
     }

@@ -402,6 +402,35 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         (v, object)
     }
 
+    /// The object an eye ray hits first ([`NO_OBJECT`] if none) and how far along the ray, as
+    /// [`Tracer::eye_sample`] finds them, without shading or any further ray (counted as a
+    /// primary ray): what the outline's apron needs.
+    pub fn eye_hit(&self, eye: Ray<R>, q: &mut Query<'_>) -> (u32, R) {
+        q.stats.rays[RayKind::Primary as usize] += 1;
+        let uv = q.eye_ray();
+        self.nearest(&eye, uv, q).map_or((NO_OBJECT, R::MAX), |hit| (hit.object, hit.t))
+    }
+
+    /// The nearest hit of `ray`; an eye ray's window position `uv` (when given) lets
+    /// [`EyeRays`] skip objects or the walk. Leaves the query with no eye ray set.
+    fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, q: &mut Query<'_>) -> Option<crate::accel::Hit<R>> {
+        let found = match uv {
+            Some(uv) if self.eye_rays != EyeRays::Plain => {
+                q.set_eye_ray(Some(uv));
+                match self.eye_rays {
+                    EyeRays::Windows => nearest_by_windows(self.scene, ray, q),
+                    _ => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, q),
+                }
+            }
+            _ => {
+                q.set_eye_ray(None);
+                self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, q)
+            }
+        };
+        q.set_eye_ray(None);
+        found
+    }
+
     /// Brightness along an eye ray, the object it hits ([`NO_OBJECT`] if none) and how far
     /// along the ray (in units of its direction's length; `R::MAX` if it hits nothing).
     pub fn eye_sample(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u32, R) {
@@ -417,20 +446,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let eye_uv = q.eye_ray();
         while let Some(node) = stack.pop() {
             q.stats.rays[node.kind as usize] += 1;
-            let found = match (node.depth, eye_uv) {
-                (0, Some(uv)) if self.eye_rays != EyeRays::Plain => {
-                    q.set_eye_ray(Some(uv));
-                    match self.eye_rays {
-                        EyeRays::Windows => nearest_by_windows(scene, &node.ray, q),
-                        _ => self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q),
-                    }
-                }
-                _ => {
-                    q.set_eye_ray(None);
-                    self.accel.nearest(scene, &node.ray, R::ZERO, R::MAX, q)
-                }
-            };
-            q.set_eye_ray(None);
+            let found = self.nearest(&node.ray, if node.depth == 0 { eye_uv } else { None }, q);
             let Some(hit) = found else {
                 total += node.weight * scene.background;
                 continue;

@@ -38,13 +38,19 @@ fn shares_of(frame: Frame, of: u8) -> Vec<(Frame, Share)> {
 fn shares_rendered_apart_give_the_whole_frame() {
     for name in ["chair", "spheres", "whitted"] {
         for sampling in [Sampling::Center, Sampling::Adaptive { contrast: 4 }] {
-            // 100x60: the last tile column and row are partial.
-            let frame = Frame { sampling, ..Frame::new(100, 60) };
-            let (whole, ws) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
-            for of in [2, 3] {
-                let (split, ss) = render_into::<Fx>(name, &shares_of(frame, of), true);
-                assert_eq!(whole, split, "{name}, {sampling:?}, {of} shares");
-                assert_eq!(ws.rays[0], ss.rays[0], "{name}, {sampling:?}: every eye ray traced once");
+            // Silhouette lines too: each tile traces its own apron, so they split like the rest.
+            for outline in [false, true] {
+                // 100x60: the last tile column and row are partial.
+                let frame = Frame { sampling, outline, ..Frame::new(100, 60) };
+                let (whole, ws) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
+                for of in [2, 3] {
+                    let (split, ss) = render_into::<Fx>(name, &shares_of(frame, of), true);
+                    assert_eq!(whole, split, "{name}, {sampling:?}, outline {outline}, {of} shares");
+                    assert_eq!(ws.rays[0], ss.rays[0], "{name}, {sampling:?}: every eye ray traced once");
+                }
+                // And bands of tile rows.
+                let bands: Vec<(Frame, Share)> = [(0, 3), (3, 5), (5, 8)].map(|rows| (Frame { rows, ..frame }, Share::ALL)).to_vec();
+                assert_eq!(whole, render_into::<Fx>(name, &bands, true).0, "{name}, {sampling:?}, outline {outline}, bands");
             }
         }
     }

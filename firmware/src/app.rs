@@ -12,12 +12,12 @@ use lattice_rt::{render_pass, render_share, Effects, Frame, LatticeConfig, Real,
 
 pub use crate::frame::{Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
-/// The frame the firmware renders: [`FRAME`], or with the `exact-sampling` feature one eye ray
-/// per pixel.
-pub const RENDERED: lattice_rt::Frame = if cfg!(feature = "exact-sampling") {
-    lattice_rt::Frame { sampling: lattice_rt::Sampling::Center, ..FRAME }
-} else {
-    FRAME
+/// The frame the firmware renders: [`FRAME`], with one eye ray per pixel under the
+/// `exact-sampling` feature and silhouette lines under the `outline` feature.
+pub const RENDERED: lattice_rt::Frame = lattice_rt::Frame {
+    sampling: if cfg!(feature = "exact-sampling") { lattice_rt::Sampling::Center } else { FRAME.sampling },
+    outline: cfg!(feature = "outline"),
+    ..FRAME
 };
 
 /// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).

@@ -17,7 +17,8 @@ pub const SAMPLING: Sampling = Sampling::Adaptive { contrast: 4 };
 /// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), blue-noise
 /// ordered dither: of the dithers whose tiles the two cores can share out, the one that scores
 /// best in `host-sim display` (docs/display.md; error diffusion scores higher but carries error
-/// from tile to tile, so one core would have to render every tile).
+/// from tile to tile, so one core would have to render every tile). No silhouette lines: they
+/// cost about a fifth more cycles (the firmware's `outline` feature draws them).
 pub const FRAME: Frame = Frame {
     width: WIDTH,
     height: HEIGHT,
