@@ -231,8 +231,8 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
         sheet_links.push((name.clone(), file));
     }
 
-    // Progressive passes with the best look (a frame with the outline cannot be split between
-    // cores, but progressive passes do not need that).
+    // Progressive passes with the best look (error diffusion cannot be split between cores, but
+    // progressive passes do not need that).
     let mut prog_rows = Vec::new();
     let mut strip = Sheet::new(4, n as u32, w as u32, h as u32);
     for (s, path) in scenes.iter().enumerate() {
