@@ -309,6 +309,11 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let mut done = 0;
     let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
+    // The eye ray through `(sx, sy)` (quarter pixels), its window position given to the query.
+    let eye = |q: &mut Query<'_>, sx: usize, sy: usize| {
+        q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
+        cam.ray(sx as i32, sy as i32, w4, h4)
+    };
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut hits = Hits::new();
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
@@ -328,8 +333,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
             let (lo, hi) = (Camera::<R>::window_uv(sx[0], sy[1], w4, h4), Camera::<R>::window_uv(sx[1], sy[0], w4, h4));
             q.set_eye_candidates(tracer.scene().eye_candidates([lo[0], hi[0]], [lo[1], hi[1]]));
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
-                q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
-                let (v, id, depth) = tracer.eye_sample(cam.ray(sx as i32, sy as i32, w4, h4), &mut q);
+                let ray = eye(&mut q, sx, sy);
+                let (v, id, depth) = tracer.eye_sample(ray, &mut q);
                 // Only the outline reads depths: a frame without it keys none.
                 (v, id as u16, if frame.outline { depth.depth_key() } else { u16::MAX })
             };
@@ -356,9 +361,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 // The apron: what the eye rays through the column left of the tile and the row
                 // above it hit (the tile's eye candidates cover them: they are a pixel away).
                 let mut probe = |x: usize, y: usize| -> (u16, u16) {
-                    let (sx, sy) = (4 * x as i32 + 2, 4 * y as i32 + 2);
-                    q.set_eye_ray(Some(Camera::<R>::window_uv(sx, sy, w4, h4)));
-                    let (id, depth) = tracer.eye_hit(cam.ray(sx, sy, w4, h4), &mut q);
+                    let ray = eye(&mut q, 4 * x + 2, 4 * y + 2);
+                    let (id, depth) = tracer.eye_hit(ray, &mut q);
                     (id as u16, depth.depth_key())
                 };
                 let (mut left, mut up) = ([(0u16, 0u16); MAX_TILE], [(0u16, 0u16); MAX_TILE]);

@@ -424,7 +424,8 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
     let (orun, orbit_dir) = run_variant(root, no_build, "orbit", false, frames_dir, &bootrom, ORBIT_CHECKED)?;
     let chair = scenes_dir.join("chair.scene");
-    let want = crate::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &crate::load::read(&chair)?, ORBIT_FRAMES, &board_frame::FRAME)?;
+    let chair_text = crate::load::read(&chair)?;
+    let want = crate::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &chair_text, ORBIT_FRAMES, &board_frame::FRAME)?;
     if orun.frames.len() < ORBIT_CHECKED {
         failures.push(format!("orbit mode: {} of {ORBIT_CHECKED} frames shown ({})", orun.frames.len(), orun.reason));
     }
@@ -491,7 +492,8 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     // Silhouette lines: the chair with the `outline` feature, bit for bit against host-sim's.
     let (lrun_outline, outline_dir) = run_variant(root, no_build, "outline", false, frames_dir, &bootrom, 1)?;
     let lined = lattice_rt::Frame { outline: true, ..board_frame::FRAME };
-    let want = crate::run::render_text::<lattice_rt::Fx>(&chair, &crate::load::read(&chair)?, &lined, |_| {})?;
+    let want = crate::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &lined, |_| {})?;
+    let plain_chair = rows.iter().find(|r| r.name == "chair");
     let mut outline_row = None;
     match lrun_outline.frames.first() {
         Some(f) => {
@@ -500,7 +502,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
             if let Some(images) = out.parent().map(|p| p.join("images")) {
                 std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
                 save_frame(&f.pixels, &images.join("board-chair-outline.png"))?;
-                if let Some(plain) = rows.iter().find(|r| r.name == "chair") {
+                if let Some(plain) = plain_chair {
                     save_frame(&plain.frame.pixels, &images.join("board-chair.png"))?;
                 }
             }
@@ -510,7 +512,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
             } else {
                 failures.push(format!("outline: the chair differs from host-sim (see {})", file.display()));
             }
-            let plain_rays = crate::run::render_text::<lattice_rt::Fx>(&chair, &crate::load::read(&chair)?, &board_frame::FRAME, |_| {})?.stats.rays[0];
+            let plain_rays = crate::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &board_frame::FRAME, |_| {})?.stats.rays[0];
             outline_row = Some((f, [plain_rays, want.stats.rays[0]], same));
         }
         None => failures.push(format!("outline: no frame shown ({})", lrun_outline.reason)),
@@ -522,7 +524,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
     md.push_str(&progressive_report(&progressive, run.clk_sys_hz)?);
-    if let (Some((f, rays, same)), Some(plain)) = (outline_row, rows.iter().find(|r| r.name == "chair")) {
+    if let (Some((f, rays, same)), Some(plain)) = (outline_row, plain_chair) {
         md.push_str(&outline_report(f, rays, same, &plain.frame, run.clk_sys_hz)?);
     }
     crate::output::write_atomic(out, md.as_bytes())?;

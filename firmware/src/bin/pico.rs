@@ -5,8 +5,9 @@
 //!
 //! The on-board LED (GP25) is lit while a frame is being rendered and goes out when the frame is
 //! on the display (with the `progressive` feature, a frame is shown in four passes and the LED
-//! goes out for a moment as each of the first three reaches the display); between scenes the core sleeps (`wfi`) until a timer alarm. With no display
-//! answering, the log says so and the LED blinks quickly while the firmware retries every second.
+//! goes out for a moment as each of the first three reaches the display); between scenes the
+//! core sleeps (`wfi`) until a timer alarm. With no display answering, the log says so and the
+//! LED blinks quickly while the firmware retries every second.
 //! `host-sim board` runs this image in an RP2040 emulator and relies on that LED protocol.
 //!
 //! Wiring (change it here, in `Wiring` below, and nowhere else): SDA on GP4, SCL on GP5,
