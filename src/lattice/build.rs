@@ -2,7 +2,7 @@
 //! in two passes (count, then fill).
 
 use super::plan::{axis_planes, lattice_bounds, lattice_resolution};
-use super::{for_each_item, locate, Lattice, LatticeConfig, SubLattice};
+use super::{for_each_item, index, locate, Lattice, LatticeConfig, SubLattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -24,7 +24,8 @@ pub struct LatticeStorage<'a, R> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LatticeError {
-    /// Which storage ran out ("lattices", "coords", "cells", "refs").
+    /// Which storage ran out ("lattices", "coords", "cells", "refs"), or "budget" when no
+    /// lattice fits [`LatticeConfig::budget`] (then counted in bytes).
     pub capacity: &'static str,
     /// Entries needed.
     pub needed: usize,
@@ -36,8 +37,11 @@ impl fmt::Display for LatticeError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "lattice capacity `{}` too small: {} entries needed, {} available",
-            self.capacity, self.needed, self.available
+            "lattice capacity `{}` too small: {} {} needed, {} available",
+            self.capacity,
+            self.needed,
+            if self.capacity == "budget" { "bytes" } else { "entries" },
+            self.available
         )
     }
 }
@@ -64,6 +68,7 @@ impl<'a, R: Real> Lattice<'a, R> {
         cfg: &LatticeConfig,
         storage: LatticeStorage<'a, R>,
     ) -> Result<(Self, &'a mut [u32]), LatticeError> {
+        let cfg = &super::budget::resolve(scene, cfg)?;
         let LatticeStorage { lattices, coords, words } = storage;
         let nlattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
         if lattices.len() < nlattices {
@@ -90,45 +95,53 @@ impl<'a, R: Real> Lattice<'a, R> {
             ncells += sub.cells();
             *slot = sub;
         }
-        if ncells + 1 > words.len() {
-            return Err(LatticeError { capacity: "cells", needed: ncells + 1, available: words.len() });
-        }
-        let (cells, refs) = words.split_at_mut(ncells + 1);
-        cells.iter_mut().for_each(|c| *c = 0);
-        // Pass 1: count references per cell (into cells[i + 1]).
+        let lattices = &lattices[..nlattices];
+        // Pass 0: count the references, which decides the index width.
         let mut nrefs = 0usize;
-        for (g, sub) in lattices.iter().enumerate().take(nlattices) {
-            for_each_item(scene, cfg, g, |_, ib| {
-                visit_cells(coords, sub, ib, |c| {
-                    cells[c + 1] += 1;
-                    nrefs += 1;
-                });
-            });
+        for_each_ref(scene, cfg, coords, lattices, |_, _| nrefs += 1);
+        let narrow = cfg.index16 && index::fits16(nrefs, scene.objects.len(), scene.composites.len());
+        let per_word = if narrow { 2 } else { 1 };
+        let cell_words = index::words(ncells + 1, narrow);
+        if cell_words > words.len() {
+            return Err(LatticeError { capacity: "cells", needed: ncells + 1, available: words.len() * per_word });
         }
-        if nrefs > refs.len() {
-            return Err(LatticeError { capacity: "refs", needed: nrefs, available: refs.len() });
+        let (cells, refs) = words.split_at_mut(cell_words);
+        let ref_words = index::words(nrefs, narrow);
+        if ref_words > refs.len() {
+            return Err(LatticeError { capacity: "refs", needed: nrefs, available: refs.len() * per_word });
         }
-        let (refs, rest) = refs.split_at_mut(nrefs);
-        for i in 1..cells.len() {
-            cells[i] += cells[i - 1];
+        let (refs, rest) = refs.split_at_mut(ref_words);
+        cells.iter_mut().chain(refs.iter_mut()).for_each(|c| *c = 0);
+        let get = |w: &[u32], i| index::get(w, narrow, i);
+        let set = |w: &mut [u32], i, v| index::set(w, narrow, i, v);
+        // Pass 1: count references per cell (into entry c + 1), then sum to cell ends.
+        for_each_ref(scene, cfg, coords, lattices, |_, c| set(cells, c + 1, get(cells, c + 1) + 1));
+        for i in 1..=ncells {
+            set(cells, i, get(cells, i) + get(cells, i - 1));
         }
-        // Pass 2: fill, using cells[i] as a cursor; afterwards cells[i] is the end of cell i,
-        // so shifting by one restores the starts.
-        for (g, sub) in lattices.iter().enumerate().take(nlattices) {
-            for_each_item(scene, cfg, g, |item, ib| {
-                visit_cells(coords, sub, ib, |c| {
-                    refs[cells[c] as usize] = item;
-                    cells[c] += 1;
-                });
-            });
+        // Pass 2: fill, using entry c as a cursor; afterwards entry c is the end of cell c, so
+        // shifting by one restores the starts.
+        for_each_ref(scene, cfg, coords, lattices, |item, c| {
+            let at = get(cells, c);
+            set(refs, at as usize, index::encode(item, narrow));
+            set(cells, c, at + 1);
+        });
+        for i in (1..=ncells).rev() {
+            set(cells, i, get(cells, i - 1));
         }
-        for i in (1..cells.len()).rev() {
-            cells[i] = cells[i - 1];
-        }
-        cells[0] = 0;
-        let lattice = Lattice { lattices: &lattices[..nlattices], coords: &coords[..nc], cells, refs, objects: scene.objects.len() };
+        set(cells, 0, 0);
+        let lattice =
+            Lattice { lattices, coords: &coords[..nc], cells, refs, entries: (ncells + 1, nrefs), narrow, objects: scene.objects.len() };
         Ok((lattice, rest))
-    }}
+    }
+}
+
+/// Calls `f(item, cell)` for every reference of every lattice, in storage order.
+fn for_each_ref<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, coords: &[R], lattices: &[SubLattice<R>], mut f: impl FnMut(u32, usize)) {
+    for (g, sub) in lattices.iter().enumerate() {
+        for_each_item(scene, cfg, g, |item, ib| visit_cells(coords, sub, ib, |c| f(item, c)));
+    }
+}
 
 /// Calls `f` with the global cell index of every cell of `sub` a box overlaps.
 fn visit_cells<R: Real>(coords: &[R], sub: &SubLattice<R>, b: &Aabb<R>, mut f: impl FnMut(usize)) {

@@ -22,10 +22,13 @@
 //!   untested objects lie in later cells, so their hits are no nearer (boxes are padded for
 //!   rounding), and the answer equals brute force.
 
+mod budget;
 mod build;
+mod index;
 mod plan;
 mod walk;
 
+pub use budget::Choice;
 pub use build::{LatticeError, LatticeStorage};
 pub use plan::{LatticeConfig, LatticeSizes, Resolution, Spacing, MAX_PER_AXIS};
 
@@ -34,8 +37,7 @@ use crate::math::{Aabb, Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::{Scene, NO_COMPOSITE};
 
-/// Marks a reference to a sub-lattice (composite) rather than an object.
-const SUB_FLAG: u32 = 1 << 31;
+use index::SUB_FLAG;
 /// Deepest nesting of lattices: the world and one level of composites.
 pub const MAX_NESTING: usize = 2;
 
@@ -73,8 +75,14 @@ impl<R: Real> SubLattice<R> {
 pub struct Lattice<'a, R> {
     lattices: &'a [SubLattice<R>],
     coords: &'a [R],
+    /// Per cell the index of its first reference, and one entry more (packed, see `narrow`).
     cells: &'a [u32],
+    /// References (packed, see `narrow`).
     refs: &'a [u32],
+    /// Entries in `cells` (cells + 1) and in `refs`.
+    entries: (usize, usize),
+    /// Whether `cells` and `refs` hold 16-bit indices, two to a word.
+    narrow: bool,
     /// Objects in the scene it was built for (mailbox entries of composites follow them).
     objects: usize,
 }
@@ -139,12 +147,24 @@ impl<'a, R: Real> Lattice<'a, R> {
 
     /// Number of cells over all lattices.
     pub fn cell_count(&self) -> usize {
-        self.cells.len() - 1
+        self.entries.0 - 1
     }
 
     /// Number of references over all cells.
     pub fn ref_count(&self) -> usize {
-        self.refs.len()
+        self.entries.1
+    }
+
+    /// Whether cell starts and references are 16-bit ([`LatticeConfig::index16`]).
+    pub fn narrow(&self) -> bool {
+        self.narrow
+    }
+
+    /// Index of the first reference of cell `c` (`c` up to the cell count: one past the last
+    /// cell gives the number of references).
+    #[inline(always)]
+    fn cell_start(&self, c: usize) -> u32 {
+        index::get(self.cells, self.narrow, c)
     }
 
     /// The coordinate list of lattice `g` along `axis`.
@@ -187,7 +207,9 @@ mod tests {
         let s = Lattice::plan(&scene, &cfg);
         let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![0.0; s.coords], vec![0; s.words()]);
         let lat = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
-        assert_eq!((lat.lattices.len(), lat.coords.len(), lat.cells.len(), lat.refs.len()), (s.lattices, s.coords, s.cells, s.refs));
+        assert_eq!((lat.lattices.len(), lat.coords.len(), lat.cell_count() + 1, lat.ref_count()), (s.lattices, s.coords, s.cells, s.refs));
+        assert_eq!(lat.cells.len() + lat.refs.len(), s.words());
+        assert_eq!(lat.bytes(), s.bytes::<f64>());
         f(&scene, &lat);
     }
 
@@ -203,11 +225,18 @@ mod tests {
         let mut b = SceneBuilder::new(&mut st);
         random_scene(&mut b, &RandomScene { objects: 20, composite_size: 5, spread: 0.0, seed: 3 }).unwrap();
         let scene = b.finish().unwrap();
+        // 16-bit indices count two to a word, 32-bit ones one.
+        for (index16, short) in [(false, 1), (true, 2)] {
+            let cfg = LatticeConfig { index16, ..LatticeConfig::default() };
+            let s = Lattice::plan(&scene, &cfg);
+            assert_eq!(s.narrow, index16);
+            let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![0.0; s.coords], vec![0; s.words() - 1]);
+            let e = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap_err();
+            assert_eq!(e, LatticeError { capacity: "refs", needed: s.refs, available: s.refs.next_multiple_of(short) - short });
+        }
         let cfg = LatticeConfig::default();
         let s = Lattice::plan(&scene, &cfg);
-        let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![0.0; s.coords], vec![0; s.words() - 1]);
-        let e = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap_err();
-        assert_eq!(e, LatticeError { capacity: "refs", needed: s.refs, available: s.refs - 1 });
+        let (mut c, mut w) = (vec![0.0; s.coords], vec![0; s.words()]);
         let mut g2 = vec![SubLattice::EMPTY; 1];
         let e = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g2, coords: &mut c, words: &mut w }).unwrap_err();
         assert_eq!(e.capacity, "lattices");

@@ -43,6 +43,13 @@ pub struct LatticeConfig {
     /// Whether composites get sub-lattices (the paper's hierarchy); if not, their primitives
     /// are listed in the world lattice like any other (a flat lattice).
     pub nested: bool,
+    /// Whether cell starts and references may be 16-bit, two to a word, when they fit (at most
+    /// 65 535 references, 32 767 objects and composites): the lattice's index memory halves.
+    pub index16: bool,
+    /// Most bytes the lattice may take ([`LatticeSizes::bytes`]); building then picks the
+    /// densest lattice within it ([`Lattice::choose`](super::Lattice::choose)). `None`: the
+    /// resolutions as configured.
+    pub budget: Option<usize>,
 }
 
 impl Default for LatticeConfig {
@@ -53,6 +60,8 @@ impl Default for LatticeConfig {
             max_per_axis: 64,
             spacing: Spacing::Uniform,
             nested: true,
+            index16: true,
+            budget: None,
         }
     }
 }
@@ -70,12 +79,20 @@ pub struct LatticeSizes {
     pub cells: usize,
     /// References.
     pub refs: usize,
+    /// Whether cell starts and references are 16-bit, two to a word.
+    pub narrow: bool,
 }
 
 impl LatticeSizes {
-    /// Words of [`LatticeStorage::words`](super::LatticeStorage::words) the lattice takes: its cells and references.
+    /// Words of [`LatticeStorage::words`](super::LatticeStorage::words) the lattice takes: its
+    /// cell starts and references, each packed two to a word when narrow.
     pub fn words(&self) -> usize {
-        self.cells + self.refs
+        super::index::words(self.cells, self.narrow) + super::index::words(self.refs, self.narrow)
+    }
+
+    /// Bytes the lattice takes in scalar `R`: lattice headers, coordinate lists and words.
+    pub fn bytes<R>(&self) -> usize {
+        self.lattices * size_of::<super::SubLattice<R>>() + self.coords * size_of::<R>() + self.words() * 4
     }
 }
 /// Cells per axis of lattice `g`.
@@ -193,8 +210,14 @@ fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &A
     refs
 }
 impl<R: Real> Lattice<'_, R> {
-    /// Storage a scene needs with this configuration.
+    /// Storage a scene needs with this configuration (within its budget, if it has one: see
+    /// [`Lattice::choose`]).
     pub fn plan(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> LatticeSizes {
+        Self::choose(scene, cfg).sizes
+    }
+
+    /// Storage a scene needs with these resolutions (no budget).
+    pub(super) fn plan_exact(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> LatticeSizes {
         let lattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
         let mut s = LatticeSizes { lattices, cells: 1, ..Default::default() };
         for g in 0..lattices {
@@ -204,5 +227,7 @@ impl<R: Real> Lattice<'_, R> {
             s.cells += n.iter().map(|&v| v as usize).product::<usize>();
             s.refs += plan_refs(scene, cfg, g, &b, n);
         }
+        s.narrow = cfg.index16 && super::index::fits16(s.refs, scene.objects.len(), scene.composites.len());
         s
-    }}
+    }
+}

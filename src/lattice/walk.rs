@@ -1,7 +1,7 @@
 //! Walking a lattice: from cell to neighbouring cell by index arithmetic (3D-DDA), with an
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
-use super::{locate, Lattice, SubLattice, MAX_NESTING, SUB_FLAG};
+use super::{index, locate, Lattice, SubLattice, MAX_NESTING};
 use crate::accel::{offer, Hit, Query};
 use crate::math::Ray;
 use crate::scalar::Real;
@@ -37,15 +37,16 @@ impl<R: Real> Lattice<'_, R> {
         while depth > 0 {
             let Some(w) = stack[depth - 1].as_mut() else { break };
             if w.ref_i < w.ref_end {
-                let item = self.refs[w.ref_i as usize];
+                let item = index::decode(index::get(self.refs, self.narrow, w.ref_i as usize), self.narrow);
                 w.ref_i += 1;
-                if item & SUB_FLAG == 0 {
-                    let i = item as usize;
+                match item {
+                Ok(i) => {
                     if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                         return best;
                     }
-                } else {
-                    let g = (item & !SUB_FLAG) as usize + 1;
+                }
+                Err(composite) => {
+                    let g = composite + 1;
                     let limit = best.map_or(tmax, |b| b.t);
                     if depth < MAX_NESTING && q.first_visit(self.objects + g - 1) {
                         if let Some((a, b)) = self.lattices[g].bounds.clip(ray, tmin, limit) {
@@ -54,6 +55,7 @@ impl<R: Real> Lattice<'_, R> {
                             q.stats.cells_visited += 1;
                         }
                     }
+                }
                 }
                 continue;
             }
@@ -131,8 +133,8 @@ impl<R: Real> Walker<R> {
     fn load_cell(&mut self, l: &Lattice<'_, R>, g: &SubLattice<R>) {
         let (nx, ny) = (g.n[0] as usize, g.n[1] as usize);
         let c = g.cell_start as usize + self.idx[0] as usize + nx * (self.idx[1] as usize + ny * self.idx[2] as usize);
-        self.ref_i = l.cells[c];
-        self.ref_end = l.cells[c + 1];
+        self.ref_i = l.cell_start(c);
+        self.ref_end = l.cell_start(c + 1);
     }
 
     /// Parameter where the ray leaves the current cell.
