@@ -92,13 +92,14 @@ fn per_ray(scene: &Scene<'_, f64>, a: &dyn Accelerator<f64>, rays: &[Ray<f64>], 
     (median(times), tests, cells)
 }
 
-fn camera_rays(scene: &Scene<'_, f64>, w: i32, h: i32) -> Vec<Ray<f64>> {
+/// Eye rays through the centres of a `w` x `h` grid of pixels.
+pub fn camera_rays(scene: &Scene<'_, f64>, w: i32, h: i32) -> Vec<Ray<f64>> {
     (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| scene.camera().ray(2 * x + 1, 2 * y + 1, 2 * w, 2 * h)).collect()
 }
 
 /// A generated scene: `n` random primitives, or the clustered "teapot in a stadium": most of
 /// them in one dense composite far from the sparse rest.
-fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
+pub fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
     *storage = vec![Object::default(); n];
     let mut b = SceneBuilder::new(storage);
     if !clustered {
@@ -221,10 +222,9 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
                         let mut bufs = lattice_storage(&scene, &cfg)?;
                         let lat = build_lattice(&mut bufs, &scene, &cfg)?;
                         let (t, tests, cells) = per_ray(&scene, &lat, &all_rays, runs);
-                        let refs_b = lat.ref_count() * 4;
-                        let cells_b = (lat.cell_count() + 1) * 4;
-                        let other = lat.bytes() - refs_b - cells_b;
-                        (t, tests, cells, lat.bytes(), format!("4 x {} refs + 4 x {} cells + {other}", lat.ref_count(), lat.cell_count() + 1))
+                        let w = if lat.narrow() { 2 } else { 4 };
+                        let other = lat.bytes() - w * (lat.ref_count() + lat.cell_count() + 1);
+                        (t, tests, cells, lat.bytes(), format!("{w} x {} refs + {w} x {} cells + {other}", lat.ref_count(), lat.cell_count() + 1))
                     }
                 };
                 let us = time.as_secs_f64() * 1e6;

@@ -7,6 +7,7 @@ mod display;
 mod effects;
 mod firmware;
 mod load;
+mod memory;
 mod pov;
 mod shared;
 mod progress;
@@ -81,6 +82,25 @@ enum Command {
         /// Plot to write (SVG).
         #[arg(long, default_value = "docs/performance.svg")]
         plot: PathBuf,
+    },
+    /// The memory-time frontier: lattices built within byte budgets from 64 B to 1 MiB on the
+    /// paper's scenes and generated ones; writes docs/memory.md and its plots.
+    Memory {
+        /// Generated scenes up to 1 000 primitives, one timed run.
+        #[arg(long)]
+        quick: bool,
+        /// Timed runs per measurement (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/memory.md")]
+        out: PathBuf,
+        /// Plot of time per ray against the budget (SVG).
+        #[arg(long, default_value = "docs/memory.svg")]
+        plot: PathBuf,
+        /// Plot of object tests per ray against the budget (SVG).
+        #[arg(long, default_value = "docs/memory-tests.svg")]
+        tests_plot: PathBuf,
     },
     /// What accuracy costs in time: error against a 16-ray f64 reference and cost, one knob
     /// at a time (scalar, tree depth, cutoff, sampling, dithering).
@@ -436,6 +456,7 @@ fn real_main() -> Result<()> {
             Ok(())
         }
         Some(Command::Bench { quick, runs, out, plot }) => bench::bench_cmd(quick, runs, &out, &plot),
+        Some(Command::Memory { quick, runs, out, plot, tests_plot }) => memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot }),
         Some(Command::Effects { scenes, runs, out, firmware_csv }) => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
         Some(Command::Firmware { out, no_build }) => firmware::firmware_cmd(&std::env::current_dir()?, &out, no_build),
         Some(Command::Board { out, frames, no_build }) => board::board_cmd(&std::env::current_dir()?, &out, &frames, no_build),

@@ -1,23 +1,30 @@
-//! A lattice within a byte budget: the densest lattice whose storage fits
-//! [`LatticeConfig::budget`].
+//! A lattice within a byte budget: the lattice whose storage fits [`LatticeConfig::budget`]
+//! and whose estimated cost per ray is least.
 //!
-//! The search scales the configured resolutions down in steps of 3/4 (cells per item for
-//! [`Resolution::Auto`], the cube root of that per axis for [`Resolution::Uniform`]); at each
-//! step it tries the configuration's sub-lattices, then a flat lattice. Indices are 16-bit
-//! whenever they fit ([`LatticeConfig::index16`]). The first that fits is built; when not even a
-//! single cell per lattice fits, building fails with a `budget` [`LatticeError`] and the
-//! caller falls back to a method that needs no lattice (bounding boxes or brute force).
+//! When the configured lattice fits it is built as it is: the budget is a cap. Otherwise the
+//! search scales the configured resolutions down in steps of 3/4 (cells per item for
+//! [`Resolution::Auto`], the cube root of that per axis for [`Resolution::Uniform`]), the world
+//! lattice and the sub-lattices each on their own, and tries a flat lattice at each world
+//! scale too. Of the lattices that fit it keeps the one of least estimated cost: per lattice,
+//! the cells a ray crosses times (one step plus the tests of a cell's share of references),
+//! a sub-lattice weighted by the chance that a ray through the world crosses its box (the
+//! ratio of their surface areas). Indices are 16-bit whenever they fit
+//! ([`LatticeConfig::index16`]). When not even one cell per lattice fits, building fails with
+//! a `budget` [`LatticeError`] and the caller falls back to a method that keeps no lattice
+//! (bounding boxes or brute force).
 
-use super::plan::{lattice_bounds, lattice_resolution};
 use super::{Lattice, LatticeConfig, LatticeError, LatticeSizes, Resolution};
+use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Scene;
 use core::fmt;
 
 /// Scale of the resolution between two steps of the search.
 const STEP: f64 = 0.75;
-/// Most steps: 0.75^80 is 1e-10 of the configured cells, far below one cell per lattice.
-const STEPS: i32 = 80;
+/// Most steps per lattice kind: 0.75^60 is 3e-8 of the configured cells.
+const STEPS: i32 = 60;
+/// Cost of an object test in cell steps, for the estimate.
+const TEST: f64 = 2.0;
 
 /// What building within a budget chose.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,8 +37,11 @@ pub struct Choice {
     pub bytes: usize,
     /// Cells per axis of the world lattice.
     pub world: [u16; 3],
-    /// Fraction of the configured cells per item kept (1: as configured).
-    pub scale: f64,
+    /// Fraction of the configured cells per item kept in the world lattice and in the
+    /// sub-lattices (1: as configured).
+    pub scale: (f64, f64),
+    /// Estimated cost of a ray, in cell steps (see the module's documentation).
+    pub cost: f64,
     /// Whether it fits the budget (always, without one).
     pub fits: bool,
 }
@@ -47,13 +57,15 @@ impl fmt::Display for Choice {
         }
         write!(
             f,
-            ", {} cells, {} references, {}-bit indices, {} bytes ({:.3} of the configured density)",
+            ", {} cells, {} references, {}-bit indices, {} bytes",
             self.sizes.cells - 1,
             self.sizes.refs,
             if self.sizes.narrow { 16 } else { 32 },
             self.bytes,
-            self.scale
         )?;
+        if self.scale != (1.0, 1.0) {
+            write!(f, " ({:.3} of the configured cells per item, {:.3} in sub-lattices)", self.scale.0, self.scale.1)?;
+        }
         if !self.fits {
             write!(f, ": over the budget")?;
         }
@@ -72,6 +84,12 @@ fn scaled(res: Resolution, scale: f64) -> Resolution {
     }
 }
 
+/// Surface area of a box (at least the smallest positive number, for ratios).
+fn area<R: Real>(b: &Aabb<R>) -> f64 {
+    let e = [0, 1, 2].map(|a| (b.max.axis(a) - b.min.axis(a)).to_f64().max(0.0));
+    (2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0])).max(f64::MIN_POSITIVE)
+}
+
 /// The configuration to build: `cfg` itself without a budget, else the search's choice.
 pub(super) fn resolve<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<LatticeConfig, LatticeError> {
     let Some(budget) = cfg.budget else { return Ok(*cfg) };
@@ -84,39 +102,67 @@ pub(super) fn resolve<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Res
 }
 
 impl<R: Real> Lattice<'_, R> {
-    /// The lattice [`Lattice::build`] makes with `cfg`: without a budget the configuration as
-    /// it is; with one the densest that fits, or the smallest there is (`fits` false).
+    /// The lattice [`Lattice::build`] makes with `cfg`: without a budget, or when it fits, the
+    /// configuration as it is; else the one of least estimated cost that fits, or the smallest
+    /// there is (`fits` false).
     pub fn choose(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Choice {
         let exact = LatticeConfig { budget: None, ..*cfg };
-        let choice = |c: LatticeConfig, scale: f64| {
-            let sizes = Lattice::plan_exact(scene, &c);
-            let bytes = sizes.bytes::<R>();
-            let world = lattice_resolution(scene, &c, 0, &lattice_bounds(scene, 0));
-            Choice { cfg: c, sizes, bytes, world, scale, fits: cfg.budget.is_none_or(|b| bytes <= b) }
-        };
-        let Some(_) = cfg.budget else { return choice(exact, 1.0) };
-        let mut smallest: Option<Choice> = None;
-        for k in 0..STEPS {
-            let scale = libm::pow(STEP, k as f64);
-            let c = LatticeConfig { top: scaled(cfg.top, scale), sub: scaled(cfg.sub, scale), ..exact };
-            let shapes = if cfg.nested && !scene.composites.is_empty() { &[true, false][..] } else { &[cfg.nested][..] };
-            let mut single = false;
-            for &nested in shapes {
-                let ch = choice(LatticeConfig { nested, ..c }, scale);
-                if ch.fits {
-                    return ch;
+        let assess = |c: LatticeConfig, scale: (f64, f64)| {
+            let (mut cost, mut world_area, mut world) = (0.0, 1.0, [1; 3]);
+            let sizes = Lattice::plan_exact(scene, &c, |g, b, n, refs| {
+                let cells = n.iter().map(|&v| v as f64).product::<f64>();
+                let crossed = 1.0 + n.iter().map(|&v| v as f64).sum::<f64>() / 2.0;
+                let here = crossed * (1.0 + TEST * refs as f64 / cells);
+                if g == 0 {
+                    (world_area, world) = (area(b), n);
+                    cost += here;
+                } else {
+                    cost += here * (area(b) / world_area).min(1.0);
                 }
-                // One cell per lattice cannot shrink further.
-                single = ch.sizes.cells - 1 == ch.sizes.lattices;
-                if smallest.is_none_or(|s| ch.bytes < s.bytes) {
-                    smallest = Some(ch);
+            });
+            let bytes = sizes.bytes::<R>();
+            Choice { cfg: c, sizes, bytes, world, scale, cost, fits: cfg.budget.is_none_or(|b| bytes <= b) }
+        };
+        let configured = assess(exact, (1.0, 1.0));
+        if configured.fits {
+            return configured;
+        }
+        let nested = cfg.nested && !scene.composites.is_empty();
+        let (mut best, mut smallest): (Option<Choice>, Choice) = (None, configured);
+        let mut keep = |c: Choice| {
+            if c.fits && best.is_none_or(|b| c.cost < b.cost) {
+                best = Some(c);
+            }
+            if c.bytes < smallest.bytes {
+                smallest = c;
+            }
+        };
+        for kt in 0..STEPS {
+            let st = libm::pow(STEP, kt as f64);
+            let top = scaled(cfg.top, st);
+            // Flat: the world lattice lists every primitive.
+            let flat = assess(LatticeConfig { top, nested: false, ..exact }, (st, st));
+            let single = flat.sizes.cells == 2;
+            keep(flat);
+            // Nested: sub-lattices from as configured down to one cell each.
+            for ks in 0..STEPS {
+                if !nested {
+                    break;
+                }
+                let ss = libm::pow(STEP, ks as f64);
+                let c = assess(LatticeConfig { top, sub: scaled(cfg.sub, ss), ..exact }, (st, ss));
+                let all_single = c.sizes.cells - 1 == c.sizes.lattices;
+                keep(c);
+                if all_single {
+                    break;
                 }
             }
+            // One world cell cannot shrink further.
             if single {
                 break;
             }
         }
-        smallest.expect("the search tries at least one lattice")
+        best.unwrap_or(smallest)
     }
 }
 
@@ -135,8 +181,8 @@ mod tests {
         random_scene(&mut b, &RandomScene { objects: 200, composite_size: 20, spread: 0.0, seed: 5 }).unwrap();
         let scene = b.finish().unwrap();
         let full = Lattice::choose(&scene, &LatticeConfig::default());
-        assert!(full.fits && full.scale == 1.0 && full.sizes.narrow);
-        let mut last = usize::MAX;
+        assert!(full.fits && full.scale == (1.0, 1.0) && full.sizes.narrow);
+        let mut last = f64::MIN;
         let mut budgets = [full.bytes * 2, full.bytes, full.bytes / 2, full.bytes / 4, full.bytes / 16, 2000, 600, 64];
         budgets.sort_unstable_by(|a, b| b.cmp(a));
         for budget in budgets {
@@ -148,8 +194,8 @@ mod tests {
             if c.fits {
                 let lat = built.unwrap();
                 assert!(c.bytes <= budget && lat.bytes() == c.bytes, "{budget}: {c}");
-                assert!(c.bytes <= last, "a smaller budget never gives a larger lattice");
-                last = c.bytes;
+                assert!(c.cost >= last, "a smaller budget never gives a lattice of less estimated cost: {c}");
+                last = c.cost;
                 if budget >= full.bytes {
                     assert_eq!(c.bytes, full.bytes, "a budget that holds the configured lattice keeps it");
                 }

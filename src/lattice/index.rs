@@ -33,7 +33,7 @@ pub(super) fn get(words: &[u32], narrow: bool, i: usize) -> u32 {
 }
 
 /// Sets index `i` of a packed array to `v` (which fits its width).
-#[inline(always)]
+#[inline(never)]
 pub(super) fn set(words: &mut [u32], narrow: bool, i: usize, v: u32) {
     if narrow {
         let shift = (i & 1) * 16;

@@ -216,18 +216,28 @@ impl<R: Real> Lattice<'_, R> {
         Self::choose(scene, cfg).sizes
     }
 
-    /// Storage a scene needs with these resolutions (no budget).
-    pub(super) fn plan_exact(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> LatticeSizes {
+    /// Storage a scene needs with these resolutions (no budget); `each(g, bounds, cells per
+    /// axis, references)` sees every lattice on the way.
+    pub(super) fn plan_exact(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut each: impl FnMut(usize, &Aabb<R>, [u16; 3], usize)) -> LatticeSizes {
         let lattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
         let mut s = LatticeSizes { lattices, cells: 1, ..Default::default() };
-        for g in 0..lattices {
-            let b = lattice_bounds(scene, g);
-            let n = lattice_resolution(scene, cfg, g, &b);
+        plan_each(scene, cfg, |g, b, n, refs| {
+            each(g, b, n, refs);
             s.coords += n.iter().map(|&v| v as usize + 1).sum::<usize>();
             s.cells += n.iter().map(|&v| v as usize).product::<usize>();
-            s.refs += plan_refs(scene, cfg, g, &b, n);
-        }
+            s.refs += refs;
+        });
         s.narrow = cfg.index16 && super::index::fits16(s.refs, scene.objects.len(), scene.composites.len());
         s
+    }
+}
+
+/// Calls `f(g, bounds, cells per axis, references)` for every lattice `cfg` builds.
+fn plan_each<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut f: impl FnMut(usize, &Aabb<R>, [u16; 3], usize)) {
+    let lattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
+    for g in 0..lattices {
+        let b = lattice_bounds(scene, g);
+        let n = lattice_resolution(scene, cfg, g, &b);
+        f(g, &b, n, plan_refs(scene, cfg, g, &b, n));
     }
 }
