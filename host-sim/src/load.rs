@@ -75,7 +75,13 @@ pub fn lattice_storage<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Re
 
 /// Builds the lattice of `scene` with `cfg` in `storage` (from [`lattice_storage`]).
 pub fn build_lattice<'a, R: Real>(storage: &'a mut HeapStorage<R>, scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Lattice<'a, R>> {
-    let (lattice, _) = storage.view().split().1.lattice(scene, cfg).map_err(|e| anyhow!("{e}"))?;
+    let (lattice, _) = storage.view().split().1.lattice(scene, cfg).map_err(|e| {
+        if e.capacity == "budget" {
+            anyhow!("no lattice fits --budget {}: the smallest takes {} bytes; give more, or use --accel bbox (no lattice)", e.available, e.needed)
+        } else {
+            anyhow!("{e}")
+        }
+    })?;
     Ok(lattice)
 }
 
@@ -89,10 +95,10 @@ mod tests {
         let text = read(path).unwrap();
         let mut storage = object_storage::<f64>(&text).unwrap();
         let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
-        let err = lattice_storage(&scene, &crate::lattice_config(Some([1024, 1024, 1024]))).expect_err("refused");
+        let err = lattice_storage(&scene, &crate::lattice_config(Some([1024, 1024, 1024]), None)).expect_err("refused");
         let msg = format!("{err:#}");
         assert!(msg.contains("--cells") && msg.contains(&MAX_LATTICE_BYTES.to_string()), "{msg}");
-        assert!(lattice_storage(&scene, &crate::lattice_config(Some([64, 64, 64]))).is_ok());
+        assert!(lattice_storage(&scene, &crate::lattice_config(Some([64, 64, 64]), None)).is_ok());
     }
 
     #[test]

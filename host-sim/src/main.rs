@@ -321,8 +321,8 @@ fn parse_cells(s: &str) -> Result<[u16; 3], String> {
 }
 
 /// The lattice configuration chosen on the command line.
-pub fn lattice_config(cells: Option<[u16; 3]>) -> lattice_rt::LatticeConfig {
-    let mut cfg = lattice_rt::LatticeConfig::default();
+pub fn lattice_config(cells: Option<[u16; 3]>, budget: Option<usize>) -> lattice_rt::LatticeConfig {
+    let mut cfg = lattice_rt::LatticeConfig { budget, ..Default::default() };
     if let Some(n) = cells {
         cfg.top = lattice_rt::lattice::Resolution::Uniform(n);
     }
@@ -370,6 +370,10 @@ pub struct RenderArgs {
     /// World lattice resolution, overriding the automatic choice.
     #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
     pub cells: Option<[u16; 3]>,
+    /// Most bytes the lattice may take: the lattice of least estimated cost within it is built
+    /// (docs/memory.md); too small for one cell, the lattice method is refused.
+    #[arg(long, value_name = "BYTES")]
+    pub budget: Option<usize>,
     /// Leave out the silhouette lines. By default the farther pixel where neighbours hit
     /// different objects is drawn black: without them thin parts of the same gray as what lies
     /// behind (the chair's legs on its floor) vanish in a 1-bit frame (docs/display.md).
@@ -398,6 +402,10 @@ pub struct StatsArgs {
     /// World lattice resolution, overriding the automatic choice.
     #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
     pub cells: Option<[u16; 3]>,
+    /// Most bytes the lattice may take: the lattice of least estimated cost within it is built
+    /// (docs/memory.md); too small for one cell, the lattice method is refused.
+    #[arg(long, value_name = "BYTES")]
+    pub budget: Option<usize>,
 }
 
 /// The scenes given, or the paper's four and the Whitted showcase.

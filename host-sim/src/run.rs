@@ -8,7 +8,7 @@ use anyhow::{anyhow, Context, Result};
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::Effects;
 use lattice_rt::{
-    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, LatticeConfig, Real, Scene, Stats,
+    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, Lattice, LatticeConfig, Real, Scene, Stats,
     Tracer,
 };
 use std::path::Path;
@@ -235,7 +235,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
         tone: lattice_rt::Tone { gamma_tenths: a.gamma },
         ..Frame::new(a.size.0, a.size.1)
     };
-    let mut out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells), &frame, |_| {}, true, true)?;
+    let mut out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true)?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
     // Every output under a temporary name first: if one cannot be written, none is left.
     let mut staged = crate::output::Staged::default();
@@ -261,7 +261,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let text = read(&a.scene)?;
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
-    let cfg = crate::lattice_config(a.cells);
+    let cfg = crate::lattice_config(a.cells, a.budget);
     let mut bufs = lattice_storage(&scene, &cfg)?;
     let t0 = Instant::now();
     let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
@@ -280,6 +280,9 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     for (i, g) in lattice.lattices().iter().enumerate() {
         let name = if i == 0 { "world lattice".to_string() } else { format!("sub-lattice {}", i - 1) };
         println!("  {name}: {} x {} x {} cells", g.n[0], g.n[1], g.n[2]);
+    }
+    if cfg.budget.is_some() {
+        println!("  within {} bytes: {}", a.budget.unwrap_or(0), Lattice::choose(&scene, &cfg));
     }
     println!(
         "  lattice: {} cells, {} references, {} bytes, built in {:.3} ms",
