@@ -68,6 +68,7 @@ impl<'a, R: Real> Lattice<'a, R> {
         cfg: &LatticeConfig,
         storage: LatticeStorage<'a, R>,
     ) -> Result<(Self, &'a mut [u32]), LatticeError> {
+        #[cfg(feature = "budget")]
         let cfg = &super::budget::resolve(scene, cfg)?;
         let LatticeStorage { lattices, coords, words } = storage;
         let nlattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };

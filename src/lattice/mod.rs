@@ -22,12 +22,14 @@
 //!   untested objects lie in later cells, so their hits are no nearer (boxes are padded for
 //!   rounding), and the answer equals brute force.
 
+#[cfg(feature = "budget")]
 mod budget;
 mod build;
 mod index;
 mod plan;
 mod walk;
 
+#[cfg(feature = "budget")]
 pub use budget::Choice;
 pub use build::{LatticeError, LatticeStorage};
 pub use plan::{LatticeConfig, LatticeSizes, Resolution, Spacing, MAX_PER_AXIS};

@@ -47,8 +47,9 @@ pub struct LatticeConfig {
     /// 65 535 references, 32 767 objects and composites): the lattice's index memory halves.
     pub index16: bool,
     /// Most bytes the lattice may take ([`LatticeSizes::bytes`]); building then picks the
-    /// densest lattice within it ([`Lattice::choose`](super::Lattice::choose)). `None`: the
-    /// resolutions as configured.
+    /// lattice of least estimated cost within it (`Lattice::choose`). `None`: the resolutions
+    /// as configured (feature `budget`).
+    #[cfg(feature = "budget")]
     pub budget: Option<usize>,
 }
 
@@ -61,6 +62,7 @@ impl Default for LatticeConfig {
             spacing: Spacing::Uniform,
             nested: true,
             index16: true,
+            #[cfg(feature = "budget")]
             budget: None,
         }
     }
@@ -211,9 +213,12 @@ fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &A
 }
 impl<R: Real> Lattice<'_, R> {
     /// Storage a scene needs with this configuration (within its budget, if it has one: see
-    /// [`Lattice::choose`]).
+    /// `Lattice::choose`).
     pub fn plan(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> LatticeSizes {
-        Self::choose(scene, cfg).sizes
+        #[cfg(feature = "budget")]
+        return Self::choose(scene, cfg).sizes;
+        #[cfg(not(feature = "budget"))]
+        Self::plan_exact(scene, cfg, |_, _, _, _| {})
     }
 
     /// Storage a scene needs with these resolutions (no budget); `each(g, bounds, cells per
