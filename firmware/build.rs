@@ -7,7 +7,9 @@
 //! too, to know which frames the image shows). Each is parsed here with the core itself, in the firmware's
 //! scalar, so a broken scene fails the build with its line and column, and the storage
 //! capacities are the exact maximum the chosen scenes need (written to `capacities.rs`).
-use lattice_rt::lattice::LatticeConfig;
+use lattice_rt::bake::Literal;
+use lattice_rt::lattice::{LatticeConfig, LatticeStorage, SubLattice};
+use lattice_rt::Lattice;
 use lattice_rt::scene::Object;
 use lattice_rt::{Real, Sizes};
 
@@ -58,19 +60,22 @@ fn main() {
     let mut list = String::new();
     let mut sizes = Sizes { objects: 1, lattices: 1, coords: 1, words: 1, rows: 0 };
     let mut effects = 0u8;
+    let baked = env::var_os("CARGO_FEATURE_BAKED").is_some();
+    let mut tables = String::new();
     for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));
         println!("cargo:rerun-if-changed={}", path.display());
         let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
         let feature = |f: &str| env::var_os(format!("CARGO_FEATURE_{f}")).is_some();
+        let bake = baked.then_some((name, &mut tables));
         let (s, e) = if feature("SCALAR_FIXED") {
-            plan::<lattice_rt::Fx>(&path, &text)
+            plan::<lattice_rt::Fx>(&path, &text, bake)
         } else if feature("SCALAR_MICROMATH") {
-            plan::<lattice_rt::F32Micro>(&path, &text)
+            plan::<lattice_rt::F32Micro>(&path, &text, bake)
         } else if feature("SCALAR_MICROMATH_NEWTON") {
-            plan::<lattice_rt::F32MicroNewton>(&path, &text)
+            plan::<lattice_rt::F32MicroNewton>(&path, &text, bake)
         } else {
-            plan::<f32>(&path, &text)
+            plan::<f32>(&path, &text, bake)
         };
         effects |= e;
         sizes = sizes.max(s);
@@ -93,12 +98,32 @@ fn main() {
         sizes.objects, sizes.lattices, sizes.coords, sizes.words, sizes.rows
     );
     fs::write(out.join("capacities.rs"), code).unwrap();
+    if baked {
+        let names: Vec<String> = names.split(',').map(str::trim).filter(|n| !n.is_empty()).map(|n| format!("({n:?}, &{})", table_name(n))).collect();
+        writeln!(tables, "/// The baked scenes, by name.\npub static BAKED: [(&str, &Baked<S>); {}] = [{}];", names.len(), names.join(", ")).unwrap();
+        fs::write(out.join("baked.rs"), tables).unwrap();
+    }
 }
 
-/// Storage and effects of one scene in the firmware's scalar.
-fn plan<R: Real>(path: &std::path::Path, text: &str) -> (Sizes, u8) {
+/// The static a baked scene's tables are named by.
+fn table_name(scene: &str) -> String {
+    scene.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect()
+}
+
+/// Storage and effects of one scene in the firmware's scalar; with `bake`, its tables too
+/// (the scene as parsed and its lattice as built in that scalar, as the firmware would).
+fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&str, &mut String)>) -> (Sizes, u8) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
     let scene = lattice_rt::parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let effects = lattice_rt::Effects::of(&scene).bits();
-    (Sizes::of(&scene, Some(&LatticeConfig::default()), &frame::FRAME), effects)
+    let cfg = LatticeConfig::default();
+    let sizes = Sizes::of(&scene, Some(&cfg), &frame::FRAME);
+    if let Some((name, out)) = bake {
+        let s = Lattice::plan(&scene, &cfg);
+        let (mut lattices, mut coords, mut words) = (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);
+        let storage = LatticeStorage { lattices: &mut lattices, coords: &mut coords, words: &mut words };
+        let lattice = Lattice::build(&scene, &cfg, storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        out.push_str(&lattice_rt::bake::source(&table_name(name), "S", &scene, &lattice));
+    }
+    (sizes, effects)
 }

@@ -32,6 +32,8 @@ pub use accel::{Accelerator, BoundingBox, BruteForce, Hit, Query, Stats};
 pub mod lattice;
 pub use lattice::{Lattice, LatticeConfig, LatticeStorage};
 pub mod storage;
+pub mod bake;
+pub use bake::Baked;
 pub use storage::{Buffers, Loaded, Scratch, Sizes, Storage, StorageView};
 #[cfg(feature = "alloc")]
 pub use storage::{HeapScratch, HeapStorage};

@@ -36,6 +36,18 @@ pub type Scalar = f32;
 // SCENES and the capacities, computed by build.rs from the scenes chosen for this build.
 include!(concat!(env!("OUT_DIR"), "/capacities.rs"));
 
+/// The embedded scenes baked into flash (the `baked` feature): tables `build.rs` wrote.
+#[cfg(feature = "baked")]
+pub mod baked {
+    use lattice_rt::bake::prelude::*;
+    /// The scalar of the tables.
+    pub type S = super::Scalar;
+    include!(concat!(env!("OUT_DIR"), "/baked.rs"));
+}
+
+#[cfg(all(feature = "baked", feature = "orbit"))]
+compile_error!("the `baked` scenes are shown from their own cameras: `orbit` needs run-time set-up");
+
 /// All memory a frame of any embedded scene needs, with the capacities build.rs computed.
 pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_LATTICES, MAX_COORDS, MAX_WORDS, MAX_ROWS>;
 
@@ -48,6 +60,10 @@ pub enum AppError<'t, E> {
     Lattice(LatticeError),
     /// The scene needs an effect this build leaves out.
     Effects(MissingEffects),
+    /// A baked scene cannot be set up.
+    Scene(lattice_rt::SceneError),
+    /// A baked scene is shown from its own camera only.
+    BakedCamera,
     /// The display failed or the render was cancelled.
     Render(RenderError<E>),
 }
@@ -58,6 +74,8 @@ impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
             AppError::Parse(e) => write!(f, "scene: {e}"),
             AppError::Lattice(e) => write!(f, "{e}"),
             AppError::Effects(e) => write!(f, "{e}"),
+            AppError::Scene(e) => write!(f, "scene: {e}"),
+            AppError::BakedCamera => write!(f, "a baked scene is shown from its own camera only"),
             AppError::Render(e) => write!(f, "{e}"),
         }
     }
@@ -72,6 +90,8 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Parse(e) => defmt::write!(f, "scene: {}", e),
             AppError::Lattice(e) => defmt::write!(f, "{}", e),
             AppError::Effects(e) => defmt::write!(f, "{}", e),
+            AppError::Scene(e) => defmt::write!(f, "scene: {}", e),
+            AppError::BakedCamera => defmt::write!(f, "a baked scene is shown from its own camera only"),
             AppError::Render(RenderError::Draw(e)) => defmt::write!(f, "display: {}", defmt::Debug2Format(e)),
             AppError::Render(RenderError::Cancelled) => defmt::write!(f, "render cancelled"),
             AppError::Render(RenderError::BadTile) => defmt::write!(f, "bad tile size"),
@@ -202,8 +222,70 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     shown: &mut dyn FnMut(u8),
 ) -> Result<Report, AppError<'t, D::Error>> {
     let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
-    let Loaded { scene, lattice, mut scratch } = st.view().load_with(text, &LatticeConfig::default(), at)?;
-    let mut tracer = Tracer::<_, _, EFFECTS>::compiled(&scene, &lattice).map_err(AppError::Effects)?;
+    let Loaded { scene, lattice, scratch } = st.view().load_with(text, &LatticeConfig::default(), at)?;
+    render_loaded(&scene, &lattice, scratch, target, hooks, shot, cores, second, now, shown)
+}
+
+/// Memory a baked scene's frame needs besides the tables in flash: the render's query scratch
+/// (mailbox and rows).
+#[derive(Debug)]
+pub struct BakedMemory {
+    mailbox: [u32; MAX_OBJECTS + MAX_LATTICES],
+    rows: [i16; MAX_ROWS],
+}
+
+impl BakedMemory {
+    /// Zeroed memory.
+    pub const fn new() -> Self {
+        BakedMemory { mailbox: [0; MAX_OBJECTS + MAX_LATTICES], rows: [0; MAX_ROWS] }
+    }
+}
+
+impl Default for BakedMemory {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// [`render_scene_at`] for a scene baked into flash (the `baked` feature: `build.rs` wrote it
+/// and its lattice as tables), which is neither parsed nor built. Its camera is the scene's
+/// own: `shot.turn` must be 0 (an orbit needs the camera set up at run time).
+#[allow(clippy::too_many_arguments)]
+pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+    baked: &lattice_rt::Baked<R>,
+    memory: &mut BakedMemory,
+    target: &mut D,
+    hooks: &mut impl Hooks,
+    shot: &Shot,
+    cores: &mut impl Cores,
+    second: &mut ShareMemory,
+    now: &(dyn Fn() -> u64 + Sync),
+    shown: &mut dyn FnMut(u8),
+) -> Result<Report, AppError<'t, D::Error>> {
+    if shot.turn != 0.0 {
+        return Err(AppError::BakedCamera);
+    }
+    let scene = baked.scene().map_err(AppError::Scene)?;
+    let lattice = baked.lattice();
+    let scratch = lattice_rt::Scratch::new(&mut memory.mailbox[..], &mut memory.rows[..]);
+    render_loaded(&scene, &lattice, scratch, target, hooks, shot, cores, second, now, shown)
+}
+
+/// The frame of a scene loaded or baked: its tracer, then every pass of both tile shares.
+#[allow(clippy::too_many_arguments)]
+fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+    scene: &lattice_rt::Scene<'_, R>,
+    lattice: &lattice_rt::Lattice<'_, R>,
+    mut scratch: lattice_rt::Scratch<'_>,
+    target: &mut D,
+    hooks: &mut impl Hooks,
+    shot: &Shot,
+    cores: &mut impl Cores,
+    second: &mut ShareMemory,
+    now: &(dyn Fn() -> u64 + Sync),
+    shown: &mut dyn FnMut(u8),
+) -> Result<Report, AppError<'t, D::Error>> {
+    let mut tracer = Tracer::<_, _, EFFECTS>::compiled(scene, lattice).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
         tracer.set_effects(Effects::ALL);
     }

@@ -133,6 +133,30 @@ fn locate_by<R: Real>(n: usize, x: R, c: impl Fn(usize) -> R) -> usize {
 fn locate<R: Real>(c: &[R], x: R) -> usize {
     locate_by(c.len() - 1, x, |i| c[i])
 }
+/// A lattice's tables: lattices, coordinate lists, packed cell starts and references, their
+/// entry counts and whether they are 16-bit.
+pub(crate) type Tables<'a, R> = (&'a [SubLattice<R>], &'a [R], (&'a [u32], &'a [u32]), (usize, usize), bool);
+
+impl<'a, R> Lattice<'a, R> {
+    /// A lattice over tables built before (baked scenes).
+    pub(crate) const fn from_tables(
+        lattices: &'a [SubLattice<R>],
+        coords: &'a [R],
+        (cells, refs): (&'a [u32], &'a [u32]),
+        entries: (usize, usize),
+        narrow: bool,
+        objects: usize,
+    ) -> Self {
+        Lattice { lattices, coords, cells, refs, entries, narrow, objects }
+    }
+
+    /// The lattice's tables (for baking).
+    #[cfg_attr(not(feature = "bake"), allow(dead_code))]
+    pub(crate) fn tables(&self) -> Tables<'a, R> {
+        (self.lattices, self.coords, (self.cells, self.refs), self.entries, self.narrow)
+    }
+}
+
 impl<'a, R: Real> Lattice<'a, R> {
     /// Bytes the built lattice occupies (lattices, coordinate lists, cells, references).
     pub fn bytes(&self) -> usize {

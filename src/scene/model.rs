@@ -233,6 +233,30 @@ impl<R: Real> Default for Object<R> {
     }
 }
 
+impl<R> Object<R> {
+    /// An object from its parts, as [`bake::source`](crate::bake) writes them: for baked
+    /// tables only, which hold objects of a validated scene.
+    #[doc(hidden)]
+    #[allow(clippy::too_many_arguments)]
+    pub const fn from_tables(
+        shape: Shape<R>,
+        to_object: Affine<R>,
+        origin: Vec3<R>,
+        unscale: R,
+        dir_factor: R,
+        material: u8,
+        composite: u16,
+        bounds: Aabb<R>,
+        dir_scale: R,
+        inv_dir_scale: R,
+        eye_local: Vec3<R>,
+        eye_window: EyeWindow,
+        shadow_window: ShadowWindow<R>,
+    ) -> Self {
+        Object { shape, to_object, origin, unscale, dir_factor, material, composite, bounds, dir_scale, inv_dir_scale, eye_local, eye_window, shadow_window }
+    }
+}
+
 impl<R: Real> Object<R> {
     /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` and the object-space normal.
     #[inline]

@@ -17,7 +17,9 @@ use cortex_m::interrupt::{free, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
-use firmware::app::{render_scene_at, OneCore, Scalar, ShareMemory, Shot, Storage, FRAME, SCENES};
+use firmware::app::{OneCore, Scalar, ShareMemory, Shot, FRAME};
+#[cfg(not(feature = "baked"))]
+use firmware::app::{render_scene_at, Storage, SCENES};
 use firmware::stack;
 use lattice_rt::{BitFrame, NoHooks};
 
@@ -75,15 +77,22 @@ fn main() -> ! {
     let t0 = ticks();
     spin(CALIBRATE_INSTRUCTIONS / 2);
     hprintln!("CALIBRATE instructions {} ticks {}", CALIBRATE_INSTRUCTIONS, ticks() - t0);
-    let mut st = Storage::<Scalar>::new();
+    #[cfg(not(feature = "baked"))]
+    let (mut st, scenes) = (Storage::<Scalar>::new(), SCENES);
+    #[cfg(feature = "baked")]
+    let (mut st, scenes) = (firmware::app::BakedMemory::new(), firmware::app::baked::BAKED);
     let mut second = ShareMemory::new();
     let mut bits = [0u8; BitFrame::bytes(FRAME.width as u32, FRAME.height as u32)];
     let mut failed = false;
-    for (name, text) in SCENES {
+    for (name, scene) in scenes {
         let mut frame = BitFrame::new(FRAME.width as u32, FRAME.height as u32, &mut bits).unwrap();
         let t0 = ticks();
         let shot = Shot::default();
-        match render_scene_at(text, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks, &mut |_| {}) {
+        #[cfg(not(feature = "baked"))]
+        let shown = render_scene_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks, &mut |_| {});
+        #[cfg(feature = "baked")]
+        let shown = firmware::app::render_baked_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks, &mut |_| {});
+        match shown {
             Ok(r) => {
                 let t = ticks() - t0;
                 let s = r.stats;

@@ -1,0 +1,318 @@
+//! Baked scenes: a validated scene and its built lattice as `static` tables, written at build
+//! time, so firmware that shows fixed scenes links no parser, no scene set-up (f64 maths) and
+//! no lattice build, and keeps neither the objects nor the lattice in RAM.
+//!
+//! [`Baked`] is the form the tables take (no_std, in flash); with the `bake` feature,
+//! `bake::source` writes one as Rust source from a scene parsed and a lattice built on the
+//! host in the firmware's scalar, so the values are the very ones the firmware would have
+//! computed: frames are bit-identical to a run-time parse.
+
+use crate::lattice::{Lattice, SubLattice};
+use crate::math::{Aabb, Vec3};
+use crate::scene::{Camera, Composite, Light, Material, Object, Scene, SceneError};
+use heapless::Vec;
+
+/// A scene and its lattice as static tables (see the module documentation).
+#[derive(Clone, Copy, Debug)]
+pub struct Baked<R: 'static> {
+    /// The scene's primitives, validated.
+    pub objects: &'static [Object<R>],
+    /// Composite objects.
+    pub composites: &'static [Composite<R>],
+    /// Materials.
+    pub materials: &'static [Material<R>],
+    /// Lights.
+    pub lights: &'static [Light<R>],
+    /// Ambient intensity.
+    pub ambient: R,
+    /// Gray of rays that hit nothing.
+    pub background: R,
+    /// Camera.
+    pub camera: Camera<R>,
+    /// Maximum depth of the intersection tree.
+    pub max_depth: u8,
+    /// The world range.
+    pub world: Aabb<R>,
+    /// Two unit vectors across the first light, when it is directional.
+    pub shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
+    /// The lattices (world first).
+    pub lattices: &'static [SubLattice<R>],
+    /// Their coordinate lists.
+    pub coords: &'static [R],
+    /// Cell starts, packed as the lattice keeps them.
+    pub cells: &'static [u32],
+    /// References, packed as the lattice keeps them.
+    pub refs: &'static [u32],
+    /// Entries in `cells` (cells + 1) and in `refs`.
+    pub entries: (usize, usize),
+    /// Whether `cells` and `refs` hold 16-bit indices.
+    pub narrow: bool,
+}
+
+impl<R: Copy> Baked<R> {
+    /// The scene, its objects still in the tables (the few composites, materials and lights
+    /// are copied into the scene's own fixed-capacity lists).
+    pub fn scene(&self) -> Result<Scene<'static, R>, SceneError> {
+        Ok(Scene {
+            objects: self.objects,
+            composites: Vec::from_slice(self.composites).map_err(|_| SceneError::TooManyComposites)?,
+            materials: Vec::from_slice(self.materials).map_err(|_| SceneError::TooManyMaterials)?,
+            lights: Vec::from_slice(self.lights).map_err(|_| SceneError::TooManyLights)?,
+            ambient: self.ambient,
+            background: self.background,
+            camera: self.camera,
+            max_depth: self.max_depth,
+            world: self.world,
+            shadow_basis: self.shadow_basis,
+        })
+    }
+
+    /// The lattice, in the tables.
+    pub fn lattice(&self) -> Lattice<'static, R> {
+        Lattice::from_tables(self.lattices, self.coords, (self.cells, self.refs), self.entries, self.narrow, self.objects.len())
+    }
+}
+
+#[cfg(feature = "bake")]
+pub use writer::{source, Literal};
+
+#[cfg(feature = "bake")]
+mod writer {
+    use super::*;
+    use crate::shape::Shape;
+    use crate::{F32Micro, F32MicroNewton, Fx, Real};
+    use alloc::string::String;
+    use core::fmt::Write as _;
+
+    /// Writes a value as a Rust constant expression (the generated code has the core's types
+    /// in scope).
+    pub trait Literal {
+        /// Appends the expression to `out`.
+        fn literal(&self, out: &mut String);
+    }
+
+    impl Literal for f32 {
+        fn literal(&self, out: &mut String) {
+            // The bits, so every value (signed zeros, subnormals) comes back exactly.
+            let _ = write!(out, "f32::from_bits({:#x})", self.to_bits());
+        }
+    }
+    impl Literal for Fx {
+        fn literal(&self, out: &mut String) {
+            let _ = write!(out, "Fx({})", self.0);
+        }
+    }
+    impl Literal for F32Micro {
+        fn literal(&self, out: &mut String) {
+            out.push_str("F32Micro(");
+            self.0.literal(out);
+            out.push(')');
+        }
+    }
+    impl Literal for F32MicroNewton {
+        fn literal(&self, out: &mut String) {
+            out.push_str("F32MicroNewton(");
+            self.0.literal(out);
+            out.push(')');
+        }
+    }
+    macro_rules! plain {
+        ($($t:ty),*) => {$(
+            impl Literal for $t {
+                fn literal(&self, out: &mut String) {
+                    let _ = write!(out, "{self}");
+                }
+            }
+        )*};
+    }
+    plain!(u8, u16, u32, i32, usize, bool);
+
+    impl<T: Literal, const N: usize> Literal for [T; N] {
+        fn literal(&self, out: &mut String) {
+            list(self, out);
+        }
+    }
+
+    /// `[a, b, ...]`.
+    fn list<T: Literal>(items: &[T], out: &mut String) {
+        out.push('[');
+        for (i, v) in items.iter().enumerate() {
+            if i > 0 {
+                out.push_str(", ");
+            }
+            v.literal(out);
+        }
+        out.push(']');
+    }
+
+    /// `Name { field: value, ... }`.
+    fn record(out: &mut String, name: &str, fields: &[(&str, &dyn Literal)]) {
+        out.push_str(name);
+        out.push_str(" { ");
+        for (i, (f, v)) in fields.iter().enumerate() {
+            if i > 0 {
+                out.push_str(", ");
+            }
+            out.push_str(f);
+            out.push_str(": ");
+            v.literal(out);
+        }
+        out.push_str(" }");
+    }
+
+    impl<R: Literal> Literal for Vec3<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "Vec3", &[("x", &self.x), ("y", &self.y), ("z", &self.z)]);
+        }
+    }
+    impl<R: Literal> Literal for Aabb<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "Aabb", &[("min", &self.min), ("max", &self.max)]);
+        }
+    }
+    impl<R: Literal> Literal for crate::math::Affine<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "Affine", &[("m", &self.m)]);
+        }
+    }
+    impl<R: Literal> Literal for Shape<R> {
+        fn literal(&self, out: &mut String) {
+            match self {
+                Shape::Sphere => out.push_str("Shape::Sphere"),
+                Shape::Cylinder => out.push_str("Shape::Cylinder"),
+                Shape::Cone { top } => record(out, "Shape::Cone", &[("top", top)]),
+                Shape::Box => out.push_str("Shape::Box"),
+            }
+        }
+    }
+    impl<R: Literal> Literal for Material<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "Material", &[("ka", &self.ka), ("kd", &self.kd), ("ks", &self.ks), ("kt", &self.kt), ("ior", &self.ior)]);
+        }
+    }
+    impl<R: Literal> Literal for Light<R> {
+        fn literal(&self, out: &mut String) {
+            match self {
+                Light::Directional { to_light, intensity } => {
+                    record(out, "Light::Directional", &[("to_light", to_light), ("intensity", intensity)])
+                }
+                Light::Point { pos, intensity } => record(out, "Light::Point", &[("pos", pos), ("intensity", intensity)]),
+            }
+        }
+    }
+    impl<R: Literal> Literal for Composite<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "Composite", &[("first", &self.first), ("len", &self.len), ("bounds", &self.bounds)]);
+        }
+    }
+    impl<R: Literal> Literal for Camera<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "Camera", &[("eye", &self.eye), ("forward", &self.forward), ("right", &self.right), ("up", &self.up)]);
+        }
+    }
+    impl<R: Literal> Literal for SubLattice<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "SubLattice", &[("bounds", &self.bounds), ("n", &self.n), ("coord_start", &self.coord_start), ("cell_start", &self.cell_start)])
+        }
+    }
+    impl<R: Literal> Literal for Object<R> {
+        fn literal(&self, out: &mut String) {
+            let o = self;
+            out.push_str("Object::from_tables(");
+            let parts: [&dyn Literal; 13] = [
+                &o.shape,
+                &o.to_object,
+                &o.origin,
+                &o.unscale,
+                &o.dir_factor,
+                &o.material,
+                &o.composite,
+                &o.bounds,
+                &o.dir_scale,
+                &o.inv_dir_scale,
+                &o.eye_local,
+                &o.eye_window,
+                &o.shadow_window,
+            ];
+            for (i, p) in parts.iter().enumerate() {
+                if i > 0 {
+                    out.push_str(", ");
+                }
+                p.literal(out);
+            }
+            out.push(')');
+        }
+    }
+    impl<R: Literal> Literal for Option<(Vec3<R>, Vec3<R>)> {
+        fn literal(&self, out: &mut String) {
+            match self {
+                None => out.push_str("None"),
+                Some((a, b)) => {
+                    out.push_str("Some((");
+                    a.literal(out);
+                    out.push_str(", ");
+                    b.literal(out);
+                    out.push_str("))");
+                }
+            }
+        }
+    }
+
+    /// Rust source of a `static {name}: Baked<{scalar}>` holding `scene` and `lattice`. The code
+    /// that includes it must have the core's scene, maths and lattice types and the scalar
+    /// `scalar` in scope (`use lattice_rt::bake::prelude::*`).
+    pub fn source<R: Real + Literal>(name: &str, scalar: &str, scene: &Scene<'_, R>, lattice: &Lattice<'_, R>) -> String {
+        let mut out = String::new();
+        let _ = write!(out, "/// The scene `{name}`, baked.\npub static {name}: Baked<{scalar}> = Baked {{\n    objects: &");
+        list(scene.objects, &mut out);
+        let mut field = |f: &str, v: &dyn Literal| {
+            let _ = write!(out, ",\n    {f}: ");
+            v.literal(&mut out);
+        };
+        field("composites", &Slice(&scene.composites));
+        field("materials", &Slice(&scene.materials));
+        field("lights", &Slice(&scene.lights));
+        field("ambient", &scene.ambient);
+        field("background", &scene.background);
+        field("camera", &scene.camera);
+        field("max_depth", &scene.max_depth);
+        field("world", &scene.world);
+        field("shadow_basis", &scene.shadow_basis);
+        let (lattices, coords, (cells, refs), entries, narrow) = lattice.tables();
+        field("lattices", &Slice(lattices));
+        field("coords", &Slice(coords));
+        field("cells", &Slice(cells));
+        field("refs", &Slice(refs));
+        field("entries", &Pair(entries));
+        field("narrow", &narrow);
+        out.push_str(",\n};\n");
+        out
+    }
+
+    /// `&[a, b, ...]`.
+    struct Slice<'a, T>(&'a [T]);
+    impl<T: Literal> Literal for Slice<'_, T> {
+        fn literal(&self, out: &mut String) {
+            out.push('&');
+            list(self.0, out);
+        }
+    }
+
+    /// `(a, b)`.
+    struct Pair((usize, usize));
+    impl Literal for Pair {
+        fn literal(&self, out: &mut String) {
+            let _ = write!(out, "({}, {})", self.0 .0, self.0 .1);
+        }
+    }
+}
+
+/// What the code that includes baked source needs in scope.
+pub mod prelude {
+    pub use super::Baked;
+    pub use crate::lattice::SubLattice;
+    pub use crate::math::{Aabb, Affine, Vec3};
+    pub use crate::scene::{Camera, Composite, Light, Material, Object};
+    pub use crate::shape::Shape;
+    pub use crate::{F32Micro, F32MicroNewton, Fx};
+}
