@@ -3,12 +3,15 @@
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::BinaryColor;
+#[cfg(not(feature = "baked"))]
 use lattice_rt::lattice::LatticeError;
+#[cfg(not(feature = "baked"))]
 use lattice_rt::scene::text::ParseError;
 use lattice_rt::render::{Hooks, RenderError};
+#[cfg(not(feature = "baked"))]
 use lattice_rt::storage::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
-use lattice_rt::{render_pass, render_share, Effects, Frame, LatticeConfig, Real, Share, Stats, Traced, Tracer};
+use lattice_rt::{render_pass, render_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 
 pub use crate::frame::{Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
@@ -54,14 +57,21 @@ pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_LATTICES, MAX_COOR
 /// Why a scene could not be shown.
 #[derive(Debug)]
 pub enum AppError<'t, E> {
-    /// The scene text is invalid or exceeds the object capacity.
+    /// The scene text is invalid or exceeds the object capacity (not in a `baked` build, which
+    /// parses nothing: the variant and its messages stay out of its flash).
+    #[cfg(not(feature = "baked"))]
     Parse(ParseError<'t>),
     /// The lattice exceeds a compiled capacity.
+    #[cfg(not(feature = "baked"))]
     Lattice(LatticeError),
     /// The scene needs an effect this build leaves out.
     Effects(MissingEffects),
-    /// A baked scene cannot be set up.
-    Scene(lattice_rt::SceneError),
+    /// A baked scene's tables hold more composites, materials or lights than a scene can.
+    BakedTables,
+    /// Only a `baked` build borrows the scene text: the lifetime `'t` of the other builds.
+    #[cfg(feature = "baked")]
+    #[doc(hidden)]
+    Text(core::marker::PhantomData<&'t str>),
     /// A baked scene is shown from its own camera only.
     BakedCamera,
     /// The display failed or the render was cancelled.
@@ -71,10 +81,14 @@ pub enum AppError<'t, E> {
 impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            #[cfg(not(feature = "baked"))]
             AppError::Parse(e) => write!(f, "scene: {e}"),
+            #[cfg(not(feature = "baked"))]
             AppError::Lattice(e) => write!(f, "{e}"),
+            #[cfg(feature = "baked")]
+            AppError::Text(_) => Ok(()),
             AppError::Effects(e) => write!(f, "{e}"),
-            AppError::Scene(e) => write!(f, "scene: {e}"),
+            AppError::BakedTables => write!(f, "baked tables exceed the scene's capacities"),
             AppError::BakedCamera => write!(f, "a baked scene is shown from its own camera only"),
             AppError::Render(e) => write!(f, "{e}"),
         }
@@ -87,10 +101,14 @@ impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
 impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
     fn format(&self, f: defmt::Formatter<'_>) {
         match self {
+            #[cfg(not(feature = "baked"))]
             AppError::Parse(e) => defmt::write!(f, "scene: {}", e),
+            #[cfg(not(feature = "baked"))]
             AppError::Lattice(e) => defmt::write!(f, "{}", e),
+            #[cfg(feature = "baked")]
+            AppError::Text(_) => {}
             AppError::Effects(e) => defmt::write!(f, "{}", e),
-            AppError::Scene(e) => defmt::write!(f, "scene: {}", e),
+            AppError::BakedTables => defmt::write!(f, "baked tables exceed the scene's capacities"),
             AppError::BakedCamera => defmt::write!(f, "a baked scene is shown from its own camera only"),
             AppError::Render(RenderError::Draw(e)) => defmt::write!(f, "display: {}", defmt::Debug2Format(e)),
             AppError::Render(RenderError::Cancelled) => defmt::write!(f, "render cancelled"),
@@ -134,6 +152,7 @@ pub const TRACED: usize = if cfg!(feature = "progressive") {
 };
 
 /// Parses `text`, builds its lattice and renders [`RENDERED`] into `target`, tile by tile.
+#[cfg(not(feature = "baked"))]
 pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     text: &'t str,
     st: &mut Storage<R>,
@@ -209,6 +228,7 @@ impl Default for ShareMemory {
 /// `target` by this core, share 1 traced by `cores`' other core into `second`'s frame and sent
 /// to `target` after. `now` reads a clock (from either core) to time each share. The frame is
 /// shown in [`PASSES`]; `shown` is called with each pass once it is on `target`.
+#[cfg(not(feature = "baked"))]
 #[allow(clippy::too_many_arguments)]
 pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     text: &'t str,
@@ -222,7 +242,7 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     shown: &mut dyn FnMut(u8),
 ) -> Result<Report, AppError<'t, D::Error>> {
     let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
-    let Loaded { scene, lattice, scratch } = st.view().load_with(text, &LatticeConfig::default(), at)?;
+    let Loaded { scene, lattice, scratch } = st.view().load_with(text, &lattice_rt::LatticeConfig::default(), at)?;
     render_loaded(&scene, &lattice, scratch, target, hooks, shot, cores, second, now, shown)
 }
 
@@ -265,7 +285,7 @@ pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     if shot.turn != 0.0 {
         return Err(AppError::BakedCamera);
     }
-    let scene = baked.scene().map_err(AppError::Scene)?;
+    let scene = baked.scene().map_err(|_| AppError::BakedTables)?;
     let lattice = baked.lattice();
     let scratch = lattice_rt::Scratch::new(&mut memory.mailbox[..], &mut memory.rows[..]);
     render_loaded(&scene, &lattice, scratch, target, hooks, shot, cores, second, now, shown)
@@ -394,6 +414,7 @@ fn send_share<D: DrawTarget<Color = BinaryColor>>(bits: &mut [u8], frame: &Frame
     Ok(())
 }
 
+#[cfg(not(feature = "baked"))]
 impl<'t, E> From<LoadError<'t>> for AppError<'t, E> {
     fn from(e: LoadError<'t>) -> Self {
         match e {

@@ -77,10 +77,15 @@ fn main() -> ! {
     let t0 = ticks();
     spin(CALIBRATE_INSTRUCTIONS / 2);
     hprintln!("CALIBRATE instructions {} ticks {}", CALIBRATE_INSTRUCTIONS, ticks() - t0);
+    // One statement each: built in a tuple, the storage would be made twice on the stack.
     #[cfg(not(feature = "baked"))]
-    let (mut st, scenes) = (Storage::<Scalar>::new(), SCENES);
+    let mut st = Storage::<Scalar>::new();
+    #[cfg(not(feature = "baked"))]
+    let scenes = SCENES;
     #[cfg(feature = "baked")]
-    let (mut st, scenes) = (firmware::app::BakedMemory::new(), firmware::app::baked::BAKED);
+    let mut st = firmware::app::BakedMemory::new();
+    #[cfg(feature = "baked")]
+    let scenes = firmware::app::baked::BAKED;
     let mut second = ShareMemory::new();
     let mut bits = [0u8; BitFrame::bytes(FRAME.width as u32, FRAME.height as u32)];
     let mut failed = false;
