@@ -7,70 +7,17 @@
 //! host in the firmware's scalar, so the values are the very ones the firmware would have
 //! computed: frames are bit-identical to a run-time parse.
 
-use crate::lattice::{Lattice, SubLattice};
-use crate::math::{Aabb, Vec3};
-use crate::scene::{Camera, Composite, Light, Material, Object, Scene, SceneError};
-use heapless::Vec;
+use crate::lattice::Lattice;
+use crate::scene::Scene;
 
-/// A scene and its lattice as static tables (see the module documentation).
-#[derive(Clone, Copy, Debug)]
+/// A scene and its lattice as static tables (see the module documentation): the scene's
+/// objects, lists and camera and the lattice's cells all in flash, used in place.
+#[derive(Debug)]
 pub struct Baked<R: 'static> {
-    /// The scene's primitives, validated.
-    pub objects: &'static [Object<R>],
-    /// Composite objects.
-    pub composites: &'static [Composite<R>],
-    /// Materials.
-    pub materials: &'static [Material<R>],
-    /// Lights.
-    pub lights: &'static [Light<R>],
-    /// Ambient intensity.
-    pub ambient: R,
-    /// Gray of rays that hit nothing.
-    pub background: R,
-    /// Camera.
-    pub camera: Camera<R>,
-    /// Maximum depth of the intersection tree.
-    pub max_depth: u8,
-    /// The world range.
-    pub world: Aabb<R>,
-    /// Two unit vectors across the first light, when it is directional.
-    pub shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
-    /// The lattices (world first).
-    pub lattices: &'static [SubLattice<R>],
-    /// Their coordinate lists.
-    pub coords: &'static [R],
-    /// Cell starts, packed as the lattice keeps them.
-    pub cells: &'static [u32],
-    /// References, packed as the lattice keeps them.
-    pub refs: &'static [u32],
-    /// Entries in `cells` (cells + 1) and in `refs`.
-    pub entries: (usize, usize),
-    /// Whether `cells` and `refs` hold 16-bit indices.
-    pub narrow: bool,
-}
-
-impl<R: Copy> Baked<R> {
-    /// The scene, its objects still in the tables (the few composites, materials and lights
-    /// are copied into the scene's own fixed-capacity lists).
-    pub fn scene(&self) -> Result<Scene<'static, R>, SceneError> {
-        Ok(Scene {
-            objects: self.objects,
-            composites: Vec::from_slice(self.composites).map_err(|_| SceneError::TooManyComposites)?,
-            materials: Vec::from_slice(self.materials).map_err(|_| SceneError::TooManyMaterials)?,
-            lights: Vec::from_slice(self.lights).map_err(|_| SceneError::TooManyLights)?,
-            ambient: self.ambient,
-            background: self.background,
-            camera: self.camera,
-            max_depth: self.max_depth,
-            world: self.world,
-            shadow_basis: self.shadow_basis,
-        })
-    }
-
-    /// The lattice, in the tables.
-    pub fn lattice(&self) -> Lattice<'static, R> {
-        Lattice::from_tables(self.lattices, self.coords, (self.cells, self.refs), self.entries, self.narrow, self.objects.len())
-    }
+    /// The validated scene.
+    pub scene: Scene<'static, R>,
+    /// Its lattice, built.
+    pub lattice: Lattice<'static, R>,
 }
 
 #[cfg(feature = "bake")]
@@ -79,6 +26,9 @@ pub use writer::{source, Literal};
 #[cfg(feature = "bake")]
 mod writer {
     use super::*;
+    use crate::lattice::SubLattice;
+    use crate::math::{Aabb, Vec3};
+    use crate::scene::{Camera, Composite, Light, Material, Object};
     use crate::shape::Shape;
     use crate::{F32Micro, F32MicroNewton, Fx, Real};
     use alloc::string::String;
@@ -259,34 +209,49 @@ mod writer {
     }
 
     /// Rust source of a `static {name}: Baked<{scalar}>` holding `scene` and `lattice`. The code
-    /// that includes it must have the core's scene, maths and lattice types and the scalar
-    /// `scalar` in scope (`use lattice_rt::bake::prelude::*`).
+    /// that includes it must have the types of [`prelude`](super::prelude) and the scalar
+    /// `scalar` in scope.
     pub fn source<R: Real + Literal>(name: &str, scalar: &str, scene: &Scene<'_, R>, lattice: &Lattice<'_, R>) -> String {
         let mut out = String::new();
-        let _ = write!(out, "/// The scene `{name}`, baked.\npub static {name}: Baked<{scalar}> = Baked {{\n    objects: &");
+        let _ = write!(out, "/// The scene `{name}`, baked.\npub static {name}: Baked<{scalar}> = Baked {{\n    scene: Scene::from_tables(\n        &");
         list(scene.objects, &mut out);
-        let mut field = |f: &str, v: &dyn Literal| {
-            let _ = write!(out, ",\n    {f}: ");
+        let mut arg = |v: &dyn Literal| {
+            out.push_str(",\n        ");
             v.literal(&mut out);
         };
-        field("composites", &Slice(&scene.composites));
-        field("materials", &Slice(&scene.materials));
-        field("lights", &Slice(&scene.lights));
-        field("ambient", &scene.ambient);
-        field("background", &scene.background);
-        field("camera", &scene.camera);
-        field("max_depth", &scene.max_depth);
-        field("world", &scene.world);
-        field("shadow_basis", &scene.shadow_basis);
+        arg(&Fixed(&scene.composites));
+        arg(&Fixed(&scene.materials));
+        arg(&Fixed(&scene.lights));
+        arg(&scene.ambient);
+        arg(&scene.background);
+        arg(&scene.camera);
+        arg(&scene.max_depth);
+        arg(&scene.world);
+        arg(&scene.shadow_basis);
+        out.push_str(",\n    ),\n    lattice: Lattice::from_tables(\n        ");
         let (lattices, coords, (cells, refs), entries, narrow) = lattice.tables();
-        field("lattices", &Slice(lattices));
-        field("coords", &Slice(coords));
-        field("cells", &Slice(cells));
-        field("refs", &Slice(refs));
-        field("entries", &Pair(entries));
-        field("narrow", &narrow);
-        out.push_str(",\n};\n");
+        Slice(lattices).literal(&mut out);
+        let mut arg = |v: &dyn Literal| {
+            out.push_str(",\n        ");
+            v.literal(&mut out);
+        };
+        arg(&Slice(coords));
+        arg(&Pair(Slice(cells), Slice(refs)));
+        arg(&Pair(entries.0, entries.1));
+        arg(&narrow);
+        arg(&scene.objects.len());
+        out.push_str(",\n    ),\n};\n");
         out
+    }
+
+    /// A fixed-capacity list: `Vec::from_array([a, b, ...])`.
+    struct Fixed<'a, T>(&'a [T]);
+    impl<T: Literal> Literal for Fixed<'_, T> {
+        fn literal(&self, out: &mut String) {
+            out.push_str("Vec::from_array(");
+            list(self.0, out);
+            out.push(')');
+        }
     }
 
     /// `&[a, b, ...]`.
@@ -299,10 +264,14 @@ mod writer {
     }
 
     /// `(a, b)`.
-    struct Pair((usize, usize));
-    impl Literal for Pair {
+    struct Pair<A, B>(A, B);
+    impl<A: Literal, B: Literal> Literal for Pair<A, B> {
         fn literal(&self, out: &mut String) {
-            let _ = write!(out, "({}, {})", self.0 .0, self.0 .1);
+            out.push('(');
+            self.0.literal(out);
+            out.push_str(", ");
+            self.1.literal(out);
+            out.push(')');
         }
     }
 }
@@ -310,7 +279,9 @@ mod writer {
 /// What the code that includes baked source needs in scope.
 pub mod prelude {
     pub use super::Baked;
-    pub use crate::lattice::SubLattice;
+    pub use crate::lattice::{Lattice, SubLattice};
+    pub use crate::scene::Scene;
+    pub use heapless::Vec;
     pub use crate::math::{Aabb, Affine, Vec3};
     pub use crate::scene::{Camera, Composite, Light, Material, Object};
     pub use crate::shape::Shape;

@@ -116,8 +116,9 @@ type Kernel = (&'static [(i8, i8, i16)], i16);
 const FLOYD_STEINBERG: Kernel = (&[(1, 0, 7), (-1, 1, 3), (0, 1, 5), (1, 1, 1)], 16);
 const ATKINSON: Kernel = (&[(1, 0, 1), (2, 0, 1), (-1, 1, 1), (0, 1, 1), (1, 1, 1), (0, 2, 1)], 8);
 
-/// Largest tile side the renderer supports.
-pub const MAX_TILE: usize = 16;
+/// Largest tile side the renderer supports: 16, or 8 with the `tile8` feature, which makes
+/// every per-tile buffer a quarter the size (firmware whose frames have 8x8 tiles).
+pub const MAX_TILE: usize = if cfg!(feature = "tile8") { 8 } else { 16 };
 /// Error units per gray level.
 const SCALE: i16 = 16;
 

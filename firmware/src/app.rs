@@ -66,8 +66,6 @@ pub enum AppError<'t, E> {
     Lattice(LatticeError),
     /// The scene needs an effect this build leaves out.
     Effects(MissingEffects),
-    /// A baked scene's tables hold more composites, materials or lights than a scene can.
-    BakedTables,
     /// Only a `baked` build borrows the scene text: the lifetime `'t` of the other builds.
     #[cfg(feature = "baked")]
     #[doc(hidden)]
@@ -88,7 +86,6 @@ impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
             #[cfg(feature = "baked")]
             AppError::Text(_) => Ok(()),
             AppError::Effects(e) => write!(f, "{e}"),
-            AppError::BakedTables => write!(f, "baked tables exceed the scene's capacities"),
             AppError::BakedCamera => write!(f, "a baked scene is shown from its own camera only"),
             AppError::Render(e) => write!(f, "{e}"),
         }
@@ -108,7 +105,6 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             #[cfg(feature = "baked")]
             AppError::Text(_) => {}
             AppError::Effects(e) => defmt::write!(f, "{}", e),
-            AppError::BakedTables => defmt::write!(f, "baked tables exceed the scene's capacities"),
             AppError::BakedCamera => defmt::write!(f, "a baked scene is shown from its own camera only"),
             AppError::Render(RenderError::Draw(e)) => defmt::write!(f, "display: {}", defmt::Debug2Format(e)),
             AppError::Render(RenderError::Cancelled) => defmt::write!(f, "render cancelled"),
@@ -285,10 +281,8 @@ pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     if shot.turn != 0.0 {
         return Err(AppError::BakedCamera);
     }
-    let scene = baked.scene().map_err(|_| AppError::BakedTables)?;
-    let lattice = baked.lattice();
     let scratch = lattice_rt::Scratch::new(&mut memory.mailbox[..], &mut memory.rows[..]);
-    render_loaded(&scene, &lattice, scratch, target, hooks, shot, cores, second, now, shown)
+    render_loaded(&baked.scene, &baked.lattice, scratch, target, hooks, shot, cores, second, now, shown)
 }
 
 /// The frame of a scene loaded or baked: its tracer, then every pass of both tile shares.

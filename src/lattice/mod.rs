@@ -138,8 +138,10 @@ fn locate<R: Real>(c: &[R], x: R) -> usize {
 pub(crate) type Tables<'a, R> = (&'a [SubLattice<R>], &'a [R], (&'a [u32], &'a [u32]), (usize, usize), bool);
 
 impl<'a, R> Lattice<'a, R> {
-    /// A lattice over tables built before (baked scenes).
-    pub(crate) const fn from_tables(
+    /// A lattice over tables built before, as [`bake::source`](crate::bake) writes them: for
+    /// baked tables only, which hold a built lattice.
+    #[doc(hidden)]
+    pub const fn from_tables(
         lattices: &'a [SubLattice<R>],
         coords: &'a [R],
         (cells, refs): (&'a [u32], &'a [u32]),

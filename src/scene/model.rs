@@ -370,6 +370,27 @@ pub struct Scene<'a, R> {
     pub(crate) shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
 }
 
+impl<'a, R> Scene<'a, R> {
+    /// A scene from its parts, as [`bake::source`](crate::bake) writes them: for baked tables
+    /// only, which hold a validated scene.
+    #[doc(hidden)]
+    #[allow(clippy::too_many_arguments)]
+    pub const fn from_tables(
+        objects: &'a [Object<R>],
+        composites: Vec<Composite<R>, MAX_COMPOSITES>,
+        materials: Vec<Material<R>, MAX_MATERIALS>,
+        lights: Vec<Light<R>, MAX_LIGHTS>,
+        ambient: R,
+        background: R,
+        camera: Camera<R>,
+        max_depth: u8,
+        world: Aabb<R>,
+        shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
+    ) -> Self {
+        Scene { objects, composites, materials, lights, ambient, background, camera, max_depth, world, shadow_basis }
+    }
+}
+
 impl<'a, R: Real> Scene<'a, R> {
     /// The objects (bit `i`: object `i`, for the first 64) whose eye window meets the window
     /// rectangle `u` x `v` (2^-16 units, inclusive bounds, see [`EyeWindow`]): an eye ray
