@@ -196,13 +196,26 @@ impl Cores for OneCore {
 /// Pixels in [`RENDERED`].
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
 
-/// The memory of the second tile share: its own query scratch and a 1-bit frame its tiles are
-/// drawn into (the display is core 0's), sent to the display when the share is done; and the
-/// rays both shares keep between progressive passes ([`TRACED`] each).
+/// Whether the board has a second core to trace share 1 (the `rp` boards): it then needs its own
+/// query scratch and 1-bit frame in [`ShareMemory`]. A one-core board draws both shares straight
+/// to the display, and the memory is empty.
+const SECOND_CORE: bool = cfg!(feature = "rp");
+/// Entries of [`ShareMemory`]'s arrays when [`SECOND_CORE`] (else none).
+const fn second(n: usize) -> usize {
+    if SECOND_CORE {
+        n
+    } else {
+        0
+    }
+}
+
+/// The memory of the second tile share: on a board with two cores its own query scratch and a
+/// 1-bit frame its tiles are drawn into (the display is core 0's), sent to the display when the
+/// share is done; and the rays both shares keep between progressive passes ([`TRACED`] each).
 pub struct ShareMemory {
-    mailbox: [u32; MAX_OBJECTS + MAX_LATTICES],
-    rows: [i16; MAX_ROWS],
-    bits: [u8; PIXELS / 8],
+    mailbox: [u32; second(MAX_OBJECTS + MAX_LATTICES)],
+    rows: [i16; second(MAX_ROWS)],
+    bits: [u8; second(PIXELS / 8)],
     traced: [[Traced; TRACED]; 2],
 }
 
@@ -210,7 +223,12 @@ impl ShareMemory {
     /// Zeroed memory.
     pub const fn new() -> Self {
         const NONE: Traced = Traced { level: 0, object: 0, depth: 0 };
-        ShareMemory { mailbox: [0; MAX_OBJECTS + MAX_LATTICES], rows: [0; MAX_ROWS], bits: [0; PIXELS / 8], traced: [[NONE; TRACED]; 2] }
+        ShareMemory {
+            mailbox: [0; second(MAX_OBJECTS + MAX_LATTICES)],
+            rows: [0; second(MAX_ROWS)],
+            bits: [0; second(PIXELS / 8)],
+            traced: [[NONE; TRACED]; 2],
+        }
     }
 }
 
@@ -319,6 +337,18 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
     for &pass in PASSES {
+        if !SECOND_CORE {
+            // One core: both shares straight to the display, one after the other.
+            let [there_us, here_us] = &mut times;
+            let t0 = now();
+            stats.add(&draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks).map_err(AppError::Render)?);
+            let t1 = now();
+            let more = draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], target, &mut scratch, &mut lattice_rt::NoHooks);
+            stats.add(&more.map_err(AppError::Render)?);
+            (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
+            shown(pass);
+            continue;
+        }
         let (mut there_result, mut here_result) = (None, None);
         let [there_us, here_us] = &mut times;
         cores.join(
