@@ -335,6 +335,48 @@ pub fn host_frame(scenes: &Path, name: &str, scalar: &str, exact: bool) -> Resul
     }
 }
 
+/// The flash of an image by part: the tracer and renderer (the core), the scenes' tables and
+/// constants (read-only data), the QEMU harness (its `main`, `core::fmt` and semihosting), the
+/// compiler's built-ins (integer division, memcpy) and the rest (vector table, start-up).
+fn flash_parts(elf: &Path) -> Result<Vec<(&'static str, u64)>> {
+    use object::{Object as _, ObjectSection as _, ObjectSymbol as _, SectionKind};
+    let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+    let file = object::File::parse(&*data)?;
+    let rodata: u64 = file.sections().filter(|s| s.name().is_ok_and(|n| n.starts_with(".rodata"))).map(|s| s.size()).sum();
+    let (flash, _) = elf_sizes(elf)?;
+    let mut parts: Vec<(&'static str, u64)> = vec![
+        ("tracer and renderer (`lattice_rt`)", 0),
+        ("the firmware's render loop (`firmware::app`)", 0),
+        ("the QEMU harness's `main` (with the render loop inlined), `core::fmt`, semihosting", 0),
+        ("compiler built-ins (integer division, memcpy)", 0),
+        ("other code (start-up, panics)", 0),
+    ];
+    for sym in file.symbols() {
+        let Some(section) = sym.section_index().and_then(|i| file.section_by_index(i).ok()) else { continue };
+        if section.kind() != SectionKind::Text {
+            continue;
+        }
+        let name = format!("{:#}", rustc_demangle::demangle(sym.name().unwrap_or("")));
+        // The render loop is inlined into the harness's `main`, which counts it there.
+        let part = if name.contains("fmt") || name.starts_with("qemu::") || name.contains("semihosting") {
+            2
+        } else if name.contains("lattice_rt::") {
+            0
+        } else if name.contains("firmware::") {
+            1
+        } else if name.contains("compiler_builtins") || name.starts_with("__") {
+            3
+        } else {
+            4
+        };
+        parts[part].1 += sym.size();
+    }
+    let counted: u64 = parts.iter().map(|p| p.1).sum::<u64>() + rodata;
+    parts.insert(2, ("tables (`.rodata`: the baked scenes and lattices, constants, strings)", rodata));
+    parts.push(("vector table and alignment", flash.saturating_sub(counted)));
+    Ok(parts)
+}
+
 /// The baked builds against the memory targets (issue: flash at most 48 KiB with all five scenes
 /// and every effect, 32 KiB for the matte paper scenes with their effects, which must be at least
 /// 25 % smaller than the all-effects build; RAM at most 4 KiB for the chair, 6 KiB for all five).
@@ -359,6 +401,29 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
     let parsed = flash("qemu-m0-fixed").zip(ram("qemu-m0-fixed"));
     if let Some((f, r)) = parsed {
         writeln!(md, "Parsed at run time the same five scenes take {f} B of flash and {r} B of RAM.")?;
+    }
+    if let Some((v, r)) = run("qemu-m0-fixed-baked-allfx") {
+        let parts = flash_parts(&elf_path(root, v))?;
+        writeln!(md, "\nWhere the {allfx} B of `qemu-m0-fixed-baked-allfx` go (symbol sizes from its ELF):\n\n| part | bytes |\n|---|---:|")?;
+        for (part, bytes) in parts.into_iter().filter(|p| p.1 > 0) {
+            writeln!(md, "| {part} | {bytes} |")?;
+        }
+        // The tables' two big parts: the objects, and each scene's own fixed-capacity lists.
+        let mut objects = 0;
+        for s in &r.scenes {
+            let text = crate::load::read(&root.join("scenes").join(format!("{}.scene", s.name)))?;
+            let mut storage = crate::load::object_storage::<lattice_rt::Fx>(&text)?;
+            objects += lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage).map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?.objects().len();
+        }
+        let (object, baked) = (size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>(), size_of::<lattice_rt::Baked<lattice_rt::Fx>>());
+        writeln!(
+            md,
+            "\nOf the tables, the {objects} objects take {objects} x {object} = {} B and the {} scenes' `Baked` statics\n{} x {baked} = {} B (a scene's composites, materials and lights sit in lists of fixed capacity,\nkept whole so that the scene is used in place, not copied to RAM); the rest are the lattices\n(cells, references, coordinate lists) and constants.",
+            objects * object,
+            r.scenes.len(),
+            r.scenes.len(),
+            r.scenes.len() * baked
+        )?;
     }
     let mb = "microbit-m0-fixed-baked";
     if let Some((_, r)) = run(mb) {
