@@ -287,3 +287,65 @@ pub mod prelude {
     pub use crate::shape::Shape;
     pub use crate::{F32Micro, F32MicroNewton, Fx};
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::{Accelerator, Query};
+    use crate::generate::{random_scene, RandomScene, Rng};
+    use crate::lattice::{LatticeConfig, LatticeStorage, SubLattice};
+    use crate::math::{Ray, Vec3};
+    use crate::scene::{Object, SceneBuilder};
+    use crate::{Fx, Real};
+    use std::vec;
+
+    #[test]
+    fn tables_answer_as_the_lattice_they_were_taken_from_and_the_source_names_every_object() {
+        let mut st = vec![Object::<Fx>::default(); 40];
+        let mut b = SceneBuilder::new(&mut st);
+        random_scene(&mut b, &RandomScene { objects: 40, composite_size: 8, spread: 0.0, seed: 9 }).unwrap();
+        let scene = b.finish().unwrap();
+        let cfg = LatticeConfig::default();
+        let s = Lattice::plan(&scene, &cfg);
+        let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![Fx(0); s.coords], vec![0; s.words()]);
+        let lattice = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
+        let (l, co, words, entries, narrow) = lattice.tables();
+        let copy = Lattice::from_tables(l, co, words, entries, narrow, scene.objects.len());
+        let tables = Scene::from_tables(
+            scene.objects,
+            scene.composites.clone(),
+            scene.materials.clone(),
+            scene.lights.clone(),
+            scene.ambient,
+            scene.background,
+            scene.camera,
+            scene.max_depth,
+            scene.world,
+            scene.shadow_basis,
+        );
+        let mut mb = vec![0; Query::mailbox_len(&scene)];
+        let mut rng = Rng::new(4);
+        let w = scene.world;
+        for _ in 0..500 {
+            let mut p = || {
+                let mut c = |lo: Fx, hi: Fx| Fx::from_f64(rng.range(lo.to_f64(), hi.to_f64()));
+                Vec3::new(c(w.min.x, w.max.x), c(w.min.y, w.max.y), c(w.min.z, w.max.z))
+            };
+            let (a, b) = (p(), p());
+            let ray = Ray::new(a, b - a);
+            let hit = |s: &Scene<'_, Fx>, l: &Lattice<'_, Fx>, mb: &mut [u32]| {
+                l.nearest(s, &ray, Fx(0), Fx::MAX, &mut Query::new(mb)).map(|h| (h.object, h.t))
+            };
+            assert_eq!(hit(&scene, &lattice, &mut mb), hit(&tables, &copy, &mut mb));
+        }
+        #[cfg(feature = "bake")]
+        {
+            let src = source("TEST", "Fx", &scene, &lattice);
+            assert_eq!(src.matches("Object::from_tables(").count(), scene.objects.len());
+            assert!(src.starts_with("/// The scene `TEST`, baked.\npub static TEST: Baked<Fx> = Baked {"));
+            let mut f = std::string::String::new();
+            (-0.0f32).literal(&mut f);
+            assert_eq!(f, "f32::from_bits(0x80000000)", "a literal keeps the bits, signed zeros too");
+        }
+    }
+}

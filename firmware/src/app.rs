@@ -50,6 +50,8 @@ pub mod baked {
 
 #[cfg(all(feature = "baked", feature = "orbit"))]
 compile_error!("the `baked` scenes are shown from their own cameras: `orbit` needs run-time set-up");
+#[cfg(all(feature = "baked", feature = "rp"))]
+compile_error!("`baked` is for the `qemu` binary (the emulated boards and the micro:bit) so far; the Raspberry Pi boards parse their scenes");
 
 /// All memory a frame of any embedded scene needs, with the capacities build.rs computed.
 pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_LATTICES, MAX_COORDS, MAX_WORDS, MAX_ROWS>;
