@@ -158,7 +158,8 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     hooks: &mut impl Hooks,
 ) -> Result<Report, AppError<'t, D::Error>> {
     let mut second = ShareMemory::new();
-    render_scene_at(text, st, target, hooks, &Shot::default(), &mut OneCore, &mut second, &|| 0, &mut |_| {})
+    let board = Board { cores: &mut OneCore, second: &mut second, now: &|| 0, shown: &mut |_| {} };
+    render_scene_at(text, st, target, hooks, &Shot::default(), board)
 }
 
 /// What one frame shows and how it is traced.
@@ -193,6 +194,19 @@ impl Cores for OneCore {
         here();
         there();
     }
+}
+
+/// The board's side of a frame: how the two tile shares run, the second share's memory, a
+/// clock and what to do once a pass is on the display.
+pub struct Board<'a, C: Cores> {
+    /// Runs the two tile shares (on two cores where there are two).
+    pub cores: &'a mut C,
+    /// The second share's memory.
+    pub second: &'a mut ShareMemory,
+    /// Reads a clock (from either core) to time each share.
+    pub now: &'a (dyn Fn() -> u64 + Sync),
+    /// Called with each pass once it is on the display.
+    pub shown: &'a mut dyn FnMut(u8),
 }
 
 /// Pixels in [`RENDERED`].
@@ -241,25 +255,22 @@ impl Default for ShareMemory {
 }
 
 /// [`render_scene`] for a [`Shot`], in [`SHARES`] tile shares: share 0 drawn straight to
-/// `target` by this core, share 1 traced by `cores`' other core into `second`'s frame and sent
-/// to `target` after. `now` reads a clock (from either core) to time each share. The frame is
-/// shown in [`PASSES`]; `shown` is called with each pass once it is on `target`.
+/// `target` by this core, share 1 traced by the board's other core into its second share's
+/// frame and sent to `target` after (a one-core board draws both straight to `target`). The
+/// board's clock times each share. The frame is shown in [`PASSES`]; the board's `shown` is
+/// called with each pass once it is on `target`.
 #[cfg(not(feature = "baked"))]
-#[allow(clippy::too_many_arguments)]
 pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     text: &'t str,
     st: &mut Storage<R>,
     target: &mut D,
     hooks: &mut impl Hooks,
     shot: &Shot,
-    cores: &mut impl Cores,
-    second: &mut ShareMemory,
-    now: &(dyn Fn() -> u64 + Sync),
-    shown: &mut dyn FnMut(u8),
+    board: Board<'_, impl Cores>,
 ) -> Result<Report, AppError<'t, D::Error>> {
     let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
     let Loaded { scene, lattice, scratch } = st.view().load_with(text, &lattice_rt::LatticeConfig::default(), at)?;
-    render_loaded(&scene, &lattice, scratch, target, hooks, shot, cores, second, now, shown)
+    render_loaded(&scene, &lattice, scratch, target, hooks, shot, board)
 }
 
 /// Memory a baked scene's frame needs besides the tables in flash: the render's query scratch
@@ -286,27 +297,22 @@ impl Default for BakedMemory {
 /// [`render_scene_at`] for a scene baked into flash (the `baked` feature: `build.rs` wrote it
 /// and its lattice as tables), which is neither parsed nor built. Its camera is the scene's
 /// own: `shot.turn` must be 0 (an orbit needs the camera set up at run time).
-#[allow(clippy::too_many_arguments)]
 pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     baked: &lattice_rt::Baked<R>,
     memory: &mut BakedMemory,
     target: &mut D,
     hooks: &mut impl Hooks,
     shot: &Shot,
-    cores: &mut impl Cores,
-    second: &mut ShareMemory,
-    now: &(dyn Fn() -> u64 + Sync),
-    shown: &mut dyn FnMut(u8),
+    board: Board<'_, impl Cores>,
 ) -> Result<Report, AppError<'t, D::Error>> {
     if shot.turn != 0.0 {
         return Err(AppError::BakedCamera);
     }
     let scratch = lattice_rt::Scratch::new(&mut memory.mailbox[..], &mut memory.rows[..]);
-    render_loaded(&baked.scene, &baked.lattice, scratch, target, hooks, shot, cores, second, now, shown)
+    render_loaded(&baked.scene, &baked.lattice, scratch, target, hooks, shot, board)
 }
 
 /// The frame of a scene loaded or baked: its tracer, then every pass of both tile shares.
-#[allow(clippy::too_many_arguments)]
 fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     scene: &lattice_rt::Scene<'_, R>,
     lattice: &lattice_rt::Lattice<'_, R>,
@@ -314,10 +320,7 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     target: &mut D,
     hooks: &mut impl Hooks,
     shot: &Shot,
-    cores: &mut impl Cores,
-    second: &mut ShareMemory,
-    now: &(dyn Fn() -> u64 + Sync),
-    shown: &mut dyn FnMut(u8),
+    board: Board<'_, impl Cores>,
 ) -> Result<Report, AppError<'t, D::Error>> {
     let mut tracer = Tracer::<_, _, EFFECTS>::compiled(scene, lattice).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
@@ -334,6 +337,7 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     let pick = |tuned| if cfg!(feature = "ladder") { tuned } else { &RENDERED };
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
+    let Board { cores, second, now, shown } = board;
     let ShareMemory { mailbox, rows, bits, traced } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();

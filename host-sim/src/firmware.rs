@@ -104,29 +104,16 @@ fn variants() -> Vec<Variant> {
     });
     // What the effect set saves: every effect forced in, and the matte paper scenes with their
     // derived set against every effect (the same scenes, so the difference is the effect code).
-    for (name, scenes, features, what) in [
-        ("qemu-m0-fixed-allfx", None, "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, all five scenes, every effect compiled in and on"),
-        ("qemu-m0-fixed-matte", Some("chair,desk,polyhedron"), "qemu,scalar-fixed", "Cortex-M0+, fixed, the matte paper scenes, their effects only (shadows, composites)"),
-        ("qemu-m0-fixed-matte-allfx", Some("chair,desk,polyhedron"), "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, the matte paper scenes, every effect compiled in"),
-    ] {
-        v.push(Variant {
-            name: name.into(),
-            target: "thumbv6m-none-eabi",
-            profile: "release",
-            features: features.into(),
-            bin: "qemu",
-            machine: Some("mps2-an385"),
-            scenes,
-            scalar: "fixed",
-            what: what.into(),
-        });
-    }
-    // Baked scenes: each scene and its lattice as tables in flash; nothing parsed or built.
+    // Then baked scenes: each scene and its lattice as tables in flash; nothing parsed or built.
+    let matte = Some("chair,desk,polyhedron");
     for (name, machine, scenes, features, what) in [
+        ("qemu-m0-fixed-allfx", "mps2-an385", None, "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, all five scenes, every effect compiled in and on"),
+        ("qemu-m0-fixed-matte", "mps2-an385", matte, "qemu,scalar-fixed", "Cortex-M0+, fixed, the matte paper scenes, their effects only (shadows, composites)"),
+        ("qemu-m0-fixed-matte-allfx", "mps2-an385", matte, "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, the matte paper scenes, every effect compiled in"),
         ("qemu-m0-fixed-baked", "mps2-an385", None, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, all five scenes baked into flash (no parser, set-up or lattice build linked)"),
         ("qemu-m0-fixed-baked-allfx", "mps2-an385", None, "qemu,scalar-fixed,baked,effects-all", "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on"),
         ("qemu-m0-fixed-baked-chair", "mps2-an385", Some("chair"), "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, only the chair, baked"),
-        ("qemu-m0-fixed-baked-matte", "mps2-an385", Some("chair,desk,polyhedron"), "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only (shadows, composites)"),
+        ("qemu-m0-fixed-baked-matte", "mps2-an385", matte, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only (shadows, composites)"),
         ("microbit-m0-fixed-baked", "microbit", None, "microbit,scalar-fixed,baked", "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, QEMU's microbit machine), fixed, all five scenes baked"),
     ] {
         v.push(Variant {

@@ -28,7 +28,7 @@ use embedded_graphics_core::Pixel;
 use firmware::app::LADDER;
 #[cfg(feature = "orbit")]
 use firmware::app::ORBIT_FRAMES;
-use firmware::app::{render_scene_at, Cores, OneCore, Scalar, ShareMemory, Shot, Storage, HEIGHT, SCENES, WIDTH};
+use firmware::app::{render_scene_at, Board, Cores, OneCore, Scalar, ShareMemory, Shot, Storage, HEIGHT, SCENES, WIDTH};
 #[cfg(not(feature = "ladder"))]
 use firmware::stack;
 use hal::fugit::RateExtU32;
@@ -345,8 +345,14 @@ fn main() -> ! {
             }
         };
         let result = match two.as_mut() {
-            Some(cores) => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, cores, &mut second, &now, &mut shown),
-            None => render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, &mut one, &mut second, &now, &mut shown),
+            Some(cores) => {
+                let board = Board { cores, second: &mut second, now: &now, shown: &mut shown };
+                render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, board)
+            }
+            None => {
+                let board = Board { cores: &mut one, second: &mut second, now: &now, shown: &mut shown };
+                render_scene_at(text, &mut st, &mut target, &mut NoHooks, shot, board)
+            }
         };
         let _ = led.set_low();
         result.map(|r| (r, (timer.get_counter() - t0).to_micros(), r.share_us))

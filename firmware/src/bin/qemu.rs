@@ -17,7 +17,7 @@ use cortex_m::interrupt::{free, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
-use firmware::app::{OneCore, Scalar, ShareMemory, Shot, FRAME};
+use firmware::app::{Board, OneCore, Scalar, ShareMemory, Shot, FRAME};
 #[cfg(not(feature = "baked"))]
 use firmware::app::{render_scene_at, Storage, SCENES};
 use firmware::stack;
@@ -93,10 +93,11 @@ fn main() -> ! {
         let mut frame = BitFrame::new(FRAME.width as u32, FRAME.height as u32, &mut bits).unwrap();
         let t0 = ticks();
         let shot = Shot::default();
+        let board = Board { cores: &mut OneCore, second: &mut second, now: &ticks, shown: &mut |_| {} };
         #[cfg(not(feature = "baked"))]
-        let shown = render_scene_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks, &mut |_| {});
+        let shown = render_scene_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, board);
         #[cfg(feature = "baked")]
-        let shown = firmware::app::render_baked_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, &mut OneCore, &mut second, &ticks, &mut |_| {});
+        let shown = firmware::app::render_baked_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, board);
         match shown {
             Ok(r) => {
                 let t = ticks() - t0;
