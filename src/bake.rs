@@ -215,31 +215,27 @@ mod writer {
         let mut out = String::new();
         let _ = write!(out, "/// The scene `{name}`, baked.\npub static {name}: Baked<{scalar}> = Baked {{\n    scene: Scene::from_tables(\n        &");
         list(scene.objects, &mut out);
-        let mut arg = |v: &dyn Literal| {
+        let arg = |out: &mut String, v: &dyn Literal| {
             out.push_str(",\n        ");
-            v.literal(&mut out);
+            v.literal(out);
         };
-        arg(&Fixed(&scene.composites));
-        arg(&Fixed(&scene.materials));
-        arg(&Fixed(&scene.lights));
-        arg(&scene.ambient);
-        arg(&scene.background);
-        arg(&scene.camera);
-        arg(&scene.max_depth);
-        arg(&scene.world);
-        arg(&scene.shadow_basis);
+        arg(&mut out, &Fixed(&scene.composites));
+        arg(&mut out, &Fixed(&scene.materials));
+        arg(&mut out, &Fixed(&scene.lights));
+        arg(&mut out, &scene.ambient);
+        arg(&mut out, &scene.background);
+        arg(&mut out, &scene.camera);
+        arg(&mut out, &scene.max_depth);
+        arg(&mut out, &scene.world);
+        arg(&mut out, &scene.shadow_basis);
         out.push_str(",\n    ),\n    lattice: Lattice::from_tables(\n        ");
         let (lattices, coords, (cells, refs), entries, narrow) = lattice.tables();
         Slice(lattices).literal(&mut out);
-        let mut arg = |v: &dyn Literal| {
-            out.push_str(",\n        ");
-            v.literal(&mut out);
-        };
-        arg(&Slice(coords));
-        arg(&Pair(Slice(cells), Slice(refs)));
-        arg(&Pair(entries.0, entries.1));
-        arg(&narrow);
-        arg(&scene.objects.len());
+        arg(&mut out, &Slice(coords));
+        arg(&mut out, &Pair(Slice(cells), Slice(refs)));
+        arg(&mut out, &Pair(entries.0, entries.1));
+        arg(&mut out, &narrow);
+        arg(&mut out, &scene.objects.len());
         out.push_str(",\n    ),\n};\n");
         out
     }

@@ -145,10 +145,8 @@ impl<R: Real> Lattice<'_, R> {
             let single = flat.sizes.cells == 2;
             keep(flat);
             // Nested: sub-lattices from as configured down to one cell each.
-            for ks in 0..STEPS {
-                if !nested {
-                    break;
-                }
+            let subs = if nested { 0..STEPS } else { 0..0 };
+            for ks in subs {
                 let ss = libm::pow(STEP, ks as f64);
                 let c = assess(LatticeConfig { top, sub: scaled(cfg.sub, ss), ..exact }, (st, ss));
                 let all_single = c.sizes.cells - 1 == c.sizes.lattices;

@@ -1,7 +1,7 @@
 //! Walking a lattice: from cell to neighbouring cell by index arithmetic (3D-DDA), with an
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
-use super::{index, locate, Lattice, SubLattice, MAX_NESTING};
+use super::{locate, Lattice, SubLattice, MAX_NESTING};
 use crate::accel::{offer, Hit, Query};
 use crate::math::Ray;
 use crate::scalar::Real;
@@ -37,25 +37,25 @@ impl<R: Real> Lattice<'_, R> {
         while depth > 0 {
             let Some(w) = stack[depth - 1].as_mut() else { break };
             if w.ref_i < w.ref_end {
-                let item = index::decode(index::get(self.refs, self.narrow, w.ref_i as usize), self.narrow);
+                let item = self.reference(w.ref_i as usize);
                 w.ref_i += 1;
                 match item {
-                Ok(i) => {
-                    if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
-                        return best;
-                    }
-                }
-                Err(composite) => {
-                    let g = composite + 1;
-                    let limit = best.map_or(tmax, |b| b.t);
-                    if depth < MAX_NESTING && q.first_visit(self.objects + g - 1) {
-                        if let Some((a, b)) = self.lattices[g].bounds.clip(ray, tmin, limit) {
-                            stack[depth] = Some(Walker::start(self, g, ray, &inv, a, b));
-                            depth += 1;
-                            q.stats.cells_visited += 1;
+                    Ok(i) => {
+                        if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
+                            return best;
                         }
                     }
-                }
+                    Err(composite) => {
+                        let g = composite + 1;
+                        let limit = best.map_or(tmax, |b| b.t);
+                        if depth < MAX_NESTING && q.first_visit(self.objects + composite) {
+                            if let Some((a, b)) = self.lattices[g].bounds.clip(ray, tmin, limit) {
+                                stack[depth] = Some(Walker::start(self, g, ray, &inv, a, b));
+                                depth += 1;
+                                q.stats.cells_visited += 1;
+                            }
+                        }
+                    }
                 }
                 continue;
             }
