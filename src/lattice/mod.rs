@@ -195,12 +195,6 @@ impl<'a, R: Real> Lattice<'a, R> {
         index::get(self.cells, self.narrow, c)
     }
 
-    /// Reference `i`: `Ok(object)`, or `Err(composite)` for a sub-lattice.
-    #[inline(always)]
-    fn reference(&self, i: usize) -> Result<usize, usize> {
-        index::decode(index::get(self.refs, self.narrow, i), self.narrow)
-    }
-
     /// The coordinate list of lattice `g` along `axis`.
     pub fn coordinate_list(&self, g: usize, axis: usize) -> &[R] {
         let sub = &self.lattices[g];

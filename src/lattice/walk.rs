@@ -1,7 +1,7 @@
 //! Walking a lattice: from cell to neighbouring cell by index arithmetic (3D-DDA), with an
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
-use super::{locate, Lattice, SubLattice, MAX_NESTING};
+use super::{index, locate, Lattice, SubLattice, MAX_NESTING};
 use crate::accel::{offer, Hit, Query};
 use crate::math::Ray;
 use crate::scalar::Real;
@@ -37,7 +37,7 @@ impl<R: Real> Lattice<'_, R> {
         while depth > 0 {
             let Some(w) = stack[depth - 1].as_mut() else { break };
             if w.ref_i < w.ref_end {
-                let item = self.reference(w.ref_i as usize);
+                let item = index::decode(index::get(self.refs, self.narrow, w.ref_i as usize), self.narrow);
                 w.ref_i += 1;
                 match item {
                     Ok(i) => {
