@@ -1,25 +1,30 @@
 #!/usr/bin/env node
-// Runs the Pico image a user flashes (its UF2 file) on rp2040js, core 0 of an RP2040 with the
-// B1 bootrom, with an SSD1306 on I2C0 at 0x3C, and reports on stdout, one JSON object a line:
+// Runs the Pico image a user flashes (its UF2 file) on an RP2040 as silicon runs it
+// (silicon.mjs: rp2040js with core 1, the XIP cache and a timed I2C bus), with the B1 bootrom
+// and an SSD1306 on I2C0 at 0x3C, and reports on stdout, one JSON object a line:
 //   {"event":"frame", ...}  each frame the panel shows: the moment the board's LED (GP25, lit
-//                           while a frame is being rendered) goes out, with the cycles and
-//                           instructions the frame took and the panel's pixels as hex rows
+//                           while a frame is being rendered) goes out, with the cycles the frame
+//                           took, each core's busy and idle cycles, the XIP cache's hits,
+//                           misses and stall, the I2C bus's bytes and busy time, and the
+//                           panel's pixels as hex rows
 //   {"event":"end", ...}    why the run ended, with totals
 // The device's defmt log (the RTT up channel, read as a probe reads it) goes to --log as raw
 // bytes for `host-sim board` to decode. Exit code 0 when the run ended as asked, 1 otherwise.
 //
-// rp2040js has no SSI flash model, so the run starts at boot2 (PC = 0x10000000) with the
-// bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2.
+// rp2040js has no SSI flash model, so core 0 starts at boot2 (PC = 0x10000000) with the
+// bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2; core 1
+// starts in the bootrom and waits there for the launch sequence.
 //
-// With --profile FILE it also samples the program counter every 97th instruction of the first
-// frame (--profile-frames N: of the first N frames; while the LED is lit) and writes the counts
-// as JSON pairs [pc, samples].
+// --no-core1, --no-cache and --untimed-bus leave a model out (to measure what each adds).
+// With --profile FILE it also samples core 0's program counter every 97th instruction of the
+// first frame (--profile-frames N: of the first N frames; while the LED is lit) and writes the
+// counts as JSON pairs [pc, samples].
 //
 // Usage: node run.mjs --uf2 FILE --bootrom FILE --rtt ADDR --log FILE
 //                     [--frames N] [--max-cycles N] [--no-display] [--until-ms T] [--profile FILE]
-//                     [--profile-frames N]
+//                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 import { readFileSync, writeFileSync } from 'node:fs';
-import { RP2040, GPIOPinState } from 'rp2040js';
+import { SiliconBoard, GPIOPinState } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
 
 const FLASH = 0x10000000;
@@ -29,7 +34,7 @@ const LED_PIN = 25;
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1 };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -46,6 +51,9 @@ function parseArgs(argv) {
     else if (a === '--no-display') o.display = false;
     else if (a === '--profile') o.profile = next();
     else if (a === '--profile-frames') o.profileFrames = Number(next());
+    else if (a === '--no-core1') o.core1 = false;
+    else if (a === '--no-cache') o.cache = false;
+    else if (a === '--untimed-bus') o.timedBus = false;
     else throw new Error(`unknown argument ${a}`);
   }
   for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
@@ -115,58 +123,49 @@ const toHex = (bytes) => Buffer.from(bytes).toString('hex');
 
 function main() {
   const opt = parseArgs(process.argv);
-  const mcu = new RP2040();
+  const board = new SiliconBoard({ cache: opt.cache, dualCore: opt.core1 });
+  const mcu = board.mcu;
   const bootrom = readFileSync(opt.bootrom);
   if (bootrom.length !== 16384) throw new Error(`${opt.bootrom}: ${bootrom.length} bytes, a bootrom is 16384`);
-  mcu.loadBootrom(new Uint32Array(bootrom.buffer, bootrom.byteOffset, 4096));
+  board.loadBootrom(new Uint32Array(bootrom.buffer, bootrom.byteOffset, 4096));
   const flashBytes = loadUf2(mcu, readFileSync(opt.uf2));
   const warnings = [];
   mcu.logger = { debug() {}, info() {}, warn() {}, error: (c, m) => warnings.push(`${c}: ${m}`) };
 
-  // I2C0 with the display model (or nothing: every address NACKs).
+  // I2C0 with the display model (or nothing: every address NACKs), bytes delivered when the bus
+  // would deliver them.
   const display = opt.display ? new Ssd1306(0x3c) : null;
-  const i2c = mcu.i2c[0];
   let i2cBytes = 0; // bytes after the address byte
   let i2cTransfers = 0; // address bytes sent (each START or repeated START)
   let naks = 0;
-  i2c.onStart = () => {
-    display?.start();
-    i2c.completeStart();
-  };
-  i2c.onConnect = (address, mode) => {
-    i2cTransfers++;
-    const ack = display ? display.connect(address, mode === 1) : false;
-    if (!ack) naks++;
-    i2c.completeConnect(ack);
-  };
-  i2c.onWriteByte = (value) => {
-    i2cBytes++;
-    i2c.completeWrite(display ? display.write(value) : false);
-  };
-  i2c.onReadByte = () => i2c.completeRead(0xff);
-  i2c.onStop = () => {
-    display?.stop();
-    i2c.completeStop();
-  };
+  let ledOn = false;
+  let firstByteOfFrame = null;
+  const snapshot = () => ({ ...board.snapshot(), i2cBytes, i2cTransfers });
+  board.attachI2c(0, display, {
+    timed: opt.timedBus,
+    listen: {
+      connect: (ack) => {
+        i2cTransfers++;
+        if (!ack) naks++;
+      },
+      byte: () => {
+        if (ledOn && firstByteOfFrame === null) firstByteOfFrame = snapshot();
+        i2cBytes++;
+      },
+    },
+  });
 
   const rtt = new RttReader(mcu, opt.rtt);
-  const core = mcu.core;
-  let instructions = 0;
-  let idleNanos = 0;
   const frames = [];
-  let ledOn = false;
   let frameStart = null;
-  let firstByteOfFrame = null;
   let ledToggles = 0;
-  let stop = null;
   let ok = false;
-  // After the last frame: run on until the core sleeps (it logs the frame first), or at most
+  // After the last frame: run on until core 0 sleeps (it logs the frame first), or at most
   // DRAIN instructions, so the log holds the last frame's line.
   let draining = false;
   let drainLeft = 50_000_000;
 
-  const snapshot = () => ({ cycles: core.cycles, instructions, i2cBytes, i2cTransfers, nanos: mcu.clock.nanos });
-  mcu.gpio[LED_PIN].addListener((state) => {
+  board.gpio(LED_PIN).addListener((state) => {
     const on = state === GPIOPinState.High;
     if (on === ledOn) return;
     ledOn = on;
@@ -181,15 +180,22 @@ function main() {
     const end = snapshot();
     const why = display.notShowable();
     const first = firstByteOfFrame ?? end;
+    const d = (k) => end[k] - frameStart[k];
     const frame = {
       event: 'frame',
       index: frames.length,
-      cycles: end.cycles - frameStart.cycles,
-      instructions: end.instructions - frameStart.instructions,
+      cycles: d('cycles'),
+      instructions: d('instructions'),
+      busy: [0, 1].map((i) => end.busy[i] - frameStart.busy[i]),
+      idle: [0, 1].map((i) => end.idle[i] - frameStart.idle[i]),
+      coreInstructions: [0, 1].map((i) => end.coreInstructions[i] - frameStart.coreInstructions[i]),
+      xipHits: end.xip.hits - frameStart.xip.hits,
+      xipMisses: end.xip.misses - frameStart.xip.misses,
+      xipStallCycles: end.xip.stallCycles - frameStart.xip.stallCycles,
       setupCycles: first.cycles - frameStart.cycles,
       setupInstructions: first.instructions - frameStart.instructions,
-      i2cBytes: end.i2cBytes - frameStart.i2cBytes,
-      i2cTransfers: end.i2cTransfers - frameStart.i2cTransfers,
+      i2cBytes: d('i2cBytes'),
+      i2cTransfers: d('i2cTransfers'),
       startMs: frameStart.nanos / 1e6,
       endMs: end.nanos / 1e6,
       error: why,
@@ -198,58 +204,44 @@ function main() {
     frames.push(frame);
     emit(frame);
     frameStart = null;
-    if (why) stop = `display: ${why}`;
+    if (why) board.stop = `display: ${why}`;
     else if (frames.length >= opt.frames) draining = true;
   });
-  const onByte = i2c.onWriteByte;
-  i2c.onWriteByte = (value) => {
-    if (ledOn && firstByteOfFrame === null) firstByteOfFrame = snapshot();
-    onByte(value);
-  };
-  mcu.onBreak = (code) => {
-    stop = `the core stopped at a breakpoint or undefined instruction (code ${code}) at pc 0x${(core.PC >>> 0).toString(16)}: a panic`;
-  };
 
-  // Start at boot2 with the stack pointer the bootrom would leave.
-  core.SP = mcu.readUint32(0);
-  core.PC = FLASH;
+  // Core 0 at boot2 with the stack pointer the bootrom would leave; core 1 in the bootrom.
+  board.start(FLASH, mcu.readUint32(0));
 
+  const core = board.cores[0];
   const profile = opt.profile ? new Map() : null;
   const untilNanos = opt.untilMs === null ? Infinity : opt.untilMs * 1e6;
-  const nanosPerCycle = () => 1e9 / mcu.clkSys;
+  let steps = 0;
   let nextPoll = 0;
-  while (stop === null) {
+  while (board.stop === null) {
     if (draining && (core.waiting || --drainLeft <= 0)) {
-      stop = `${frames.length} frames shown`;
+      board.stop = `${frames.length} frames shown`;
       ok = true;
       break;
     }
-    if (core.waiting) {
-      const dt = mcu.clock.nanosToNextAlarm;
-      if (!(dt > 0) || !Number.isFinite(dt)) {
-        stop = 'the core sleeps (wfi) with no timer alarm to wake it';
+    if (profile && ledOn && frames.length < opt.profileFrames && steps % PROFILE_EVERY === 0 && board.runnable(0)) {
+      const pc = core.PC >>> 0;
+      profile.set(pc, (profile.get(pc) || 0) + 1);
+    }
+    if (board.step() < 0) {
+      if (!board.wake()) {
+        board.stop = 'both cores sleep (wfi/wfe) with no timer alarm to wake them';
         break;
       }
-      mcu.clock.tick(dt);
-      idleNanos += dt;
       if (mcu.clock.nanos >= untilNanos) nextPoll = 0; // time is up while asleep: check now
-    } else {
-      if (profile && ledOn && frames.length < opt.profileFrames && instructions % PROFILE_EVERY === 0) {
-        const pc = core.PC >>> 0;
-        profile.set(pc, (profile.get(pc) || 0) + 1);
-      }
-      const c = core.executeInstruction();
-      mcu.clock.tick(c * nanosPerCycle());
-      instructions++;
     }
-    if (instructions >= nextPoll) {
-      nextPoll = instructions + 200000;
+    steps++;
+    if (steps >= nextPoll) {
+      nextPoll = steps + 200000;
       rtt.poll();
-      if (core.IPSR === 3) stop = `HardFault at pc 0x${(core.PC >>> 0).toString(16)}`;
-      else if (core.cycles > opt.maxCycles) stop = `no result within ${opt.maxCycles} cycles`;
-      else if (display?.error) stop = `display: ${display.error}`;
-      if (mcu.clock.nanos >= untilNanos) {
-        stop = `${opt.untilMs} ms of emulated time`;
+      for (const [i, c] of board.cores.entries()) if (c.IPSR === 3) board.stop ??= `HardFault on core ${i} at pc 0x${(c.PC >>> 0).toString(16)}`;
+      if (board.time > opt.maxCycles) board.stop ??= `no result within ${opt.maxCycles} cycles`;
+      else if (display?.error) board.stop ??= `display: ${display.error}`;
+      if (mcu.clock.nanos >= untilNanos && board.stop === null) {
+        board.stop = `${opt.untilMs} ms of emulated time`;
         ok = true;
       }
     }
@@ -257,15 +249,23 @@ function main() {
   rtt.poll();
   rtt.save(opt.log);
   if (profile) writeFileSync(opt.profile, JSON.stringify([...profile.entries()]));
+  const total = board.snapshot();
   emit({
     event: 'end',
     ok,
-    reason: stop,
+    reason: board.stop,
     frames: frames.length,
-    cycles: core.cycles,
-    instructions,
+    cycles: total.cycles,
+    instructions: total.instructions,
+    coreInstructions: total.coreInstructions,
+    busy: total.busy,
+    idle: total.idle,
+    xip: total.xip,
+    xipMissCycles: board.xip ? board.xip.missCycles() : 0,
+    sclPeriodCycles: board.sclPeriod(0),
+    models: { core1: opt.core1, cache: opt.cache, timedBus: opt.timedBus },
     emulatedMs: mcu.clock.nanos / 1e6,
-    idleMs: idleNanos / 1e6,
+    idleMs: (Math.min(...total.idle.slice(0, opt.core1 ? 2 : 1)) * 1e3) / mcu.clkSys,
     clkSysHz: mcu.clkSys,
     flashBytes,
     logBytes: rtt.bytes,

@@ -1,0 +1,73 @@
+// Unit tests of what silicon.mjs adds to rp2040js, each against the RP2040 datasheet
+// (`npm test` in firmware/board; `.ci/run` runs them). The firmware itself is the rest of the
+// test: `host-sim board` requires its two-core frames to be bit-identical to host-sim's.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { Divider, Fifos, XipCache } from './silicon.mjs';
+
+test('each core reads what the other wrote, in order, 8 words deep', () => {
+  const f = new Fifos();
+  assert.equal(f.status(0) & 3, 2, 'empty: RDY, not VLD');
+  for (let i = 0; i < 8; i++) f.write(0, 100 + i);
+  assert.equal(f.status(0) & 2, 0, 'full: core 0 may not write');
+  assert.equal(f.status(1) & 1, 1, 'core 1 has data');
+  f.write(0, 999);
+  assert.equal(f.status(0) & 4, 4, 'a write to a full FIFO sets WOF');
+  for (let i = 0; i < 8; i++) assert.equal(f.read(1), 100 + i);
+  assert.equal(f.status(1) & 1, 0);
+  f.read(1);
+  assert.equal(f.status(1) & 8, 8, 'a read of an empty FIFO sets ROE');
+  f.clear(1, 8);
+  f.clear(0, 4);
+  assert.equal(f.status(0) & 12, 0);
+  assert.equal(f.status(1) & 12, 0, 'writing 1 clears the sticky flags');
+});
+
+test('the divider divides signed and unsigned, and by zero as the datasheet says', () => {
+  const d = new Divider();
+  d.write(0x068, -7 >>> 0);
+  d.write(0x06c, 2);
+  assert.equal(d.read(0x070) | 0, -3);
+  assert.equal(d.read(0x074) | 0, -1);
+  d.write(0x060, 0xffffffff);
+  d.write(0x064, 16);
+  assert.equal(d.read(0x070), 0x0fffffff);
+  assert.equal(d.read(0x074), 15);
+  d.write(0x060, 5);
+  d.write(0x064, 0);
+  assert.equal(d.read(0x070), 0xffffffff);
+  assert.equal(d.read(0x074), 5);
+});
+
+/** An SSI as boot2 for the Pico's W25Q080 leaves it: quad continuous read, SCK = clk_sys / 2. */
+const W25Q080_XIP = { baudr: 2, crtlr0: (2 << 21) | (31 << 16), spictlr0: (4 << 11) | (0 << 8) | (8 << 2) | 2 };
+
+test('a line fill takes 28 SCK periods of clk_sys / 2 after boot2', () => {
+  // 32 address and mode bits and 64 data bits on four lanes, 4 wait cycles: 8 + 4 + 16.
+  assert.equal(new XipCache(W25Q080_XIP).missCycles(), 56);
+  assert.equal(new XipCache({ baudr: 0, crtlr0: 0, spictlr0: 0 }).missCycles(), 0);
+});
+
+test('16 KiB, 2-way, 8-byte lines: a third line on a set evicts the least recently used', () => {
+  const c = new XipCache(W25Q080_XIP);
+  const way = 8192; // addresses this far apart share a set
+  assert.equal(c.access(0x10000000, 0), 56, 'cold miss');
+  assert.equal(c.access(0x10000004, 100), 0, 'same line');
+  c.access(0x10000000 + way, 200);
+  assert.equal(c.access(0x10000000, 300), 0, 'both ways hold a line');
+  c.access(0x10000000 + 2 * way, 400); // evicts the line at +way (least recently used)
+  assert.equal(c.access(0x10000000, 500), 0);
+  assert.equal(c.access(0x10000000 + way, 600), 56);
+  assert.deepEqual([c.hits, c.misses], [3, 4]);
+});
+
+test('no-allocate and no-cache aliases, and misses queue on the one flash interface', () => {
+  const c = new XipCache(W25Q080_XIP);
+  c.access(0x11000100, 0);
+  assert.equal(c.access(0x10000100, 1000), 56, 'XIP_NOALLOC does not fill the cache');
+  assert.equal(c.access(0x12000100, 2000), 56, 'XIP_NOCACHE always goes to the flash');
+  assert.equal(c.uncached, 1);
+  // Two misses at the same moment (one per core): the second waits for the first.
+  assert.equal(c.access(0x10002000, 5000), 56);
+  assert.equal(c.access(0x10003000, 5000), 112);
+});

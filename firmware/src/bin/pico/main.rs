@@ -1,0 +1,116 @@
+//! Raspberry Pi Pico (RP2040, `--features pico`, fixed point) or Pico 2 (RP2350, Cortex-M33
+//! with an FPU, `--features pico2`, f32) + SSD1306 128x64 OLED on I2C: renders the embedded
+//! scenes in turn, tile by tile straight to the display (each 8x8 tile is one SSD1306 page high,
+//! so it is sent as eight column bytes; no framebuffer), core 1 tracing every second tile, and
+//! logs per-frame time and statistics over defmt-rtt.
+//!
+//! The on-board LED is lit while a frame is being rendered and goes out when the frame is on
+//! the display; between scenes the core sleeps (`wfi`) until a timer alarm. With no display
+//! answering, the log says so and the LED blinks quickly while the firmware retries every
+//! second. `host-sim board` runs this image on an emulated RP2040 (both cores, the flash cache,
+//! the I2C bus's timing) and relies on that LED protocol.
+//!
+//! The rooms: [`wiring`] (the pins, address and bus clock: the one place to change them),
+//! [`display`] (the SSD1306 as a draw target), [`cores`] (core 1), [`sleep`] (the timer alarm),
+//! [`modes`] (what is shown: scenes, orbit or ladder). The two boards differ only in what their
+//! HALs name differently (boot block, timer, its interrupt); each difference is one `cfg`.
+#![no_std]
+#![no_main]
+
+mod cores;
+mod display;
+mod modes;
+mod sleep;
+mod wiring;
+
+use defmt_rtt as _;
+use firmware::app::{ShareMemory, Storage, HEIGHT, SCENES, WIDTH};
+use hal::pac;
+use hal::Clock;
+use panic_probe as _;
+#[cfg(feature = "pico")]
+use rp2040_hal as hal;
+#[cfg(feature = "pico2")]
+use rp235x_hal as hal;
+use ssd1306::prelude::*;
+use wiring::Wiring;
+
+#[cfg(all(feature = "pico", feature = "pico2"))]
+compile_error!("choose one board: `pico` (RP2040) or `pico2` (RP2350)");
+
+/// The second-stage bootloader for the Pico's W25Q080 flash.
+#[cfg(feature = "pico")]
+#[link_section = ".boot2"]
+#[used]
+pub static BOOT2: [u8; 256] = rp2040_boot2::BOOT_LOADER_W25Q080;
+
+/// The RP2350's image definition: the boot ROM starts a secure Arm image from it.
+#[cfg(feature = "pico2")]
+#[link_section = ".start_block"]
+#[used]
+pub static IMAGE_DEF: hal::block::ImageDef = hal::block::ImageDef::secure_exe();
+
+/// What `picotool info` shows about the Pico 2 image.
+#[cfg(feature = "pico2")]
+#[link_section = ".bi_entries"]
+#[used]
+pub static PICOTOOL_ENTRIES: [hal::binary_info::EntryAddr; 4] = [
+    hal::binary_info::rp_cargo_bin_name!(),
+    hal::binary_info::rp_cargo_version!(),
+    hal::binary_info::rp_program_description!(c"lattice-rt: a lattice ray tracer on an SSD1306"),
+    hal::binary_info::rp_cargo_homepage_url!(),
+];
+
+/// The board's name in the log.
+#[cfg(feature = "pico")]
+const BOARD: &str = "Pico (RP2040)";
+/// The board's name in the log.
+#[cfg(feature = "pico2")]
+const BOARD: &str = "Pico 2 (RP2350)";
+
+/// The Pico's crystal.
+const XTAL_FREQ_HZ: u32 = 12_000_000;
+
+#[hal::entry]
+fn main() -> ! {
+    let mut pac = pac::Peripherals::take().unwrap();
+    let mut watchdog = hal::Watchdog::new(pac.WATCHDOG);
+    let Ok(clocks) = hal::clocks::init_clocks_and_plls(
+        XTAL_FREQ_HZ,
+        pac.XOSC,
+        pac.CLOCKS,
+        pac.PLL_SYS,
+        pac.PLL_USB,
+        &mut pac.RESETS,
+        &mut watchdog,
+    ) else {
+        defmt::panic!("the clocks did not start (crystal or PLL)");
+    };
+    let sio = hal::Sio::new(pac.SIO);
+    let pins = hal::gpio::Pins::new(pac.IO_BANK0, pac.PADS_BANK0, sio.gpio_bank0, &mut pac.RESETS);
+    let (bus, mut led) = wiring::connect(pins, pac.I2C0, &mut pac.RESETS, &clocks.system_clock);
+    #[cfg(feature = "pico")]
+    let timer_block = pac.TIMER;
+    #[cfg(feature = "pico2")]
+    let timer_block = pac.TIMER0;
+    let (timer, mut alarm) = sleep::start(timer_block, &mut pac.RESETS, &clocks);
+
+    let interface = ssd1306::I2CDisplayInterface::new_custom_address(display::CheckedI2c(bus), Wiring::ADDRESS);
+    let mut display = ssd1306::Ssd1306::new(interface, DisplaySize128x64, DisplayRotation::Rotate0);
+    while display.init().is_err() {
+        defmt::error!(
+            "no SSD1306 answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
+            Wiring::SDA, Wiring::SCL, Wiring::ADDRESS
+        );
+        sleep::blink(&mut led, &mut alarm, 5);
+    }
+    let cores = cores::TwoCores::start(&mut pac.PSM, &mut pac.PPB, sio.fifo);
+    defmt::info!(
+        "lattice-rt on the {}: {} scenes, {}x{}, {} MHz, I2C at {} kHz, both cores",
+        BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz(), Wiring::I2C_HZ / 1000
+    );
+    let mut st = Storage::new();
+    let mut second = ShareMemory::new();
+    let target = display::PageTiles { display };
+    modes::run(modes::Panel { target, led, timer, alarm, cores, st: &mut st, second: &mut second })
+}

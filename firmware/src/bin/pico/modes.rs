@@ -1,0 +1,129 @@
+//! What the firmware shows, one mode per build: the embedded scenes in turn (the default), an
+//! orbit around each (`orbit`), or the ladder of levers on the first scene (`ladder`).
+
+use crate::sleep::{sleep_ms, Alarm0, Timer};
+use crate::cores::TwoCores;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::pixelcolor::BinaryColor;
+use embedded_hal::digital::OutputPin;
+use firmware::app::{render_scene_at, AppError, Board, Report, Scalar, ShareMemory, Shot, Storage};
+#[cfg(not(feature = "ladder"))]
+use firmware::app::SCENES;
+#[cfg(not(feature = "ladder"))]
+use firmware::stack;
+use lattice_rt::NoHooks;
+
+/// The pause between two scenes.
+const PAUSE_MS: u32 = 3000;
+
+/// The board as the modes use it: the display, the LED, the clock, both cores and the memory
+/// of a frame.
+pub struct Panel<'m, T, L> {
+    /// The display, drawn tile by tile.
+    pub target: T,
+    /// Lit while a frame renders.
+    pub led: L,
+    /// The 1 MHz timer frames are timed with.
+    pub timer: Timer,
+    /// The alarm the firmware sleeps on between scenes.
+    pub alarm: Alarm0,
+    /// Core 1, which traces the second tile share of every frame.
+    pub cores: TwoCores,
+    /// The scene, its lattice and core 0's scratch.
+    pub st: &'m mut Storage<Scalar>,
+    /// Core 1's scratch and 1-bit frame.
+    pub second: &'m mut ShareMemory,
+}
+
+impl<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin> Panel<'_, T, L> {
+    /// One frame, with the LED lit while it renders; its report and microseconds. A progressive
+    /// frame (the `progressive` feature) puts the LED out for a moment as each pass but the last
+    /// reaches the display, so the LED goes out once per picture the panel shows.
+    pub fn show(&mut self, text: &'static str, shot: &Shot) -> Result<(Report, u64), AppError<'static, T::Error>> {
+        let timer = self.timer;
+        let t0 = timer.get_counter();
+        let _ = self.led.set_high();
+        let led = &mut self.led;
+        let mut shown = |pass: u8| {
+            if pass > 1 {
+                let _ = led.set_low();
+                let _ = led.set_high();
+            }
+        };
+        let now = || timer.get_counter().ticks();
+        let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut shown };
+        let result = render_scene_at(text, self.st, &mut self.target, &mut NoHooks, shot, board);
+        let _ = self.led.set_low();
+        result.map(|r| (r, (timer.get_counter() - t0).to_micros()))
+    }
+
+    /// Sleeps between scenes.
+    pub fn pause(&mut self) {
+        sleep_ms(&mut self.alarm, PAUSE_MS);
+    }
+}
+
+/// The embedded scenes in turn, each frame's time and statistics logged.
+#[cfg(not(any(feature = "orbit", feature = "ladder")))]
+pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+    loop {
+        for (name, text) in SCENES {
+            match panel.show(text, &Shot::default()) {
+                Ok((r, us)) => {
+                    let (s, shares) = (r.stats, r.share_us);
+                    defmt::info!(
+                        "{}: {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
+                        name, us / 1000, shares[0], shares[1], s.total_rays(), s.rays[1], s.rays[2], s.rays[3], s.object_tests, s.cells_visited,
+                        r.lattice_bytes, stack::high_water()
+                    );
+                }
+                Err(e) => defmt::error!("{}: {}", name, e),
+            }
+            panel.pause();
+        }
+    }
+}
+
+/// Orbit mode: the camera circles each scene, frame after frame, for one turn.
+#[cfg(all(feature = "orbit", not(feature = "ladder")))]
+pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+    use firmware::app::ORBIT_FRAMES;
+    loop {
+        for (name, text) in SCENES {
+            let t0 = panel.timer.get_counter();
+            for i in 0..ORBIT_FRAMES {
+                let shot = Shot { turn: i as f64 / ORBIT_FRAMES as f64, ..Shot::default() };
+                if let Err(e) = panel.show(text, &shot) {
+                    defmt::error!("{}: orbit frame {}: {}", name, i, e);
+                    break;
+                }
+            }
+            let us = (panel.timer.get_counter() - t0).to_micros().max(1);
+            let centi_fps = ORBIT_FRAMES as u64 * 100_000_000 / us;
+            defmt::info!(
+                "{}: orbit of {} frames in {} ms: {}.{=u64:02} frames per second, stack high-water {} B",
+                name, ORBIT_FRAMES, us / 1000, centi_fps / 100, centi_fps % 100, stack::high_water()
+            );
+            panel.pause();
+        }
+    }
+}
+
+/// The ladder: the first scene once per rung, from the paper's method to the default.
+#[cfg(feature = "ladder")]
+pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+    use firmware::app::{LADDER, SCENES};
+    loop {
+        let (name, text) = SCENES[0];
+        for (rung, (what, tuning)) in LADDER.iter().enumerate() {
+            match panel.show(text, &Shot { turn: 0.0, tuning: *tuning }) {
+                Ok((r, us)) => defmt::info!(
+                    "ladder {}: {}: {} us, shares {} us and {} us, object tests {}, cells {} ({})",
+                    rung, name, us, r.share_us[0], r.share_us[1], r.stats.object_tests, r.stats.cells_visited, what
+                ),
+                Err(e) => defmt::error!("ladder {}: {}: {}", rung, name, e),
+            }
+        }
+        panel.pause();
+    }
+}
