@@ -43,7 +43,17 @@ fn main() {
     let core = if m33 { "m33" } else if target.starts_with("thumbv7em") { "m4f" } else { "m0" };
     println!("cargo:rustc-env=FIRMWARE_CORE={core}");
     println!("cargo:rerun-if-env-changed=FIRMWARE_SCENES");
+    // The Pico's hot code runs from SRAM (pico/ram-code.x), unless `code-in-flash` keeps it in
+    // flash behind the XIP cache (to measure what that costs). Its script comes before link.x,
+    // so that its sections claim their input sections before link.x's `.text` can.
+    println!("cargo:rerun-if-changed=pico/ram-code.x");
+    if pico && env::var_os("CARGO_FEATURE_CODE_IN_FLASH").is_none() {
+        fs::copy("pico/ram-code.x", out.join("ram-code.x")).expect("ram-code.x");
+        println!("cargo:rustc-link-arg-bins=-Tram-code.x");
+        println!("cargo:rustc-cfg=ram_code");
+    }
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
+    println!("cargo::rustc-check-cfg=cfg(ram_code)");
     if pico || pico2 {
         println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
     }

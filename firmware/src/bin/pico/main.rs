@@ -12,7 +12,7 @@
 //!
 //! The rooms: [`wiring`] (the pins, address and bus clock: the one place to change them),
 //! [`display`] (the SSD1306 as a draw target), [`cores`] (core 1), [`sleep`] (the timer alarm),
-//! [`modes`] (what is shown: scenes, orbit or ladder). The two boards differ only in what their
+//! [`modes`] (what is shown: scenes, orbit or ladder), [`ram_code`] (the hot code copied to SRAM). The two boards differ only in what their
 //! HALs name differently (boot block, timer, its interrupt); each difference is one `cfg`.
 #![no_std]
 #![no_main]
@@ -20,6 +20,7 @@
 mod cores;
 mod display;
 mod modes;
+mod ram_code;
 mod sleep;
 mod wiring;
 
@@ -73,6 +74,7 @@ const XTAL_FREQ_HZ: u32 = 12_000_000;
 
 #[hal::entry]
 fn main() -> ! {
+    ram_code::load();
     let mut pac = pac::Peripherals::take().unwrap();
     let mut watchdog = hal::Watchdog::new(pac.WATCHDOG);
     let Ok(clocks) = hal::clocks::init_clocks_and_plls(
