@@ -5,7 +5,7 @@
 //   {"event":"frame", ...}  each frame the panel shows: the moment the board's LED (GP25, lit
 //                           while a frame is being rendered) goes out, with the cycles the frame
 //                           took, each core's busy and idle cycles, the XIP cache's hits,
-//                           misses and stall, the I2C bus's bytes and busy time, and the
+//                           misses and stall, the I2C bus's bytes and busy cycles, and the
 //                           panel's pixels as hex rows
 //   {"event":"end", ...}    why the run ended, with totals
 // The device's defmt log (the RTT up channel, read as a probe reads it) goes to --log as raw
@@ -15,7 +15,8 @@
 // bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2; core 1
 // starts in the bootrom and waits there for the launch sequence.
 //
-// --no-core1, --no-cache and --untimed-bus leave a model out (to measure what each adds).
+// --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
+// leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
 // With --profile FILE it also samples core 0's program counter every 97th instruction of the
 // first frame (--profile-frames N: of the first N frames; while the LED is lit) and writes the
 // counts as JSON pairs [pc, samples].
@@ -195,6 +196,7 @@ function main() {
       setupCycles: first.cycles - frameStart.cycles,
       setupInstructions: first.instructions - frameStart.instructions,
       i2cBytes: d('i2cBytes'),
+      i2cBusCycles: d('busCycles'),
       i2cTransfers: d('i2cTransfers'),
       startMs: frameStart.nanos / 1e6,
       endMs: end.nanos / 1e6,

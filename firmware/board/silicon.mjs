@@ -420,6 +420,7 @@ export class SiliconBoard {
     this.instructions = [0, 0];
     this.time = 0; // cycles both cores have reached
     this.spklen = [7, 7]; // IC_FS_SPKLEN as written (rp2040js drops odd values)
+    this.busCycles = 0; // cycles the I2C buses spent on START, bytes and STOP
     this.stop = null; // why the run must end
     this.onBreakHook = null;
   }
@@ -560,7 +561,9 @@ export class SiliconBoard {
 
   /** Runs `fn` once `periods` SCL periods of controller `n` have passed on the bus. */
   afterScl(n, periods, fn) {
-    const nanos = (periods * this.sclPeriod(n) * 1e9) / this.mcu.clkSys;
+    const cycles = periods * this.sclPeriod(n);
+    this.busCycles += cycles;
+    const nanos = (cycles * 1e9) / this.mcu.clkSys;
     this.mcu.clock.createAlarm(fn).schedule(nanos);
   }
 
@@ -612,6 +615,7 @@ export class SiliconBoard {
       instructions: this.instructions[0] + this.instructions[1],
       coreInstructions: [...this.instructions],
       nanos: this.mcu.clock.nanos,
+      busCycles: this.busCycles,
       xip: this.xip ? this.xip.counters() : { hits: 0, misses: 0, uncached: 0, stallCycles: 0 },
     };
   }

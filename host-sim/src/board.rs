@@ -1,11 +1,12 @@
 //! `host-sim board`: the Pico image a user flashes, run on an emulated RP2040 with an SSD1306.
 //!
 //! Builds the image exactly as `cargo pico-build` does (flip-link and all), writes its UF2 file,
-//! runs that UF2 on rp2040js (`firmware/board/run.mjs`: core 0, the B1 bootrom, an SSD1306 model
-//! on I2C0), decodes the device's defmt log from its RTT buffer, and requires every frame the
-//! panel shows to be bit-identical to host-sim's render of the same scene in the same scalar. A
-//! second run with no display on the bus checks the documented message. Writes the measured
-//! budgets (cycles, instructions, I2C bytes, flash, stack) to `docs/board.md`.
+//! runs that UF2 on an RP2040 as silicon runs it (`firmware/board/run.mjs`: rp2040js with core 1,
+//! the XIP cache and a timed I2C bus, the B1 bootrom, an SSD1306 model on I2C0), decodes the
+//! device's defmt log from its RTT buffer, and requires every frame the panel shows to be
+//! bit-identical to host-sim's render of the same scene in the same scalar. A second run with no
+//! display on the bus checks the documented message. Writes the measured budgets (cycles per
+//! core, cache misses, bus time, flash, stack) to `docs/board.md`.
 //!
 //! `host-sim uf2` is the first half alone: the UF2 file to drag onto a Pico (or, with
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
@@ -24,9 +25,9 @@ use std::process::{Command, Stdio};
 const PICO_SCALAR: &str = "fixed";
 /// Width and height of the SSD1306 panel.
 const PANEL: (u32, u32) = (128, 64);
-/// The Pico's I2C clock (`I2C_HZ` in `firmware/src/bin/pico.rs`); 9 bit times per byte,
-/// address bytes included.
-const I2C_HZ: f64 = 400_000.0;
+/// What a frame may cost on the Pico (cycles at 125 MHz, LED on to LED off): 10 frames per
+/// second for the chair, 5 for the other paper scenes, 2 for the Whitted scene.
+const TARGETS: &[(&str, f64)] = &[("chair", 12.5e6), ("desk", 25e6), ("polyhedron", 25e6), ("spheres", 25e6), ("whitted", 62e6)];
 /// Cycles a frame may take before the run is called stuck (the Whitted scene needs about 1 G).
 const MAX_CYCLES_PER_FRAME: u64 = 3_000_000_000;
 /// The message the firmware logs when no display answers (checked in the run without one).
@@ -108,6 +109,20 @@ pub fn build_board(root: &Path, board: Board) -> Result<PathBuf> {
     Ok(root.join("firmware/target").join(board.target()).join(profile).join("pico"))
 }
 
+/// The silicon models the emulator can leave out (`run.mjs` switches), to show what each adds
+/// to the first scene's frame.
+const MODELS: &[(&str, &[&str])] = &[
+    ("the XIP cache", &["--no-cache"]),
+    ("the I2C bus's timing", &["--untimed-bus"]),
+    ("either", &["--no-cache", "--untimed-bus"]),
+];
+
+/// Build-time levers measured against the default image (firmware features, the chair alone).
+const LEVERS: &[(&str, &str)] = &[
+    ("code-in-flash", "the code in flash, behind the 16 KiB XIP cache (the default image runs its hot code from SRAM)"),
+    ("i2c-1mhz", "the display's bus at 1 MHz (fast mode plus) instead of 400 kHz"),
+];
+
 /// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).
 const ORBIT_CHECKED: usize = 4;
 
@@ -140,7 +155,7 @@ fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, fra
     let uf2 = dir.join(format!("lattice-rt-pico-{feature}.uf2"));
     write_uf2(&elf, &uf2)?;
     eprintln!("running {} ({frames} frames)", uf2.display());
-    let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir)?;
+    let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir, &[])?;
     Ok((run, dir))
 }
 
@@ -201,10 +216,17 @@ fn prepare_emulator(root: &Path) -> Result<PathBuf> {
 struct PanelFrame {
     cycles: u64,
     instructions: u64,
+    /// Cycles each core ran instructions (core 0, core 1).
+    busy: [u64; 2],
+    /// Cycles each core slept (`wfe`/`wfi`).
+    idle: [u64; 2],
+    /// Flash reads that missed the XIP cache, and the cycles the cores stalled for them.
+    xip_misses: u64,
+    xip_stall: u64,
+    /// Cycles the I2C bus was busy (START, bytes, STOP).
+    i2c_bus_cycles: u64,
     setup_cycles: u64,
-    setup_instructions: u64,
     i2c_bytes: u64,
-    i2c_transfers: u64,
     error: Option<String>,
     pixels: Vec<u8>,
 }
@@ -216,6 +238,10 @@ struct BoardRun {
     ok: bool,
     reason: String,
     clk_sys_hz: f64,
+    /// Cycles one XIP cache line fill takes, as boot2 set the flash up.
+    xip_miss_cycles: u64,
+    /// Cycles of one SCL period, as the firmware set the I2C controller up.
+    scl_period: u64,
     emulated_ms: f64,
     idle_ms: f64,
     display_initialised: bool,
@@ -232,8 +258,10 @@ struct LogLine {
     text: String,
 }
 
-/// Runs `uf2` in the emulator and decodes its log with the ELF's defmt table.
-fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usize, display: bool, work: &Path) -> Result<BoardRun> {
+/// Runs `uf2` in the emulator (with `models` switches such as `--no-cache`) and decodes its log
+/// with the ELF's defmt table.
+#[allow(clippy::too_many_arguments)]
+fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usize, display: bool, work: &Path, models: &[&str]) -> Result<BoardRun> {
     let elf_bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file = object::File::parse(&*elf_bytes)?;
     let rtt = file
@@ -247,9 +275,10 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
         .args(["--uf2".as_ref(), uf2.as_os_str(), "--bootrom".as_ref(), bootrom.as_os_str(), "--log".as_ref(), log_path.as_os_str()])
         .args(["--rtt", &format!("{rtt:#x}"), "--frames", &frames.to_string()])
         .args(["--max-cycles", &(MAX_CYCLES_PER_FRAME * frames.max(1) as u64).to_string()])
+        .args(models)
         .stdin(Stdio::null())
         .stdout(Stdio::piped());
-    if display {
+    if display && models.is_empty() {
         cmd.arg("--profile").arg(work.join("profile.json"));
     } else {
         cmd.args(["--no-display", "--until-ms", "2500"]);
@@ -261,6 +290,7 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
         let line = line?;
         let v: serde_json::Value = serde_json::from_str(&line).with_context(|| format!("emulator printed `{line}`"))?;
         let num = |k: &str| v[k].as_f64().unwrap_or(0.0);
+        let pair = |k: &str| [0, 1].map(|i| v[k][i].as_f64().unwrap_or(0.0) as u64);
         match v["event"].as_str() {
             Some("frame") => {
                 let pixels = v["pixels"].as_str().map(hex_bytes).unwrap_or_default();
@@ -268,10 +298,13 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
                 run.frames.push(PanelFrame {
                     cycles: num("cycles") as u64,
                     instructions: num("instructions") as u64,
+                    busy: pair("busy"),
+                    idle: pair("idle"),
+                    xip_misses: num("xipMisses") as u64,
+                    xip_stall: num("xipStallCycles") as u64,
+                    i2c_bus_cycles: num("i2cBusCycles") as u64,
                     setup_cycles: num("setupCycles") as u64,
-                    setup_instructions: num("setupInstructions") as u64,
                     i2c_bytes: num("i2cBytes") as u64,
-                    i2c_transfers: num("i2cTransfers") as u64,
                     error: v["error"].as_str().map(String::from),
                     pixels,
                 });
@@ -280,6 +313,8 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
                 run.ok = v["ok"].as_bool().unwrap_or(false);
                 run.reason = v["reason"].as_str().unwrap_or("").to_string();
                 run.clk_sys_hz = num("clkSysHz");
+                run.xip_miss_cycles = num("xipMissCycles") as u64;
+                run.scl_period = num("sclPeriodCycles") as u64;
                 run.emulated_ms = num("emulatedMs");
                 run.idle_ms = num("idleMs");
                 run.display_initialised = v["displayInitialised"].as_bool().unwrap_or(false);
@@ -366,7 +401,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let mut passed = 0;
 
     eprintln!("running {} on rp2040js with an SSD1306 ({} scenes)", uf2.display(), scenes.len());
-    let run = run_emulator(root, &elf, &uf2, &bootrom, scenes.len(), true, frames_dir)?;
+    let run = run_emulator(root, &elf, &uf2, &bootrom, scenes.len(), true, frames_dir, &[])?;
     for l in &run.log {
         eprintln!("  device {:5} {}", l.level, l.text);
         if l.level == "ERROR" {
@@ -407,7 +442,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
 
     eprintln!("running the same image with no display on the bus");
-    let bare = run_emulator(root, &elf, &uf2, &bootrom, 0, false, frames_dir)?;
+    let bare = run_emulator(root, &elf, &uf2, &bootrom, 0, false, frames_dir, &[])?;
     let said = bare.log.iter().any(|l| l.level == "ERROR" && l.text.contains(NO_DISPLAY_MESSAGE));
     let panicked = bare.log.iter().any(|l| l.text.contains("panicked"));
     if bare.ok && said && !panicked && bare.led_toggles >= 4 {
@@ -419,6 +454,41 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
             bare.reason,
             bare.led_toggles
         ));
+    }
+
+    // What each silicon model adds: the first scene's frame with a model left out, and the
+    // image's build-time levers, each frame bit for bit against host-sim's.
+    let first = scenes.first().context("no scene")?;
+    let first_want = host_frame(&scenes_dir, first, PICO_SCALAR, false)?;
+    let mut models = Vec::new();
+    for (what, switches) in MODELS {
+        let dir = frames_dir.join("models");
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        eprintln!("running the image without {what}");
+        let m = run_emulator(root, &elf, &uf2, &bootrom, 1, true, &dir, switches)?;
+        match m.frames.into_iter().next() {
+            Some(f) if f.pixels == first_want => {
+                passed += 1;
+                models.push((*what, f));
+            }
+            Some(_) => failures.push(format!("without {what}: the {first} differs from host-sim")),
+            None => failures.push(format!("without {what}: no frame shown ({})", m.reason)),
+        }
+    }
+    let mut levers = Vec::new();
+    for (feature, what) in LEVERS {
+        let (lrun, dir) = run_variant(root, no_build, feature, false, frames_dir, &bootrom, 1)?;
+        match lrun.frames.into_iter().next() {
+            Some(f) if f.pixels == host_frame(&scenes_dir, "chair", PICO_SCALAR, false)? => {
+                passed += 1;
+                levers.push((*feature, *what, f));
+            }
+            Some(f) => {
+                save_frame(&f.pixels, &dir.join("chair.png"))?;
+                failures.push(format!("`{feature}`: the chair differs from host-sim (see {}/chair.png)", dir.display()));
+            }
+            None => failures.push(format!("`{feature}`: no frame shown ({})", lrun.reason)),
+        }
     }
 
     // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
@@ -518,9 +588,10 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         None => failures.push(format!("outline: no frame shown ({})", lrun_outline.reason)),
     }
 
-    let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms };
+    let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period };
     let profile = profile_shares(&elf, &frames_dir.join("profile.json"))?;
     let mut md = report(&summary, &rows, flash, static_ram, &bare, &scenes, &profile)?;
+    md.push_str(&silicon_report(&summary, rows.first().map(|r| &r.frame), &models, &levers)?);
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
     md.push_str(&progressive_report(&progressive, run.clk_sys_hz)?);
@@ -641,8 +712,8 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
             r.passes.iter().map(|f| f.i2c_bytes).sum::<u64>(),
         )?;
     }
-    writeln!(md, "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The I2C bytes are four frames' worth: at 400 kHz", 1e3 / mhz)?;
-    writeln!(md, "each pass's page bytes take about 57.6 ms on the bus, which the emulator does not model.")?;
+    writeln!(md, "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The I2C bytes are four frames' worth, each on the", 1e3 / mhz)?;
+    writeln!(md, "emulated bus for the time it takes there.")?;
     Ok(md)
 }
 
@@ -656,7 +727,7 @@ fn outline_report(f: &PanelFrame, rays: [u64; 2], same: bool, plain: &PanelFrame
     writeln!(md, "seat stand out from a floor of the same gray. Each tile traces its own apron (hit-only eye rays")?;
     writeln!(md, "through the column left of it and the row above), so the lines need nothing from the other")?;
     writeln!(md, "core's tiles. The frame the panel showed was {} host-sim's.\n", if same { "bit-identical to" } else { "**not** the same as" })?;
-    writeln!(md, "| chair | cycles | eye rays | frames per second at {:.0} MHz, one core |\n|---|---:|---:|---:|", clk_hz / 1e6)?;
+    writeln!(md, "| chair | cycles | eye rays | frames per second at {:.0} MHz |\n|---|---:|---:|---:|", clk_hz / 1e6)?;
     writeln!(md, "| without lines (the default image) | {:.1} M | {} | {:.2} |", plain.cycles as f64 / 1e6, rays[0], clk_hz / plain.cycles.max(1) as f64)?;
     writeln!(md, "| with lines | {:.1} M ({:.2}x) | {} | {:.2} |", f.cycles as f64 / 1e6, f.cycles as f64 / plain.cycles.max(1) as f64, rays[1], clk_hz / f.cycles.max(1) as f64)?;
     writeln!(md, "\n![the chair on the emulated panel, without and with lines](images/board-chair.png) ![with lines](images/board-chair-outline.png)")?;
@@ -703,118 +774,179 @@ fn ladder_report(rungs: &[Rung<'_>], clk_hz: f64) -> Result<String> {
     writeln!(md, "The image built with `--features ladder` (the chair alone) renders the chair once per rung of")?;
     writeln!(md, "`LADDER` (`firmware/src/frame.rs`), from the paper's method to what the boards run, each rung")?;
     writeln!(md, "switching one more lever on at run time; every frame is checked bit for bit against host-sim's")?;
-    writeln!(md, "render with the same levers. *Tiles* are cycles from the first byte of the first tile on the")?;
-    writeln!(md, "bus to the LED going out, as above (target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz).")?;
-    writeln!(md, "The frame is traced in two tile shares, a checkerboard of tiles: on a Pico core 0 traces share 0")?;
-    writeln!(md, "straight to the display while core 1 traces share 1 into a 1-bit frame that core 0 then sends.")?;
-    writeln!(md, "rp2040js runs core 0 alone, so there core 0 traces both, one after the other, and times each")?;
-    writeln!(md, "with the RP2040 timer (1 us, {mhz:.0} cycles). *Two cores* is set-up + the larger share + what")?;
-    writeln!(md, "is left of the tiles' cycles once both shares are taken out (sending share 1): the frame with")?;
-    writeln!(md, "each core tracing its own share. It is computed from core 0's shares, not measured on two cores")?;
-    writeln!(md, "(the emulator has no core 1; on silicon the cores also contend for the flash cache and RAM).\n")?;
-    writeln!(md, "| rung | tiles: cycles | instructions | object tests | share 0 | share 1 | tiles on two cores | fps at {mhz:.0} MHz, one core / two |")?;
+    writeln!(md, "render with the same levers. *Cycles* are the whole frame as above (set-up, both cores, the bus;")?;
+    writeln!(md, "target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz). Core 0 traces tile share 0")?;
+    writeln!(md, "straight to the display while core 1 traces share 1 into a 1-bit frame that core 0 then sends;")?;
+    writeln!(md, "*share 0* and *share 1* are each core's time on its share as the device's timer measured it.\n")?;
+    writeln!(md, "| rung | cycles | frames per second at {mhz:.0} MHz | instructions | object tests | share 0 (core 0) | share 1 (core 1) | core 1 idle |")?;
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|")?;
     let mut first = None;
     for r in rungs {
         let f = r.frame;
-        let tiles = f.cycles - f.setup_cycles;
-        let base = *first.get_or_insert(tiles);
-        let [a, b] = r.shares.map(|us| us as f64 * mhz);
-        // What core 0 does beyond tracing: sending share 1 (and the set-up, counted apart).
-        let rest = (tiles as f64 - a - b).max(0.0);
-        let two = a.max(b) + rest;
+        let base = *first.get_or_insert(f.cycles);
+        let [a, b] = r.shares.map(|us| (us as f64 * mhz) as u64);
         writeln!(
             md,
-            "| {} | {:.1} M ({:.1}x) | {:.1} M | {} | {:.1} M | {:.1} M | {:.1} M | {:.2} / {:.2} |",
+            "| {} | {} ({:.1}x) | {:.2} | {} | {} | {} | {} | {} |",
             r.what,
-            tiles as f64 / 1e6,
-            base as f64 / tiles.max(1) as f64,
-            (f.instructions - f.setup_instructions) as f64 / 1e6,
-            r.tests,
-            a / 1e6,
-            b / 1e6,
-            two / 1e6,
+            m(f.cycles),
+            base as f64 / f.cycles.max(1) as f64,
             clk_hz / f.cycles.max(1) as f64,
-            clk_hz / (f.setup_cycles as f64 + two).max(1.0),
+            m(f.instructions),
+            r.tests,
+            m(a),
+            m(b),
+            m(f.idle[1]),
         )?;
     }
     Ok(md)
 }
 
-/// Clock and time of the run with the display.
+/// Clock, time and bus figures of the run with the display.
 struct Summary {
     clk_hz: f64,
     emulated_ms: f64,
     idle_ms: f64,
+    xip_miss_cycles: u64,
+    scl_period: u64,
 }
 
-/// docs/board.md.
-#[allow(clippy::too_many_arguments)]
+/// Millions, one decimal.
+fn m(cycles: u64) -> String {
+    format!("{:.1} M", cycles as f64 / 1e6)
+}
+
+/// docs/board.md's head: the run, a frame per scene against the targets, where the first
+/// frame's time goes.
 fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &BoardRun, scenes: &[String], profile: &[(String, f64)]) -> Result<String> {
     let mut md = String::new();
     let mhz = s.clk_hz / 1e6;
     writeln!(md, "# The Pico image on an emulated board\n")?;
     writeln!(md, "Written by `cargo run --release -p host-sim -- board` (also run by `.ci/run`). It builds the image")?;
-    writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, flip-link), writes its UF2 file, runs that")?;
-    writeln!(md, "file on [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 (core 0 of an RP2040, the B1 bootrom)")?;
-    writeln!(md, "with an SSD1306 model on I2C0, decodes the defmt log, and requires every frame the panel shows to")?;
-    writeln!(md, "be bit-identical to host-sim's render of the scene (128x64, fixed point, blue-noise dither). Scenes embedded:")?;
-    writeln!(md, "{}.\n", scenes.join(", "))?;
+    writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, flip-link), writes its UF2 file, and runs that")?;
+    writeln!(md, "file on an RP2040 as silicon runs it: [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 with what")?;
+    writeln!(md, "`firmware/board/silicon.mjs` adds from the RP2040 datasheet, **core 1** (started by the B1 bootrom and")?;
+    writeln!(md, "rp2040-hal's launch handshake, per-core SIO FIFOs, divider, NVIC and MPU stack guard), the **16 KiB")?;
+    writeln!(md, "XIP flash cache** and the **I2C bus's timing**, with an SSD1306 model on I2C0. It decodes the defmt log")?;
+    writeln!(md, "and requires every frame the panel shows to be bit-identical to host-sim's render of the scene")?;
+    writeln!(md, "(128x64, fixed point, blue-noise dither): core 0 traces one tile share, core 1 the other. Every")?;
+    writeln!(md, "figure below is what the emulated board ran; none is computed. Scenes embedded: {}.\n", scenes.join(", "))?;
     writeln!(md, "## Per frame\n")?;
     writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;
-    writeln!(md, "frame on the panel: parsing the scene, building its lattice, tracing and sending every tile.")?;
-    writeln!(md, "*Set-up* is the part before the first byte of the first tile reaches the display; the rest, from")?;
-    writeln!(md, "there to the last byte of the last tile, is *tiles*. Cycles are")?;
-    writeln!(md, "rp2040js's count; milliseconds are those cycles at the configured clock ({mhz:.0} MHz).\n")?;
-    writeln!(md, "| scene | cycles | instructions | cycles / instruction | set-up cycles | tiles: first to last | ms at {mhz:.0} MHz | I2C transfers | I2C bytes | I2C time at 400 kHz | stack high-water |")?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    writeln!(md, "frame on the panel: parsing the scene and building its lattice (*set-up*, core 0 alone, up to the")?;
+    writeln!(md, "first byte of the first tile on the bus), then both cores tracing their tile shares and core 0")?;
+    writeln!(md, "sending every tile. *Busy* is cycles a core ran instructions (waiting for the bus or the other")?;
+    writeln!(md, "core in a loop included), *idle* cycles it slept (`wfe`). *Misses* are flash reads that missed")?;
+    writeln!(md, "the XIP cache ({} cycles each, queued when both cores miss); *bus* is the time the I2C bus was busy", s.xip_miss_cycles)?;
+    writeln!(md, "({} cycles per SCL period, {:.1} kHz).\n", s.scl_period, s.clk_hz / s.scl_period.max(1) as f64 / 1e3)?;
+    writeln!(md, "| scene | cycles | frames per second at {mhz:.0} MHz | target | set-up | core 0 busy | core 1 busy / idle | instructions | XIP misses (stall) | I2C bytes | bus | stack high-water |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     for r in rows {
         let f = &r.frame;
+        let target = TARGETS.iter().find(|t| t.0 == r.name).map_or("-".to_string(), |t| {
+            format!("{:.1} M ({})", t.1 / 1e6, if (f.cycles as f64) <= t.1 { "met" } else { "not met" })
+        });
         writeln!(
             md,
-            "| {} | {:.1} M | {:.1} M | {:.2} | {:.2} M | {:.1} M cycles, {:.1} M instructions | {:.0} | {} | {} | {:.1} ms | {} |",
+            "| {} | {} | {:.2} | {target} | {} | {} | {} / {} | {} | {} ({}) | {} | {} | {} |",
             r.name,
-            f.cycles as f64 / 1e6,
-            f.instructions as f64 / 1e6,
-            f.cycles as f64 / f.instructions.max(1) as f64,
-            f.setup_cycles as f64 / 1e6,
-            (f.cycles - f.setup_cycles) as f64 / 1e6,
-            (f.instructions - f.setup_instructions) as f64 / 1e6,
-            f.cycles as f64 / s.clk_hz * 1e3,
-            f.i2c_transfers,
+            m(f.cycles),
+            s.clk_hz / f.cycles.max(1) as f64,
+            m(f.setup_cycles),
+            m(f.busy[0]),
+            m(f.busy[1]),
+            m(f.idle[1]),
+            m(f.instructions),
+            f.xip_misses,
+            m(f.xip_stall),
             f.i2c_bytes,
-            (f.i2c_bytes + f.i2c_transfers) as f64 * 9.0 / I2C_HZ * 1e3,
+            m(f.i2c_bus_cycles),
             r.stack.map_or("-".to_string(), |b| format!("{b} B")),
         )?;
     }
-    writeln!(md, "\nImage: {flash} bytes of flash, {static_ram} bytes of static RAM; the stack high-water mark is the")?;
-    writeln!(md, "firmware's own (stack painting), as it logged it after each frame. The run emulated {:.2} s of", s.emulated_ms / 1e3)?;
-    writeln!(md, "board time, of which {:.2} s the core slept in `wfi` between scenes (skipped, not emulated).\n", s.idle_ms / 1e3)?;
+    writeln!(md, "\nImage: {flash} bytes of flash, {static_ram} bytes of static RAM (core 1's 32 KiB stack included); the")?;
+    writeln!(md, "stack high-water mark is core 0's (stack painting), as it logged it after each frame. The run emulated")?;
+    writeln!(md, "{:.2} s of board time, of which {:.2} s both cores slept between scenes (skipped, not emulated).\n", s.emulated_ms / 1e3, s.idle_ms / 1e3)?;
     writeln!(md, "With no display on the bus the firmware logs `{NO_DISPLAY_MESSAGE} ...`, blinks the LED and")?;
     writeln!(md, "retries every second ({} LED changes in {:.1} s of emulated time, no panic).\n", bare.led_toggles, bare.emulated_ms / 1e3)?;
     if let (Some(first), false) = (scenes.first(), profile.is_empty()) {
-        writeln!(md, "## Where the {first} frame's time goes\n")?;
-        writeln!(md, "The program counter sampled every 97th instruction of the first frame (the {first}, LED on to")?;
-        writeln!(md, "LED off), each sample credited to the function whose code holds it (`object` reads the ELF's")?;
-        writeln!(md, "symbols): shares of instructions, with code the compiler inlined counted in its caller.\n")?;
+        writeln!(md, "## Where the {first} frame's time goes on core 0\n")?;
+        writeln!(md, "Core 0's program counter sampled every 97th instruction of the first frame (the {first}, LED on")?;
+        writeln!(md, "to LED off), each sample credited to the function whose code holds it (`object` reads the ELF's")?;
+        writeln!(md, "symbols): shares of core 0's instructions, with code the compiler inlined counted in its caller.\n")?;
         writeln!(md, "| share | function |\n|---:|---|")?;
         for (name, share) in profile {
             writeln!(md, "| {:.1} % | `{name}` |", share * 100.0)?;
         }
         writeln!(md)?;
     }
-    writeln!(md, "## What the emulator does not model\n")?;
-    writeln!(md, "- **I2C bus timing.** The model acknowledges each byte at once, so the cycles above leave out the")?;
-    writeln!(md, "  time the bus takes: at 400 kHz every byte, address bytes included, is 9 bit times: the *I2C")?;
-    writeln!(md, "  time* column (I2C bytes count what follows each transfer's address byte). On a board the")?;
-    writeln!(md, "  core waits for the I2C FIFO, so a frame takes roughly cycles plus that time.")?;
-    writeln!(md, "- **Flash cache misses.** rp2040js reads flash (XIP) at the speed of RAM; on silicon a miss in the")?;
-    writeln!(md, "  16 KiB XIP cache costs tens of cycles, so code that does not fit the cache runs slower there.")?;
-    writeln!(md, "- **Core 1.** rp2040js runs core 0 alone and has no SIO FIFO (its status reads 0). The firmware")?;
-    writeln!(md, "  starts core 1 only when the FIFO can take a word, so here core 0 renders both tile shares, one")?;
-    writeln!(md, "  after the other, through the same code (share 1 into its 1-bit frame, then sent): the frames")?;
-    writeln!(md, "  above check that path, not the hand-over to core 1, which only a board runs.")?;
-    writeln!(md, "- **The bootrom's flash set-up.** There is no SSI flash model, so the run starts at boot2 as the")?;
-    writeln!(md, "  bootrom would leave it; the figures above start long after that.")?;
+    Ok(md)
+}
+
+/// The section on the silicon models: how each is derived, what each adds, and the build-time
+/// levers against the default image.
+fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, PanelFrame)], levers: &[(&str, &str, PanelFrame)]) -> Result<String> {
+    let mut md = String::new();
+    writeln!(md, "## The board as silicon runs it\n")?;
+    writeln!(md, "- **Core 1** starts in the bootrom at the reset vector and waits there for the launch sequence;")?;
+    writeln!(md, "  rp2040-hal's `Multicore::spawn` (PSM reset of core 1, then 0, 0, 1, vector table, stack, entry,")?;
+    writeln!(md, "  each echoed through the FIFO) runs unchanged. The two cores are stepped interleaved by cycle count,")?;
+    writeln!(md, "  never more than one instruction apart. Each has its own SIO divider, interpolators, CPUID, event")?;
+    writeln!(md, "  register, NVIC, SysTick and MPU; core 1's stack guard (the MPU region rp2040-hal installs) is")?;
+    writeln!(md, "  enforced, so a stack overflow on core 1 stops the run. There is one firmware path: the image")?;
+    writeln!(md, "  always starts core 1, here and on a board.")?;
+    writeln!(md, "- **The XIP cache**: 16 KiB, 2-way set-associative, 8-byte lines, least recently used way replaced,")?;
+    writeln!(md, "  shared by both cores, with its no-allocate and no-cache aliases. A miss costs the time the SSI takes")?;
+    writeln!(md, "  to fetch one line as boot2 set it up (read from its registers): quad-I/O continuous read, no")?;
+    writeln!(md, "  instruction, 32 address and mode bits on four lanes (8 SCK), 4 wait cycles, 64 data bits on four")?;
+    writeln!(md, "  lanes (16 SCK): 28 SCK periods of clk_sys / 2 = **{} cycles**. Misses of the two cores queue on", s.xip_miss_cycles)?;
+    writeln!(md, "  the one flash interface.")?;
+    writeln!(md, "- **The I2C bus**: the firmware sets IC_FS_SCL_HCNT, LCNT and SPKLEN; SCL is high HCNT + SPKLEN + 7")?;
+    writeln!(md, "  and low LCNT + 1 clk_sys cycles (DW_apb_i2c): **{} cycles per SCL period** at {:.0} MHz. START and", s.scl_period, s.clk_hz / 1e6)?;
+    writeln!(md, "  STOP take one period, every byte, address included, nine (eight bits and the acknowledge). The")?;
+    writeln!(md, "  16-entry TX FIFO fills while the bus is busy and a write waits for room, as on silicon; the display")?;
+    writeln!(md, "  model receives each byte when the bus has delivered it.")?;
+    writeln!(md, "- Not modelled: contention between the cores on SRAM and the peripheral bus (the RP2040's striped")?;
+    writeln!(md, "  SRAM banks make it rare), and the bootrom's own flash set-up (there is no SSI flash model, so the")?;
+    writeln!(md, "  run starts at boot2 as the bootrom leaves it).\n")?;
+    let Some(plain) = plain else { return Ok(md) };
+    let row = |md: &mut String, what: &str, f: &PanelFrame| -> Result<()> {
+        writeln!(
+            md,
+            "| {what} | {} ({:.2}x) | {:.2} | {} / {} | {} / {} | {} ({}) | {} |",
+            m(f.cycles),
+            f.cycles as f64 / plain.cycles.max(1) as f64,
+            s.clk_hz / f.cycles.max(1) as f64,
+            m(f.busy[0]),
+            m(f.idle[0]),
+            m(f.busy[1]),
+            m(f.idle[1]),
+            f.xip_misses,
+            m(f.xip_stall),
+            m(f.i2c_bus_cycles),
+        )?;
+        Ok(())
+    };
+    let header = |md: &mut String| -> Result<()> {
+        writeln!(md, "| | cycles | frames per second | core 0 busy / idle | core 1 busy / idle | XIP misses (stall) | bus |")?;
+        writeln!(md, "|---|---:|---:|---:|---:|---:|---:|")?;
+        Ok(())
+    };
+    writeln!(md, "### What each model adds\n")?;
+    writeln!(md, "The first scene's frame from the same image with a model left out (`run.mjs --no-cache`,")?;
+    writeln!(md, "`--untimed-bus`); each frame bit-identical to host-sim's.\n")?;
+    header(&mut md)?;
+    row(&mut md, "the board as silicon runs it", plain)?;
+    for (what, f) in models {
+        row(&mut md, &format!("without {what}"), f)?;
+    }
+    writeln!(md, "\n### Build-time levers\n")?;
+    writeln!(md, "The chair alone from images built with a firmware feature, against the default image's chair")?;
+    writeln!(md, "above; each frame bit-identical to host-sim's.\n")?;
+    header(&mut md)?;
+    row(&mut md, "the default image", plain)?;
+    for (feature, what, f) in levers {
+        row(&mut md, &format!("`{feature}`: {what}"), f)?;
+    }
     Ok(md)
 }

@@ -56,32 +56,100 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
     }
 }
 
-/// I2C0 that reports a device that does not answer. rp2040-hal 0.12 checks the controller's
-/// abort flags only while a write waits for room in the 16-byte TX FIFO, so a shorter write to
-/// an address nobody acknowledges (every SSD1306 command is one) returns `Ok` and the display
-/// seems to be there. This reads the abort source after each transaction, as the hardware
-/// leaves it once the STOP has gone out.
-pub struct CheckedI2c<P>(pub hal::I2C<pac::I2C0, P>);
+/// I2C0 driven through its 16-entry TX FIFO: a transaction is queued (a write waits only while
+/// the FIFO is full) and the controller sends it while the core goes on tracing; each ends with
+/// a STOP, and the controller starts the next on its own when more bytes follow. rp2040-hal's
+/// own `transaction` waits for the STOP after every transaction, which on a 400 kHz bus keeps
+/// core 0 waiting about 60,000 cycles per tile. A display that does not answer aborts the
+/// transfer; the abort is reported by the next transaction or [`flush`], whichever comes first.
+pub struct QueuedI2c<P> {
+    /// The bus, set up by the HAL (pins, clock, speed) and owned here so nothing else drives it.
+    _bus: hal::I2C<pac::I2C0, P>,
+    /// The one target address (set once: changing it needs the controller disabled, which would
+    /// cut off a transfer under way).
+    address: u8,
+}
 
-impl<P> embedded_hal::i2c::ErrorType for CheckedI2c<P> {
+/// I2C0's registers.
+fn regs() -> &'static pac::i2c0::RegisterBlock {
+    // SAFETY: I2C0 belongs to the `QueuedI2c` that owns its HAL driver; only that driver's
+    // methods and `flush` touch the registers, from core 0 alone.
+    #[allow(unsafe_code)]
+    unsafe {
+        &*pac::I2C0::ptr()
+    }
+}
+
+/// The abort the controller reported since the last call, if any (reading IC_CLR_TX_ABRT clears
+/// it and releases the TX FIFO, as the HAL does after an abort it noticed).
+fn take_abort() -> Result<(), hal::i2c::Error> {
+    let reason = regs().ic_tx_abrt_source().read().bits();
+    if reason != 0 {
+        regs().ic_clr_tx_abrt().read();
+        return Err(hal::i2c::Error::Abort(reason));
+    }
+    Ok(())
+}
+
+/// Waits until every queued byte has left the controller and the bus is idle: the frame is on
+/// the panel. Reports an abort of the last transfers.
+pub fn flush() -> Result<(), hal::i2c::Error> {
+    loop {
+        take_abort()?;
+        let status = regs().ic_status().read();
+        if status.tfe().bit_is_set() && status.activity().bit_is_clear() {
+            return take_abort();
+        }
+    }
+}
+
+impl<P> QueuedI2c<P> {
+    /// Takes the HAL's bus and sets its one target `address` (7 bits).
+    pub fn new(bus: hal::I2C<pac::I2C0, P>, address: u8) -> Self {
+        let r = regs();
+        r.ic_enable().write(|w| w.enable().clear_bit());
+        r.ic_con().modify(|_, w| w.ic_10bitaddr_master().clear_bit());
+        // SAFETY: any 7-bit address is a valid IC_TAR value.
+        #[allow(unsafe_code)]
+        r.ic_tar().write(|w| unsafe { w.ic_tar().bits(u16::from(address)) });
+        r.ic_enable().write(|w| w.enable().set_bit());
+        QueuedI2c { _bus: bus, address }
+    }
+}
+
+impl<P> embedded_hal::i2c::ErrorType for QueuedI2c<P> {
     type Error = hal::i2c::Error;
 }
 
-impl<P> embedded_hal::i2c::I2c for CheckedI2c<P>
-where
-    hal::I2C<pac::I2C0, P>: embedded_hal::i2c::I2c<Error = hal::i2c::Error>,
-{
+impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
     fn transaction(&mut self, address: u8, operations: &mut [embedded_hal::i2c::Operation<'_>]) -> Result<(), Self::Error> {
-        self.0.transaction(address, operations)?;
-        // SAFETY: I2C0 belongs to `self.0`, and no transaction is under way; reading
-        // IC_TX_ABRT_SOURCE has no side effect, reading IC_CLR_TX_ABRT clears the abort (and
-        // releases the TX FIFO) exactly as the HAL itself does after an abort it noticed.
-        #[allow(unsafe_code)]
-        let regs = unsafe { &*pac::I2C0::ptr() };
-        let reason = regs.ic_tx_abrt_source().read().bits();
-        if reason != 0 {
-            regs.ic_clr_tx_abrt().read();
-            return Err(hal::i2c::Error::Abort(reason));
+        use embedded_hal::i2c::Operation;
+        if address != self.address {
+            return Err(hal::i2c::Error::AddressOutOfRange(u16::from(address)));
+        }
+        take_abort()?;
+        let mut left: usize = 0;
+        for op in operations.iter() {
+            match op {
+                Operation::Write(bytes) => left += bytes.len(),
+                Operation::Read(_) => return Err(hal::i2c::Error::InvalidReadBufferLength),
+            }
+        }
+        if left == 0 {
+            return Err(hal::i2c::Error::InvalidWriteBufferLength);
+        }
+        let r = regs();
+        for op in operations.iter() {
+            let Operation::Write(bytes) = op else { continue };
+            for &byte in bytes.iter() {
+                while r.ic_status().read().tfnf().bit_is_clear() {
+                    take_abort()?;
+                }
+                left -= 1;
+                // SAFETY: DAT takes any byte; STOP on the transaction's last byte.
+                #[allow(unsafe_code)]
+                r.ic_data_cmd().write(|w| unsafe { w.stop().bit(left == 0).dat().bits(byte) });
+            }
         }
         Ok(())
     }

@@ -97,9 +97,9 @@ fn main() -> ! {
     let timer_block = pac.TIMER0;
     let (timer, mut alarm) = sleep::start(timer_block, &mut pac.RESETS, &clocks);
 
-    let interface = ssd1306::I2CDisplayInterface::new_custom_address(display::CheckedI2c(bus), Wiring::ADDRESS);
+    let interface = ssd1306::I2CDisplayInterface::new_custom_address(display::QueuedI2c::new(bus, Wiring::ADDRESS), Wiring::ADDRESS);
     let mut display = ssd1306::Ssd1306::new(interface, DisplaySize128x64, DisplayRotation::Rotate0);
-    while display.init().is_err() {
+    while display.init().is_err() || display::flush().is_err() {
         defmt::error!(
             "no SSD1306 answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
             Wiring::SDA, Wiring::SCL, Wiring::ADDRESS

@@ -11,6 +11,8 @@ use firmware::app::{render_scene_at, AppError, Board, Report, Scalar, ShareMemor
 use firmware::app::SCENES;
 #[cfg(not(feature = "ladder"))]
 use firmware::stack;
+use display_interface::DisplayError;
+use lattice_rt::render::RenderError;
 use lattice_rt::NoHooks;
 
 /// The pause between two scenes.
@@ -35,7 +37,7 @@ pub struct Panel<'m, T, L> {
     pub second: &'m mut ShareMemory,
 }
 
-impl<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin> Panel<'_, T, L> {
+impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin> Panel<'_, T, L> {
     /// One frame, with the LED lit while it renders; its report and microseconds. A progressive
     /// frame (the `progressive` feature) puts the LED out for a moment as each pass but the last
     /// reaches the display, so the LED goes out once per picture the panel shows.
@@ -45,6 +47,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin> 
         let _ = self.led.set_high();
         let led = &mut self.led;
         let mut shown = |pass: u8| {
+            let _ = crate::display::flush();
             if pass > 1 {
                 let _ = led.set_low();
                 let _ = led.set_high();
@@ -53,7 +56,10 @@ impl<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin> 
         let now = || timer.get_counter().ticks();
         let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut shown };
         let result = render_scene_at(text, self.st, &mut self.target, &mut NoHooks, shot, board);
+        // The frame is on the panel once the bus has sent its last queued byte.
+        let sent = crate::display::flush();
         let _ = self.led.set_low();
+        let result = result.and_then(|r| sent.map(|()| r).map_err(|_| AppError::Render(RenderError::Draw(DisplayError::BusWriteError))));
         result.map(|r| (r, (timer.get_counter() - t0).to_micros()))
     }
 
@@ -65,7 +71,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin> 
 
 /// The embedded scenes in turn, each frame's time and statistics logged.
 #[cfg(not(any(feature = "orbit", feature = "ladder")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     loop {
         for (name, text) in SCENES {
             match panel.show(text, &Shot::default()) {
@@ -86,7 +92,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: Outpu
 
 /// Orbit mode: the camera circles each scene, frame after frame, for one turn.
 #[cfg(all(feature = "orbit", not(feature = "ladder")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     use firmware::app::ORBIT_FRAMES;
     loop {
         for (name, text) in SCENES {
@@ -111,7 +117,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: Outpu
 
 /// The ladder: the first scene once per rung, from the paper's method to the default.
 #[cfg(feature = "ladder")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error: core::fmt::Debug>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     use firmware::app::{LADDER, SCENES};
     loop {
         let (name, text) = SCENES[0];
