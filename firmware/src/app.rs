@@ -2,7 +2,10 @@
 
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::Dimensions;
 use embedded_graphics_core::pixelcolor::BinaryColor;
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
 #[cfg(not(feature = "baked"))]
 use lattice_rt::lattice::LatticeError;
 #[cfg(not(feature = "baked"))]
@@ -151,7 +154,7 @@ pub const TRACED: usize = if cfg!(feature = "progressive") {
 
 /// Parses `text`, builds its lattice and renders [`RENDERED`] into `target`, tile by tile.
 #[cfg(not(feature = "baked"))]
-pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     text: &'t str,
     st: &mut Storage<R>,
     target: &mut D,
@@ -209,12 +212,9 @@ pub struct Board<'a, C: Cores> {
     pub shown: &'a mut dyn FnMut(u8),
 }
 
-/// Pixels in [`RENDERED`].
-const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
-
 /// Whether the board has a second core to trace share 1 (the `rp` boards): it then needs its own
-/// query scratch and 1-bit frame in [`ShareMemory`]. A one-core board draws both shares straight
-/// to the display, and the memory is empty.
+/// query scratch in [`ShareMemory`]. A one-core board draws both shares one after the other, and
+/// the memory is empty.
 const SECOND_CORE: bool = cfg!(feature = "rp");
 /// Entries of [`ShareMemory`]'s arrays when [`SECOND_CORE`] (else none).
 const fn second(n: usize) -> usize {
@@ -225,13 +225,11 @@ const fn second(n: usize) -> usize {
     }
 }
 
-/// The memory of the second tile share: on a board with two cores its own query scratch and a
-/// 1-bit frame its tiles are drawn into (the display is core 0's), sent to the display when the
-/// share is done; and the rays both shares keep between progressive passes ([`TRACED`] each).
+/// The memory of the second tile share: on a board with two cores its own query scratch; and
+/// the rays both shares keep between progressive passes ([`TRACED`] each).
 pub struct ShareMemory {
     mailbox: [u32; second(MAX_OBJECTS + MAX_LATTICES)],
     rows: [i16; second(MAX_ROWS)],
-    bits: [u8; second(PIXELS / 8)],
     traced: [[Traced; TRACED]; 2],
 }
 
@@ -242,7 +240,6 @@ impl ShareMemory {
         ShareMemory {
             mailbox: [0; second(MAX_OBJECTS + MAX_LATTICES)],
             rows: [0; second(MAX_ROWS)],
-            bits: [0; second(PIXELS / 8)],
             traced: [[NONE; TRACED]; 2],
         }
     }
@@ -254,13 +251,13 @@ impl Default for ShareMemory {
     }
 }
 
-/// [`render_scene`] for a [`Shot`], in [`SHARES`] tile shares: share 0 drawn straight to
-/// `target` by this core, share 1 traced by the board's other core into its second share's
-/// frame and sent to `target` after (a one-core board draws both straight to `target`). The
-/// board's clock times each share. The frame is shown in [`PASSES`]; the board's `shown` is
+/// [`render_scene`] for a [`Shot`], in [`SHARES`] tile shares: share 0 traced by this core,
+/// share 1 by the board's other core, each drawing its tiles straight to `target` as it
+/// finishes them, one tile at a time under the board's critical section (a one-core board draws
+/// both shares, one after the other). The board's clock times each share. The frame is shown in [`PASSES`]; the board's `shown` is
 /// called with each pass once it is on `target`.
 #[cfg(not(feature = "baked"))]
-pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     text: &'t str,
     st: &mut Storage<R>,
     target: &mut D,
@@ -297,7 +294,7 @@ impl Default for BakedMemory {
 /// [`render_scene_at`] for a scene baked into flash (the `baked` feature: `build.rs` wrote it
 /// and its lattice as tables), which is neither parsed nor built. Its camera is the scene's
 /// own: `shot.turn` must be 0 (an orbit needs the camera set up at run time).
-pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     baked: &lattice_rt::Baked<R>,
     memory: &mut BakedMemory,
     target: &mut D,
@@ -313,7 +310,7 @@ pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
 }
 
 /// The frame of a scene loaded or baked: its tracer, then every pass of both tile shares.
-fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
+fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     scene: &lattice_rt::Scene<'_, R>,
     lattice: &lattice_rt::Lattice<'_, R>,
     mut scratch: lattice_rt::Scratch<'_>,
@@ -338,7 +335,7 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
     let Board { cores, second, now, shown } = board;
-    let ShareMemory { mailbox, rows, bits, traced } = second;
+    let ShareMemory { mailbox, rows, traced } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
@@ -355,31 +352,27 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor>>(
             shown(pass);
             continue;
         }
+        // Two cores: each draws its own tiles straight to the display as it finishes them,
+        // one tile at a time under a lock (`Shared`), so the bus carries one core's tiles while
+        // the other traces, and no tile waits for the other share to finish.
+        let shared = Shared::new(&mut *target);
         let (mut there_result, mut here_result) = (None, None);
         let [there_us, here_us] = &mut times;
         cores.join(
             &mut || {
                 let t0 = now();
                 let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-                let result = match lattice_rt::BitFrame::wrap(WIDTH as u32, HEIGHT as u32, &mut bits[..]) {
-                    Some(mut frame_bits) => {
-                        draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], &mut frame_bits, &mut scratch, &mut lattice_rt::NoHooks)
-                    }
-                    None => Err(RenderError::BadTile),
-                };
-                there_result = Some(result);
+                there_result = Some(draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], &mut &shared, &mut scratch, &mut lattice_rt::NoHooks));
                 *there_us += now() - t0;
             },
             &mut || {
                 let t0 = now();
-                here_result = Some(draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks));
+                here_result = Some(draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], &mut &shared, &mut scratch, hooks));
                 *here_us += now() - t0;
             },
         );
         stats.add(&here_result.unwrap_or(Err(RenderError::Cancelled)).map_err(AppError::Render)?);
-        let more = there_result.unwrap_or(Err(RenderError::Cancelled));
-        stats.add(&more.map_err(|e| AppError::Render(widen(e)))?);
-        send_share(bits, pick(&tuned), other, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
+        stats.add(&there_result.unwrap_or(Err(RenderError::Cancelled)).map_err(AppError::Render)?);
         shown(pass);
     }
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
@@ -409,39 +402,37 @@ fn draw<R: Real, D: DrawTarget<Color = BinaryColor>>(
     }
 }
 
-/// An error of a render into memory (which cannot fail to draw) as one of any target.
-fn widen<E>(e: RenderError<core::convert::Infallible>) -> RenderError<E> {
-    match e {
-        RenderError::Draw(never) => match never {},
-        RenderError::Cancelled => RenderError::Cancelled,
-        RenderError::BadTile => RenderError::BadTile,
-        RenderError::EdgesNotCompiled => RenderError::EdgesNotCompiled,
-        RenderError::ScratchTooSmall { needed } => RenderError::ScratchTooSmall { needed },
-        RenderError::BadShare => RenderError::BadShare,
-        RenderError::NotProgressive => RenderError::NotProgressive,
+/// A draw target both cores draw into, one tile (`fill_contiguous`) at a time: each call holds
+/// the board's critical section (on the RP2040 a hardware spinlock shared by the cores, with
+/// interrupts off) while it hands the tile to the target, so one core's tile commands and pixels
+/// never interleave with the other's.
+struct Shared<'d, D> {
+    target: critical_section::Mutex<core::cell::RefCell<&'d mut D>>,
+}
+
+impl<'d, D> Shared<'d, D> {
+    fn new(target: &'d mut D) -> Self {
+        Shared { target: critical_section::Mutex::new(core::cell::RefCell::new(target)) }
     }
 }
 
-/// Sends the tiles of `share`, drawn into the 1-bit frame `bits`, to `target`, one tile at a time.
-fn send_share<D: DrawTarget<Color = BinaryColor>>(bits: &mut [u8], frame: &Frame, share: Share, target: &mut D) -> Result<(), D::Error> {
-    use embedded_graphics_core::geometry::{Point, Size};
-    use embedded_graphics_core::primitives::Rectangle;
-    let Some(drawn) = lattice_rt::BitFrame::wrap(frame.width as u32, frame.height as u32, bits) else { return Ok(()) };
-    let raster = drawn.raster();
-    let t = frame.tile as usize;
-    let (w, h) = (frame.width as usize, frame.height as usize);
-    let stride = w.div_ceil(8);
-    for ty in 0..h.div_ceil(t) {
-        for tx in (0..w.div_ceil(t)).filter(|&tx| share.holds(tx, ty)) {
-            let (x0, y0) = (tx * t, ty * t);
-            let (tw, th) = (t.min(w - x0), t.min(h - y0));
-            let rows = raster[y0 * stride..].chunks(stride).take(th);
-            let pixels = rows.flat_map(|row| (x0..x0 + tw).map(move |x| BinaryColor::from(row[x / 8] & (0x80 >> (x % 8)) != 0)));
-            let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
-            target.fill_contiguous(&area, pixels)?;
-        }
+impl<D: Dimensions> Dimensions for &Shared<'_, D> {
+    fn bounding_box(&self) -> Rectangle {
+        critical_section::with(|cs| self.target.borrow_ref(cs).bounding_box())
     }
-    Ok(())
+}
+
+impl<D: DrawTarget<Color = BinaryColor>> DrawTarget for &Shared<'_, D> {
+    type Color = BinaryColor;
+    type Error = D::Error;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<BinaryColor>>>(&mut self, pixels: I) -> Result<(), D::Error> {
+        critical_section::with(|cs| self.target.borrow_ref_mut(cs).draw_iter(pixels))
+    }
+
+    fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
+        critical_section::with(|cs| self.target.borrow_ref_mut(cs).fill_contiguous(area, colors))
+    }
 }
 
 #[cfg(not(feature = "baked"))]

@@ -37,7 +37,7 @@ pub struct Panel<'m, T, L> {
     pub second: &'m mut ShareMemory,
 }
 
-impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin> Panel<'_, T, L> {
+impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin> Panel<'_, T, L> {
     /// One frame, with the LED lit while it renders; its report and microseconds. A progressive
     /// frame (the `progressive` feature) puts the LED out for a moment as each pass but the last
     /// reaches the display, so the LED goes out once per picture the panel shows.
@@ -71,7 +71,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin> Pan
 
 /// The embedded scenes in turn, each frame's time and statistics logged.
 #[cfg(not(any(feature = "orbit", feature = "ladder")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     loop {
         for (name, text) in SCENES {
             match panel.show(text, &Shot::default()) {
@@ -92,7 +92,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPi
 
 /// Orbit mode: the camera circles each scene, frame after frame, for one turn.
 #[cfg(all(feature = "orbit", not(feature = "ladder")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     use firmware::app::ORBIT_FRAMES;
     loop {
         for (name, text) in SCENES {
@@ -117,7 +117,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPi
 
 /// The ladder: the first scene once per rung, from the paper's method to the default.
 #[cfg(feature = "ladder")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError>, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     use firmware::app::{LADDER, SCENES};
     loop {
         let (name, text) = SCENES[0];
