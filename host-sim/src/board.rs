@@ -278,10 +278,10 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
         .args(models)
         .stdin(Stdio::null())
         .stdout(Stdio::piped());
-    if display && models.is_empty() {
-        cmd.arg("--profile").arg(work.join("profile.json"));
-    } else {
+    if !display {
         cmd.args(["--no-display", "--until-ms", "2500"]);
+    } else if models.is_empty() {
+        cmd.arg("--profile").arg(work.join("profile.json"));
     }
     let mut child = cmd.spawn().context("cannot run node (Node.js 18 or newer is needed)")?;
     let mut run = BoardRun::default();
@@ -359,6 +359,14 @@ fn decode_log(elf: &[u8], bytes: &[u8]) -> Result<Vec<LogLine>> {
         }
     }
     Ok(lines)
+}
+
+/// Bytes of the ELF section `name` (0 when there is none).
+fn section_size(elf: &Path, name: &str) -> Result<u64> {
+    use object::ObjectSection as _;
+    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+    let file = object::File::parse(&*bytes)?;
+    Ok(file.section_by_name(name).map_or(0, |s| s.size()))
 }
 
 /// Writes a panel frame (rows MSB first, lit = 1) as a PNG the way the OLED shows it.
@@ -590,7 +598,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
 
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period };
     let profile = profile_shares(&elf, &frames_dir.join("profile.json"))?;
-    let mut md = report(&summary, &rows, flash, static_ram, &bare, &scenes, &profile)?;
+    let mut md = report(&summary, &rows, (flash, static_ram, section_size(&elf, ".ram_code")?), &bare, &scenes, &profile)?;
     md.push_str(&silicon_report(&summary, rows.first().map(|r| &r.frame), &models, &levers)?);
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
@@ -775,9 +783,10 @@ fn ladder_report(rungs: &[Rung<'_>], clk_hz: f64) -> Result<String> {
     writeln!(md, "`LADDER` (`firmware/src/frame.rs`), from the paper's method to what the boards run, each rung")?;
     writeln!(md, "switching one more lever on at run time; every frame is checked bit for bit against host-sim's")?;
     writeln!(md, "render with the same levers. *Cycles* are the whole frame as above (set-up, both cores, the bus;")?;
-    writeln!(md, "target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz). Core 0 traces tile share 0")?;
-    writeln!(md, "straight to the display while core 1 traces share 1 into a 1-bit frame that core 0 then sends;")?;
-    writeln!(md, "*share 0* and *share 1* are each core's time on its share as the device's timer measured it.\n")?;
+    writeln!(md, "target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz). Core 0 traces tile share 0 and")?;
+    writeln!(md, "core 1 share 1, each drawing its tiles straight to the display as it finishes them (one tile at a")?;
+    writeln!(md, "time under a lock); *share 0* and *share 1* are each core's time on its share as the device's")?;
+    writeln!(md, "timer measured it.\n")?;
     writeln!(md, "| rung | cycles | frames per second at {mhz:.0} MHz | instructions | object tests | share 0 (core 0) | share 1 (core 1) | core 1 idle |")?;
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|")?;
     let mut first = None;
@@ -818,7 +827,7 @@ fn m(cycles: u64) -> String {
 
 /// docs/board.md's head: the run, a frame per scene against the targets, where the first
 /// frame's time goes.
-fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &BoardRun, scenes: &[String], profile: &[(String, f64)]) -> Result<String> {
+fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u64, u64), bare: &BoardRun, scenes: &[String], profile: &[(String, f64)]) -> Result<String> {
     let mut md = String::new();
     let mhz = s.clk_hz / 1e6;
     writeln!(md, "# The Pico image on an emulated board\n")?;
@@ -864,8 +873,9 @@ fn report(s: &Summary, rows: &[SceneRow], flash: u64, static_ram: u64, bare: &Bo
             r.stack.map_or("-".to_string(), |b| format!("{b} B")),
         )?;
     }
-    writeln!(md, "\nImage: {flash} bytes of flash, {static_ram} bytes of static RAM (core 1's 32 KiB stack included); the")?;
-    writeln!(md, "stack high-water mark is core 0's (stack painting), as it logged it after each frame. The run emulated")?;
+    writeln!(md, "\nImage: {flash} bytes of flash, {static_ram} bytes of static RAM: {ram_code} bytes of code copied to SRAM at boot")?;
+    writeln!(md, "(`firmware/pico/ram-code.x`), core 1's 32 KiB stack and the statics. The stack high-water mark is core")?;
+    writeln!(md, "0's (stack painting), as it logged it after each frame. The run emulated")?;
     writeln!(md, "{:.2} s of board time, of which {:.2} s both cores slept between scenes (skipped, not emulated).\n", s.emulated_ms / 1e3, s.idle_ms / 1e3)?;
     writeln!(md, "With no display on the bus the firmware logs `{NO_DISPLAY_MESSAGE} ...`, blinks the LED and")?;
     writeln!(md, "retries every second ({} LED changes in {:.1} s of emulated time, no panic).\n", bare.led_toggles, bare.emulated_ms / 1e3)?;
