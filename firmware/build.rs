@@ -13,9 +13,7 @@ use lattice_rt::Lattice;
 use lattice_rt::scene::Object;
 use lattice_rt::{Real, Sizes};
 
-#[path = "src/frame.rs"]
-#[allow(dead_code)]
-mod frame;
+use board_records::frame;
 use std::fmt::Write as _;
 use std::{env, fs, path::PathBuf};
 

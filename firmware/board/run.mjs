@@ -9,7 +9,9 @@
 //                           panel's pixels as hex rows
 //   {"event":"end", ...}    why the run ended, with totals
 // The device's defmt log (the RTT up channel, read as a probe reads it) goes to --log as raw
-// bytes for `host-sim board` to decode. Exit code 0 when the run ended as asked, 1 otherwise.
+// bytes for people, and its typed records (the board_records channel at --records ADDR) to
+// --records-log, for `host-sim board` to decode. Exit code 0 when the run ended as asked, 1
+// otherwise.
 //
 // rp2040js has no SSI flash model, so core 0 starts at boot2 (PC = 0x10000000) with the
 // bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2; core 1
@@ -22,7 +24,8 @@
 // counts as JSON pairs [pc, samples].
 //
 // Usage: node run.mjs --uf2 FILE --bootrom FILE --rtt ADDR --log FILE
-//                     [--frames N] [--max-cycles N] [--no-display] [--until-ms T] [--profile FILE]
+//                     [--records ADDR --records-log FILE] [--frames N] [--max-cycles N]
+//                     [--no-display] [--until-ms T] [--profile FILE]
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState } from './silicon.mjs';
@@ -46,6 +49,8 @@ function parseArgs(argv) {
     else if (a === '--bootrom') o.bootrom = next();
     else if (a === '--rtt') o.rtt = Number(next());
     else if (a === '--log') o.log = next();
+    else if (a === '--records') o.records = Number(next());
+    else if (a === '--records-log') o.recordsLog = next();
     else if (a === '--frames') o.frames = Number(next());
     else if (a === '--max-cycles') o.maxCycles = Number(next());
     else if (a === '--until-ms') o.untilMs = Number(next());
@@ -58,6 +63,7 @@ function parseArgs(argv) {
     else throw new Error(`unknown argument ${a}`);
   }
   for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
+  if ((o.records === undefined) !== (o.recordsLog === undefined)) throw new Error('--records ADDR and --records-log FILE go together');
   if (!Number.isInteger(o.rtt)) throw new Error('--rtt ADDR (the _SEGGER_RTT symbol) is required');
   return o;
 }
@@ -119,6 +125,43 @@ class RttReader {
   }
 }
 
+/**
+ * Reads the board's record channel (board_records::Channel at the `BOARD_RECORDS` symbol: magic,
+ * size, write offset, read offset, dropped, buffer) as a probe would: what lies between the
+ * read and the write offset, then the read offset moved on.
+ */
+class RecordReader {
+  constructor(mcu, address) {
+    this.mcu = mcu;
+    this.address = address;
+    this.chunks = [];
+  }
+  poll() {
+    const m = this.mcu;
+    const a = this.address;
+    const magic = Array.from({ length: 8 }, (_, i) => m.readUint8(a + i));
+    if (String.fromCharCode(...magic) !== 'LRT-RECS') return;
+    const size = m.readUint32(a + 8);
+    const write = m.readUint32(a + 12);
+    let read = m.readUint32(a + 16);
+    if (size === 0 || write >= size || read >= size) return;
+    while (read !== write) {
+      const end = write > read ? write : size;
+      const out = new Uint8Array(end - read);
+      for (let i = 0; i < out.length; i++) out[i] = m.readUint8(a + 24 + read + i);
+      this.chunks.push(out);
+      read = end % size;
+    }
+    m.writeUint32(a + 16, read);
+  }
+  dropped() {
+    return this.mcu.readUint32(this.address + 20);
+  }
+  save(path) {
+    writeFileSync(path, Buffer.concat(this.chunks.map((c) => Buffer.from(c))));
+  }
+}
+
 const emit = (o) => process.stdout.write(JSON.stringify(o) + '\n');
 const toHex = (bytes) => Buffer.from(bytes).toString('hex');
 
@@ -157,6 +200,7 @@ function main() {
   });
 
   const rtt = new RttReader(mcu, opt.rtt);
+  const records = opt.records === undefined ? null : new RecordReader(mcu, opt.records);
   const frames = [];
   let frameStart = null;
   let ledToggles = 0;
@@ -239,6 +283,7 @@ function main() {
     if (steps >= nextPoll) {
       nextPoll = steps + 200000;
       rtt.poll();
+      records?.poll();
       for (const [i, c] of board.cores.entries()) if (c.IPSR === 3) board.stop ??= `HardFault on core ${i} at pc 0x${(c.PC >>> 0).toString(16)}`;
       if (board.time > opt.maxCycles) board.stop ??= `no result within ${opt.maxCycles} cycles`;
       else if (display?.error) board.stop ??= `display: ${display.error}`;
@@ -250,6 +295,8 @@ function main() {
   }
   rtt.poll();
   rtt.save(opt.log);
+  records?.poll();
+  if (records) records.save(opt.recordsLog);
   if (profile) writeFileSync(opt.profile, JSON.stringify([...profile.entries()]));
   const total = board.snapshot();
   emit({
@@ -271,6 +318,7 @@ function main() {
     clkSysHz: mcu.clkSys,
     flashBytes,
     logBytes: rtt.bytes,
+    recordsDropped: records ? records.dropped() : 0,
     i2cBytes,
     naks,
     ledToggles,

@@ -16,7 +16,7 @@ use lattice_rt::storage::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::{render_pass, render_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 
-pub use crate::frame::{Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
+pub use board_records::frame::{Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
 /// The frame the firmware renders: [`FRAME`], with one eye ray per pixel under the
 /// `exact-sampling` feature and silhouette lines under the `outline` feature.

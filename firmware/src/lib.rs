@@ -6,5 +6,4 @@
 #![deny(missing_docs)]
 
 pub mod app;
-pub mod frame;
 pub mod stack;

@@ -14,6 +14,7 @@
 use crate::firmware::{board_frame, elf_sizes, host_frame};
 use board_frame::{LADDER, ORBIT_FRAMES};
 use anyhow::{bail, Context, Result};
+use board_records::{FrameDone, Record};
 use lattice_rt::BitFrame;
 use object::{Object, ObjectSymbol};
 use std::fmt::Write as _;
@@ -249,6 +250,8 @@ struct BoardRun {
     naks: u64,
     warnings: Vec<String>,
     log: Vec<LogLine>,
+    /// What the board reported on its record channel, in order.
+    records: Vec<Record>,
 }
 
 /// One decoded defmt log line.
@@ -269,11 +272,20 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
         .find(|s| s.name() == Ok("_SEGGER_RTT"))
         .context("the image has no _SEGGER_RTT symbol (defmt-rtt's control block)")?
         .address();
+    let records_at = file
+        .symbols()
+        .find(|s| s.name() == Ok("BOARD_RECORDS"))
+        .context("the image has no BOARD_RECORDS symbol (its board_records::Channel)")?
+        .address();
     let log_path = work.join(if display { "defmt.bin" } else { "defmt-no-display.bin" });
+    let records_path = work.join(if display { "records.bin" } else { "records-no-display.bin" });
     let mut cmd = Command::new("node");
     cmd.arg(root.join("firmware/board/run.mjs"))
         .args(["--uf2".as_ref(), uf2.as_os_str(), "--bootrom".as_ref(), bootrom.as_os_str(), "--log".as_ref(), log_path.as_os_str()])
         .args(["--rtt", &format!("{rtt:#x}"), "--frames", &frames.to_string()])
+        .args(["--records", &format!("{records_at:#x}")])
+        .arg("--records-log")
+        .arg(&records_path)
         .args(["--max-cycles", &(MAX_CYCLES_PER_FRAME * frames.max(1) as u64).to_string()])
         .args(models)
         .stdin(Stdio::null())
@@ -330,7 +342,21 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
         bail!("the emulator ended without a report ({status})");
     }
     run.log = decode_log(&elf_bytes, &std::fs::read(&log_path).unwrap_or_default())?;
+    run.records = decode_records(&mut std::fs::read(&records_path).unwrap_or_default())?;
     Ok(run)
+}
+
+/// The records in what the runner copied out of the board's channel: each a COBS frame ending
+/// in a zero byte.
+fn decode_records(bytes: &mut [u8]) -> Result<Vec<Record>> {
+    let mut records = Vec::new();
+    let mut start = 0;
+    while let Some(len) = bytes[start..].iter().position(|&b| b == 0) {
+        let frame = &mut bytes[start..=start + len];
+        records.push(Record::decode(frame).with_context(|| format!("the board's record at byte {start} does not decode"))?);
+        start += len + 1;
+    }
+    Ok(records)
 }
 
 fn hex_bytes(s: &str) -> Vec<u8> {
@@ -389,11 +415,12 @@ struct SceneRow {
     stack: Option<u64>,
 }
 
-/// The stack high-water mark the firmware logged for `scene`.
-fn logged_stack(log: &[LogLine], scene: &str) -> Option<u64> {
-    let line = log.iter().find(|l| l.text.starts_with(&format!("{scene}:")))?;
-    let rest = line.text.split("stack high-water ").nth(1)?;
-    rest.split_whitespace().next()?.parse().ok()
+/// What the board reported for the frame of scene `index`.
+fn reported_frame(records: &[Record], index: usize) -> Option<FrameDone> {
+    records.iter().find_map(|r| match r {
+        Record::Frame(f) if usize::from(f.scene) == index => Some(*f),
+        _ => None,
+    })
 }
 
 /// The command `host-sim board`.
@@ -426,7 +453,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
     let scenes_dir = root.join("scenes");
     let mut rows = Vec::new();
-    for (name, frame) in scenes.iter().zip(run.frames) {
+    for (index, (name, frame)) in scenes.iter().zip(run.frames).enumerate() {
         if let Some(e) = &frame.error {
             failures.push(format!("{name}: the panel shows no picture: {e}"));
             continue;
@@ -445,7 +472,10 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
                 frames_dir.display()
             ));
         }
-        let stack = logged_stack(&run.log, name);
+        let stack = reported_frame(&run.records, index).map(|f| u64::from(f.stack));
+        if stack.is_none() {
+            failures.push(format!("{name}: the board reported no frame record"));
+        }
         rows.push(SceneRow { name: name.clone(), frame, stack });
     }
 
@@ -533,9 +563,13 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         } else {
             failures.push(format!("ladder rung {i} ({what}): the chair differs from host-sim (see {}/chair-{i}.png)", ladder_dir.display()));
         }
-        match logged_rung(&lrun.log, i) {
-            Some((shares, tests)) => rungs.push(Rung { what, frame: f, shares, tests }),
-            None => failures.push(format!("ladder rung {i}: the device logged no share times")),
+        let reported = lrun.records.iter().find_map(|r| match r {
+            Record::Rung { rung, frame } if usize::from(*rung) == i => Some(*frame),
+            _ => None,
+        });
+        match reported {
+            Some(done) => rungs.push(Rung { what, frame: f, shares: done.share_us, tests: done.object_tests }),
+            None => failures.push(format!("ladder rung {i}: the board reported no rung record")),
         }
     }
 
@@ -763,15 +797,6 @@ fn ladder_frame(chair: &Path, tuning: &board_frame::Tuning) -> Result<Vec<u8>> {
         t.set_shadow_coherence(tuning.shadow_coherence);
     })?
     .bits)
-}
-
-/// The tile shares' microseconds and the object tests the ladder image logged for rung `i`.
-fn logged_rung(log: &[LogLine], i: usize) -> Option<([u64; 2], u64)> {
-    let line = log.iter().find(|l| l.text.starts_with(&format!("ladder {i}:")))?;
-    let rest = line.text.split("shares ").nth(1)?;
-    // "A us and B us, object tests T, ..."
-    let mut nums = rest.split(|c: char| !c.is_ascii_digit()).filter(|w| !w.is_empty()).map(|w| w.parse::<u64>().ok());
-    Some(([nums.next()??, nums.next()??], nums.next()??))
 }
 
 /// The ladder section of docs/board.md.

@@ -296,10 +296,8 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
     Ok(run)
 }
 
-/// The frame the boards render, from the file the firmware compiles.
-#[path = "../../firmware/src/frame.rs"]
-#[allow(dead_code)]
-pub mod board_frame;
+/// The frame the boards render (the records crate the firmware compiles too).
+pub use board_records::frame as board_frame;
 
 /// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R` (`exact`: one
 /// eye ray per pixel, as the `exact-sampling` feature renders).

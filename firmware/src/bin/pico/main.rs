@@ -107,6 +107,11 @@ fn main() -> ! {
         sleep::blink(&mut led, &mut alarm, 5);
     }
     let cores = cores::TwoCores::start(&mut pac.PSM, &mut pac.PPB, sio.fifo);
+    modes::report(board_records::Record::Started {
+        scenes: SCENES.len() as u8,
+        clk_mhz: clocks.system_clock.freq().to_MHz() as u16,
+        bus_khz: (Wiring::I2C_HZ / 1000) as u16,
+    });
     defmt::info!(
         "lattice-rt on the {}: {} scenes, {}x{}, {} MHz, I2C at {} kHz, both cores",
         BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz(), Wiring::I2C_HZ / 1000

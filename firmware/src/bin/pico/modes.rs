@@ -13,10 +13,39 @@ use firmware::app::SCENES;
 use firmware::stack;
 use display_interface::DisplayError;
 use lattice_rt::render::RenderError;
+#[cfg(any(feature = "ladder", not(feature = "orbit")))]
+use board_records::FrameDone;
+use board_records::{Channel, Record};
 use lattice_rt::NoHooks;
 
 /// The pause between two scenes.
 const PAUSE_MS: u32 = 3000;
+
+/// The records this board reports (`board_records`): `host-sim board` finds the channel by this
+/// symbol in the emulated board's RAM and decodes them into the same types.
+#[no_mangle]
+static BOARD_RECORDS: Channel = Channel::new();
+
+/// Reports `record` on [`BOARD_RECORDS`].
+pub fn report(record: Record) {
+    BOARD_RECORDS.send(&record);
+}
+
+/// What a frame of scene `scene` reports (orbit mode reports whole orbits instead).
+#[cfg(any(feature = "ladder", not(feature = "orbit")))]
+fn frame_done(scene: usize, r: &Report, us: u64) -> FrameDone {
+    let s = &r.stats;
+    FrameDone {
+        scene: scene as u8,
+        us,
+        share_us: r.share_us,
+        rays: s.rays,
+        object_tests: s.object_tests,
+        cells: s.cells_visited,
+        lattice_bytes: r.lattice_bytes as u32,
+        stack: firmware::stack::high_water() as u32,
+    }
+}
 
 /// The board as the modes use it: the display, the LED, the clock, both cores and the memory
 /// of a frame.
@@ -73,9 +102,10 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
 #[cfg(not(any(feature = "orbit", feature = "ladder")))]
 pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     loop {
-        for (name, text) in SCENES {
+        for (i, (name, text)) in SCENES.iter().enumerate() {
             match panel.show(text, &Shot::default()) {
                 Ok((r, us)) => {
+                    report(Record::Frame(frame_done(i, &r, us)));
                     let (s, shares) = (r.stats, r.share_us);
                     defmt::info!(
                         "{}: {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
@@ -83,7 +113,10 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
                         r.lattice_bytes, stack::high_water()
                     );
                 }
-                Err(e) => defmt::error!("{}: {}", name, e),
+                Err(e) => {
+                    report(Record::Failed { scene: i as u8 });
+                    defmt::error!("{}: {}", name, e)
+                }
             }
             panel.pause();
         }
@@ -95,7 +128,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
 pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     use firmware::app::ORBIT_FRAMES;
     loop {
-        for (name, text) in SCENES {
+        for (scene, (name, text)) in SCENES.iter().enumerate() {
             let t0 = panel.timer.get_counter();
             for i in 0..ORBIT_FRAMES {
                 let shot = Shot { turn: i as f64 / ORBIT_FRAMES as f64, ..Shot::default() };
@@ -105,6 +138,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
                 }
             }
             let us = (panel.timer.get_counter() - t0).to_micros().max(1);
+            report(Record::Orbit { scene: scene as u8, frames: ORBIT_FRAMES, us, stack: stack::high_water() as u32 });
             let centi_fps = ORBIT_FRAMES as u64 * 100_000_000 / us;
             defmt::info!(
                 "{}: orbit of {} frames in {} ms: {}.{=u64:02} frames per second, stack high-water {} B",
@@ -123,11 +157,17 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
         let (name, text) = SCENES[0];
         for (rung, (what, tuning)) in LADDER.iter().enumerate() {
             match panel.show(text, &Shot { turn: 0.0, tuning: *tuning }) {
-                Ok((r, us)) => defmt::info!(
-                    "ladder {}: {}: {} us, shares {} us and {} us, object tests {}, cells {} ({})",
-                    rung, name, us, r.share_us[0], r.share_us[1], r.stats.object_tests, r.stats.cells_visited, what
-                ),
-                Err(e) => defmt::error!("ladder {}: {}: {}", rung, name, e),
+                Ok((r, us)) => {
+                    report(Record::Rung { rung: rung as u8, frame: frame_done(0, &r, us) });
+                    defmt::info!(
+                        "ladder {}: {}: {} us, shares {} us and {} us, object tests {}, cells {} ({})",
+                        rung, name, us, r.share_us[0], r.share_us[1], r.stats.object_tests, r.stats.cells_visited, what
+                    )
+                }
+                Err(e) => {
+                    report(Record::Failed { scene: 0 });
+                    defmt::error!("ladder {}: {}: {}", rung, name, e)
+                }
             }
         }
         panel.pause();

@@ -1,4 +1,5 @@
-//! The frame every board renders (also read by `build.rs`, which sizes the storage for it).
+//! The frame every board renders: the firmware renders it, its `build.rs` sizes the storage
+//! for it, and the host renders it to check the board's frames bit for bit.
 
 use lattice_rt::render::Sampling;
 use lattice_rt::{Dither, EyeRays, Frame, Tone};

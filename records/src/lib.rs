@@ -1,0 +1,11 @@
+//! The contract between the firmware and the host: the frame every board renders
+//! ([`frame`]), and what a board reports ([`Record`]), written by the firmware into a
+//! [`Channel`] in its RAM and read back by the host as the same types: no log line is parsed
+//! as text. The defmt log stays for people; records are for `host-sim board`.
+#![no_std]
+#![deny(missing_docs)]
+
+pub mod frame;
+mod record;
+
+pub use record::{Channel, FrameDone, Record, CHANNEL_BYTES, CHANNEL_MAGIC};
