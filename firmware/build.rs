@@ -3,7 +3,7 @@
 //! embedded in the firmware.
 //!
 //! Scenes: `FIRMWARE_SCENES` (comma-separated names from `scenes/`), or the list in
-//! `default-scenes.txt` (the paper's four and the Whitted showcase; `host-sim board` reads it
+//! `default-scenes.txt` (the paper's four and the Whitted showcase; `cargo xtask board` reads it
 //! too, to know which frames the image shows). Each is parsed here with the core itself, in the firmware's
 //! scalar, so a broken scene fails the build with its line and column, and the storage
 //! capacities are the exact maximum the chosen scenes need (written to `capacities.rs`).

@@ -10,7 +10,7 @@
 //   {"event":"end", ...}    why the run ended, with totals
 // The device's defmt log (the RTT up channel, read as a probe reads it) goes to --log as raw
 // bytes for people, and its typed records (the board_records channel at --records ADDR) to
-// --records-log, for `host-sim board` to decode. Exit code 0 when the run ended as asked, 1
+// --records-log, for `cargo xtask board` to decode. Exit code 0 when the run ended as asked, 1
 // otherwise.
 //
 // rp2040js has no SSI flash model, so core 0 starts at boot2 (PC = 0x10000000) with the

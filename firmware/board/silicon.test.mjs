@@ -1,6 +1,6 @@
 // Unit tests of what silicon.mjs adds to rp2040js, each against the RP2040 datasheet
 // (`npm test` in firmware/board; `.ci/run` runs them). The firmware itself is the rest of the
-// test: `host-sim board` requires its two-core frames to be bit-identical to host-sim's.
+// test: `cargo xtask board` requires its two-core frames to be bit-identical to host-sim's.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { Divider, Fifos, XipCache } from './silicon.mjs';

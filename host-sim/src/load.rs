@@ -95,10 +95,10 @@ mod tests {
         let text = read(path).unwrap();
         let mut storage = object_storage::<f64>(&text).unwrap();
         let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
-        let err = lattice_storage(&scene, &crate::lattice_config(Some([1024, 1024, 1024]), None)).expect_err("refused");
+        let err = lattice_storage(&scene, &crate::cli::lattice_config(Some([1024, 1024, 1024]), None)).expect_err("refused");
         let msg = format!("{err:#}");
         assert!(msg.contains("--cells") && msg.contains(&MAX_LATTICE_BYTES.to_string()), "{msg}");
-        assert!(lattice_storage(&scene, &crate::lattice_config(Some([64, 64, 64]), None)).is_ok());
+        assert!(lattice_storage(&scene, &crate::cli::lattice_config(Some([64, 64, 64]), None)).is_ok());
     }
 
     #[test]

@@ -3,7 +3,7 @@
 use crate::shared::{median, PAPER_SCENES};
 use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
 use crate::output::{write_gray_png, write_pbm, write_pgm, write_png, Theme};
-use crate::{Accel, RenderArgs, StatsArgs};
+use crate::cli::{Accel, RenderArgs, StatsArgs};
 use anyhow::{anyhow, Context, Result};
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::Effects;
@@ -235,7 +235,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
         tone: lattice_rt::Tone { gamma_tenths: a.gamma },
         ..Frame::new(a.size.0, a.size.1)
     };
-    let mut out = render_accel(&scene, a.accel, &crate::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true)?;
+    let mut out = render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true)?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
     // Every output under a temporary name first: if one cannot be written, none is left.
     let mut staged = crate::output::Staged::default();
@@ -261,7 +261,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let text = read(&a.scene)?;
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
-    let cfg = crate::lattice_config(a.cells, a.budget);
+    let cfg = crate::cli::lattice_config(a.cells, a.budget);
     let mut bufs = lattice_storage(&scene, &cfg)?;
     let t0 = Instant::now();
     let lattice = build_lattice(&mut bufs, &scene, &cfg)?;

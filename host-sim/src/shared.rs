@@ -1,6 +1,6 @@
 //! What the commands share: the scene lists, the accelerator names and the median of timings.
 
-use crate::Accel;
+use crate::cli::Accel;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 

@@ -17,7 +17,7 @@ pub const SAMPLING: Sampling = Sampling::Adaptive { contrast: 4 };
 
 /// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), blue-noise
 /// ordered dither: of the dithers whose tiles the two cores can share out, the one that scores
-/// best in `host-sim display` (docs/display.md; error diffusion scores higher but carries error
+/// best in `cargo xtask display` (docs/display.md; error diffusion scores higher but carries error
 /// from tile to tile, so one core would have to render every tile). No silhouette lines: they
 /// cost about a fifth more cycles (the firmware's `outline` feature draws them).
 pub const FRAME: Frame = Frame {
@@ -51,7 +51,7 @@ pub struct Tuning {
 pub const TUNING: Tuning = Tuning { eye_rays: None, shadow_coherence: true, sampling: SAMPLING };
 
 /// The ladder of the real-time work, from the paper's method to what the boards run, one lever
-/// added per rung (docs/board.md, written by `host-sim board` from the `ladder` image).
+/// added per rung (docs/board.md, written by `cargo xtask board` from the `ladder` image).
 pub const LADDER: [(&str, Tuning); 5] = [
     ("the paper's nested lattice, one ray per pixel", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: false, sampling: Sampling::Center }),
     ("+ shadow rays try the last occluder first", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, sampling: Sampling::Center }),

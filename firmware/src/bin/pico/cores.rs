@@ -1,6 +1,6 @@
 //! Both cores: core 1 is started once at boot and then runs each job core 0 hands it through
 //! the SIO FIFO. There is one path: a board always has core 1, and so does the emulated one
-//! (`host-sim board` runs core 1 and requires its tile share to be bit-identical too).
+//! (`cargo xtask board` runs core 1 and requires its tile share to be bit-identical too).
 
 use crate::hal;
 use firmware::app::Cores;

@@ -7,7 +7,7 @@
 //! The on-board LED is lit while a frame is being rendered and goes out when the frame is on
 //! the display; between scenes the core sleeps (`wfi`) until a timer alarm. With no display
 //! answering, the log says so and the LED blinks quickly while the firmware retries every
-//! second. `host-sim board` runs this image on an emulated RP2040 (both cores, the flash cache,
+//! second. `cargo xtask board` runs this image on an emulated RP2040 (both cores, the flash cache,
 //! the I2C bus's timing) and relies on that LED protocol.
 //!
 //! The rooms: [`wiring`] (the pins, address and bus clock: the one place to change them),

@@ -21,7 +21,7 @@ use lattice_rt::NoHooks;
 /// The pause between two scenes.
 const PAUSE_MS: u32 = 3000;
 
-/// The records this board reports (`board_records`): `host-sim board` finds the channel by this
+/// The records this board reports (`board_records`): `cargo xtask board` finds the channel by this
 /// symbol in the emulated board's RAM and decodes them into the same types.
 #[no_mangle]
 static BOARD_RECORDS: Channel = Channel::new();

@@ -1,7 +1,7 @@
 //! The hot code that runs from SRAM (`firmware/pico/ram-code.x`): copied there from flash once,
 //! before anything calls it. On silicon a miss in the 16 KiB XIP cache stalls a core for a
 //! QSPI line fill (56 cycles at 125 MHz); the tracer's code is several times the cache, so in
-//! flash it misses all the time (`host-sim board` measures both).
+//! flash it misses all the time (`cargo xtask board` measures both).
 
 /// Copies the hot code from its flash image to SRAM. Called first thing in `main`, before any
 /// of that code runs, and on core 0 alone (core 1 starts later).

@@ -33,7 +33,7 @@ pub type DisplayBus = hal::I2C<
 pub type Led = hal::gpio::Pin<hal::gpio::bank0::Gpio25, hal::gpio::FunctionSioOutput, hal::gpio::PullDown>;
 
 /// Sets the pins up as [`Wiring`] says: the display's bus, and the on-board LED on GP25 (lit
-/// while a frame renders; `host-sim board` watches it).
+/// while a frame renders; `cargo xtask board` watches it).
 pub fn connect(pins: hal::gpio::Pins, i2c0: pac::I2C0, resets: &mut pac::RESETS, system_clock: &hal::clocks::SystemClock) -> (DisplayBus, Led) {
     let sda = pins.gpio4.reconfigure::<hal::gpio::FunctionI2C, hal::gpio::PullUp>();
     let scl = pins.gpio5.reconfigure::<hal::gpio::FunctionI2C, hal::gpio::PullUp>();

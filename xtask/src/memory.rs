@@ -1,12 +1,12 @@
-//! `host-sim memory`: the memory-time frontier. Each scene's lattice is built within byte
+//! `cargo xtask memory`: the memory-time frontier. Each scene's lattice is built within byte
 //! budgets from 64 B to 1 MiB (`LatticeConfig::budget`), and its time, object tests and cells
 //! per ray are set against the bytes it took; the bounding-box method and brute force are the
 //! end that keeps no lattice. Writes `docs/memory.md` and two plots.
 
 use crate::bench::{camera_rays, generated};
-use crate::load::{build_lattice, lattice_storage, object_storage, parse_scene, read};
-use crate::output::write_atomic;
-use crate::shared::{median, plot_link, PAPER_SCENES};
+use host_sim::load::{build_lattice, lattice_storage, object_storage, parse_scene, read};
+use host_sim::output::write_atomic;
+use host_sim::shared::{median, plot_link, PAPER_SCENES};
 use anyhow::{ensure, Result};
 use lattice_rt::lattice::Choice;
 use lattice_rt::scene::Object;
@@ -259,7 +259,7 @@ pub fn memory_cmd(a: &MemoryArgs) -> Result<()> {
     let mut subjects = subjects(a.quick)?;
     let mut sections = String::new();
     let mut summaries = Vec::new();
-    let bar = crate::progress::bar(subjects.len(), "memory sweep");
+    let bar = host_sim::progress::bar(subjects.len(), "memory sweep");
     for s in subjects.iter_mut() {
         let t0 = Instant::now();
         let summary = match &s.source {
@@ -273,14 +273,14 @@ pub fn memory_cmd(a: &MemoryArgs) -> Result<()> {
             }
         };
         bar.inc(1);
-        crate::progress::log(&bar, format_args!("  {} done in {:.1} s", s.name, t0.elapsed().as_secs_f64()));
+        host_sim::progress::log(&bar, format_args!("  {} done in {:.1} s", s.name, t0.elapsed().as_secs_f64()));
         summaries.push(summary);
     }
     drop(bar);
     let mut md = String::new();
     writeln!(
         md,
-        "# Memory: the lattice within a byte budget\n\nWritten by `cargo run --release -p host-sim -- memory{}` on the host (f64, one core). Each\nscene's lattice is built within budgets from {} B to {} KiB, doubling, and at a quarter of\nits automatic lattice's bytes (`LatticeConfig::budget`: the densest lattice that fits, its\ncells per item scaled down in steps of 3/4, sub-lattices tried before a flat lattice, 16-bit\nindices whenever they fit). Where not one cell per lattice fits, the tracer keeps no lattice\nand uses bounding boxes. Per ray: nearest-hit queries of {}x{} eye rays, median time of {runs}\nruns with every method interleaved in each run; all methods find the same hits.\n",
+        "# Memory: the lattice within a byte budget\n\nWritten by `cargo xtask memory{}` on the host (f64, one core). Each\nscene's lattice is built within budgets from {} B to {} KiB, doubling, and at a quarter of\nits automatic lattice's bytes (`LatticeConfig::budget`: the densest lattice that fits, its\ncells per item scaled down in steps of 3/4, sub-lattices tried before a flat lattice, 16-bit\nindices whenever they fit). Where not one cell per lattice fits, the tracer keeps no lattice\nand uses bounding boxes. Per ray: nearest-hit queries of {}x{} eye rays, median time of {runs}\nruns with every method interleaved in each run; all methods find the same hits.\n",
         if a.quick { " --quick" } else { "" },
         BUDGETS.0,
         BUDGETS.1 >> 10,

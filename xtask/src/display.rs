@@ -1,13 +1,13 @@
-//! `host-sim display`: what a person sees on the 1-bit display. Each scene is rendered as the
+//! `cargo xtask display`: what a person sees on the 1-bit display. Each scene is rendered as the
 //! boards render it (128x64, fixed point, adaptive sampling) with every dither, with and
 //! without silhouette lines and through several tone curves; each 1-bit frame is compared with
 //! the reference gray image (f64, 4x4 rays per pixel) after a Gaussian low-pass that models
 //! viewing distance, by mean error and SSIM. Writes `docs/display.md`, a contact sheet per
 //! scene and the progressive passes of each scene.
 
-use crate::load::read;
-use crate::output::write_atomic;
-use crate::run::{progressive_passes, render_text};
+use host_sim::load::read;
+use host_sim::output::write_atomic;
+use host_sim::run::{progressive_passes, render_text};
 use crate::tradeoff::reference;
 use anyhow::Result;
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
@@ -136,7 +136,7 @@ impl Sheet {
     }
     fn save(&self, path: &Path, scale: u32) -> Result<()> {
         let settings = OutputSettingsBuilder::new().scale(scale).build();
-        let mut staged = crate::output::Staged::default();
+        let mut staged = host_sim::output::Staged::default();
         let tmp = staged.stage(path)?;
         self.display.to_grayscale_output_image(&settings).save_png(&tmp)?;
         staged.commit()
@@ -178,7 +178,7 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
     let names: Vec<String> = scenes.iter().map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()).collect();
     let mut frames: Vec<Vec<Vec<u8>>> = Vec::new();
     let mut references = Vec::new();
-    let bar = crate::progress::bar(scenes.len(), "scenes");
+    let bar = host_sim::progress::bar(scenes.len(), "scenes");
     for path in scenes {
         bar.inc(1);
         let text = read(path)?;
@@ -270,7 +270,7 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
     writeln!(md, "# What the display shows\n")?;
     writeln!(
         md,
-        "Written by `cargo run --release -p host-sim -- display` ({n} scenes: {}). Every frame is rendered as the\nboards render it: {w}x{h}, Q16.16 fixed point, adaptive sampling. Each 1-bit frame (lit pixel = 64,\ndark = 0) and the reference gray image (f64, 4x4 rays per pixel) are both low-passed by a\nGaussian of sigma 1 and 2 display pixels, a model of viewing the panel from a distance where\nsingle dots merge; the table gives the mean absolute difference of the two (levels of 64) and\ntheir SSIM (Wang et al. 2004; 1 is identical), averaged over the scenes. Ranked by SSIM averaged\nover both sigmas.\n",
+        "Written by `cargo xtask display` ({n} scenes: {}). Every frame is rendered as the\nboards render it: {w}x{h}, Q16.16 fixed point, adaptive sampling. Each 1-bit frame (lit pixel = 64,\ndark = 0) and the reference gray image (f64, 4x4 rays per pixel) are both low-passed by a\nGaussian of sigma 1 and 2 display pixels, a model of viewing the panel from a distance where\nsingle dots merge; the table gives the mean absolute difference of the two (levels of 64) and\ntheir SSIM (Wang et al. 2004; 1 is identical), averaged over the scenes. Ranked by SSIM averaged\nover both sigmas.\n",
         names.join(", ")
     )?;
     writeln!(md, "**Best: {}** (mean SSIM {:.3}).\n", best.label(), scores[order[0]].ssim(n))?;

@@ -1,9 +1,9 @@
-//! `host-sim firmware`: builds the firmware variants, runs the emulated ones in QEMU with
+//! `cargo xtask firmware`: builds the firmware variants, runs the emulated ones in QEMU with
 //! `-icount shift=0`, checks every frame bit for bit against the same render on the host,
 //! measures flash, RAM and instructions per frame, and writes `docs/firmware.md`.
 
-use crate::run::render_text;
-use crate::load::read;
+use host_sim::run::render_text;
+use host_sim::load::read;
 use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 use std::fmt::Write as _;
@@ -137,7 +137,7 @@ fn variants() -> Vec<Variant> {
         machine: None,
         scenes: None,
         scalar: "fixed",
-        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes (run on an emulated board by `host-sim board`: docs/board.md)".into(),
+        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes (run on an emulated board by `cargo xtask board`: docs/board.md)".into(),
     });
     v.push(Variant {
         name: "pico2".into(),
@@ -396,8 +396,8 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
         // The tables' two big parts: the objects, and each scene's own fixed-capacity lists.
         let mut objects = 0;
         for s in &r.scenes {
-            let text = crate::load::read(&root.join("scenes").join(format!("{}.scene", s.name)))?;
-            let mut storage = crate::load::object_storage::<lattice_rt::Fx>(&text)?;
+            let text = host_sim::load::read(&root.join("scenes").join(format!("{}.scene", s.name)))?;
+            let mut storage = host_sim::load::object_storage::<lattice_rt::Fx>(&text)?;
             objects += lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage).map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?.objects().len();
         }
         let (object, baked) = (size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>(), size_of::<lattice_rt::Baked<lattice_rt::Fx>>());
@@ -430,23 +430,23 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
 pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     let (mut passed, mut failed) = (0, 0);
     let mut md = String::new();
-    writeln!(md, "# Firmware budgets\n\nWritten by `cargo run --release -p host-sim -- firmware` (also run by `.ci/run`).\nFrames are 128x64, lattice, blue-noise dither, each scene's own effects and depth.\n")?;
+    writeln!(md, "# Firmware budgets\n\nWritten by `cargo xtask firmware` (also run by `.ci/run`).\nFrames are 128x64, lattice, blue-noise dither, each scene's own effects and depth.\n")?;
     writeln!(md, "## Builds\n\n| variant | what | flash bytes | static RAM | stack high-water | RAM total |\n|---|---|---|---|---|---|")?;
     let variants = variants();
     let mut runs = Vec::new();
-    let bar = crate::progress::bar(variants.len(), "firmware variants");
+    let bar = host_sim::progress::bar(variants.len(), "firmware variants");
     for v in &variants {
         bar.set_message(v.name.clone());
         bar.inc(1);
         if !skip_build {
-            crate::progress::log(&bar, format_args!("  building {} ({})", v.name, v.target));
+            host_sim::progress::log(&bar, format_args!("  building {} ({})", v.name, v.target));
             build(root, v)?;
         }
         let elf = elf_path(root, v);
         let (flash, _) = elf_sizes(&elf)?;
         let run = match v.machine {
             Some(m) => {
-                crate::progress::log(&bar, format_args!("  running {} on {m}", v.name));
+                host_sim::progress::log(&bar, format_args!("  running {} on {m}", v.name));
                 Some(run_qemu(&elf, m)?)
             }
             None => None,

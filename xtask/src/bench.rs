@@ -1,11 +1,11 @@
-//! `host-sim bench`: the paper's Table 1 reproduced, then scaling to 100 000 primitives, and
+//! `cargo xtask bench`: the paper's Table 1 reproduced, then scaling to 100 000 primitives, and
 //! the lattice's resolution choice against a sweep. Writes `docs/performance.md` and a plot.
 
-use crate::shared::median;
-use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
-use crate::run::render_band;
-use crate::output::write_atomic;
-use crate::shared::plot_link;
+use host_sim::shared::median;
+use host_sim::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
+use host_sim::run::render_band;
+use host_sim::output::write_atomic;
+use host_sim::shared::plot_link;
 use anyhow::Result;
 use lattice_rt::generate::{random_object, random_scene, RandomScene, Rng};
 use lattice_rt::lattice::{Resolution, Spacing};
@@ -133,7 +133,7 @@ pub fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> R
 pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()> {
     let runs = if quick { 1 } else { runs.max(1) };
     let mut md = String::new();
-    writeln!(md, "# Performance\n\nWritten by `cargo run --release -p host-sim -- bench{}` on the host (f64, one core). Times are\nmedians of {runs} runs, the methods interleaved in each run so drift on a shared machine hits all alike.\n", if quick { " --quick" } else { "" })?;
+    writeln!(md, "# Performance\n\nWritten by `cargo xtask bench{}` on the host (f64, one core). Times are\nmedians of {runs} runs, the methods interleaved in each run so drift on a shared machine hits all alike.\n", if quick { " --quick" } else { "" })?;
     // Table 1.
     writeln!(md, "## The paper's Table 1, reproduced\n\nThe four paper scenes at 160x100 with the paper's settings (directional light, 40x25 degree\nview, full Whitted tree). Ratio = bounding-box time / method time (the paper's \"how many\ntimes faster than the bounding box\"). Tests, inside tests and cells are per primary ray\n(eye rays alone). The first four methods trace eye rays as the paper does; the last row is the\ntracer's default, where an eye ray skips every object whose window on the image (its box\nprojected through the eye) does not hold it, and scenes of up to 64 objects skip the walk too\n(`EyeRays`); its tests count only the exact tests made.\n")?;
     writeln!(md, "| scene | method | ms/frame | ratio to bbox | paper's ratio | object tests/ray | inside tests/ray | cells/ray | lattice build ms | lattice bytes |\n|---|---|---|---|---|---|---|---|---|---|")?;
@@ -191,7 +191,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     writeln!(md, "## Scaling\n\nGenerated scenes (random mixes of the four primitives in a cube growing with N; \"clustered\":\n10 % spread over a stadium, 90 % packed in one composite far from them). Nearest-hit queries\nfor camera rays (a 64x40 grid; fewer for the O(N) methods at large N). Bytes: lattice storage\n(lattices, coordinate lists, cells, references); the bounding-box method keeps one box per object.\n")?;
     writeln!(md, "| scene | N | method | us/ray | object tests/ray | cells/ray | bytes | bytes/ref + bytes/cell |\n|---|---|---|---|---|---|---|---|")?;
     let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-    let bar = crate::progress::bar(2 * sizes.len(), "generated scenes");
+    let bar = host_sim::progress::bar(2 * sizes.len(), "generated scenes");
     for clustered in [false, true] {
         for &n in &sizes {
             let mut storage = Vec::new();
@@ -236,7 +236,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
                 }
             }
             bar.inc(1);
-            crate::progress::log(&bar, format_args!("  {kind} N={n} done"));
+            host_sim::progress::log(&bar, format_args!("  {kind} N={n} done"));
         }
     }
     let at = |key: &str, n: f64| series.iter().find(|(k, _)| k == key).and_then(|(_, v)| v.iter().find(|p| p.0 == n)).map(|p| p.1);
@@ -285,7 +285,7 @@ fn against_povray(quick: bool, runs: usize) -> Result<String> {
     let cfg = LatticeConfig::default();
     let mut rows = Vec::new();
     let sizes: &[usize] = if quick { &[100, 1000] } else { &[100, 1000, 10_000] };
-    let bar = crate::progress::bar(PAPER.len() + 2 * sizes.len(), "against POV-Ray");
+    let bar = host_sim::progress::bar(PAPER.len() + 2 * sizes.len(), "against POV-Ray");
     for (name, ..) in PAPER {
         let path = Path::new("scenes").join(format!("{name}.scene"));
         let text = read(&path)?;
@@ -305,7 +305,7 @@ fn against_povray(quick: bool, runs: usize) -> Result<String> {
             let name = format!("{} {n}", if clustered { "clustered" } else { "random" });
             rows.extend(crate::versus::compare(&name, &scene, &lattice, runs, work)?);
             bar.inc(1);
-            crate::progress::log(&bar, format_args!("  {name} against POV-Ray done"));
+            host_sim::progress::log(&bar, format_args!("  {name} against POV-Ray done"));
         }
     }
     crate::versus::section(&rows, runs)

@@ -1,10 +1,10 @@
-//! `host-sim bench`'s POV-Ray columns: host-sim's render time on one core against POV-Ray 3.7's
+//! `cargo xtask bench`'s POV-Ray columns: host-sim's render time on one core against POV-Ray 3.7's
 //! own "Trace Time" for the same scene (exported with `export --pov`), the same size, one
 //! thread (`+WT1`), no anti-aliasing, with and without shadows.
 
-use crate::pov::{export, PovMode};
-use crate::run::render_band;
-use crate::shared::median;
+use host_sim::pov::{export, PovMode};
+use host_sim::run::render_band;
+use host_sim::shared::median;
 use anyhow::{bail, Context, Result};
 use lattice_rt::{Accelerator, Effects, Frame, Scene, Tracer};
 use std::fmt::Write as _;

@@ -1,4 +1,4 @@
-//! `host-sim board`: the Pico image a user flashes, run on an emulated RP2040 with an SSD1306.
+//! `cargo xtask board`: the Pico image a user flashes, run on an emulated RP2040 with an SSD1306.
 //!
 //! Builds the image exactly as `cargo pico-build` does (flip-link and all), writes its UF2 file,
 //! runs that UF2 on an RP2040 as silicon runs it (`firmware/board/run.mjs`: rp2040js with core 1,
@@ -12,6 +12,7 @@
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
+use host_sim::uf2::{build_pico, pico_elf, pico_elf_in, write_uf2};
 use board_frame::{LADDER, ORBIT_FRAMES};
 use anyhow::{bail, Context, Result};
 use board_records::{FrameDone, Record};
@@ -33,82 +34,6 @@ const TARGETS: &[(&str, f64)] = &[("chair", 12.5e6), ("desk", 25e6), ("polyhedro
 const MAX_CYCLES_PER_FRAME: u64 = 3_000_000_000;
 /// The message the firmware logs when no display answers (checked in the run without one).
 const NO_DISPLAY_MESSAGE: &str = "no SSD1306 answers on I2C0";
-
-/// Where the image `cargo pico-build` writes.
-fn pico_elf(root: &Path) -> PathBuf {
-    pico_elf_in(&root.join("firmware/target"))
-}
-
-/// A Raspberry Pi board the firmware is built for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Board {
-    /// Raspberry Pi Pico (RP2040, Cortex-M0+): fixed point.
-    Pico,
-    /// Raspberry Pi Pico 2 (RP2350, Cortex-M33 with an FPU): f32.
-    Pico2,
-}
-
-impl Board {
-    /// Its name in file names and its cargo feature (`pico`, `pico2`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Board::Pico => "pico",
-            Board::Pico2 => "pico2",
-        }
-    }
-    /// The Rust target its image is built for.
-    fn target(self) -> &'static str {
-        match self {
-            Board::Pico => "thumbv6m-none-eabi",
-            Board::Pico2 => "thumbv8m.main-none-eabihf",
-        }
-    }
-    /// The drive the board shows in BOOTSEL mode.
-    fn drive(self) -> &'static str {
-        match self {
-            Board::Pico => "RPI-RP2",
-            Board::Pico2 => "RP2350",
-        }
-    }
-    /// Writes `elf` as a UF2 file for the board's family (via a temporary file, so a failed
-    /// write leaves nothing behind).
-    fn write_uf2(self, elf: &Path, out: &Path) -> Result<()> {
-        let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-        let mut bytes = Vec::new();
-        let converted = match self {
-            Board::Pico => elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2040, elf2flash_core::NoProgress),
-            Board::Pico2 => elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2350, elf2flash_core::NoProgress),
-        };
-        converted.map_err(|e| anyhow::anyhow!("cannot convert {} to UF2: {e}", elf.display()))?;
-        crate::output::write_atomic(out, &bytes)
-    }
-}
-
-/// Builds the Pico image with the repository's own alias, so it is the image `cargo pico` flashes.
-pub fn build_pico(root: &Path) -> Result<PathBuf> {
-    build_board(root, Board::Pico)
-}
-
-/// Builds `board`'s image with the repository's own alias (`cargo pico-build`,
-/// `cargo pico2-build`), so it is the image `cargo pico` / `cargo pico2` flashes.
-pub fn build_board(root: &Path, board: Board) -> Result<PathBuf> {
-    let alias = format!("{}-build", board.name());
-    eprintln!("building the {} image (cargo {alias})", board.name());
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(root)
-        .arg(&alias)
-        .env_remove("RUSTFLAGS")
-        .status()
-        .context("cannot run cargo")?;
-    if !status.success() {
-        bail!("`cargo {alias}` failed (it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target());
-    }
-    let profile = match board {
-        Board::Pico => "release",
-        Board::Pico2 => "speed",
-    };
-    Ok(root.join("firmware/target").join(board.target()).join(profile).join("pico"))
-}
 
 /// The silicon models the emulator can leave out (`run.mjs` switches), to show what each adds
 /// to the first scene's frame.
@@ -158,25 +83,6 @@ fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, fra
     eprintln!("running {} ({frames} frames)", uf2.display());
     let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir, &[])?;
     Ok((run, dir))
-}
-
-/// The image in target folder `dir`.
-fn pico_elf_in(dir: &Path) -> PathBuf {
-    dir.join("thumbv6m-none-eabi/release/pico")
-}
-
-/// Writes `elf` as a UF2 file for the RP2040's BOOTSEL drive.
-pub fn write_uf2(elf: &Path, out: &Path) -> Result<()> {
-    Board::Pico.write_uf2(elf, out)
-}
-
-/// The command `host-sim uf2`: `out` defaults to `out/lattice-rt-<board>.uf2`.
-pub fn uf2_cmd(root: &Path, board: Board, out: Option<&Path>) -> Result<()> {
-    let elf = build_board(root, board)?;
-    let out = out.map_or_else(|| PathBuf::from(format!("out/lattice-rt-{}.uf2", board.name())), Path::to_path_buf);
-    board.write_uf2(&elf, &out)?;
-    println!("wrote {}: hold BOOTSEL while plugging the board in, then copy this file onto the {} drive", out.display(), board.drive());
-    Ok(())
 }
 
 /// The scenes the image embeds, in order: `FIRMWARE_SCENES` as the build saw it, or the
@@ -400,7 +306,7 @@ fn save_frame(bits: &[u8], path: &Path) -> Result<()> {
     let mut raster = bits.to_vec();
     raster.resize(BitFrame::bytes(PANEL.0, PANEL.1), 0);
     let frame = BitFrame::wrap(PANEL.0, PANEL.1, &mut raster).context("frame size")?;
-    crate::output::write_png(&frame, path, crate::output::Theme::OledWhite, 4)
+    host_sim::output::write_png(&frame, path, host_sim::output::Theme::OledWhite, 4)
 }
 
 /// A picture of where two frames differ: lit where they do.
@@ -423,7 +329,7 @@ fn reported_frame(records: &[Record], index: usize) -> Option<FrameDone> {
     })
 }
 
-/// The command `host-sim board`.
+/// The command `cargo xtask board`.
 pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> Result<()> {
     let elf = if no_build { pico_elf(root) } else { build_pico(root)? };
     let scenes = embedded_scenes(root)?;
@@ -532,8 +438,8 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
     let (orun, orbit_dir) = run_variant(root, no_build, "orbit", false, frames_dir, &bootrom, ORBIT_CHECKED)?;
     let chair = scenes_dir.join("chair.scene");
-    let chair_text = crate::load::read(&chair)?;
-    let want = crate::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &chair_text, ORBIT_FRAMES, &board_frame::FRAME)?;
+    let chair_text = host_sim::load::read(&chair)?;
+    let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &chair_text, ORBIT_FRAMES, &board_frame::FRAME)?;
     if orun.frames.len() < ORBIT_CHECKED {
         failures.push(format!("orbit mode: {} of {ORBIT_CHECKED} frames shown ({})", orun.frames.len(), orun.reason));
     }
@@ -582,7 +488,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let mut progressive = Vec::new();
     for (name, shown) in scenes.iter().zip(prun.frames.chunks(passes)) {
         let path = scenes_dir.join(format!("{name}.scene"));
-        let want = crate::run::progressive_passes::<lattice_rt::Fx>(&path, &crate::load::read(&path)?, &board_frame::FRAME)?;
+        let want = host_sim::run::progressive_passes::<lattice_rt::Fx>(&path, &host_sim::load::read(&path)?, &board_frame::FRAME)?;
         let mut same = 0;
         for (f, p) in shown.iter().zip(&want) {
             let file = prog_dir.join(format!("{name}-pass{}.png", p.pass));
@@ -604,7 +510,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     // Silhouette lines: the chair with the `outline` feature, bit for bit against host-sim's.
     let (lrun_outline, outline_dir) = run_variant(root, no_build, "outline", false, frames_dir, &bootrom, 1)?;
     let lined = lattice_rt::Frame { outline: true, ..board_frame::FRAME };
-    let want = crate::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &lined, |_| {})?;
+    let want = host_sim::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &lined, |_| {})?;
     let plain_chair = rows.iter().find(|r| r.name == "chair");
     let mut outline_row = None;
     match lrun_outline.frames.first() {
@@ -624,7 +530,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
             } else {
                 failures.push(format!("outline: the chair differs from host-sim (see {})", file.display()));
             }
-            let plain_rays = crate::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &board_frame::FRAME, |_| {})?.stats.rays[0];
+            let plain_rays = host_sim::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &board_frame::FRAME, |_| {})?.stats.rays[0];
             outline_row = Some((f, [plain_rays, want.stats.rays[0]], same));
         }
         None => failures.push(format!("outline: no frame shown ({})", lrun_outline.reason)),
@@ -640,7 +546,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     if let (Some((f, rays, same)), Some(plain)) = (outline_row, plain_chair) {
         md.push_str(&outline_report(f, rays, same, &plain.frame, run.clk_sys_hz)?);
     }
-    crate::output::write_atomic(out, md.as_bytes())?;
+    host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     for f in &failures {
         eprintln!("FAIL {f}");
@@ -729,7 +635,7 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
     writeln!(md, "each pass reusing every ray traced before it, so no eye ray is traced twice. The display is")?;
     writeln!(md, "updated after each pass (both tile shares of the pass), and the LED goes out for a moment as")?;
     writeln!(md, "each pass reaches the panel; every pass the panel showed is checked bit for bit against")?;
-    writeln!(md, "host-sim's (`host-sim display` draws the same passes). *At* is cycles from the LED going on")?;
+    writeln!(md, "host-sim's (`cargo xtask display` draws the same passes). *At* is cycles from the LED going on")?;
     writeln!(md, "(set-up included) to the pass on the panel; *plain* is the same scene's frame in the default")?;
     writeln!(md, "image above, and *cost* the whole progressive frame against it (target: at most 1.05x).\n")?;
     writeln!(md, "| scene | passes identical | pass 8 at | pass 4 at | pass 2 at | finished at | plain | cost | first picture: share of the plain frame's time | eye rays per pass | I2C bytes |")?;
@@ -789,8 +695,8 @@ struct Rung<'f> {
 /// The host's frame of the chair traced with a rung's levers.
 fn ladder_frame(chair: &Path, tuning: &board_frame::Tuning) -> Result<Vec<u8>> {
     let frame = lattice_rt::Frame { sampling: tuning.sampling, ..board_frame::FRAME };
-    let text = crate::load::read(chair)?;
-    Ok(crate::run::render_text::<lattice_rt::Fx>(chair, &text, &frame, |t| {
+    let text = host_sim::load::read(chair)?;
+    Ok(host_sim::run::render_text::<lattice_rt::Fx>(chair, &text, &frame, |t| {
         if let Some(how) = tuning.eye_rays {
             t.set_eye_rays(how);
         }
@@ -856,7 +762,7 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
     let mut md = String::new();
     let mhz = s.clk_hz / 1e6;
     writeln!(md, "# The Pico image on an emulated board\n")?;
-    writeln!(md, "Written by `cargo run --release -p host-sim -- board` (also run by `.ci/run`). It builds the image")?;
+    writeln!(md, "Written by `cargo xtask board` (also run by `.ci/run`). It builds the image")?;
     writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, flip-link), writes its UF2 file, and runs that")?;
     writeln!(md, "file on an RP2040 as silicon runs it: [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 with what")?;
     writeln!(md, "`firmware/board/silicon.mjs` adds from the RP2040 datasheet, **core 1** (started by the B1 bootrom and")?;

@@ -1,7 +1,7 @@
 //! The plots in docs/, drawn with `plotters` as SVG (grid lines, log axes, legends) and written
 //! atomically: a failed command leaves no half-written plot.
 
-use crate::output::write_atomic;
+use host_sim::output::write_atomic;
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 use std::path::Path;

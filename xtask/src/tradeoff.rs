@@ -1,12 +1,12 @@
-//! `host-sim tradeoff`: what accuracy costs in time. Varies one knob at a time from a default
+//! `cargo xtask tradeoff`: what accuracy costs in time. Varies one knob at a time from a default
 //! (f64, the scene's depth, no cutoff, one ray per pixel, Bayer), measures the error against a
 //! reference (f64, 4x4 rays per pixel) and the cost, and writes `docs/accuracy.md` and a plot.
 
-use crate::shared::median;
-use crate::run::render_text;
-use crate::load::read;
-use crate::output::write_atomic;
-use crate::shared::plot_link;
+use host_sim::shared::median;
+use host_sim::run::render_text;
+use host_sim::load::read;
+use host_sim::output::write_atomic;
+use host_sim::shared::plot_link;
 use anyhow::Result;
 use lattice_rt::dither::Ditherer;
 use lattice_rt::{Dither, F32Micro, F32MicroNewton, Frame, Fx, Real, Sampling};
@@ -94,7 +94,7 @@ fn shoot(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Result<Shot> {
 
 /// Gray levels (0..=64, as reals) of `n x n` f64 rays per pixel, averaged.
 pub fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f64>> {
-    crate::run::with_tracer::<f64, _>(path, text, |_| {}, |tracer| {
+    host_sim::run::with_tracer::<f64, _>(path, text, |_| {}, |tracer| {
         let scene = tracer.scene();
         let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(scene)];
         let mut q = lattice_rt::Query::new(&mut mb);
@@ -164,11 +164,11 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
     let configs = configs();
     let mut tallies = vec![Tally::default(); configs.len()];
     let mut per_scene: BTreeMap<(String, &'static str), (usize, usize)> = BTreeMap::new();
-    let bar = crate::progress::bar(scenes.len(), "scenes");
+    let bar = host_sim::progress::bar(scenes.len(), "scenes");
     for path in scenes {
         let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
         bar.inc(1);
-        crate::progress::log(&bar, format_args!("  {name}: reference (16 rays/pixel, f64)"));
+        host_sim::progress::log(&bar, format_args!("  {name}: reference (16 rays/pixel, f64)"));
         let text = read(path)?;
         let reference = reference(&text, path, w, h, 4)?;
         let ref_levels: Vec<u8> = reference.iter().map(|v| v.round().clamp(0.0, 64.0) as u8).collect();
@@ -229,13 +229,13 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
     writeln!(md, "# What accuracy costs\n")?;
     writeln!(
         md,
-        "Written by `cargo run --release -p host-sim -- tradeoff` ({} scenes: {}; {w}x{h}; host time is the\nmedian of {} interleaved runs per scene, averaged over the scenes). Reference: f64, 4x4 rays per\npixel. One knob varies at a time from the default row (f64, each scene's depth, no cutoff).\n",
+        "Written by `cargo xtask tradeoff` ({} scenes: {}; {w}x{h}; host time is the\nmedian of {} interleaved runs per scene, averaged over the scenes). Reference: f64, 4x4 rays per\npixel. One knob varies at a time from the default row (f64, each scene's depth, no cutoff).\n",
         names.len(),
         names.join(", "),
         runs.max(1)
     )?;
     writeln!(md, "Error diffusion (Floyd-Steinberg, Atkinson) is chaotic: a change of one level anywhere moves\nthe dots that follow, so its dithered-pixel figure against the reference is large by nature;\ncompare its gray error, which is the same as the default's.\n")?;
-    writeln!(md, "Error columns compare with the reference: share of 1-bit display pixels that differ after\ndithering (the reference dithered the same way), mean and max absolute gray error in levels\n(of 64), PSNR of the gray image. Cortex-M columns: instructions per frame summed over the\nscenes, from `docs/firmware.csv` (`host-sim firmware`, QEMU `-icount shift=0`).\n")?;
+    writeln!(md, "Error columns compare with the reference: share of 1-bit display pixels that differ after\ndithering (the reference dithered the same way), mean and max absolute gray error in levels\n(of 64), PSNR of the gray image. Cortex-M columns: instructions per frame summed over the\nscenes, from `docs/firmware.csv` (`cargo xtask firmware`, QEMU `-icount shift=0`).\n")?;
     writeln!(md, "| knob | setting | dithered px differ | mean abs gray | max abs gray | PSNR dB | host ms/frame | rays/frame | M0 Minstr | M4F Minstr |\n|---|---|---|---|---|---|---|---|---|---|")?;
     let scenes_n = names.len().max(1) as f64;
     let mut points = Vec::new();
@@ -263,7 +263,7 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
         points.push((c.label.clone(), c.knob, ms, mean));
     }
     if !instr_complete {
-        writeln!(md, "\n(No `docs/firmware.csv` at {w}x{h}: run `host-sim firmware` first for the Cortex-M columns.)")?;
+        writeln!(md, "\n(No `docs/firmware.csv` at {w}x{h}: run `cargo xtask firmware` first for the Cortex-M columns.)")?;
     }
     writeln!(md, "\nCortex-M columns are per scene on average (the f64 row has no firmware build).\n")?;
     writeln!(md, "## Each scalar against f64 at the same settings\n\nShare of dithered pixels that differ from the f64 frame rendered with the same settings\n(1 ray per pixel, Bayer): the error the scalar alone adds.\n")?;

@@ -1,10 +1,10 @@
-//! `host-sim effects`: what simulating only the effects a scene calls for saves, in rays, host
+//! `cargo xtask effects`: what simulating only the effects a scene calls for saves, in rays, host
 //! time, Cortex-M instructions and flash, and what the contribution cutoff (Hall and
 //! Greenberg's adaptive tree depth) saves and costs. Writes `docs/effects.md`.
 
-use crate::shared::median;
-use crate::run::render_text;
-use crate::load::{object_storage, parse_scene, read};
+use host_sim::shared::median;
+use host_sim::run::render_text;
+use host_sim::load::{object_storage, parse_scene, read};
 use anyhow::{Context, Result};
 use lattice_rt::{Effects, Frame, Stats};
 use std::collections::BTreeMap;
@@ -50,11 +50,11 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
     }
     let mut md = String::new();
     writeln!(md, "# Simulating only the effects a scene calls for\n")?;
-    writeln!(md, "Written by `cargo run --release -p host-sim -- effects` (128x64, f64 on the host, median of {} interleaved\nruns; Cortex-M figures from `docs/firmware.csv`, written by `host-sim firmware`: QEMU `-icount\nshift=0`, fixed point, Cortex-M0+ build).\n", runs.max(1))?;
+    writeln!(md, "Written by `cargo xtask effects` (128x64, f64 on the host, median of {} interleaved\nruns; Cortex-M figures from `docs/firmware.csv`, written by `cargo xtask firmware`: QEMU `-icount\nshift=0`, fixed point, Cortex-M0+ build).\n", runs.max(1))?;
     writeln!(md, "## Derived effect set against every effect forced on\n\nRays are primary / shadow / reflection / refraction. \"All\" forces every effect on at run time\n(and, on the Cortex-M, compiles every effect in).\n")?;
     writeln!(md, "| scene | effect set | rays, derived | rays, all | host ms derived | host ms all | all / derived | same image | M0 Minstr derived | M0 Minstr all |\n|---|---|---|---|---|---|---|---|---|---|")?;
     let mut cut_rows = Vec::new();
-    let bar = crate::progress::bar(scenes.len(), "scenes");
+    let bar = host_sim::progress::bar(scenes.len(), "scenes");
     for path in scenes {
         let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
         bar.set_message(name.clone());
@@ -113,7 +113,7 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
         let flash = |v: &str| fw.iter().find(|((var, _), _)| var == v).map(|(_, x)| x.1);
         match (flash(derived), flash(all)) {
             (Some(d), Some(a)) => writeln!(md, "| {label} | {fx} | {d} | {a} | {} bytes ({:.1} %) |", a as i64 - d as i64, 100.0 * (1.0 - d as f64 / a as f64))?,
-            _ => writeln!(md, "| {label} | {fx} | - | - | (run `host-sim firmware` first) |")?,
+            _ => writeln!(md, "| {label} | {fx} | - | - | (run `cargo xtask firmware` first) |")?,
         }
     }
     std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;

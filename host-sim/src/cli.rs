@@ -1,0 +1,211 @@
+//! The command line's shared vocabulary: scalars, accelerators, dithers and sampling as
+//! options, the options of `render` and `stats`, and their parsers (also used by `cargo xtask`).
+
+use crate::output;
+use crate::shared;
+use clap::ValueEnum;
+use lattice_rt::Dither;
+use std::path::PathBuf;
+
+/// Numeric type the tracer runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Scalar {
+    /// 64-bit float (the reference).
+    F64,
+    /// 32-bit float with libm.
+    F32,
+    /// Q16.16 fixed point.
+    Fixed,
+}
+
+/// Ray-query method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Accel {
+    /// The lattice (space subdivision with sub-lattices).
+    Lattice,
+    /// The paper's baseline: a bounding-box inside test per object per ray.
+    Bbox,
+    /// Every object for every ray.
+    Brute,
+}
+
+/// Dithering mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum DitherArg {
+    /// 8x8 Bayer ordered dither, one ray per pixel.
+    Bayer,
+    /// The paper's 8x8 patterning: one ray per 8x8 block (65 levels).
+    Pattern8,
+    /// 4x4 patterning: one ray per 4x4 block (17 levels).
+    Pattern4,
+    /// 2x2 patterning: one ray per 2x2 block (5 levels).
+    Pattern2,
+    /// Floyd-Steinberg error diffusion.
+    Fs,
+    /// Atkinson error diffusion.
+    Atkinson,
+    /// Ordered dither with a 16x16 blue-noise (void-and-cluster) mask, one ray per pixel.
+    BlueNoise,
+}
+
+impl DitherArg {
+    /// The core's dithering mode.
+    pub fn mode(self) -> Dither {
+        match self {
+            DitherArg::Bayer => Dither::Bayer,
+            DitherArg::Pattern8 => Dither::Pattern(8),
+            DitherArg::Pattern4 => Dither::Pattern(4),
+            DitherArg::Pattern2 => Dither::Pattern(2),
+            DitherArg::Fs => Dither::FloydSteinberg,
+            DitherArg::Atkinson => Dither::Atkinson,
+            DitherArg::BlueNoise => Dither::BlueNoise,
+        }
+    }
+}
+
+/// Eye rays per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SamplingArg {
+    /// One ray through each pixel centre.
+    One,
+    /// Four rays per pixel (2x2 grid).
+    Four,
+    /// One ray per pixel, four at object edges only.
+    Edges,
+    /// One ray per pixel, four at object edges and where neighbours differ by 16 of 64 levels.
+    EdgesContrast,
+    /// Adaptive sub-sampling (the boards' default): every second pixel traced, the rest
+    /// filled in where the traced pixels around hit one object and differ by at most 4 levels.
+    Adaptive,
+}
+
+impl SamplingArg {
+    /// The core's sampling mode.
+    pub fn mode(self) -> lattice_rt::render::Sampling {
+        use lattice_rt::render::Sampling;
+        match self {
+            SamplingArg::One => Sampling::Center,
+            SamplingArg::Four => Sampling::Grid2x2,
+            SamplingArg::Edges => Sampling::Edges { contrast: u8::MAX },
+            SamplingArg::EdgesContrast => Sampling::Edges { contrast: 16 },
+            SamplingArg::Adaptive => Sampling::Adaptive { contrast: 4 },
+        }
+    }
+}
+
+/// Parses `WxH`.
+pub fn parse_size(s: &str) -> Result<(u16, u16), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size `{s}` is not WIDTHxHEIGHT"))?;
+    let num = |v: &str| v.trim().parse::<u16>().ok().filter(|&n| n > 0 && n <= 4096);
+    match (num(w), num(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("size `{s}`: width and height must be whole numbers from 1 to 4096")),
+    }
+}
+
+/// Parses `NXxNYxNZ` into a manual lattice resolution.
+pub fn parse_cells(s: &str) -> Result<[u16; 3], String> {
+    let v: Vec<Option<u16>> = s.split(['x', 'X']).map(|p| p.trim().parse::<u16>().ok().filter(|&n| (1..=1024).contains(&n))).collect();
+    match v.as_slice() {
+        [Some(x), Some(y), Some(z)] => Ok([*x, *y, *z]),
+        _ => Err(format!("cells `{s}`: expected NXxNYxNZ with each from 1 to 1024")),
+    }
+}
+
+/// The lattice configuration chosen on the command line.
+pub fn lattice_config(cells: Option<[u16; 3]>, budget: Option<usize>) -> lattice_rt::LatticeConfig {
+    let mut cfg = lattice_rt::LatticeConfig { budget, ..Default::default() };
+    if let Some(n) = cells {
+        cfg.top = lattice_rt::lattice::Resolution::Uniform(n);
+    }
+    cfg
+}
+
+/// Options of `render`.
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file.
+    pub scene: PathBuf,
+    /// PNG to write.
+    #[arg(short, long, default_value = "out/render.png")]
+    pub output: PathBuf,
+    /// Image size.
+    #[arg(long, default_value = "128x64", value_parser = parse_size)]
+    pub size: (u16, u16),
+    /// Dithering mode (the default scores best in `host-sim display`, docs/display.md).
+    #[arg(long, value_enum, default_value_t = DitherArg::Fs)]
+    pub dither: DitherArg,
+    /// Eye rays per pixel.
+    #[arg(long, value_enum, default_value_t = SamplingArg::One)]
+    pub sampling: SamplingArg,
+    /// Ray-query method.
+    #[arg(long, value_enum, default_value_t = Accel::Lattice)]
+    pub accel: Accel,
+    /// Numeric type.
+    #[arg(long, value_enum, default_value_t = Scalar::F64)]
+    pub scalar: Scalar,
+    /// Display theme of the PNG.
+    #[arg(long, value_enum, default_value_t = output::Theme::OledWhite)]
+    pub theme: output::Theme,
+    /// PNG pixel scale (1 to 64; the PNG may have at most 2^26 pixels).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub scale: u32,
+    /// Also write the gray levels (0..=64) as PGM.
+    #[arg(long)]
+    pub gray: Option<PathBuf>,
+    /// Also write the 1-bit frame as PBM.
+    #[arg(long)]
+    pub pbm: Option<PathBuf>,
+    /// Tile side in pixels.
+    #[arg(long, default_value_t = 8)]
+    pub tile: u8,
+    /// World lattice resolution, overriding the automatic choice.
+    #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
+    pub cells: Option<[u16; 3]>,
+    /// Most bytes the lattice may take: the lattice of least estimated cost within it is built
+    /// (docs/memory.md); too small for one cell, the lattice method is refused.
+    #[arg(long, value_name = "BYTES")]
+    pub budget: Option<usize>,
+    /// Leave out the silhouette lines. By default the farther pixel where neighbours hit
+    /// different objects is drawn black: without them thin parts of the same gray as what lies
+    /// behind (the chair's legs on its floor) vanish in a 1-bit frame (docs/display.md).
+    #[arg(long)]
+    pub no_outline: bool,
+    /// Tone curve before dithering: gray levels raised to the power GAMMA/10 (5 to 20; 10 leaves
+    /// them unchanged).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u8).range(5..=20))]
+    pub gamma: u8,
+}
+
+/// Options of `stats`.
+#[derive(clap::Args, Debug)]
+pub struct StatsArgs {
+    /// Scene file.
+    pub scene: PathBuf,
+    /// Image size used to count work per ray.
+    #[arg(long, default_value = "160x100", value_parser = parse_size)]
+    pub size: (u16, u16),
+    /// Numeric type.
+    #[arg(long, value_enum, default_value_t = Scalar::F64)]
+    pub scalar: Scalar,
+    /// Timed repetitions per accelerator (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub runs: usize,
+    /// World lattice resolution, overriding the automatic choice.
+    #[arg(long, value_parser = parse_cells, value_name = "NXxNYxNZ")]
+    pub cells: Option<[u16; 3]>,
+    /// Most bytes the lattice may take: the lattice of least estimated cost within it is built
+    /// (docs/memory.md); too small for one cell, the lattice method is refused.
+    #[arg(long, value_name = "BYTES")]
+    pub budget: Option<usize>,
+}
+
+/// The scenes given, or the paper's four and the Whitted showcase.
+pub fn default_scenes(scenes: Vec<PathBuf>) -> Vec<PathBuf> {
+    if scenes.is_empty() {
+        shared::default_scene_paths()
+    } else {
+        scenes
+    }
+}
+

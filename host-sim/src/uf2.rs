@@ -1,0 +1,103 @@
+//! `host-sim uf2`: the Pico (or Pico 2) image as a UF2 file, to drag onto the board's BOOTSEL
+//! drive; and building that image with the repository's own alias, so it is the image `cargo
+//! pico` flashes (`cargo xtask board` runs the same build on the emulated board).
+
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Where the image `cargo pico-build` writes.
+pub fn pico_elf(root: &Path) -> PathBuf {
+    pico_elf_in(&root.join("firmware/target"))
+}
+
+/// A Raspberry Pi board the firmware is built for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Board {
+    /// Raspberry Pi Pico (RP2040, Cortex-M0+): fixed point.
+    Pico,
+    /// Raspberry Pi Pico 2 (RP2350, Cortex-M33 with an FPU): f32.
+    Pico2,
+}
+
+impl Board {
+    /// Its name in file names and its cargo feature (`pico`, `pico2`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Board::Pico => "pico",
+            Board::Pico2 => "pico2",
+        }
+    }
+    /// The Rust target its image is built for.
+    fn target(self) -> &'static str {
+        match self {
+            Board::Pico => "thumbv6m-none-eabi",
+            Board::Pico2 => "thumbv8m.main-none-eabihf",
+        }
+    }
+    /// The drive the board shows in BOOTSEL mode.
+    fn drive(self) -> &'static str {
+        match self {
+            Board::Pico => "RPI-RP2",
+            Board::Pico2 => "RP2350",
+        }
+    }
+    /// Writes `elf` as a UF2 file for the board's family (via a temporary file, so a failed
+    /// write leaves nothing behind).
+    fn write_uf2(self, elf: &Path, out: &Path) -> Result<()> {
+        let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+        let mut bytes = Vec::new();
+        let converted = match self {
+            Board::Pico => elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2040, elf2flash_core::NoProgress),
+            Board::Pico2 => elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2350, elf2flash_core::NoProgress),
+        };
+        converted.map_err(|e| anyhow::anyhow!("cannot convert {} to UF2: {e}", elf.display()))?;
+        crate::output::write_atomic(out, &bytes)
+    }
+}
+
+/// Builds the Pico image with the repository's own alias, so it is the image `cargo pico` flashes.
+pub fn build_pico(root: &Path) -> Result<PathBuf> {
+    build_board(root, Board::Pico)
+}
+
+/// Builds `board`'s image with the repository's own alias (`cargo pico-build`,
+/// `cargo pico2-build`), so it is the image `cargo pico` / `cargo pico2` flashes.
+pub fn build_board(root: &Path, board: Board) -> Result<PathBuf> {
+    let alias = format!("{}-build", board.name());
+    eprintln!("building the {} image (cargo {alias})", board.name());
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .arg(&alias)
+        .env_remove("RUSTFLAGS")
+        .status()
+        .context("cannot run cargo")?;
+    if !status.success() {
+        bail!("`cargo {alias}` failed (it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target());
+    }
+    let profile = match board {
+        Board::Pico => "release",
+        Board::Pico2 => "speed",
+    };
+    Ok(root.join("firmware/target").join(board.target()).join(profile).join("pico"))
+}
+
+/// The image in target folder `dir`.
+pub fn pico_elf_in(dir: &Path) -> PathBuf {
+    dir.join("thumbv6m-none-eabi/release/pico")
+}
+
+/// Writes `elf` as a UF2 file for the RP2040's BOOTSEL drive.
+pub fn write_uf2(elf: &Path, out: &Path) -> Result<()> {
+    Board::Pico.write_uf2(elf, out)
+}
+
+/// The command `host-sim uf2`: `out` defaults to `out/lattice-rt-<board>.uf2`.
+pub fn uf2_cmd(root: &Path, board: Board, out: Option<&Path>) -> Result<()> {
+    let elf = build_board(root, board)?;
+    let out = out.map_or_else(|| PathBuf::from(format!("out/lattice-rt-{}.uf2", board.name())), Path::to_path_buf);
+    board.write_uf2(&elf, &out)?;
+    println!("wrote {}: hold BOOTSEL while plugging the board in, then copy this file onto the {} drive", out.display(), board.drive());
+    Ok(())
+}
+

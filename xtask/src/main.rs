@@ -1,0 +1,177 @@
+//! `cargo xtask`: the project's own checks and studies, which users of the ray tracer never
+//! compile (the xtask convention). Each command builds what it needs (firmware images, host
+//! renders), runs it, checks it and writes its report under docs/: the Pico image on the
+//! emulated board (`board`), the firmware in QEMU (`firmware`), and the studies (`bench`,
+//! `memory`, `tradeoff`, `effects`, `display`, `motion`).
+
+mod bench;
+mod board;
+mod display;
+mod effects;
+mod firmware;
+mod memory;
+mod motion;
+mod plot;
+mod tradeoff;
+mod versus;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use host_sim::cli::{default_scenes, parse_size};
+use std::path::PathBuf;
+
+/// The lattice-rt project's checks and studies (`cargo xtask COMMAND`).
+#[derive(Parser, Debug)]
+#[command(version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run the Pico image (the one `cargo pico` flashes) on an emulated RP2040 with an SSD1306:
+    /// every frame must match host-sim bit for bit; writes the board's budgets to a report.
+    ///
+    /// Needs Node.js (rp2040js is installed from firmware/board/package-lock.json), python3 and
+    /// PyPI (for the RP2040 bootrom), and flip-link (`cargo install flip-link`).
+    Board {
+        /// Report to write.
+        #[arg(long, default_value = "docs/board.md")]
+        out: PathBuf,
+        /// Folder for the UF2 file that was run, the frames the panel showed (PNG), and, when a
+        /// frame differs, host-sim's frame and a picture of the difference.
+        #[arg(long, default_value = "target/board")]
+        frames: PathBuf,
+        /// Use the image already built instead of running `cargo pico-build`.
+        #[arg(long)]
+        no_build: bool,
+    },
+    /// Build the firmware, run it in QEMU, check its frames against the host bit for bit,
+    /// and write the flash/RAM/instruction budgets to a report.
+    Firmware {
+        /// Report to write.
+        #[arg(long, default_value = "docs/firmware.md")]
+        out: PathBuf,
+        /// Use the firmware already built instead of building it.
+        #[arg(long)]
+        no_build: bool,
+    },
+    /// The paper's Table 1 reproduced, scaling to 100 000 primitives, the lattice's resolution
+    /// choice against a sweep, and host-sim against POV-Ray (when `povray` is installed):
+    /// docs/performance.md and a log-log plot.
+    Bench {
+        /// A short run for CI (N up to 1 000, one timed run).
+        #[arg(long)]
+        quick: bool,
+        /// Timed runs per measurement (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/performance.md")]
+        out: PathBuf,
+        /// Plot to write (SVG).
+        #[arg(long, default_value = "docs/performance.svg")]
+        plot: PathBuf,
+    },
+    /// The memory-time frontier: lattices built within byte budgets from 64 B to 1 MiB on the
+    /// paper's scenes and generated ones; writes docs/memory.md and its plots.
+    Memory {
+        /// Generated scenes up to 1 000 primitives, one timed run.
+        #[arg(long)]
+        quick: bool,
+        /// Timed runs per measurement (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/memory.md")]
+        out: PathBuf,
+        /// Plot of time per ray against the budget (SVG).
+        #[arg(long, default_value = "docs/memory.svg")]
+        plot: PathBuf,
+        /// Plot of object tests per ray against the budget (SVG).
+        #[arg(long, default_value = "docs/memory-tests.svg")]
+        tests_plot: PathBuf,
+    },
+    /// What accuracy costs in time: error against a 16-ray f64 reference and cost, one knob
+    /// at a time (scalar, tree depth, cutoff, sampling, dithering).
+    Tradeoff {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Image size.
+        #[arg(long, default_value = "128x64", value_parser = parse_size)]
+        size: (u16, u16),
+        /// Timed runs per configuration (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/accuracy.md")]
+        out: PathBuf,
+        /// Plot to write (SVG).
+        #[arg(long, default_value = "docs/accuracy.svg")]
+        plot: PathBuf,
+        /// Instruction counts written by `cargo xtask firmware`.
+        #[arg(long, default_value = "docs/firmware.csv")]
+        firmware_csv: PathBuf,
+    },
+    /// What simulating only the effects a scene calls for saves (rays, time, instructions,
+    /// flash), and what the contribution cutoff saves and changes.
+    Effects {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Timed runs per configuration (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Report to write.
+        #[arg(long, default_value = "docs/effects.md")]
+        out: PathBuf,
+        /// Instruction counts and flash sizes written by `cargo xtask firmware`.
+        #[arg(long, default_value = "docs/firmware.csv")]
+        firmware_csv: PathBuf,
+    },
+    /// What the 1-bit display shows: every dither with and without silhouette lines and
+    /// through several tone curves, measured against the reference gray image after a low-pass
+    /// (mean error, SSIM); contact sheets per scene and the progressive passes: docs/display.md.
+    Display {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Report to write.
+        #[arg(long, default_value = "docs/display.md")]
+        out: PathBuf,
+        /// Folder for the contact sheets.
+        #[arg(long, default_value = "docs/images")]
+        images: PathBuf,
+    },
+    /// Flicker of each dither while the camera orbits the scenes: docs/motion.md.
+    Motion {
+        /// Scene files (default: the paper's four and the Whitted showcase).
+        scenes: Vec<PathBuf>,
+        /// Frames per turn.
+        #[arg(long, default_value_t = 36)]
+        frames: u32,
+        /// Report to write.
+        #[arg(long, default_value = "docs/motion.md")]
+        out: PathBuf,
+    },
+}
+
+fn main() {
+    if let Err(e) = real_main() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn real_main() -> Result<()> {
+    let root = std::env::current_dir()?;
+    match Cli::parse().command {
+        Command::Board { out, frames, no_build } => board::board_cmd(&root, &out, &frames, no_build),
+        Command::Firmware { out, no_build } => firmware::firmware_cmd(&root, &out, no_build),
+        Command::Bench { quick, runs, out, plot } => bench::bench_cmd(quick, runs, &out, &plot),
+        Command::Memory { quick, runs, out, plot, tests_plot } => memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot }),
+        Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv } => tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv),
+        Command::Effects { scenes, runs, out, firmware_csv } => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
+        Command::Display { scenes, out, images } => display::display_cmd(&default_scenes(scenes), &out, &images),
+        Command::Motion { scenes, frames, out } => motion::motion_cmd(&default_scenes(scenes), frames, &out),
+    }
+}
