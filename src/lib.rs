@@ -12,7 +12,7 @@ extern crate std;
 extern crate alloc;
 
 // In the order the data flows: numbers, geometry, the scene (text in, validated scene out),
-// the lattice over it, the storage that holds both, then tracing, sampling, dithering and the
+// the lattice over it, the storage that holds both and the loading that fills it, then tracing, sampling, dithering and the
 // tile loop that writes a display.
 pub mod scalar;
 pub use scalar::{F32Micro, F32MicroNewton, Real};
@@ -32,9 +32,11 @@ pub use accel::{Accelerator, BoundingBox, BruteForce, Hit, Query, Stats};
 pub mod lattice;
 pub use lattice::{Lattice, LatticeConfig, LatticeStorage};
 pub mod storage;
+pub mod load;
+pub use load::{LoadError, Loaded};
 pub mod bake;
 pub use bake::Baked;
-pub use storage::{Buffers, Loaded, Scratch, Sizes, Storage, StorageView};
+pub use storage::{Buffers, Sizes, Storage, StorageView};
 #[cfg(feature = "alloc")]
 pub use storage::{HeapScratch, HeapStorage};
 pub mod trace;
@@ -44,6 +46,6 @@ pub mod dither;
 pub use dither::{Dither, Tone};
 pub mod outline;
 pub mod render;
-pub use render::{render, render_pass, render_share, Frame, Hooks, NoHooks, Sampling, Share, Traced};
+pub use render::{render, render_pass, render_share, Frame, Hooks, NoHooks, Sampling, Scratch, Share, Traced};
 pub mod bitframe;
 pub use bitframe::BitFrame;

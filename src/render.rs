@@ -16,7 +16,6 @@ use crate::scalar::Real;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
 use crate::scene::Camera;
-use crate::storage::Scratch;
 use crate::trace::Tracer;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -453,5 +452,21 @@ fn preview_tile<R: Real, const N: usize>(
                 levels[row + cols.start..row + cols.end].fill(k.level);
             }
         }
+    }
+}
+
+/// The memory a render works in: the mailbox (one stamp per primitive and per composite,
+/// so a ray tests each once; a shorter one only costs repeated tests) and the rows
+/// ([`Frame::scratch_len`] entries; error diffusion and edge detection fail without them).
+#[derive(Debug)]
+pub struct Scratch<'a> {
+    pub(crate) mailbox: &'a mut [u32],
+    pub(crate) rows: &'a mut [i16],
+}
+
+impl<'a> Scratch<'a> {
+    /// Scratch in caller-owned slices.
+    pub fn new(mailbox: &'a mut [u32], rows: &'a mut [i16]) -> Self {
+        Scratch { mailbox, rows }
     }
 }

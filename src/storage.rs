@@ -2,7 +2,8 @@
 //! capacities are const parameters (heapless style: firmware sizes them at build time);
 //! with the `alloc` feature, `HeapStorage` holds the same on the heap, sized at run time by
 //! [`Sizes::of`]. Both lend a [`StorageView`] that erases the capacities, so the code that
-//! loads a scene, builds its lattice and hands the rest to the render is written once.
+//! loads a scene ([`crate::load`]), builds its lattice and hands the rest to the render is
+//! written once. This module holds memory; it neither parses nor renders.
 //!
 //! The view is used up in the order the data flows: objects (the scene), then lattices,
 //! coordinate lists and the word pool (the lattice's cells and references), then what is
@@ -10,11 +11,9 @@
 
 use crate::accel::Query;
 use crate::lattice::{SubLattice, Lattice, LatticeConfig, LatticeError, LatticeStorage};
-use crate::scene::text::{parse_with, ParseError};
-use crate::render::Frame;
+use crate::render::{Frame, Scratch};
 use crate::scalar::Real;
-use crate::scene::{CameraDesc, Object, Scene};
-use core::fmt;
+use crate::scene::{Object, Scene};
 
 /// How much of each kind of storage a scene and a frame need.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -209,38 +208,6 @@ pub struct FrameStorage<'a, R> {
     rows: &'a mut [i16],
 }
 
-/// A scene loaded from text with its lattice built, and the scratch left for the render.
-#[derive(Debug)]
-pub struct Loaded<'a, R> {
-    /// The validated scene.
-    pub scene: Scene<'a, R>,
-    /// Its lattice.
-    pub lattice: Lattice<'a, R>,
-    /// What the render works in.
-    pub scratch: Scratch<'a>,
-}
-
-/// Why a scene could not be loaded into a [`StorageView`].
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LoadError<'t> {
-    /// The text is not a valid scene, or declares more objects than the storage holds.
-    Parse(ParseError<'t>),
-    /// The lattice does not fit the storage.
-    Lattice(LatticeError),
-}
-
-impl fmt::Display for LoadError<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            LoadError::Parse(e) => write!(f, "scene: {e}"),
-            LoadError::Lattice(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-impl core::error::Error for LoadError<'_> {}
-
 impl<'a, R: Real> StorageView<'a, R> {
     /// A view of caller-owned slices.
     pub fn new(
@@ -259,34 +226,6 @@ impl<'a, R: Real> StorageView<'a, R> {
                 rows,
             },
         }
-    }
-
-    /// Parses `text` into the object storage and builds its lattice with `cfg` in the rest;
-    /// what is left becomes the render's scratch.
-    pub fn load<'t>(
-        self,
-        text: &'t str,
-        cfg: &LatticeConfig,
-    ) -> Result<Loaded<'a, R>, LoadError<'t>> {
-        self.load_with(text, cfg, |_| {})
-    }
-
-    /// [`StorageView::load`] with the scene's camera changed by `camera` before validation
-    /// (an orbit's frames: [`crate::scene::CameraDesc::orbit`]).
-    pub fn load_with<'t>(
-        self,
-        text: &'t str,
-        cfg: &LatticeConfig,
-        camera: impl FnOnce(&mut CameraDesc),
-    ) -> Result<Loaded<'a, R>, LoadError<'t>> {
-        let (objects, rest) = self.split();
-        let scene = parse_with::<R>(text, objects, camera).map_err(LoadError::Parse)?;
-        let (lattice, scratch) = rest.lattice(&scene, cfg).map_err(LoadError::Lattice)?;
-        Ok(Loaded {
-            scene,
-            lattice,
-            scratch,
-        })
     }
 
     /// The object storage (for a [`crate::SceneBuilder`]) and the rest.
@@ -315,22 +254,6 @@ impl<'a, R: Real> FrameStorage<'a, R> {
     /// No lattice (an accelerator that needs no storage): every word is scratch.
     pub fn scratch(self) -> Scratch<'a> {
         Scratch::new(self.words, self.rows)
-    }
-}
-
-/// The memory a render works in: the mailbox (one stamp per primitive and per composite,
-/// so a ray tests each once; a shorter one only costs repeated tests) and the rows
-/// ([`Frame::scratch_len`] entries; error diffusion and edge detection fail without them).
-#[derive(Debug)]
-pub struct Scratch<'a> {
-    pub(crate) mailbox: &'a mut [u32],
-    pub(crate) rows: &'a mut [i16],
-}
-
-impl<'a> Scratch<'a> {
-    /// Scratch in caller-owned slices.
-    pub fn new(mailbox: &'a mut [u32], rows: &'a mut [i16]) -> Self {
-        Scratch { mailbox, rows }
     }
 }
 

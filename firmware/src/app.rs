@@ -12,7 +12,7 @@ use lattice_rt::lattice::LatticeError;
 use lattice_rt::scene::text::ParseError;
 use lattice_rt::render::{Hooks, RenderError};
 #[cfg(not(feature = "baked"))]
-use lattice_rt::storage::{LoadError, Loaded};
+use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::{render_pass, render_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 

@@ -29,6 +29,17 @@ pub enum Accel {
     Brute,
 }
 
+impl Accel {
+    /// The name reports use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Lattice => "lattice",
+            Accel::Bbox => "bbox",
+            Accel::Brute => "brute",
+        }
+    }
+}
+
 /// Dithering mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum DitherArg {

@@ -1,6 +1,5 @@
 //! What the commands share: the scene lists, the accelerator names and the median of timings.
 
-use crate::cli::Accel;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -16,17 +15,6 @@ pub fn default_scene_paths() -> Vec<PathBuf> {
         .filter(|n| !n.is_empty())
         .map(|n| PathBuf::from(format!("scenes/{n}.scene")))
         .collect()
-}
-
-impl Accel {
-    /// The name reports use.
-    pub fn name(self) -> &'static str {
-        match self {
-            Accel::Lattice => "lattice",
-            Accel::Bbox => "bbox",
-            Accel::Brute => "brute",
-        }
-    }
 }
 
 /// The median of timings (the upper one of an even count).
