@@ -1,5 +1,6 @@
 //! How the display is wired to the board: the one place for its pins, bus, address and clock
-//! (the Pico and the Pico 2 share the pin-out). The messages and README name what is here.
+//! (the Pico and the Pico 2 share the pin-out). The log messages and docs/flashing.md name what
+//! is here.
 
 use crate::hal;
 use hal::fugit::RateExtU32;
