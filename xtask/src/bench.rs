@@ -134,7 +134,19 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     let runs = if quick { 1 } else { runs.max(1) };
     let mut md = String::new();
     writeln!(md, "# Performance\n\nWritten by `cargo xtask bench{}` on the host (f64, one core). Times are\nmedians of {runs} runs, the methods interleaved in each run so drift on a shared machine hits all alike.\n", if quick { " --quick" } else { "" })?;
-    // Table 1.
+    table1(&mut md, runs)?;
+    let series = scaling(&mut md, quick, runs)?;
+    resolution_sweep(&mut md, quick, runs)?;
+    writeln!(md, "\n![time per ray against N]({})\n", plot_link(out, plot))?;
+    md.push_str(&against_povray(quick, runs)?);
+    crate::plot::loglog(plot, "Time per ray against scene size", "primitives N", "microseconds per ray", &series)?;
+    write_atomic(out, md.as_bytes())?;
+    println!("wrote {} and {}", out.display(), plot.display());
+    Ok(())
+}
+
+/// The paper's Table 1 on its four scenes, every method drawing the same frame.
+fn table1(md: &mut String, runs: usize) -> Result<()> {
     writeln!(md, "## The paper's Table 1, reproduced\n\nThe four paper scenes at 160x100 with the paper's settings (directional light, 40x25 degree\nview, full Whitted tree). Ratio = bounding-box time / method time (the paper's \"how many\ntimes faster than the bounding box\"). Tests, inside tests and cells are per primary ray\n(eye rays alone). The first four methods trace eye rays as the paper does; the last row is the\ntracer's default, where an eye ray skips every object whose window on the image (its box\nprojected through the eye) does not hold it, and scenes of up to 64 objects skip the walk too\n(`EyeRays`); its tests count only the exact tests made.\n")?;
     writeln!(md, "| scene | method | ms/frame | ratio to bbox | paper's ratio | object tests/ray | inside tests/ray | cells/ray | lattice build ms | lattice bytes |\n|---|---|---|---|---|---|---|---|---|---|")?;
     let frame = Frame::new(160, 100);
@@ -186,11 +198,18 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
         }
     }
     writeln!(md, "\nNested lattice against bounding box: {}. The paper: 2.01x to 2.70x.\n", ratios.iter().map(|(n, r, _)| format!("{n} {r:.2}x")).collect::<Vec<_>>().join(", "))?;
-    // Scaling.
+    Ok(())
+}
+
+/// Named curves of (N, microseconds per ray), as the log-log plot draws them.
+type Series = Vec<(String, Vec<(f64, f64)>)>;
+
+/// Time per ray against the number of primitives, random and clustered; the plot's series.
+fn scaling(md: &mut String, quick: bool, runs: usize) -> Result<Series> {
     let sizes: Vec<usize> = if quick { vec![10, 100, 1000] } else { vec![10, 100, 1_000, 10_000, 100_000] };
     writeln!(md, "## Scaling\n\nGenerated scenes (random mixes of the four primitives in a cube growing with N; \"clustered\":\n10 % spread over a stadium, 90 % packed in one composite far from them). Nearest-hit queries\nfor camera rays (a 64x40 grid; fewer for the O(N) methods at large N). Bytes: lattice storage\n(lattices, coordinate lists, cells, references); the bounding-box method keeps one box per object.\n")?;
     writeln!(md, "| scene | N | method | us/ray | object tests/ray | cells/ray | bytes | bytes/ref + bytes/cell |\n|---|---|---|---|---|---|---|---|")?;
-    let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    let mut series: Series = Vec::new();
     let bar = host_sim::progress::bar(2 * sizes.len(), "generated scenes");
     for clustered in [false, true] {
         for &n in &sizes {
@@ -250,7 +269,11 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     if let (Some(u), Some(a), Some(nst)) = (at("clustered: lattice, uniform", *sizes.last().unwrap() as f64), at("clustered: lattice, adaptive", *sizes.last().unwrap() as f64), at("clustered: lattice, nested", *sizes.last().unwrap() as f64)) {
         writeln!(md, "Clustered, N = {}: uniform {u:.2} us/ray, adaptive coordinate lists {a:.2}, nested sub-lattice {nst:.2}.", sizes.last().unwrap())?;
     }
-    // Resolution sweep.
+    Ok(series)
+}
+
+/// The automatic lattice resolution against a sweep of uniform ones.
+fn resolution_sweep(md: &mut String, quick: bool, runs: usize) -> Result<()> {
     let n = if quick { 1000 } else { 10_000 };
     writeln!(md, "\n## Lattice resolution: automatic against a sweep\n\nRandom scene, N = {n}; uniform lists. The automatic choice aims at about 2 cells per object\n(cells per axis proportional to extent x cube root of the count, as in Cleary and Wyvill's\nanalysis and pbrt's `GridAccel`).\n")?;
     writeln!(md, "| resolution | cells | us/ray | object tests/ray | cells/ray | bytes |\n|---|---|---|---|---|---|")?;
@@ -266,11 +289,6 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
         let (t, tests, cells) = per_ray(&scene, &lat, &rays, runs);
         writeln!(md, "| {label} | {} | {:.3} | {tests:.2} | {cells:.1} | {} |", lat.cell_count(), t.as_secs_f64() * 1e6, lat.bytes())?;
     }
-    writeln!(md, "\n![time per ray against N]({})\n", plot_link(out, plot))?;
-    md.push_str(&against_povray(quick, runs)?);
-    crate::plot::loglog(plot, "Time per ray against scene size", "primitives N", "microseconds per ray", &series)?;
-    write_atomic(out, md.as_bytes())?;
-    println!("wrote {} and {}", out.display(), plot.display());
     Ok(())
 }
 

@@ -329,216 +329,64 @@ fn reported_frame(records: &[Record], index: usize) -> Option<FrameDone> {
     })
 }
 
-/// The command `cargo xtask board`.
+/// What `cargo xtask board` checked: how many checks passed, and why the others failed.
+#[derive(Default)]
+struct Checks {
+    passed: usize,
+    failures: Vec<String>,
+}
+
+impl Checks {
+    /// One check: passed when `ok`, else failed with `why()`.
+    fn check(&mut self, ok: bool, why: impl FnOnce() -> String) -> bool {
+        if ok {
+            self.passed += 1;
+        } else {
+            self.failures.push(why());
+        }
+        ok
+    }
+    fn fail(&mut self, why: String) {
+        self.failures.push(why);
+    }
+}
+
+/// One `cargo xtask board` run: the image, where its frames go, the emulator, the checks.
+struct Session<'a> {
+    root: &'a Path,
+    frames_dir: &'a Path,
+    no_build: bool,
+    elf: PathBuf,
+    uf2: PathBuf,
+    bootrom: PathBuf,
+    scenes: Vec<String>,
+    scenes_dir: PathBuf,
+    chair: PathBuf,
+    chair_text: String,
+    checks: Checks,
+}
+
+/// The command `cargo xtask board`: the default image on every embedded scene, then each
+/// variant (a model left out, a build-time lever, orbit, ladder, progressive, outline) as a
+/// row of the report, every frame checked against host-sim's.
 pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> Result<()> {
-    let elf = if no_build { pico_elf(root) } else { build_pico(root)? };
-    let scenes = embedded_scenes(root)?;
-    let bootrom = prepare_emulator(root)?;
-    std::fs::create_dir_all(frames_dir).with_context(|| format!("cannot create {}", frames_dir.display()))?;
-    let uf2 = frames_dir.join("lattice-rt-pico.uf2");
-    write_uf2(&elf, &uf2)?;
-    let (flash, static_ram) = elf_sizes(&elf)?;
-    let mut failures = Vec::new();
-    let mut passed = 0;
-
-    eprintln!("running {} on rp2040js with an SSD1306 ({} scenes)", uf2.display(), scenes.len());
-    let run = run_emulator(root, &elf, &uf2, &bootrom, scenes.len(), true, frames_dir, &[])?;
-    for l in &run.log {
-        eprintln!("  device {:5} {}", l.level, l.text);
-        if l.level == "ERROR" {
-            failures.push(format!("the device logged an error: {}", l.text));
-        }
-    }
-    if !run.ok {
-        failures.push(format!("the run did not finish: {}", run.reason));
-    }
-    if run.display_initialised {
-        passed += 1;
-    } else {
-        failures.push("the display was never initialised (switched on with its charge pump)".into());
-    }
-    let scenes_dir = root.join("scenes");
-    let mut rows = Vec::new();
-    for (index, (name, frame)) in scenes.iter().zip(run.frames).enumerate() {
-        if let Some(e) = &frame.error {
-            failures.push(format!("{name}: the panel shows no picture: {e}"));
-            continue;
-        }
-        let want = host_frame(&scenes_dir, name, PICO_SCALAR, false)?;
-        save_frame(&frame.pixels, &frames_dir.join(format!("{name}.png")))?;
-        if want == frame.pixels {
-            passed += 1;
-        } else {
-            let differ: u32 = want.iter().zip(&frame.pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
-            save_frame(&want, &frames_dir.join(format!("{name}-host.png")))?;
-            save_frame(&diff_frame(&want, &frame.pixels), &frames_dir.join(format!("{name}-diff.png")))?;
-            failures.push(format!(
-                "{name}: the panel differs from host-sim in {differ} of {} pixels (see {}/{name}.png, {name}-host.png, {name}-diff.png)",
-                PANEL.0 * PANEL.1,
-                frames_dir.display()
-            ));
-        }
-        let stack = reported_frame(&run.records, index).map(|f| u64::from(f.stack));
-        if stack.is_none() {
-            failures.push(format!("{name}: the board reported no frame record"));
-        }
-        rows.push(SceneRow { name: name.clone(), frame, stack });
-    }
-
-    eprintln!("running the same image with no display on the bus");
-    let bare = run_emulator(root, &elf, &uf2, &bootrom, 0, false, frames_dir, &[])?;
-    let said = bare.log.iter().any(|l| l.level == "ERROR" && l.text.contains(NO_DISPLAY_MESSAGE));
-    let panicked = bare.log.iter().any(|l| l.text.contains("panicked"));
-    if bare.ok && said && !panicked && bare.led_toggles >= 4 {
-        passed += 1;
-    } else {
-        failures.push(format!(
-            "with no display: run {} ({}), message logged: {said}, panic: {panicked}, LED toggles: {}",
-            if bare.ok { "ran" } else { "failed" },
-            bare.reason,
-            bare.led_toggles
-        ));
-    }
-
-    // What each silicon model adds: the first scene's frame with a model left out, and the
-    // image's build-time levers, each frame bit for bit against host-sim's.
-    let first = scenes.first().context("no scene")?;
-    let first_want = host_frame(&scenes_dir, first, PICO_SCALAR, false)?;
-    let mut models = Vec::new();
-    for (what, switches) in MODELS {
-        let dir = frames_dir.join("models");
-        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        eprintln!("running the image without {what}");
-        let m = run_emulator(root, &elf, &uf2, &bootrom, 1, true, &dir, switches)?;
-        match m.frames.into_iter().next() {
-            Some(f) if f.pixels == first_want => {
-                passed += 1;
-                models.push((*what, f));
-            }
-            Some(_) => failures.push(format!("without {what}: the {first} differs from host-sim")),
-            None => failures.push(format!("without {what}: no frame shown ({})", m.reason)),
-        }
-    }
-    let mut levers = Vec::new();
-    for (feature, what) in LEVERS {
-        let (lrun, dir) = run_variant(root, no_build, feature, false, frames_dir, &bootrom, 1)?;
-        match lrun.frames.into_iter().next() {
-            Some(f) if f.pixels == host_frame(&scenes_dir, "chair", PICO_SCALAR, false)? => {
-                passed += 1;
-                levers.push((*feature, *what, f));
-            }
-            Some(f) => {
-                save_frame(&f.pixels, &dir.join("chair.png"))?;
-                failures.push(format!("`{feature}`: the chair differs from host-sim (see {}/chair.png)", dir.display()));
-            }
-            None => failures.push(format!("`{feature}`: no frame shown ({})", lrun.reason)),
-        }
-    }
-
-    // Orbit mode: the first frames of the chair's orbit, bit for bit against host-sim's.
-    let (orun, orbit_dir) = run_variant(root, no_build, "orbit", false, frames_dir, &bootrom, ORBIT_CHECKED)?;
-    let chair = scenes_dir.join("chair.scene");
-    let chair_text = host_sim::load::read(&chair)?;
-    let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(&chair, &chair_text, ORBIT_FRAMES, &board_frame::FRAME)?;
-    if orun.frames.len() < ORBIT_CHECKED {
-        failures.push(format!("orbit mode: {} of {ORBIT_CHECKED} frames shown ({})", orun.frames.len(), orun.reason));
-    }
-    let mut orbit_same = 0;
-    for (i, f) in orun.frames.iter().enumerate() {
-        save_frame(&f.pixels, &orbit_dir.join(format!("chair-{i}.png")))?;
-        if want.get(i) == Some(&f.pixels) {
-            passed += 1;
-            orbit_same += 1;
-        } else {
-            failures.push(format!("orbit mode: frame {i} of the chair differs from host-sim (see {}/chair-{i}.png)", orbit_dir.display()));
-        }
-    }
-
-    // The ladder: the chair once per rung, each frame bit for bit against host-sim's.
-    let (lrun, ladder_dir) = run_variant(root, no_build, "ladder", false, frames_dir, &bootrom, LADDER.len())?;
-    if lrun.frames.len() < LADDER.len() {
-        failures.push(format!("ladder: {} of {} frames shown ({})", lrun.frames.len(), LADDER.len(), lrun.reason));
-    }
-    let mut rungs = Vec::new();
-    for (i, f) in lrun.frames.iter().enumerate() {
-        let Some((what, tuning)) = LADDER.get(i) else { break };
-        save_frame(&f.pixels, &ladder_dir.join(format!("chair-{i}.png")))?;
-        let want = ladder_frame(&chair, tuning)?;
-        if want == f.pixels {
-            passed += 1;
-        } else {
-            failures.push(format!("ladder rung {i} ({what}): the chair differs from host-sim (see {}/chair-{i}.png)", ladder_dir.display()));
-        }
-        let reported = lrun.records.iter().find_map(|r| match r {
-            Record::Rung { rung, frame } if usize::from(*rung) == i => Some(*frame),
-            _ => None,
-        });
-        match reported {
-            Some(done) => rungs.push(Rung { what, frame: f, shares: done.share_us, tests: done.object_tests }),
-            None => failures.push(format!("ladder rung {i}: the board reported no rung record")),
-        }
-    }
-
-    // Progressive mode: every scene in four passes, each pass bit for bit against host-sim's.
-    let passes = 4;
-    let (prun, prog_dir) = run_variant(root, no_build, "progressive", true, frames_dir, &bootrom, passes * scenes.len())?;
-    if prun.frames.len() < passes * scenes.len() {
-        failures.push(format!("progressive mode: {} of {} passes shown ({})", prun.frames.len(), passes * scenes.len(), prun.reason));
-    }
-    let mut progressive = Vec::new();
-    for (name, shown) in scenes.iter().zip(prun.frames.chunks(passes)) {
-        let path = scenes_dir.join(format!("{name}.scene"));
-        let want = host_sim::run::progressive_passes::<lattice_rt::Fx>(&path, &host_sim::load::read(&path)?, &board_frame::FRAME)?;
-        let mut same = 0;
-        for (f, p) in shown.iter().zip(&want) {
-            let file = prog_dir.join(format!("{name}-pass{}.png", p.pass));
-            save_frame(&f.pixels, &file)?;
-            if f.pixels == p.bits {
-                same += 1;
-                passed += 1;
-            } else {
-                failures.push(format!("progressive mode: pass {} of {name} differs from host-sim (see {})", p.pass, file.display()));
-            }
-        }
-        let rays: Vec<u64> = want.iter().map(|p| p.stats.rays[0]).collect();
-        if let (Some(plain), true) = (rows.iter().find(|r| &r.name == name), shown.len() == passes) {
-            progressive.push(ProgressiveRow { name: name.clone(), passes: shown, rays, plain: &plain.frame, same });
-        }
-        eprintln!("  {name}: {same} of {} passes bit-identical to host-sim", shown.len());
-    }
-
-    // Silhouette lines: the chair with the `outline` feature, bit for bit against host-sim's.
-    let (lrun_outline, outline_dir) = run_variant(root, no_build, "outline", false, frames_dir, &bootrom, 1)?;
-    let lined = lattice_rt::Frame { outline: true, ..board_frame::FRAME };
-    let want = host_sim::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &lined, |_| {})?;
+    let mut s = Session::prepare(root, frames_dir, no_build)?;
+    let (run, rows) = s.scenes_run()?;
+    let bare = s.no_display_run()?;
+    let (models, levers) = (s.model_runs()?, s.lever_runs()?);
+    let (orun, orbit_same) = s.orbit_run()?;
+    let lrun = s.variant("ladder", false, LADDER.len())?.0;
+    let rungs = s.ladder_rows(&lrun)?;
+    let prun = s.variant("progressive", true, PASSES * s.scenes.len())?;
+    let progressive = s.progressive_rows(&prun, &rows)?;
+    let orun_outline = s.variant("outline", false, 1)?;
     let plain_chair = rows.iter().find(|r| r.name == "chair");
-    let mut outline_row = None;
-    match lrun_outline.frames.first() {
-        Some(f) => {
-            let file = outline_dir.join("chair.png");
-            save_frame(&f.pixels, &file)?;
-            if let Some(images) = out.parent().map(|p| p.join("images")) {
-                std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
-                save_frame(&f.pixels, &images.join("board-chair-outline.png"))?;
-                if let Some(plain) = plain_chair {
-                    save_frame(&plain.frame.pixels, &images.join("board-chair.png"))?;
-                }
-            }
-            let same = f.pixels == want.bits;
-            if same {
-                passed += 1;
-            } else {
-                failures.push(format!("outline: the chair differs from host-sim (see {})", file.display()));
-            }
-            let plain_rays = host_sim::run::render_text::<lattice_rt::Fx>(&chair, &chair_text, &board_frame::FRAME, |_| {})?.stats.rays[0];
-            outline_row = Some((f, [plain_rays, want.stats.rays[0]], same));
-        }
-        None => failures.push(format!("outline: no frame shown ({})", lrun_outline.reason)),
-    }
+    let outline_row = s.outline_row(&orun_outline, out, plain_chair)?;
 
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period };
-    let profile = profile_shares(&elf, &frames_dir.join("profile.json"))?;
-    let mut md = report(&summary, &rows, (flash, static_ram, section_size(&elf, ".ram_code")?), &bare, &scenes, &profile)?;
+    let profile = profile_shares(&s.elf, &frames_dir.join("profile.json"))?;
+    let (flash, static_ram) = elf_sizes(&s.elf)?;
+    let mut md = report(&summary, &rows, (flash, static_ram, section_size(&s.elf, ".ram_code")?), &bare, &s.scenes, &profile)?;
     md.push_str(&silicon_report(&summary, rows.first().map(|r| &r.frame), &models, &levers)?);
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
@@ -548,6 +396,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
+    let Checks { passed, failures } = s.checks;
     for f in &failures {
         eprintln!("FAIL {f}");
     }
@@ -556,6 +405,218 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         bail!("{} board checks failed", failures.len());
     }
     Ok(())
+}
+
+/// Passes of a progressive frame (8x8, 4x4, 2x2 blocks, every pixel).
+const PASSES: usize = 4;
+
+impl<'a> Session<'a> {
+    /// Builds the default image (unless `no_build`), writes its UF2 file, fetches the emulator.
+    fn prepare(root: &'a Path, frames_dir: &'a Path, no_build: bool) -> Result<Self> {
+        let elf = if no_build { pico_elf(root) } else { build_pico(root)? };
+        let scenes = embedded_scenes(root)?;
+        let bootrom = prepare_emulator(root)?;
+        std::fs::create_dir_all(frames_dir).with_context(|| format!("cannot create {}", frames_dir.display()))?;
+        let uf2 = frames_dir.join("lattice-rt-pico.uf2");
+        write_uf2(&elf, &uf2)?;
+        let scenes_dir = root.join("scenes");
+        let chair = scenes_dir.join("chair.scene");
+        let chair_text = host_sim::load::read(&chair)?;
+        Ok(Session { root, frames_dir, no_build, elf, uf2, bootrom, scenes, scenes_dir, chair, chair_text, checks: Checks::default() })
+    }
+
+    /// Runs the image with `feature` (the chair alone, or `all_scenes`) for `frames` frames.
+    fn variant(&self, feature: &str, all_scenes: bool, frames: usize) -> Result<(BoardRun, PathBuf)> {
+        run_variant(self.root, self.no_build, feature, all_scenes, self.frames_dir, &self.bootrom, frames)
+    }
+
+    /// The default image on every embedded scene: each frame against host-sim's, the log's
+    /// errors, the display's set-up, the board's frame records.
+    fn scenes_run(&mut self) -> Result<(BoardRun, Vec<SceneRow>)> {
+        eprintln!("running {} on the emulated RP2040 with an SSD1306 ({} scenes)", self.uf2.display(), self.scenes.len());
+        let mut run = run_emulator(self.root, &self.elf, &self.uf2, &self.bootrom, self.scenes.len(), true, self.frames_dir, &[])?;
+        for l in &run.log {
+            eprintln!("  device {:5} {}", l.level, l.text);
+            if l.level == "ERROR" {
+                self.checks.fail(format!("the device logged an error: {}", l.text));
+            }
+        }
+        if !run.ok {
+            self.checks.fail(format!("the run did not finish: {}", run.reason));
+        }
+        self.checks.check(run.display_initialised, || "the display was never initialised (switched on with its charge pump)".into());
+        let mut rows = Vec::new();
+        for (index, frame) in std::mem::take(&mut run.frames).into_iter().enumerate() {
+            let Some(name) = self.scenes.get(index).cloned() else { break };
+            if let Some(e) = &frame.error {
+                self.checks.fail(format!("{name}: the panel shows no picture: {e}"));
+                continue;
+            }
+            self.compare_scene(&name, &frame.pixels)?;
+            let stack = reported_frame(&run.records, index).map(|f| u64::from(f.stack));
+            self.checks.check(stack.is_some(), || format!("{name}: the board reported no frame record"));
+            rows.push(SceneRow { name, frame, stack });
+        }
+        Ok((run, rows))
+    }
+
+    /// Scene `name`'s panel frame against host-sim's; on a difference, both and their
+    /// difference are saved beside it.
+    fn compare_scene(&mut self, name: &str, pixels: &[u8]) -> Result<()> {
+        let want = host_frame(&self.scenes_dir, name, PICO_SCALAR, false)?;
+        let dir = self.frames_dir;
+        save_frame(pixels, &dir.join(format!("{name}.png")))?;
+        let differ: u32 = want.iter().zip(pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
+        if want != pixels {
+            save_frame(&want, &dir.join(format!("{name}-host.png")))?;
+            save_frame(&diff_frame(&want, pixels), &dir.join(format!("{name}-diff.png")))?;
+        }
+        self.checks.check(want == pixels, || {
+            let (all, dir) = (PANEL.0 * PANEL.1, dir.display());
+            format!("{name}: the panel differs from host-sim in {differ} of {all} pixels (see {dir}/{name}.png, {name}-host.png, {name}-diff.png)")
+        });
+        Ok(())
+    }
+
+    /// The image with no display on the bus: the documented message, the LED blinking, no panic.
+    fn no_display_run(&mut self) -> Result<BoardRun> {
+        eprintln!("running the same image with no display on the bus");
+        let bare = run_emulator(self.root, &self.elf, &self.uf2, &self.bootrom, 0, false, self.frames_dir, &[])?;
+        let said = bare.log.iter().any(|l| l.level == "ERROR" && l.text.contains(NO_DISPLAY_MESSAGE));
+        let panicked = bare.log.iter().any(|l| l.text.contains("panicked"));
+        self.checks.check(bare.ok && said && !panicked && bare.led_toggles >= 4, || {
+            let ran = if bare.ok { "ran" } else { "failed" };
+            format!("with no display: run {ran} ({}), message logged: {said}, panic: {panicked}, LED toggles: {}", bare.reason, bare.led_toggles)
+        });
+        Ok(bare)
+    }
+
+    /// The first scene's frame with each silicon model left out ([`MODELS`]).
+    fn model_runs(&mut self) -> Result<Vec<(&'static str, PanelFrame)>> {
+        let first = self.scenes.first().context("no scene")?.clone();
+        let want = host_frame(&self.scenes_dir, &first, PICO_SCALAR, false)?;
+        let dir = self.frames_dir.join("models");
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let mut models = Vec::new();
+        for (what, switches) in MODELS {
+            eprintln!("running the image without {what}");
+            let m = run_emulator(self.root, &self.elf, &self.uf2, &self.bootrom, 1, true, &dir, switches)?;
+            match m.frames.into_iter().next() {
+                Some(f) if self.checks.check(f.pixels == want, || format!("without {what}: the {first} differs from host-sim")) => models.push((*what, f)),
+                Some(_) => {}
+                None => self.checks.fail(format!("without {what}: no frame shown ({})", m.reason)),
+            }
+        }
+        Ok(models)
+    }
+
+    /// The chair from each build-time lever's image ([`LEVERS`]).
+    fn lever_runs(&mut self) -> Result<Vec<(&'static str, &'static str, PanelFrame)>> {
+        let want = host_frame(&self.scenes_dir, "chair", PICO_SCALAR, false)?;
+        let mut levers = Vec::new();
+        for (feature, what) in LEVERS {
+            let (run, dir) = self.variant(feature, false, 1)?;
+            match run.frames.into_iter().next() {
+                Some(f) => {
+                    save_frame(&f.pixels, &dir.join("chair.png"))?;
+                    if self.checks.check(f.pixels == want, || format!("`{feature}`: the chair differs from host-sim (see {}/chair.png)", dir.display())) {
+                        levers.push((*feature, *what, f));
+                    }
+                }
+                None => self.checks.fail(format!("`{feature}`: no frame shown ({})", run.reason)),
+            }
+        }
+        Ok(levers)
+    }
+
+    /// Orbit mode: the first frames of the chair's orbit against host-sim's; the run and how
+    /// many were identical.
+    fn orbit_run(&mut self) -> Result<(BoardRun, usize)> {
+        let (orun, dir) = self.variant("orbit", false, ORBIT_CHECKED)?;
+        let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(&self.chair, &self.chair_text, ORBIT_FRAMES, &board_frame::FRAME)?;
+        let shown = orun.frames.len();
+        self.checks.check(shown >= ORBIT_CHECKED, || format!("orbit mode: {shown} of {ORBIT_CHECKED} frames shown ({})", orun.reason));
+        let mut same = 0;
+        for (i, f) in orun.frames.iter().enumerate() {
+            save_frame(&f.pixels, &dir.join(format!("chair-{i}.png")))?;
+            if self.checks.check(want.get(i) == Some(&f.pixels), || format!("orbit mode: frame {i} of the chair differs from host-sim (see {}/chair-{i}.png)", dir.display())) {
+                same += 1;
+            }
+        }
+        Ok((orun, same))
+    }
+
+    /// The ladder: the chair once per rung against host-sim's, with the rung records.
+    fn ladder_rows<'r>(&mut self, lrun: &'r BoardRun) -> Result<Vec<Rung<'r>>> {
+        let dir = self.frames_dir.join("ladder");
+        let shown = lrun.frames.len();
+        self.checks.check(shown >= LADDER.len(), || format!("ladder: {shown} of {} frames shown ({})", LADDER.len(), lrun.reason));
+        let mut rungs = Vec::new();
+        for (i, (f, (what, tuning))) in lrun.frames.iter().zip(LADDER.iter()).enumerate() {
+            save_frame(&f.pixels, &dir.join(format!("chair-{i}.png")))?;
+            let want = ladder_frame(&self.chair, tuning)?;
+            self.checks.check(want == f.pixels, || format!("ladder rung {i} ({what}): the chair differs from host-sim (see {}/chair-{i}.png)", dir.display()));
+            let reported = lrun.records.iter().find_map(|r| match r {
+                Record::Rung { rung, frame } if usize::from(*rung) == i => Some(*frame),
+                _ => None,
+            });
+            match reported {
+                Some(done) => rungs.push(Rung { what, frame: f, shares: done.share_us, tests: done.object_tests }),
+                None => self.checks.fail(format!("ladder rung {i}: the board reported no rung record")),
+            }
+        }
+        Ok(rungs)
+    }
+
+    /// Progressive mode: every pass of every scene against host-sim's.
+    fn progressive_rows<'r>(&mut self, (prun, dir): &'r (BoardRun, PathBuf), rows: &'r [SceneRow]) -> Result<Vec<ProgressiveRow<'r>>> {
+        let wanted = PASSES * self.scenes.len();
+        let shown = prun.frames.len();
+        self.checks.check(shown >= wanted, || format!("progressive mode: {shown} of {wanted} passes shown ({})", prun.reason));
+        let mut progressive = Vec::new();
+        for (name, passes) in self.scenes.clone().iter().zip(prun.frames.chunks(PASSES)) {
+            let path = self.scenes_dir.join(format!("{name}.scene"));
+            let want = host_sim::run::progressive_passes::<lattice_rt::Fx>(&path, &host_sim::load::read(&path)?, &board_frame::FRAME)?;
+            let mut same = 0;
+            for (f, p) in passes.iter().zip(&want) {
+                let file = dir.join(format!("{name}-pass{}.png", p.pass));
+                save_frame(&f.pixels, &file)?;
+                if self.checks.check(f.pixels == p.bits, || format!("progressive mode: pass {} of {name} differs from host-sim (see {})", p.pass, file.display())) {
+                    same += 1;
+                }
+            }
+            let rays: Vec<u64> = want.iter().map(|p| p.stats.rays[0]).collect();
+            if let (Some(plain), true) = (rows.iter().find(|r| &r.name == name), passes.len() == PASSES) {
+                progressive.push(ProgressiveRow { name: name.clone(), passes, rays, plain: &plain.frame, same });
+            }
+            eprintln!("  {name}: {same} of {} passes bit-identical to host-sim", passes.len());
+        }
+        Ok(progressive)
+    }
+
+    /// Silhouette lines: the chair with `outline` against host-sim's; its frame, the eye rays
+    /// without and with lines, and whether it was identical. Saves the panel pictures README and
+    /// docs/board.md show beside `out`.
+    fn outline_row<'r>(&mut self, (run, dir): &'r (BoardRun, PathBuf), out: &Path, plain: Option<&SceneRow>) -> Result<Option<(&'r PanelFrame, [u64; 2], bool)>> {
+        let Some(f) = run.frames.first() else {
+            self.checks.fail(format!("outline: no frame shown ({})", run.reason));
+            return Ok(None);
+        };
+        let lined = lattice_rt::Frame { outline: true, ..board_frame::FRAME };
+        let want = host_sim::run::render_text::<lattice_rt::Fx>(&self.chair, &self.chair_text, &lined, |_| {})?;
+        let file = dir.join("chair.png");
+        save_frame(&f.pixels, &file)?;
+        if let Some(images) = out.parent().map(|p| p.join("images")) {
+            std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
+            save_frame(&f.pixels, &images.join("board-chair-outline.png"))?;
+            if let Some(plain) = plain {
+                save_frame(&plain.frame.pixels, &images.join("board-chair.png"))?;
+            }
+        }
+        let same = self.checks.check(f.pixels == want.bits, || format!("outline: the chair differs from host-sim (see {})", file.display()));
+        let plain_rays = host_sim::run::render_text::<lattice_rt::Fx>(&self.chair, &self.chair_text, &board_frame::FRAME, |_| {})?.stats.rays[0];
+        Ok(Some((f, [plain_rays, want.stats.rays[0]], same)))
+    }
 }
 
 /// Most functions the profile lists; the rest are summed into one row.

@@ -164,8 +164,6 @@ fn link(out: &Path, file: &Path) -> String {
 
 /// The command.
 pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> {
-    let (w, h) = (128u16, 64u16);
-    let (wu, hu) = (w as usize, h as usize);
     let mut looks = Vec::new();
     for dither in 0..DITHERS.len() {
         for outline in [false, true] {
@@ -174,8 +172,31 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
             }
         }
     }
-    let mut scores = vec![Score::default(); looks.len()];
     let names: Vec<String> = scenes.iter().map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()).collect();
+    let (scores, frames, references) = score_looks(scenes, &looks)?;
+    let n = scenes.len();
+    let mut order: Vec<usize> = (0..looks.len()).collect();
+    order.sort_by(|&a, &b| scores[b].ssim(n).total_cmp(&scores[a].ssim(n)));
+    let best = looks[order[0]];
+    std::fs::create_dir_all(images)?;
+    let sheet_links = contact_sheets(&names, &looks, &scores, &frames, &references, best, images)?;
+    let (prog_rows, strip_file) = progressive_rows(scenes, &names, &references, best, images)?;
+    let md = report(out, &names, &looks, &scores, &order, &sheet_links, &prog_rows, &strip_file)?;
+    write_atomic(out, md.as_bytes())?;
+    println!("wrote {} (best: {}), contact sheets and passes in {}", out.display(), best.label(), images.display());
+    Ok(())
+}
+
+/// The panel's size.
+const PANEL: (u16, u16) = (128, 64);
+
+/// Every look rendered on every scene and scored against the scene's reference; the scores,
+/// the frames (per scene, per look) and the references.
+#[allow(clippy::type_complexity)]
+fn score_looks(scenes: &[PathBuf], looks: &[Look]) -> Result<(Vec<Score>, Vec<Vec<Vec<u8>>>, Vec<Vec<f64>>)> {
+    let (w, h) = PANEL;
+    let (wu, hu) = (w as usize, h as usize);
+    let mut scores = vec![Score::default(); looks.len()];
     let mut frames: Vec<Vec<Vec<u8>>> = Vec::new();
     let mut references = Vec::new();
     let bar = host_sim::progress::bar(scenes.len(), "scenes");
@@ -200,15 +221,14 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
         references.push(reference);
     }
     bar.finish_and_clear();
-    let n = scenes.len();
-    let mut order: Vec<usize> = (0..looks.len()).collect();
-    order.sort_by(|&a, &b| scores[b].ssim(n).total_cmp(&scores[a].ssim(n)));
-    let best = looks[order[0]];
-    let linear = |d: usize, o: bool| looks.iter().position(|l| l.dither == d && l.outline == o && l.gamma == 10).expect("in the grid");
+    Ok((scores, frames, references))
+}
 
-    // Contact sheets: rows are dithers, columns without and with the outline, at gamma 1.0 and
-    // at the best look's gamma; the reference gray first.
-    std::fs::create_dir_all(images)?;
+/// Contact sheets: rows are dithers, columns without and with the outline, at gamma 1.0 and
+/// at the best look's gamma; the reference gray first. The scene names and sheet files.
+fn contact_sheets(names: &[String], looks: &[Look], scores: &[Score], frames: &[Vec<Vec<u8>>], references: &[Vec<f64>], best: Look, images: &Path) -> Result<Vec<(String, PathBuf)>> {
+    let (w, h) = PANEL;
+    let (wu, hu) = (w as usize, h as usize);
     let mut sheet_links = Vec::new();
     for (s, name) in names.iter().enumerate() {
         let gammas: Vec<u8> = if best.gamma == 10 { vec![10] } else { vec![10, best.gamma] };
@@ -231,8 +251,15 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
         sheet_links.push((name.clone(), file));
     }
 
-    // Progressive passes with the best look (error diffusion cannot be split between cores, but
-    // progressive passes do not need that).
+    Ok(sheet_links)
+}
+
+/// Progressive passes with the best look (error diffusion cannot be split between cores, but
+/// progressive passes do not need that): the report's rows and the strip of passes.
+fn progressive_rows(scenes: &[PathBuf], names: &[String], references: &[Vec<f64>], best: Look, images: &Path) -> Result<(Vec<String>, PathBuf)> {
+    let (w, h) = PANEL;
+    let (wu, hu) = (w as usize, h as usize);
+    let n = scenes.len();
     let mut prog_rows = Vec::new();
     let mut strip = Sheet::new(4, n as u32, w as u32, h as u32);
     for (s, path) in scenes.iter().enumerate() {
@@ -266,6 +293,16 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
     let strip_file = images.join("display-progressive.png");
     strip.save(&strip_file, 2)?;
 
+    Ok((prog_rows, strip_file))
+}
+
+/// docs/display.md.
+#[allow(clippy::too_many_arguments)]
+fn report(out: &Path, names: &[String], looks: &[Look], scores: &[Score], order: &[usize], sheet_links: &[(String, PathBuf)], prog_rows: &[String], strip_file: &Path) -> Result<String> {
+    let (w, h) = PANEL;
+    let n = names.len();
+    let best = looks[order[0]];
+    let linear = |d: usize, o: bool| looks.iter().position(|l| l.dither == d && l.outline == o && l.gamma == 10).expect("in the grid");
     let mut md = String::new();
     writeln!(md, "# What the display shows\n")?;
     writeln!(
@@ -299,18 +336,16 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
         }
     }
     writeln!(md, "\n## Contact sheets\n\nEach dither without and with the outline (gamma 1.0{}), under the reference; the number after\neach label is that frame's SSIM.\n", if best.gamma == 10 { String::new() } else { format!(", then gamma {:.1}", best.gamma as f64 / 10.0) })?;
-    for (name, file) in &sheet_links {
+    for (name, file) in sheet_links {
         writeln!(md, "### {name}\n\n![{name}]({})\n", link(out, file))?;
     }
     writeln!(md, "## Progressive preview\n\nThe best look rendered in passes (`render_pass`): pass 8 traces one ray per 8x8 block, passes 4\nand 2 add the rays of the finer blocks, pass 1 completes the frame with the adaptive sampler,\nreusing every ray traced before. Eye rays per pass and SSIM (sigma 1) of what the panel shows\nafter it; the last pass must equal the plain frame bit for bit. Host time is one run, for\nscale only; the boards' cycle cost is in docs/board.md.\n")?;
     writeln!(md, "| scene | pass 8 | pass 4 | pass 2 | pass 1 | eye rays, all passes / plain frame | last pass = plain frame | host ms, passes / plain |\n|---|---|---|---|---|---|---|---|")?;
-    for r in &prog_rows {
+    for r in prog_rows {
         writeln!(md, "{r}")?;
     }
-    writeln!(md, "\n![progressive passes]({})", link(out, &strip_file))?;
-    write_atomic(out, md.as_bytes())?;
-    println!("wrote {} (best: {}), contact sheets and passes in {}", out.display(), best.label(), images.display());
-    Ok(())
+    writeln!(md, "\n![progressive passes]({})", link(out, strip_file))?;
+    Ok(md)
 }
 
 #[cfg(test)]

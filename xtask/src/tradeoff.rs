@@ -160,8 +160,29 @@ struct Tally {
 
 /// The command.
 pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Path, plot: &Path, firmware_csv: &Path) -> Result<()> {
-    let (w, h) = size;
     let configs = configs();
+    let (tallies, per_scene) = measure(scenes, &configs, size, runs)?;
+    let names: Vec<String> = scenes.iter().filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string())).collect();
+    let instr = firmware_instructions(firmware_csv, &names, size);
+    let mut md = String::new();
+    let points = knob_table(&mut md, &configs, &tallies, &instr, &names, size, runs)?;
+    scalar_section(&mut md, &names, &per_scene)?;
+    targets_section(&mut md, &configs, &tallies, &names, &per_scene)?;
+    writeln!(md, "\n![error against cost]({})", plot_link(out, plot))?;
+    let title = "Error against cost, one knob at a time";
+    crate::plot::scatter(plot, title, "host ms per frame (median, mean over scenes)", "mean abs gray error (levels of 64)", &points)?;
+    write_atomic(out, md.as_bytes())?;
+    println!("wrote {} and {}", out.display(), plot.display());
+    Ok(())
+}
+
+/// Dithered pixels of each scalar's frame that differ from the f64 frame with the same
+/// settings, per scene and scalar: (differing, all).
+type PerScene = BTreeMap<(String, &'static str), (usize, usize)>;
+
+/// Renders every scene with every configuration (interleaved, `runs` times) against a 16-ray
+/// f64 reference; the error and cost tallies per configuration.
+fn measure(scenes: &[PathBuf], configs: &[Config], (w, h): (u16, u16), runs: usize) -> Result<(Vec<Tally>, PerScene)> {
     let mut tallies = vec![Tally::default(); configs.len()];
     let mut per_scene: BTreeMap<(String, &'static str), (usize, usize)> = BTreeMap::new();
     let bar = host_sim::progress::bar(scenes.len(), "scenes");
@@ -209,11 +230,14 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
             }
         }
     }
-    // Instructions per frame from the firmware report, summed over the scenes studied.
+    Ok((tallies, per_scene))
+}
+
+/// Instructions per frame from the firmware report (`docs/firmware.csv`), summed over the
+/// scenes studied, by scalar and board (empty unless the size is the boards' 128x64).
+fn firmware_instructions(firmware_csv: &Path, names: &[String], (w, h): (u16, u16)) -> BTreeMap<(String, String), u64> {
     let mut instr: BTreeMap<(String, String), u64> = BTreeMap::new();
     let csv = std::fs::read_to_string(firmware_csv).unwrap_or_default();
-    let names: Vec<String> = scenes.iter().filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string())).collect();
-    let mut instr_complete = true;
     for line in csv.lines().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
         // Only the plain build of each scalar and board (not the effect-study variants).
@@ -222,10 +246,11 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
             *instr.entry((f[1].to_string(), f[2].to_string())).or_default() += f[3].parse::<u64>().unwrap_or(0);
         }
     }
-    if instr.is_empty() {
-        instr_complete = false;
-    }
-    let mut md = String::new();
+    instr
+}
+
+/// The main table: one row per knob setting; the points of the plot.
+fn knob_table(md: &mut String, configs: &[Config], tallies: &[Tally], instr: &BTreeMap<(String, String), u64>, names: &[String], (w, h): (u16, u16), runs: usize) -> Result<Vec<(String, &'static str, f64, f64)>> {
     writeln!(md, "# What accuracy costs\n")?;
     writeln!(
         md,
@@ -239,7 +264,7 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
     writeln!(md, "| knob | setting | dithered px differ | mean abs gray | max abs gray | PSNR dB | host ms/frame | rays/frame | M0 Minstr | M4F Minstr |\n|---|---|---|---|---|---|---|---|---|---|")?;
     let scenes_n = names.len().max(1) as f64;
     let mut points = Vec::new();
-    for (c, t) in configs.iter().zip(&tallies) {
+    for (c, t) in configs.iter().zip(tallies) {
         let mse = t.sq_sum / t.pixels.max(1) as f64;
         let psnr = if mse > 0.0 { 10.0 * (64.0f64 * 64.0 / mse).log10() } else { f64::INFINITY };
         let ms = t.time.as_secs_f64() * 1e3 / scenes_n;
@@ -262,16 +287,26 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
         )?;
         points.push((c.label.clone(), c.knob, ms, mean));
     }
-    if !instr_complete {
+    if instr.is_empty() {
         writeln!(md, "\n(No `docs/firmware.csv` at {w}x{h}: run `cargo xtask firmware` first for the Cortex-M columns.)")?;
     }
     writeln!(md, "\nCortex-M columns are per scene on average (the f64 row has no firmware build).\n")?;
+    Ok(points)
+}
+
+/// Each scalar against f64 at the same settings, per scene.
+fn scalar_section(md: &mut String, names: &[String], per_scene: &PerScene) -> Result<()> {
     writeln!(md, "## Each scalar against f64 at the same settings\n\nShare of dithered pixels that differ from the f64 frame rendered with the same settings\n(1 ray per pixel, Bayer): the error the scalar alone adds.\n")?;
     writeln!(md, "| scene | f32 | f32-micromath | f32-micromath-newton | fixed |\n|---|---|---|---|---|")?;
-    for n in &names {
+    for n in names {
         let cell = |s: &'static str| per_scene.get(&(n.clone(), s)).map_or("-".into(), |(d, p)| format!("{:.3} %", 100.0 * *d as f64 / *p as f64));
         writeln!(md, "| {n} | {} | {} | {} | {} |", cell("f32"), cell("f32-micromath"), cell("f32-micromath-newton"), cell("fixed"))?;
     }
+    Ok(())
+}
+
+/// The targets: the scalars' worst scenes, anti-aliasing and adaptive sub-sampling.
+fn targets_section(md: &mut String, configs: &[Config], tallies: &[Tally], names: &[String], per_scene: &PerScene) -> Result<()> {
     let worst = |s: &'static str| names.iter().filter_map(|n| per_scene.get(&(n.clone(), s))).map(|(d, p)| 100.0 * *d as f64 / *p as f64).fold(0.0, f64::max);
     let find = |label: &str| configs.iter().position(|c| c.label.starts_with(label)).map(|i| &tallies[i]);
     writeln!(md, "\n## Targets\n")?;
@@ -305,10 +340,5 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
             a.rays as f64 / one.rays as f64
         )?;
     }
-    writeln!(md, "\n![error against cost]({})", plot_link(out, plot))?;
-    let title = "Error against cost, one knob at a time";
-    crate::plot::scatter(plot, title, "host ms per frame (median, mean over scenes)", "mean abs gray error (levels of 64)", &points)?;
-    write_atomic(out, md.as_bytes())?;
-    println!("wrote {} and {}", out.display(), plot.display());
     Ok(())
 }
