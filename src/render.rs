@@ -15,7 +15,7 @@ use crate::outline::Apron;
 use crate::scalar::Real;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
-use crate::scene::Camera;
+use crate::scene::{Camera, Scene};
 use crate::trace::Tracer;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -278,17 +278,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
-    let t = frame.tile as usize;
-    let block = frame.dither.block() as usize;
-    if t == 0 || t > MAX_TILE || !t.is_multiple_of(block) {
-        return Err(RenderError::BadTile);
-    }
-    if frame.edges() && !cfg!(feature = "edge-sampling") {
-        return Err(RenderError::EdgesNotCompiled);
-    }
-    if !share.valid() || (share.of > 1 && !frame.bands_independent()) {
-        return Err(RenderError::BadShare);
-    }
+    check(frame, share)?;
+    let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
     let (w, h) = (frame.width as usize, frame.height as usize);
     let too_small = || RenderError::ScratchTooSmall { needed: frame.scratch_len() };
     let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or_else(too_small)?;
@@ -325,12 +316,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
         for tx in (0..tiles_x).filter(|&tx| share.holds(tx, ty)) {
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
-            // The objects this tile's eye rays can hit: those whose window meets the tile's
-            // (widened by a block on each side, beyond any ray the sampler shoots in the tile).
-            let m = 4 * block as i32;
-            let (sx, sy) = ([4 * x0 as i32 - m, 4 * (x0 + tw) as i32 + m], [4 * y0 as i32 - m, 4 * (y0 + th) as i32 + m]);
-            let (lo, hi) = (Camera::<R>::window_uv(sx[0], sy[1], w4, h4), Camera::<R>::window_uv(sx[1], sy[0], w4, h4));
-            q.set_eye_candidates(tracer.scene().eye_candidates([lo[0], hi[0]], [lo[1], hi[1]]));
+            let at = Block { x0, y0, tw, th, t };
+            q.set_eye_candidates(tile_candidates(tracer.scene(), at, block, (w4, h4)));
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 let ray = eye(&mut q, sx, sy);
                 let (v, id, depth) = tracer.eye_sample(ray, &mut q);
@@ -341,15 +328,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels, &mut hits),
                 Some((n, traced)) => {
                     let k = skipped + done as usize;
-                    let kept = &mut traced[k * per_tile..(k + 1) * per_tile];
-                    let at = Block { x0, y0, tw, th, t };
-                    // Each preview side is a constant in its own copy of the loop (no division).
-                    match *n {
-                        8 => preview_tile::<R, 8>(at, kept, &mut shoot, &mut levels),
-                        4 => preview_tile::<R, 4>(at, kept, &mut shoot, &mut levels),
-                        2 => preview_tile::<R, 2>(at, kept, &mut shoot, &mut levels),
-                        _ => finish_tile(&mut sampler, at, kept, &mut shoot, &mut levels, &mut hits),
-                    }
+                    pass_tile(*n, &mut sampler, at, &mut traced[k * per_tile..(k + 1) * per_tile], &mut shoot, &mut levels, &mut hits);
                 }
             }
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
@@ -364,15 +343,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                     let (id, depth) = tracer.eye_hit(ray, &mut q);
                     (id as u16, depth.depth_key())
                 };
-                let (mut left, mut up) = ([(0u16, 0u16); MAX_TILE], [(0u16, 0u16); MAX_TILE]);
-                if x0 > 0 {
-                    (0..th).for_each(|y| left[y] = probe(x0 - 1, y0 + y));
-                }
-                if y0 > 0 {
-                    (0..tw).for_each(|x| up[x] = probe(x0 + x, y0 - 1));
-                }
-                let apron = Apron { left: (x0 > 0).then_some(&left[..th]), up: (y0 > 0).then_some(&up[..tw]) };
-                crate::outline::tile(tw, th, &hits, apron, &mut levels[..tw * th]);
+                outline_tile(Block { x0, y0, tw, th, t }, &mut probe, &hits, &mut levels[..tw * th]);
             }
             dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
@@ -384,6 +355,59 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
         }
     }
     Ok(q.stats)
+}
+
+/// The objects the eye rays of the tile `at` can hit: those whose window meets the tile's
+/// (widened by a `block` on each side, beyond any ray the sampler shoots in the tile), on an
+/// image of `size` quarter pixels.
+fn tile_candidates<R: Real>(scene: &Scene<'_, R>, at: Block, block: usize, (w4, h4): (i32, i32)) -> u64 {
+    let Block { x0, y0, tw, th, .. } = at;
+    let m = 4 * block as i32;
+    let (sx, sy) = ([4 * x0 as i32 - m, 4 * (x0 + tw) as i32 + m], [4 * y0 as i32 - m, 4 * (y0 + th) as i32 + m]);
+    let (lo, hi) = (Camera::<R>::window_uv(sx[0], sy[1], w4, h4), Camera::<R>::window_uv(sx[1], sy[0], w4, h4));
+    scene.eye_candidates([lo[0], hi[0]], [lo[1], hi[1]])
+}
+
+/// A tile of pass `n` of a progressive frame: a preview of `n`x`n` blocks (each side a constant
+/// in its own copy of the loop: no division), or the finished tile (`n` 1) from the rays `kept`.
+fn pass_tile<R: Real>(n: u8, sampler: &mut Sampler<'_>, at: Block, kept: &mut [Traced], shoot: &mut impl FnMut(usize, usize) -> Shot<R>, levels: &mut [u8; MAX_TILE * MAX_TILE], hits: &mut Hits) {
+    match n {
+        8 => preview_tile::<R, 8>(at, kept, shoot, levels),
+        4 => preview_tile::<R, 4>(at, kept, shoot, levels),
+        2 => preview_tile::<R, 2>(at, kept, shoot, levels),
+        _ => finish_tile(sampler, at, kept, shoot, levels, hits),
+    }
+}
+
+/// Whether `frame` can be rendered in `share`: its tile a multiple of its dither's block and at
+/// most [`MAX_TILE`], its sampling compiled in, and the share one of its independent bands.
+fn check<E>(frame: &Frame, share: Share) -> Result<(), RenderError<E>> {
+    let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
+    if t == 0 || t > MAX_TILE || !t.is_multiple_of(block) {
+        return Err(RenderError::BadTile);
+    }
+    if frame.edges() && !cfg!(feature = "edge-sampling") {
+        return Err(RenderError::EdgesNotCompiled);
+    }
+    if !share.valid() || (share.of > 1 && !frame.bands_independent()) {
+        return Err(RenderError::BadShare);
+    }
+    Ok(())
+}
+
+/// Silhouette lines on a tile's `levels`: its own `hits`, and the apron `probe` answers (what
+/// the eye rays through the column left of the tile and the row above it hit).
+fn outline_tile(at: Block, probe: &mut impl FnMut(usize, usize) -> (u16, u16), hits: &Hits, levels: &mut [u8]) {
+    let Block { x0, y0, tw, th, .. } = at;
+    let (mut left, mut up) = ([(0u16, 0u16); MAX_TILE], [(0u16, 0u16); MAX_TILE]);
+    if x0 > 0 {
+        (0..th).for_each(|y| left[y] = probe(x0 - 1, y0 + y));
+    }
+    if y0 > 0 {
+        (0..tw).for_each(|x| up[x] = probe(x0 + x, y0 - 1));
+    }
+    let apron = Apron { left: (x0 > 0).then_some(&left[..th]), up: (y0 > 0).then_some(&up[..tw]) };
+    crate::outline::tile(tw, th, hits, apron, levels);
 }
 
 /// Where a tile lies: its top-left pixel, its size and the frame's tile side.
