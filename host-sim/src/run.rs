@@ -291,7 +291,12 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
         lattice.bytes(),
         build.as_secs_f64() * 1e3
     );
-    let frame = Frame::new(a.size.0, a.size.1);
+    per_accelerator(&scene, &cfg, Frame::new(a.size.0, a.size.1), a.runs)
+}
+
+
+/// Work per primary ray and full-render time of each accelerator on `scene`, printed.
+fn per_accelerator<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, frame: Frame, runs: usize) -> Result<()> {
     let pixels = frame.width as f64 * frame.height as f64;
     // Primary rays only: the paper's per-ray figures.
     let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>| {
@@ -301,7 +306,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     println!("  per primary ray at {}x{} (eye rays only):", frame.width, frame.height);
     let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];
     for acc in accels {
-        let r = render_accel(&scene, acc, &cfg, &frame, primary_only, false, false)?;
+        let r = render_accel(scene, acc, cfg, &frame, primary_only, false, false)?;
         println!(
             "    {:8} object tests {:6.3}, inside tests {:6.2}, cells visited {:6.2}",
             format!("{acc:?}").to_lowercase(),
@@ -313,16 +318,16 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     // Full renders, interleaved so drift on a shared machine hits all methods alike.
     let mut times: Vec<Vec<Duration>> = vec![Vec::new(); accels.len()];
     let mut last = Vec::new();
-    for _ in 0..a.runs.max(1) {
+    for _ in 0..runs.max(1) {
         last.clear();
         for (i, acc) in accels.iter().enumerate() {
-            let r = render_accel(&scene, *acc, &cfg, &frame, |_| {}, false, false)?;
+            let r = render_accel(scene, *acc, cfg, &frame, |_| {}, false, false)?;
             times[i].push(r.elapsed);
             last.push(r);
         }
     }
     let med: Vec<Duration> = times.into_iter().map(median).collect();
-    println!("  full render at {}x{}, median of {} interleaved runs:", frame.width, frame.height, a.runs.max(1));
+    println!("  full render at {}x{}, median of {} interleaved runs:", frame.width, frame.height, runs.max(1));
     for (i, acc) in accels.iter().enumerate() {
         let s = &last[i].stats;
         println!(
@@ -342,7 +347,6 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     );
     Ok(())
 }
-
 
 /// The default job: the paper's scenes at 160x100 and 128x64.
 pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {

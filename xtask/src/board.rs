@@ -118,8 +118,9 @@ fn prepare_emulator(root: &Path) -> Result<PathBuf> {
     Ok(bootrom)
 }
 
-/// One frame the emulated panel showed.
-#[derive(Debug)]
+/// One frame the emulated panel showed (run.mjs's `frame` event).
+#[derive(Debug, serde::Deserialize)]
+#[serde(rename_all = "camelCase")]
 struct PanelFrame {
     cycles: u64,
     instructions: u64,
@@ -129,13 +130,56 @@ struct PanelFrame {
     idle: [u64; 2],
     /// Flash reads that missed the XIP cache, and the cycles the cores stalled for them.
     xip_misses: u64,
+    #[serde(rename = "xipStallCycles")]
     xip_stall: u64,
     /// Cycles the I2C bus was busy (START, bytes, STOP).
     i2c_bus_cycles: u64,
     setup_cycles: u64,
     i2c_bytes: u64,
     error: Option<String>,
+    /// The panel's pixels (rows MSB first, lit = 1), sent as hex.
+    #[serde(deserialize_with = "hex_pixels")]
     pixels: Vec<u8>,
+}
+
+/// The end of a run (run.mjs's `end` event), as far as the report reads it.
+#[derive(Debug, serde::Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct RunEnd {
+    ok: bool,
+    reason: String,
+    #[serde(default)]
+    clk_sys_hz: f64,
+    #[serde(default)]
+    xip_miss_cycles: u64,
+    #[serde(default)]
+    scl_period_cycles: u64,
+    #[serde(default)]
+    emulated_ms: f64,
+    #[serde(default)]
+    idle_ms: f64,
+    #[serde(default)]
+    display_initialised: bool,
+    #[serde(default)]
+    led_toggles: u64,
+    #[serde(default)]
+    naks: u64,
+    #[serde(default)]
+    warnings: Vec<String>,
+}
+
+/// What run.mjs prints, one JSON object a line.
+#[derive(Debug, serde::Deserialize)]
+#[serde(tag = "event", rename_all = "camelCase")]
+enum Event {
+    Frame(PanelFrame),
+    End(RunEnd),
+}
+
+/// The panel's hex rows as bytes (none when the panel showed no picture).
+fn hex_pixels<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
+    let hex: Option<String> = serde::Deserialize::deserialize(d)?;
+    Ok(hex.as_deref().map(hex_bytes).unwrap_or_default())
 }
 
 /// What one emulator run reported.
@@ -206,41 +250,24 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
     let stdout = child.stdout.take().context("no stdout from the emulator")?;
     for line in BufReader::new(stdout).lines() {
         let line = line?;
-        let v: serde_json::Value = serde_json::from_str(&line).with_context(|| format!("emulator printed `{line}`"))?;
-        let num = |k: &str| v[k].as_f64().unwrap_or(0.0);
-        let pair = |k: &str| [0, 1].map(|i| v[k][i].as_f64().unwrap_or(0.0) as u64);
-        match v["event"].as_str() {
-            Some("frame") => {
-                let pixels = v["pixels"].as_str().map(hex_bytes).unwrap_or_default();
-                eprintln!("  frame {} shown: {:.1} M cycles", run.frames.len() + 1, num("cycles") / 1e6);
-                run.frames.push(PanelFrame {
-                    cycles: num("cycles") as u64,
-                    instructions: num("instructions") as u64,
-                    busy: pair("busy"),
-                    idle: pair("idle"),
-                    xip_misses: num("xipMisses") as u64,
-                    xip_stall: num("xipStallCycles") as u64,
-                    i2c_bus_cycles: num("i2cBusCycles") as u64,
-                    setup_cycles: num("setupCycles") as u64,
-                    i2c_bytes: num("i2cBytes") as u64,
-                    error: v["error"].as_str().map(String::from),
-                    pixels,
-                });
+        match serde_json::from_str::<Event>(&line).with_context(|| format!("emulator printed `{line}`"))? {
+            Event::Frame(f) => {
+                eprintln!("  frame {} shown: {:.1} M cycles", run.frames.len() + 1, f.cycles as f64 / 1e6);
+                run.frames.push(f);
             }
-            Some("end") => {
-                run.ok = v["ok"].as_bool().unwrap_or(false);
-                run.reason = v["reason"].as_str().unwrap_or("").to_string();
-                run.clk_sys_hz = num("clkSysHz");
-                run.xip_miss_cycles = num("xipMissCycles") as u64;
-                run.scl_period = num("sclPeriodCycles") as u64;
-                run.emulated_ms = num("emulatedMs");
-                run.idle_ms = num("idleMs");
-                run.display_initialised = v["displayInitialised"].as_bool().unwrap_or(false);
-                run.led_toggles = num("ledToggles") as u64;
-                run.naks = num("naks") as u64;
-                run.warnings = v["warnings"].as_array().into_iter().flatten().filter_map(|w| w.as_str().map(String::from)).collect();
+            Event::End(e) => {
+                run.ok = e.ok;
+                run.reason = e.reason;
+                run.clk_sys_hz = e.clk_sys_hz;
+                run.xip_miss_cycles = e.xip_miss_cycles;
+                run.scl_period = e.scl_period_cycles;
+                run.emulated_ms = e.emulated_ms;
+                run.idle_ms = e.idle_ms;
+                run.display_initialised = e.display_initialised;
+                run.led_toggles = e.led_toggles;
+                run.naks = e.naks;
+                run.warnings = e.warnings;
             }
-            _ => bail!("emulator printed an unknown event: {line}"),
         }
     }
     let status = child.wait()?;

@@ -39,15 +39,7 @@ fn kinds(s: &Stats) -> String {
 
 /// The command.
 pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &Path) -> Result<()> {
-    let csv = std::fs::read_to_string(firmware_csv).unwrap_or_default();
-    // (variant, scene) -> (instructions, flash)
-    let mut fw: BTreeMap<(String, String), (u64, u64)> = BTreeMap::new();
-    for line in csv.lines().skip(1) {
-        let f: Vec<&str> = line.split(',').collect();
-        if f.len() >= 7 {
-            fw.insert((f[5].to_string(), f[0].to_string()), (f[3].parse().unwrap_or(0), f[6].parse().unwrap_or(0)));
-        }
-    }
+    let fw = firmware_figures(firmware_csv);
     let mut md = String::new();
     writeln!(md, "# Simulating only the effects a scene calls for\n")?;
     writeln!(md, "Written by `cargo xtask effects` (128x64, f64 on the host, median of {} interleaved\nruns; Cortex-M figures from `docs/firmware.csv`, written by `cargo xtask firmware`: QEMU `-icount\nshift=0`, fixed point, Cortex-M0+ build).\n", runs.max(1))?;
@@ -94,16 +86,47 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
         }
         cut_rows.push(row);
     }
+    cutoff_section(&mut md, &cut_rows)?;
+    flash_section(&mut md, &fw)?;
+    std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
+    std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Instructions and flash bytes per (variant, scene), from `docs/firmware.csv` (empty without it).
+fn firmware_figures(firmware_csv: &Path) -> BTreeMap<(String, String), (u64, u64)> {
+    let csv = std::fs::read_to_string(firmware_csv).unwrap_or_default();
+    let mut fw = BTreeMap::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() >= 7 {
+            fw.insert((f[5].to_string(), f[0].to_string()), (f[3].parse().unwrap_or(0), f[6].parse().unwrap_or(0)));
+        }
+    }
+    fw
+}
+
+/// Rays of each scene, and the cutoff's rays and changed pixels at each cutoff.
+type CutRow = (String, u64, Vec<(f64, u64, u32)>);
+
+/// What the contribution cutoff saves and changes.
+fn cutoff_section(md: &mut String, cut_rows: &[CutRow]) -> Result<()> {
     writeln!(md, "\n## Contribution cutoff\n\nA branch of the intersection tree is not traced when its weight (the product of `Ks`/`Kt`\nalong the path) is below the cutoff; 1/64 is one of the 65 gray levels, 1/128 half of one.\nPixels are those of the 1-bit frame that differ from the frame without cutoff.\n")?;
     writeln!(md, "| scene | rays, no cutoff | rays, 1/128 | fewer | px changed | rays, 1/64 | fewer | px changed |\n|---|---|---|---|---|---|---|---|")?;
     let npx = 128.0 * 64.0;
-    for (name, base, cuts) in &cut_rows {
+    for (name, base, cuts) in cut_rows {
         let mut row = format!("| {name} | {base} |");
         for (_, rays, px) in cuts {
             write!(row, " {rays} | {:.1} % | {px} ({:.2} %) |", 100.0 * (1.0 - *rays as f64 / *base as f64), 100.0 * *px as f64 / npx)?;
         }
         writeln!(md, "{row}")?;
     }
+    Ok(())
+}
+
+/// The flash the derived effect set saves against every effect compiled in.
+fn flash_section(md: &mut String, fw: &BTreeMap<(String, String), (u64, u64)>) -> Result<()> {
     writeln!(md, "\n## Flash: code for effects a scene does not need\n\nThe same scenes built with the effects they call for and with every effect compiled in\n(`firmware/build.rs` derives the set from the embedded scenes; a const parameter of the tracer\nremoves the rest).\n")?;
     writeln!(md, "| scenes | derived effects | flash bytes, derived | flash bytes, every effect | saved |\n|---|---|---|---|---|")?;
     for (label, derived, all, fx) in [
@@ -116,8 +139,5 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
             _ => writeln!(md, "| {label} | {fx} | - | - | (run `cargo xtask firmware` first) |")?,
         }
     }
-    std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
-    std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
-    println!("wrote {}", out.display());
     Ok(())
 }
