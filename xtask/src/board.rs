@@ -168,12 +168,26 @@ struct RunEnd {
     warnings: Vec<String>,
 }
 
-/// What run.mjs prints, one JSON object a line.
-#[derive(Debug, serde::Deserialize)]
-#[serde(tag = "event", rename_all = "camelCase")]
+/// What run.mjs prints, one JSON object a line, told apart by its `event` field. (Not a serde
+/// internally tagged enum: serde_json's `arbitrary_precision`, which a dependency turns on,
+/// breaks numbers inside those.)
+#[derive(Debug)]
 enum Event {
     Frame(PanelFrame),
     End(RunEnd),
+}
+
+impl Event {
+    /// Parses one line the runner printed.
+    fn parse(line: &str) -> Result<Event> {
+        let v: serde_json::Value = serde_json::from_str(line).with_context(|| format!("emulator printed `{line}`"))?;
+        let event = match v["event"].as_str() {
+            Some("frame") => Event::Frame(serde_json::from_value(v)?),
+            Some("end") => Event::End(serde_json::from_value(v)?),
+            _ => bail!("emulator printed an unknown event: {line}"),
+        };
+        Ok(event)
+    }
 }
 
 /// The panel's hex rows as bytes (none when the panel showed no picture).
@@ -250,7 +264,7 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
     let stdout = child.stdout.take().context("no stdout from the emulator")?;
     for line in BufReader::new(stdout).lines() {
         let line = line?;
-        match serde_json::from_str::<Event>(&line).with_context(|| format!("emulator printed `{line}`"))? {
+        match Event::parse(&line).with_context(|| format!("emulator printed `{line}`"))? {
             Event::Frame(f) => {
                 eprintln!("  frame {} shown: {:.1} M cycles", run.frames.len() + 1, f.cycles as f64 / 1e6);
                 run.frames.push(f);
@@ -799,7 +813,7 @@ fn ladder_report(rungs: &[Rung<'_>], clk_hz: f64) -> Result<String> {
     let mhz = clk_hz / 1e6;
     writeln!(md, "\n## The ladder: what each lever gave\n")?;
     writeln!(md, "The image built with `--features ladder` (the chair alone) renders the chair once per rung of")?;
-    writeln!(md, "`LADDER` (`firmware/src/frame.rs`), from the paper's method to what the boards run, each rung")?;
+    writeln!(md, "`LADDER` (`records/src/frame.rs`), from the paper's method to what the boards run, each rung")?;
     writeln!(md, "switching one more lever on at run time; every frame is checked bit for bit against host-sim's")?;
     writeln!(md, "render with the same levers. *Cycles* are the whole frame as above (set-up, both cores, the bus;")?;
     writeln!(md, "target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz). Core 0 traces tile share 0 and")?;
@@ -978,4 +992,31 @@ fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, Pane
         row(&mut md, &format!("`{feature}`: {what}"), f)?;
     }
     Ok(md)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_runners_events_deserialize_into_their_types() {
+        let end = r#"{"event":"end","ok":true,"reason":"5 frames shown","frames":5,"cycles":1877839334,"instructions":482013801,"coreInstructions":[255689711,226324090],"busy":[377728246,334422558],"idle":[1500111032,1543416647],"xip":{"hits":123470883,"misses":11294,"uncached":0,"stallCycles":633658},"xipMissCycles":56,"sclPeriodCycles":332,"models":{"core1":true,"cache":true,"timedBus":true},"emulatedMs":15023.034306153846,"idleMs":12000.888256,"clkSysHz":125000000,"flashBytes":104704,"logBytes":328,"recordsDropped":0,"i2cBytes":10923,"naks":0,"ledToggles":10,"displayInitialised":true,"displayCommands":3866,"warnings":[]}"#;
+        match Event::parse(end).unwrap() {
+            Event::End(e) => {
+                assert!(e.ok);
+                assert_eq!((e.xip_miss_cycles, e.scl_period_cycles, e.led_toggles), (56, 332, 10));
+                assert_eq!(e.clk_sys_hz, 125e6);
+            }
+            Event::Frame(_) => panic!("an end event read as a frame"),
+        }
+        let frame = r#"{"event":"frame","index":0,"cycles":31447325,"instructions":39300000,"busy":[31447325,26591316],"idle":[0,4856009],"coreInstructions":[1,2],"xipHits":5,"xipMisses":519,"xipStallCycles":29104,"setupCycles":3594371,"setupInstructions":1,"i2cBytes":2176,"i2cBusCycles":7900000,"i2cTransfers":384,"startMs":1,"endMs":2,"error":null,"pixels":"00ff"}"#;
+        match Event::parse(frame).unwrap() {
+            Event::Frame(f) => {
+                assert_eq!((f.cycles, f.busy, f.idle, f.xip_stall, f.i2c_bytes), (31447325, [31447325, 26591316], [0, 4856009], 29104, 2176));
+                assert_eq!(f.pixels, vec![0x00, 0xff]);
+                assert!(f.error.is_none());
+            }
+            Event::End(_) => panic!("a frame read as an end event"),
+        }
+    }
 }
