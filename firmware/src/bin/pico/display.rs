@@ -72,8 +72,9 @@ pub struct QueuedI2c<P> {
 
 /// I2C0's registers.
 fn regs() -> &'static pac::i2c0::RegisterBlock {
-    // SAFETY: I2C0 belongs to the `QueuedI2c` that owns its HAL driver; only that driver's
-    // methods and `flush` touch the registers, from core 0 alone.
+    // SAFETY: I2C0 belongs to the `QueuedI2c` that owns its HAL driver; only its methods and
+    // `flush` touch the registers, and the two cores call those one at a time (each tile is
+    // drawn under the board's critical section, `app::Shared`; `flush` runs once core 1 is done).
     #[allow(unsafe_code)]
     unsafe {
         &*pac::I2C0::ptr()
