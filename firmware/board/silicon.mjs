@@ -422,7 +422,6 @@ export class SiliconBoard {
     this.spklen = [7, 7]; // IC_FS_SPKLEN as written (rp2040js drops odd values)
     this.busCycles = 0; // cycles the I2C buses spent on START, bytes and STOP
     this.stop = null; // why the run must end
-    this.onBreakHook = null;
   }
 
   loadBootrom(words) {
@@ -484,7 +483,6 @@ export class SiliconBoard {
 
   onBreak(core, code) {
     this.stop = `core ${core} stopped at a breakpoint or undefined instruction (code ${code}) at pc 0x${(this.cores[core].PC >>> 0).toString(16)}: a panic`;
-    this.onBreakHook?.(core, code);
   }
 
   guardHit(core, address) {
