@@ -6,9 +6,9 @@ use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Where the image `cargo pico-build` writes.
+/// The copy of the last Pico image [`build_pico`] built.
 pub fn pico_elf(root: &Path) -> PathBuf {
-    pico_elf_in(&root.join("firmware/target"))
+    kept_image(root, Board::Pico.name())
 }
 
 /// A Raspberry Pi board the firmware is built for.
@@ -34,6 +34,14 @@ impl Board {
             Board::Pico => "thumbv6m-none-eabi",
             Board::Pico2 => "thumbv8m.main-none-eabihf",
         }
+    }
+    /// Where `cargo <board>-build` writes the image, inside `firmware/target`.
+    fn built(self) -> PathBuf {
+        let profile = match self {
+            Board::Pico => "release",
+            Board::Pico2 => "speed",
+        };
+        Path::new(self.target()).join(profile).join("pico")
     }
     /// The drive the board shows in BOOTSEL mode.
     fn drive(self) -> &'static str {
@@ -66,25 +74,59 @@ pub fn build_pico(root: &Path) -> Result<PathBuf> {
 pub fn build_board(root: &Path, board: Board) -> Result<PathBuf> {
     let alias = format!("{}-build", board.name());
     eprintln!("building the {} image (cargo {alias})", board.name());
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(root)
-        .arg(&alias)
-        .env_remove("RUSTFLAGS")
-        .status()
-        .context("cannot run cargo")?;
-    if !status.success() {
-        bail!("`cargo {alias}` failed (it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target());
-    }
-    let profile = match board {
-        Board::Pico => "release",
-        Board::Pico2 => "speed",
-    };
-    Ok(root.join("firmware/target").join(board.target()).join(profile).join("pico"))
+    build_image(root, board.name(), &[&alias], Scenes::Inherited, &board.built())
+        .with_context(|| format!("`cargo {alias}` failed (it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target()))
 }
 
-/// The image in target folder `dir`.
-pub fn pico_elf_in(dir: &Path) -> PathBuf {
-    dir.join("thumbv6m-none-eabi/release/pico")
+/// The scenes an image embeds (the firmware's build script reads `FIRMWARE_SCENES`).
+#[derive(Clone, Copy, Debug)]
+pub enum Scenes<'a> {
+    /// As the caller's environment says (the firmware's default list when it says nothing).
+    Inherited,
+    /// The firmware's default list (`firmware/default-scenes.txt`), whatever the environment says.
+    Default,
+    /// These, comma-separated names from `scenes/`.
+    Listed(&'a str),
+}
+
+/// Runs `cargo <args>` from the repository's root with `scenes` and keeps the image it wrote, `built` (a path inside
+/// `firmware/target`), as [`kept_image`]`(name)`; returns that copy.
+///
+/// Every image builds in the firmware's one target folder, so a dependency compiles once per
+/// target and feature set, not once per image (a folder per image took 14 GB for the project's
+/// checks); the copy keeps an image from being overwritten by the next build of the same binary.
+pub fn build_image(root: &Path, name: &str, args: &[&str], scenes: Scenes, built: &Path) -> Result<PathBuf> {
+    let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    cmd.current_dir(root).args(args).env_remove("RUSTFLAGS");
+    match scenes {
+        Scenes::Inherited => {}
+        Scenes::Default => {
+            cmd.env_remove("FIRMWARE_SCENES");
+        }
+        Scenes::Listed(list) => {
+            cmd.env("FIRMWARE_SCENES", list);
+        }
+    }
+    let status = cmd.status().context("cannot run cargo")?;
+    if !status.success() {
+        bail!("`cargo {}` failed", args.join(" "));
+    }
+    let kept = kept_image(root, name);
+    let dir = kept.parent().expect("kept images live in a folder");
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let from = root.join("firmware/target").join(built);
+    std::fs::copy(&from, &kept).with_context(|| format!("cannot copy {} to {}", from.display(), kept.display()))?;
+    Ok(kept)
+}
+
+/// Where `cargo pico-build` (with any extra features) writes the Pico image, inside `firmware/target`.
+pub fn pico_built() -> PathBuf {
+    Board::Pico.built()
+}
+
+/// Where [`build_image`] keeps the image called `name`: `firmware/target/images/<name>`.
+pub fn kept_image(root: &Path, name: &str) -> PathBuf {
+    root.join("firmware/target/images").join(name)
 }
 
 /// Writes `elf` as a UF2 file for the RP2040's BOOTSEL drive.

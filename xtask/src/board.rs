@@ -12,7 +12,7 @@
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
-use host_sim::uf2::{build_pico, pico_elf, pico_elf_in, write_uf2};
+use host_sim::uf2::{build_image, build_pico, kept_image, pico_built, pico_elf, write_uf2, Scenes};
 use board_frame::{LADDER, ORBIT_FRAMES};
 use anyhow::{bail, Context, Result};
 use board_records::{FrameDone, Record};
@@ -52,30 +52,26 @@ const LEVERS: &[(&str, &str)] = &[
 /// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).
 const ORBIT_CHECKED: usize = 4;
 
-/// Builds the Pico image with an extra `feature` beside the default image (its own target
-/// folder, `firmware/target/<feature>`), with the chair alone or (`all_scenes`) the scenes of
+/// Builds the Pico image with an extra `feature` beside the default image (kept as
+/// `firmware/target/images/pico-<feature>`), with the chair alone or (`all_scenes`) the scenes of
 /// the default image.
 fn build_pico_with(root: &Path, feature: &str, all_scenes: bool) -> Result<PathBuf> {
     let which = if all_scenes { "the default scenes" } else { "the chair alone" };
     eprintln!("building the Pico image with `{feature}` (cargo pico-build --features {feature}, {which})");
-    let dir = root.join("firmware/target").join(feature);
-    let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
-    cmd.current_dir(root).args(["pico-build", "--features", feature, "--target-dir"]).arg(&dir).env_remove("RUSTFLAGS");
-    if !all_scenes {
-        cmd.env("FIRMWARE_SCENES", "chair");
-    }
-    let status = cmd.status().context("cannot run cargo")?;
-    if !status.success() {
-        bail!("`cargo pico-build --features {feature}` failed");
-    }
-    Ok(pico_elf_in(&dir))
+    let scenes = if all_scenes { Scenes::Inherited } else { Scenes::Listed("chair") };
+    build_image(root, &variant_image(feature), &["pico-build", "--features", feature], scenes, &pico_built())
+}
+
+/// The name the image with `feature` is kept under.
+fn variant_image(feature: &str) -> String {
+    format!("pico-{feature}")
 }
 
 /// Builds (unless `no_build`) the image with `feature` and the chair alone (or `all_scenes`),
 /// writes its UF2 file into `frames_dir/<feature>` and runs it for `frames` frames; returns the
 /// run and that folder.
 fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, frames_dir: &Path, bootrom: &Path, frames: usize) -> Result<(BoardRun, PathBuf)> {
-    let elf = if no_build { pico_elf_in(&root.join("firmware/target").join(feature)) } else { build_pico_with(root, feature, all_scenes)? };
+    let elf = if no_build { kept_image(root, &variant_image(feature)) } else { build_pico_with(root, feature, all_scenes)? };
     let dir = frames_dir.join(feature);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let uf2 = dir.join(format!("lattice-rt-pico-{feature}.uf2"));

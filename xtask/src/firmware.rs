@@ -4,6 +4,7 @@
 
 use host_sim::run::render_text;
 use host_sim::load::read;
+use host_sim::uf2::Scenes;
 use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 use std::fmt::Write as _;
@@ -153,28 +154,15 @@ fn variants() -> Vec<Variant> {
     v
 }
 
-fn target_dir(root: &Path, v: &Variant) -> PathBuf {
-    root.join("firmware/target/variants").join(&v.name)
-}
-
 fn elf_path(root: &Path, v: &Variant) -> PathBuf {
-    target_dir(root, v).join(v.target).join(v.profile).join(v.bin)
+    host_sim::uf2::kept_image(root, &v.name)
 }
 
 fn build(root: &Path, v: &Variant) -> Result<()> {
-    let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
-    cmd.current_dir(root.join("firmware"))
-        .args(["build", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target, "--target-dir"])
-        .arg(target_dir(root, v))
-        .env_remove("RUSTFLAGS");
-    match v.scenes {
-        Some(s) => cmd.env("FIRMWARE_SCENES", s),
-        None => cmd.env_remove("FIRMWARE_SCENES"),
-    };
-    let status = cmd.status().context("cannot run cargo")?;
-    if !status.success() {
-        bail!("building firmware variant {} failed", v.name);
-    }
+    let args = ["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target];
+    let built = Path::new(v.target).join(v.profile).join(v.bin);
+    let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);
+    host_sim::uf2::build_image(root, &v.name, &args, scenes, &built).with_context(|| format!("building firmware variant {} failed", v.name))?;
     Ok(())
 }
 
