@@ -19,6 +19,9 @@ pub struct Hit<R> {
     pub object: u32,
     /// Outward normal in object space (not normalised).
     pub normal: Vec3<R>,
+    /// The point in object space, as the ray reached it ([`crate::Object::surface_point`] puts
+    /// it on the surface and in the world).
+    pub point: Vec3<R>,
 }
 
 /// Kinds of rays counted by [`Stats`].
@@ -188,14 +191,15 @@ pub fn offer<R: Real>(
     };
     q.stats.object_tests += 1;
     match hit {
-        Some((t, n)) => {
+        Some(h) => {
+            let t = h.t;
             q.last_hit = i as u32;
             let better = match best {
                 Some(b) => t < b.t || (t == b.t && (i as u32) < b.object),
                 None => true,
             };
             if better {
-                *best = Some(Hit { t, object: i as u32, normal: n });
+                *best = Some(Hit { t, object: i as u32, normal: h.normal, point: h.point });
             }
             true
         }

@@ -172,7 +172,7 @@ mod writer {
             let parts: [&dyn Literal; 13] = [
                 &o.shape,
                 &o.to_object,
-                &o.origin,
+                &o.to_world,
                 &o.unscale,
                 &o.dir_factor,
                 &o.material,

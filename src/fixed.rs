@@ -176,6 +176,7 @@ impl Real for Fx {
     const MAX: Self = Fx(i32::MAX);
     const NAME: &'static str = "fixed";
     const LIMIT: f64 = 8192.0;
+    const RESOLUTION: f64 = 1.0 / 65536.0;
     fn from_f64(v: f64) -> Self {
         if v.is_nan() {
             return Fx(0);
@@ -222,10 +223,14 @@ impl Real for Fx {
     fn pad_eps() -> Self {
         Fx(1 << 6)
     }
+    fn point_eps() -> Self {
+        Fx(0)
+    }
     /// Fixed point has the same absolute precision everywhere, so the offset depends on the
-    /// size of the scene only, not on where the point lies.
-    fn offset(_p_max: Self, extent: Self) -> Self {
-        Self::offset_eps() * extent
+    /// size of the object only, not on where the point lies: a few units of the last place,
+    /// and as many of the object's own (unit-sized) coordinates scaled to its size.
+    fn offset(_p_max: Self, size: Self) -> Self {
+        Self::offset_eps() * (Self::ONE + size)
     }
     fn is_finite(self) -> bool {
         true

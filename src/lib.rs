@@ -21,7 +21,7 @@ pub use fixed::Fx;
 pub mod math;
 pub use math::{Aabb, Affine, Ray, Vec3};
 pub mod shape;
-pub use shape::Shape;
+pub use shape::{Shape, ShapeHit};
 pub mod scene;
 pub use scene::text::{parse, ParseError};
 pub use scene::{Scene, SceneBuilder, SceneError};

@@ -13,6 +13,7 @@ use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
 use crate::outline::Apron;
 use crate::scalar::Real;
+use crate::math::Vec3;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
 use crate::scene::{Camera, Scene};
@@ -176,6 +177,16 @@ pub enum RenderError<E> {
     /// The share is not one of its frame's (`index >= of`), or the frame's tiles depend on
     /// each other (error diffusion, edge sampling) and cannot be shared out.
     BadShare,
+    /// The angle between neighbouring pixels is below what the scalar resolves: the view is
+    /// too narrow (a telephoto) for this scalar at this frame size.
+    ViewTooNarrow {
+        /// The angle between neighbouring pixels (radians, the smaller of the two axes).
+        step: f64,
+        /// The smallest angle the scalar traces there.
+        smallest: f64,
+        /// The scalar's name.
+        scalar: &'static str,
+    },
     /// A progressive pass was asked of a frame that cannot be rendered progressively
     /// ([`Frame::progressive`]), or the pass is not 8, 4, 2 or 1, or the [`Traced`] storage is
     /// shorter than [`Frame::traced_len`].
@@ -195,6 +206,10 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
             RenderError::BadShare => write!(f, "tile share out of range, or the frame carries state from tile to tile (error diffusion, edge sampling)"),
+            RenderError::ViewTooNarrow { step, smallest, scalar } => write!(
+                f,
+                "the view is too narrow for {scalar} at this size: neighbouring pixels are {step:.1e} radians apart, the smallest {scalar} traces is {smallest:.1e} (widen the field of view, render fewer pixels, or trace in f64)"
+            ),
             RenderError::NotProgressive => write!(f, "progressive passes need tiles of a multiple of 8, one ray per pixel, a pass of 8, 4, 2 or 1 and room for the traced samples"),
         }
     }
@@ -279,6 +294,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
     check(frame, share)?;
+    resolves(tracer.scene().camera(), frame)?;
     let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
     let (w, h) = (frame.width as usize, frame.height as usize);
     let too_small = || RenderError::ScratchTooSmall { needed: frame.scratch_len() };
@@ -393,6 +409,24 @@ fn check<E>(frame: &Frame, share: Share) -> Result<(), RenderError<E>> {
         return Err(RenderError::BadShare);
     }
     Ok(())
+}
+
+/// How many times the scalar's resolution the angle between neighbouring pixels must be: an
+/// eye ray's direction (and the eye itself, relative to its distance) is rounded to about one
+/// unit of the last place, so edges then move by at most 1/32 of a pixel.
+pub const VIEW_MARGIN: f64 = 32.0;
+
+/// Whether `R` resolves the angle between neighbouring pixels of `frame` through `camera`
+/// (whose `right` and `up` are scaled by the tangents of the half fields of view).
+fn resolves<R: Real, E>(camera: &Camera<R>, frame: &Frame) -> Result<(), RenderError<E>> {
+    let half = |v: Vec3<R>| v.cast::<f64>().length();
+    let step = (2.0 * half(camera.right) / f64::from(frame.width.max(1))).min(2.0 * half(camera.up) / f64::from(frame.height.max(1)));
+    let smallest = VIEW_MARGIN * R::RESOLUTION;
+    if step >= smallest {
+        Ok(())
+    } else {
+        Err(RenderError::ViewTooNarrow { step, smallest, scalar: R::NAME })
+    }
 }
 
 /// Silhouette lines on a tile's `levels`: its own `hits`, and the apron `probe` answers (what

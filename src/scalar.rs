@@ -40,6 +40,9 @@ pub trait Real:
     fn from_f64(v: f64) -> Self;
     /// Largest coordinate magnitude a scene may use with this scalar (checked by validation).
     const LIMIT: f64;
+    /// The spacing of the scalar's numbers just above 1 (its machine epsilon; fixed point's
+    /// last bit).
+    const RESOLUTION: f64;
     /// Converts from a small integer (pixel coordinates).
     fn from_i32(v: i32) -> Self {
         Self::from_f64(v as f64)
@@ -72,13 +75,20 @@ pub trait Real:
             self
         }
     }
-    /// Relative epsilon for offsetting secondary-ray origins off a surface (see [`Real::offset`]).
+    /// Relative epsilon of the size term of [`Real::offset`]: the rounding of an object's own
+    /// arithmetic (the transform into its space, the quadratic), relative to its size.
     fn offset_eps() -> Self;
-    /// How far a secondary ray starts off the surface at a point whose largest coordinate is
-    /// `p_max`, in a world of extent `extent`. Floating point loses absolute precision as
-    /// coordinates grow, so the default grows with `p_max` too; fixed point overrides it.
-    fn offset(p_max: Self, extent: Self) -> Self {
-        Self::offset_eps() * (p_max + extent)
+    /// Relative epsilon of the point term of [`Real::offset`]: eight units of the last place
+    /// (the rounding of the hit point, of the offset point and of its map back into the
+    /// object's space, each at most one unit of the last place per coordinate, with a margin of
+    /// two). Zero for fixed point, whose absolute precision is the same everywhere.
+    fn point_eps() -> Self;
+    /// How far a secondary ray starts off the surface at a hit point whose largest coordinate
+    /// is `p_max`, on an object whose largest side is `size`: `point_eps * p_max + offset_eps *
+    /// size` (fixed point: `offset_eps * (1 + size)`). Local to the hit: what else the scene
+    /// holds, and where the ray came from, do not change it.
+    fn offset(p_max: Self, size: Self) -> Self {
+        Self::point_eps() * p_max + Self::offset_eps() * size
     }
     /// Relative padding of bounding boxes registered in lattice cells, so that rounding in
     /// an object test can never put a hit outside the cells the object is listed in.
@@ -130,6 +140,7 @@ impl Real for f64 {
     const MAX: Self = f64::MAX;
     const NAME: &'static str = "f64";
     const LIMIT: f64 = 1e150;
+    const RESOLUTION: f64 = f64::EPSILON;
     fn from_f64(v: f64) -> Self {
         v
     }
@@ -144,6 +155,9 @@ impl Real for f64 {
     }
     fn offset_eps() -> Self {
         1e-10
+    }
+    fn point_eps() -> Self {
+        8.0 * f64::EPSILON / 2.0 // 2^-50
     }
     fn pad_eps() -> Self {
         1e-9
@@ -205,6 +219,7 @@ impl Real for f32 {
     const MAX: Self = f32::MAX;
     const NAME: &'static str = "f32";
     const LIMIT: f64 = 1e15;
+    const RESOLUTION: f64 = f32::EPSILON as f64;
     fn from_f64(v: f64) -> Self {
         v as f32
     }
@@ -222,6 +237,9 @@ impl Real for f32 {
     }
     fn offset_eps() -> Self {
         3e-6
+    }
+    fn point_eps() -> Self {
+        8.0 * f32::EPSILON / 2.0 // 2^-21
     }
     fn pad_eps() -> Self {
         2e-5
@@ -371,6 +389,7 @@ macro_rules! f32_with_sqrt {
             const MAX: Self = $name(f32::MAX);
             const NAME: &'static str = $label;
             const LIMIT: f64 = <f32 as Real>::LIMIT;
+            const RESOLUTION: f64 = <f32 as Real>::RESOLUTION;
             fn from_f64(v: f64) -> Self {
                 $name(v as f32)
             }
@@ -388,6 +407,9 @@ macro_rules! f32_with_sqrt {
             }
             fn offset_eps() -> Self {
                 $name(<f32 as Real>::offset_eps())
+            }
+            fn point_eps() -> Self {
+                $name(<f32 as Real>::point_eps())
             }
             fn pad_eps() -> Self {
                 $name(<f32 as Real>::pad_eps())

@@ -28,6 +28,18 @@ pub enum Shape<R> {
     Box,
 }
 
+/// Where a ray meets a primitive, in object space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeHit<R> {
+    /// The ray parameter.
+    pub t: R,
+    /// The outward normal (not normalised).
+    pub normal: Vec3<R>,
+    /// The point, as the ray reached it: along the ray it is as far off as the ray's origin
+    /// is rounded, so [`Shape::on_surface`] puts it back on the surface before it is used.
+    pub point: Vec3<R>,
+}
+
 /// Which primitive a shape is, without parameters (for names and statistics).
 pub const SHAPE_NAMES: [&str; 4] = ["sphere", "cylinder", "cone", "box"];
 
@@ -42,14 +54,14 @@ impl<R: Real> Shape<R> {
         }
     }
 
-    /// Nearest intersection with `tmin < t <= tmax`: the parameter and the outward normal
-    /// (not normalised) in object space.
+    /// Nearest intersection with `tmin < t <= tmax`: the parameter, the outward normal
+    /// (not normalised) and the point, in object space.
     ///
     /// The ray is first clipped to the shape's object-space box (a slab test needs no squares),
     /// and the quadratic is solved from the entry point: every square then involves numbers of
     /// about the shape's own size, however far away the ray started. That keeps fixed point
     /// from overflowing and floats from cancelling.
-    pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
+    pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
         let (lo, hi) = self.bounds();
         let (t0, t1) = Aabb { min: lo, max: hi }.clip(r, tmin, tmax)?;
         if let Shape::Box = self {
@@ -57,14 +69,31 @@ impl<R: Real> Shape<R> {
             return unit_box(r, tmin, t0, t1);
         }
         let local = Ray::new(r.at(t0), r.dir);
-        let mut best = Closest { t: tmax - t0, n: None, tmin: tmin - t0 };
+        let mut best = Closest { t: tmax - t0, hit: None, tmin: tmin - t0 };
         match *self {
             Shape::Sphere => sphere(&local, &mut best),
             Shape::Cylinder => cone_side_and_caps(&local, R::ONE, &mut best),
             Shape::Cone { top } => cone_side_and_caps(&local, top, &mut best),
             Shape::Box => {}
         }
-        best.n.map(|n| (best.t + t0, n))
+        best.hit.map(|(normal, point)| ShapeHit { t: best.t + t0, normal, point })
+    }
+
+    /// `p`, a point [`Shape::intersect`] found with outward normal `n`, on the surface to the
+    /// rounding of the shape's own (unit-sized) coordinates.
+    ///
+    /// A hit is only as exact along the ray as the ray's origin: from an eye 10^14 units away
+    /// the slab clip's entry point is many units of the last place of the object's coordinates
+    /// off, and a secondary ray from such a point would start inside the object. The sphere,
+    /// cylinder and cone solve their quadratic from that entry point, so their hit lies on the
+    /// surface (of a ray beside the true one, which only moves it along the surface); the box's
+    /// hit is the entry point itself, so the coordinate of its face is set to 0 or 1.
+    #[inline]
+    pub fn on_surface(&self, p: Vec3<R>, n: Vec3<R>) -> Vec3<R> {
+        match self {
+            Shape::Box => Vec3::new(onto_face(p.x, n.x), onto_face(p.y, n.y), onto_face(p.z, n.z)),
+            _ => p,
+        }
     }
 
     /// Corners of an object-space box that holds the shape.
@@ -78,19 +107,31 @@ impl<R: Real> Shape<R> {
     }
 }
 
-/// The running nearest root of one shape test.
+/// A unit cube's coordinate `c` of a hit whose normal has component `n` along it: 0 or 1 on
+/// the face the normal leaves (the other coordinates are kept).
+fn onto_face<R: Real>(c: R, n: R) -> R {
+    if n > R::ZERO {
+        R::ONE
+    } else if n < R::ZERO {
+        R::ZERO
+    } else {
+        c
+    }
+}
+
+/// The running nearest root of one shape test: its parameter, and its normal and point.
 struct Closest<R> {
     t: R,
-    n: Option<Vec3<R>>,
+    hit: Option<(Vec3<R>, Vec3<R>)>,
     tmin: R,
 }
 
 impl<R: Real> Closest<R> {
     #[inline]
-    fn offer(&mut self, t: R, n: impl FnOnce() -> Vec3<R>) {
+    fn offer(&mut self, t: R, hit: impl FnOnce() -> (Vec3<R>, Vec3<R>)) {
         if t > self.tmin && t <= self.t {
             self.t = t;
-            self.n = Some(n());
+            self.hit = Some(hit());
         }
     }
 }
@@ -122,7 +163,10 @@ fn sphere<R: Real>(r: &Ray<R>, best: &mut Closest<R>) {
         return;
     }
     for t in roots(a, b, c, disc).into_iter().flatten() {
-        best.offer(t, || r.at(t));
+        best.offer(t, || {
+            let p = r.at(t);
+            (p, p)
+        });
     }
 }
 
@@ -151,9 +195,9 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
                 best.offer(t, || {
                     let n = Vec3::new(p.x, -k * (R::ONE + k * p.y), p.z);
                     if n.x == R::ZERO && n.z == R::ZERO && n.y == R::ZERO {
-                        Vec3::new(R::ZERO, R::ONE, R::ZERO) // the apex itself
+                        (Vec3::new(R::ZERO, R::ONE, R::ZERO), p) // the apex itself
                     } else {
-                        n
+                        (n, p)
                     }
                 });
             }
@@ -167,7 +211,7 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
             let t = (y - o.y) / d.y;
             let (px, pz) = (o.x + d.x * t, o.z + d.z * t);
             if px * px + pz * pz <= radius * radius {
-                best.offer(t, || Vec3::new(R::ZERO, ny, R::ZERO));
+                best.offer(t, || (Vec3::new(R::ZERO, ny, R::ZERO), Vec3::new(px, y, pz)));
             }
         }
     }
@@ -175,7 +219,7 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
 
 /// The unit cube, given the ray's parameter range inside it `[t0, t1]` from the slab clip:
 /// the first of entry and exit after `tmin`, with the normal of the face it crosses.
-fn unit_box<R: Real>(r: &Ray<R>, tmin: R, t0: R, t1: R) -> Option<(R, Vec3<R>)> {
+fn unit_box<R: Real>(r: &Ray<R>, tmin: R, t0: R, t1: R) -> Option<ShapeHit<R>> {
     let t = if t0 > tmin { t0 } else if t1 > tmin { t1 } else { return None };
     // The face is the one the point lies on: the axis whose coordinate is nearest 0 or 1.
     let p = r.at(t);
@@ -190,7 +234,7 @@ fn unit_box<R: Real>(r: &Ray<R>, tmin: R, t0: R, t1: R) -> Option<(R, Vec3<R>)> 
     }
     let mut n = [R::ZERO; 3];
     n[axis] = sign;
-    Some((t, Vec3::new(n[0], n[1], n[2])))
+    Some(ShapeHit { t, normal: Vec3::new(n[0], n[1], n[2]), point: p })
 }
 
 #[cfg(test)]
@@ -204,17 +248,17 @@ mod tests {
     #[test]
     fn sphere_front_hit_and_inside_exit() {
         let s = Shape::<f64>::Sphere;
-        let (t, n) = s.intersect(&ray([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]), 0.0, 100.0).unwrap();
+        let ShapeHit { t, normal: n, .. } = s.intersect(&ray([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]), 0.0, 100.0).unwrap();
         assert_eq!(t, 4.0);
         assert_eq!(n, Vec3::new(0.0, 0.0, -1.0));
-        let (t, _) = s.intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, 2.0]), 0.0, 100.0).unwrap();
+        let ShapeHit { t, .. } = s.intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, 2.0]), 0.0, 100.0).unwrap();
         assert_eq!(t, 0.5);
     }
 
     #[test]
     fn cylinder_parallel_to_axis_hits_the_cap() {
         let s = Shape::<f64>::Cylinder;
-        let (t, n) = s.intersect(&ray([0.5, -1.0, 0.0], [0.0, 1.0, 0.0]), 0.0, 100.0).unwrap();
+        let ShapeHit { t, normal: n, .. } = s.intersect(&ray([0.5, -1.0, 0.0], [0.0, 1.0, 0.0]), 0.0, 100.0).unwrap();
         assert_eq!((t, n), (1.0, Vec3::new(0.0, -1.0, 0.0)));
         assert!(s.intersect(&ray([1.5, -1.0, 0.0], [0.0, 1.0, 0.0]), 0.0, 100.0).is_none());
     }
@@ -225,16 +269,16 @@ mod tests {
         // A horizontal ray at y = 1.5 crosses the mirror cone above the apex only.
         assert!(s.intersect(&ray([-5.0, 1.5, 0.0], [1.0, 0.0, 0.0]), 0.0, 100.0).is_none());
         // At y = 0.5 the radius is 0.5.
-        let (t, _) = s.intersect(&ray([-5.0, 0.5, 0.0], [1.0, 0.0, 0.0]), 0.0, 100.0).unwrap();
+        let ShapeHit { t, .. } = s.intersect(&ray([-5.0, 0.5, 0.0], [1.0, 0.0, 0.0]), 0.0, 100.0).unwrap();
         assert!((t - 4.5).abs() < 1e-12);
     }
 
     #[test]
     fn box_entering_and_leaving_faces() {
         let s = Shape::<f64>::Box;
-        let (t, n) = s.intersect(&ray([0.5, 0.5, -1.0], [0.0, 0.0, 1.0]), 0.0, 100.0).unwrap();
+        let ShapeHit { t, normal: n, .. } = s.intersect(&ray([0.5, 0.5, -1.0], [0.0, 0.0, 1.0]), 0.0, 100.0).unwrap();
         assert_eq!((t, n), (1.0, Vec3::new(0.0, 0.0, -1.0)));
-        let (t, n) = s.intersect(&ray([0.5, 0.5, 0.5], [0.0, 0.0, -1.0]), 0.0, 100.0).unwrap();
+        let ShapeHit { t, normal: n, .. } = s.intersect(&ray([0.5, 0.5, 0.5], [0.0, 0.0, -1.0]), 0.0, 100.0).unwrap();
         assert_eq!((t, n), (0.5, Vec3::new(0.0, 0.0, -1.0)));
     }
 }

@@ -7,12 +7,16 @@
 //! (depth-first, each node pushes at most two children).
 //!
 //! Secondary rays start at `p + n * eps` on the side they travel to, with `n` the normal
-//! flipped to face the incoming ray and `eps = Real::offset(max|p|, extent of the world)`. In
-//! floating point that is `offset_eps * (max|p| + extent)`: above the rounding error of `p`
-//! wherever the scene sits (the `max|p|` term), never zero at the origin (the extent term), and
-//! exactly proportional to the scene when it is scaled by a power of two, so such a scaling
-//! leaves the image bit for bit the same. Fixed point, whose absolute precision is the same
-//! everywhere, uses `offset_eps * extent`.
+//! flipped to face the incoming ray, `p` the hit put on the object's surface in object space
+//! and mapped to the world ([`crate::Object::surface_point`]: its error does not depend on
+//! where the ray came from), and `eps = Real::offset(max|p|, size of the object hit)`. That is
+//! local: a far object or a far eye does not change it. In floating point it is
+//! `point_eps * max|p| + offset_eps * size`: above the rounding of `p` wherever the object sits
+//! (the `max|p|` term, a few units of its last place) and above the rounding of the object's own
+//! arithmetic (the size term), never zero at the origin, and exactly proportional to the scene
+//! when it is scaled by a power of two, so such a scaling leaves the image bit for bit the
+//! same. Fixed point, whose absolute precision is the same everywhere, uses
+//! `offset_eps * (1 + size)`.
 
 use crate::accel::{Accelerator, BruteForce, Query, RayKind};
 use crate::math::{Ray, Vec3};
@@ -189,9 +193,14 @@ pub fn facing<R: Real>(d: Vec3<R>, outward: Vec3<R>, ior: R) -> (Vec3<R>, R, boo
 /// Snell's law: the unit direction refracted from unit `d` at a surface with unit normal `n`
 /// facing the ray, for the ratio of indices `eta`; `None` past the critical angle (total
 /// internal reflection).
+///
+/// `sin^2` of the incidence comes from the cross product, not from `1 - cos^2`: near the normal
+/// that difference cancels to the rounding of `cos`, which `eta^2` then magnifies (glass of
+/// index 40,000 in f32 decided total internal reflection by rounding).
 pub fn refract<R: Real>(d: Vec3<R>, n: Vec3<R>, eta: R) -> Option<Vec3<R>> {
     let cos_i = -d.dot(n);
-    let k = R::ONE - eta * eta * (R::ONE - cos_i * cos_i);
+    let c = d.cross(n);
+    let k = R::ONE - eta * eta * c.dot(c);
     if k < R::ZERO {
         None
     } else {
@@ -212,8 +221,6 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     /// overflows.
     max_depth: u8,
     cutoff: R,
-    /// Extent of the world box, the scale term of the self-intersection offset.
-    scale: R,
     /// How eye rays given a window position find their nearest hit.
     eye_rays: EyeRays,
     /// Whether a shadow ray first tries the object that last hid its light.
@@ -292,7 +299,6 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
             effects: Effects::of(scene),
             max_depth: scene.max_depth.min(MAX_DEPTH),
             cutoff: R::ZERO,
-            scale: scene.world.extent(),
             eye_rays: EyeRays::for_scene(scene),
             coherence: true,
         }
@@ -313,7 +319,6 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             effects: need,
             max_depth: scene.max_depth.min(MAX_DEPTH),
             cutoff: R::ZERO,
-            scale: scene.world.extent(),
             eye_rays: EyeRays::for_scene(scene),
             coherence: true,
         })
@@ -457,11 +462,11 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             }
             let obj = &scene.objects[hit.object as usize];
             let m = scene.materials[obj.material as usize];
-            let p = node.ray.at(hit.t);
+            let p = obj.surface_point(hit.point, hit.normal);
             let d = node.ray.dir.normalize();
             let (n, eta, _) = facing(d, obj.world_normal(hit.normal), m.ior);
             let cos_i = -d.dot(n);
-            let eps = R::offset(p.max_abs(), self.scale);
+            let eps = R::offset(p.max_abs(), obj.size());
             let outside = p + n * eps;
             let mut local = scene.ambient * m.ka;
             if m.kd > R::ZERO {

@@ -52,7 +52,7 @@ fn pane(thick: f64) -> String {
 fn a_pane_thinner_than_the_ray_offset_is_refused_naming_it_and_the_smallest_size() {
     let text = pane(1e-5);
     let msg = err::<f32>(&text);
-    assert!(msg.starts_with("line 4, column 1 at `box`: object 0 is too thin for this scene in f32: it is 1e-5 across, the smallest this scalar traces here is 1e-4"), "{msg}");
+    assert!(msg.starts_with("line 4, column 1 at `box`: object 0 is too thin for this scene in f32: it is 1e-5 across, the smallest this scalar traces here is 3e-5"), "{msg}");
     // Fixed point finds it too small for its object-space range first.
     let msg = err::<Fx>(&text);
     assert!(msg.starts_with("line 4, column 1 at `box`: object 0 is too small for this scene in fixed"), "{msg}");
@@ -62,11 +62,13 @@ fn a_pane_thinner_than_the_ray_offset_is_refused_naming_it_and_the_smallest_size
 #[test]
 fn a_thin_pane_that_is_accepted_renders_as_in_f64() {
     let frame = Frame::new(96, 64);
-    // Thin, yet thick enough for f32 (its limit here is about 2.4e-4).
-    let text = pane(1e-3);
-    assert!(accepted::<f32>(&text));
-    let off = share_off(&gray::<f32>(&text, &frame), &gray::<f64>(&text, &frame));
-    assert!(off < 0.01, "f32 against f64: {:.1} % of pixels more than one level off", off * 100.0);
+    // Thin, yet thick enough for f32 (its limit here is about 3e-5: the pane's own offset).
+    for thick in [1e-3, 1e-4] {
+        let text = pane(thick);
+        assert!(accepted::<f32>(&text));
+        let off = share_off(&gray::<f32>(&text, &frame), &gray::<f64>(&text, &frame));
+        assert!(off < 0.01, "pane {thick}: f32 against f64: {:.1} % of pixels more than one level off", off * 100.0);
+    }
     // The 1e-5 pane in f64 renders like a slightly thicker one (no pixel of the sphere is lost).
     let thin = gray::<f64>(&pane(1e-5), &frame);
     let thicker = gray::<f64>(&pane(1e-4), &frame);
@@ -87,7 +89,7 @@ fn shading_numbers_beyond_the_scalar_are_refused_at_their_column() {
     );
     assert_eq!(
         err::<f32>("material glass kt 0.5 ior 1e39\nsphere material glass"),
-        "line 1, column 27 at `1e39`: index of refraction out of range for f32: magnitude must stay below 3e7"
+        "line 1, column 27 at `1e39`: index of refraction out of range for f32: magnitude must stay below 8192"
     );
     assert_eq!(
         err::<f64>("light point pos 0 5 0 intensity 1e200\nsphere"),
@@ -175,8 +177,21 @@ fn a_byte_order_mark_and_every_line_ending_parse_alike() {
 }
 
 #[test]
+fn zero_is_zero_whatever_its_exponent() {
+    for zero in ["0e999", "-0e999", "0.000e-999", "0e0"] {
+        let text = format!("sphere center {zero} 0 0");
+        let mut storage = vec![Object::<f64>::default(); 1];
+        let scene = parse::<f64>(&text, &mut storage).unwrap_or_else(|e| panic!("{zero}: {e}"));
+        let expected = parse::<f64>("sphere center 0 0 0", &mut vec![Object::<f64>::default(); 1]).unwrap().objects()[0].origin();
+        assert_eq!(scene.objects()[0].origin(), expected, "{zero}");
+    }
+    // Tiny non-zero numbers underflow to zero as f64 itself rounds them.
+    assert!(accepted::<f64>("sphere center 1e-999 0 0"));
+}
+
+#[test]
 fn numbers_and_transforms_beyond_f64_say_out_of_range() {
-    assert_eq!(err::<f64>("sphere center 0e999 0 0"), "line 1, column 15 at `0e999`: number out of range: beyond the largest f64 (about 1.8e308)");
+    assert_eq!(err::<f64>("sphere center 1e999 0 0"), "line 1, column 15 at `1e999`: number out of range: beyond the largest f64 (about 1.8e308)");
     assert_eq!(err::<f64>("ambient -1e400\nsphere"), "line 1, column 9 at `-1e400`: number out of range: beyond the largest f64 (about 1.8e308)");
     assert_eq!(
         err::<f64>("sphere scale 1e200 scale 1e200"),

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use lattice_rt::lattice::Resolution;
 use lattice_rt::scene::Object;
-use lattice_rt::shape::Shape;
+use lattice_rt::shape::{Shape, ShapeHit};
 use lattice_rt::trace::{facing, refract};
 use lattice_rt::{
     parse, Accelerator, BoundingBox, BruteForce, Effects, Frame, Fx, LatticeConfig, Query, Ray,
@@ -160,7 +160,7 @@ fn tangent_rays<R: Real>() {
             let z = (if let Shape::Cone { .. } = shape { 0.5 } else { 1.0 }) + k as f64 * step;
             let r = Ray::new(v::<R>(-5.0, if let Shape::Sphere = shape { 0.0 } else { 1.0 - top }, z), v::<R>(1.0, 0.0, 0.0));
             let hit = shape.intersect(&r, R::ZERO, R::MAX);
-            if let Some((t, n)) = hit {
+            if let Some(ShapeHit { t, normal: n, .. }) = hit {
                 assert!(t.is_finite() && n.x.is_finite() && n.y.is_finite() && n.z.is_finite(), "{}: NaN", R::NAME);
                 assert!(!missed, "{} {shape:?}: hit again at +{k} LSB after a miss", R::NAME);
             } else {
@@ -313,7 +313,7 @@ fn large_object_and_mailbox<R: Real>() {
 fn cylinder_and_cone_special_rays<R: Real>() {
     let cyl = Shape::<R>::Cylinder;
     // Parallel to the axis, inside the radius: hits the bottom cap.
-    let (t, n) = cyl.intersect(&Ray::new(v(0.3, -2.0, 0.2), v(0.0, 1.0, 0.0)), R::ZERO, R::MAX).unwrap();
+    let ShapeHit { t, normal: n, .. } = cyl.intersect(&Ray::new(v(0.3, -2.0, 0.2), v(0.0, 1.0, 0.0)), R::ZERO, R::MAX).unwrap();
     assert_eq!((t, n), (R::from_f64(2.0), v(0.0, -1.0, 0.0)), "{}", R::NAME);
     // Down onto the cap rim and just inside/outside it: no crack between cap and side.
     for x in [0.999, 1.0] {
@@ -327,11 +327,11 @@ fn cylinder_and_cone_special_rays<R: Real>() {
     }
     let cone = Shape::Cone { top: R::ZERO };
     // Through the apex along the axis from above: hits at the apex.
-    let (t, _) = cone.intersect(&Ray::new(v(0.0, 3.0, 0.0), v(0.0, -1.0, 0.0)), R::ZERO, R::MAX).unwrap();
+    let ShapeHit { t, .. } = cone.intersect(&Ray::new(v(0.0, 3.0, 0.0), v(0.0, -1.0, 0.0)), R::ZERO, R::MAX).unwrap();
     assert!((t.to_f64() - 2.0).abs() < 1e-3, "{} apex t {t:?}", R::NAME);
     // Parallel to a generating line (slope -1 in x against y), outside: the linear case.
     let r = Ray::new(v(-2.0, -1.0, 0.0), v(1.0, 1.0, 0.0));
-    if let Some((t, n)) = cone.intersect(&r, R::ZERO, R::MAX) {
+    if let Some(ShapeHit { t, normal: n, .. }) = cone.intersect(&r, R::ZERO, R::MAX) {
         assert!(t.is_finite() && n.x.is_finite(), "{}", R::NAME);
     }
     // The mirror cone above the apex is never hit.

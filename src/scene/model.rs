@@ -2,7 +2,7 @@
 
 use crate::math::{Aabb, Affine, Ray, Vec3};
 use crate::scalar::Real;
-use crate::shape::Shape;
+use crate::shape::{Shape, ShapeHit};
 use heapless::Vec;
 
 /// Most materials a scene may define.
@@ -152,10 +152,11 @@ pub struct Object<R> {
     /// `1 / unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
     /// full precision however large or small the object is (exact in floating point).
     pub(crate) to_object: Affine<R>,
-    /// The world point at the object's origin: rays are taken relative to it before
-    /// `to_object` (whose translation is then zero), so a scene far from the world's origin
-    /// loses no precision to cancellation.
-    pub(crate) origin: Vec3<R>,
+    /// The placement, from canonical object space to the world: hit points are mapped back
+    /// through it ([`Object::surface_point`]). Its translation is the object's origin: rays are
+    /// taken relative to it before `to_object` (whose translation is then zero), so a scene far
+    /// from the world's origin loses no precision to cancellation.
+    pub(crate) to_world: Affine<R>,
     /// The power of two that `to_object`'s results are multiplied by to get object space.
     pub(crate) unscale: R,
     /// `unscale * dir_scale`: what `to_object`'s direction results are multiplied by.
@@ -218,7 +219,7 @@ impl<R: Real> Default for Object<R> {
         Object {
             shape: Shape::Sphere,
             to_object: Affine::identity(),
-            origin: z,
+            to_world: Affine::identity(),
             unscale: R::ONE,
             dir_factor: R::ONE,
             material: 0,
@@ -241,7 +242,7 @@ impl<R> Object<R> {
     pub const fn from_tables(
         shape: Shape<R>,
         to_object: Affine<R>,
-        origin: Vec3<R>,
+        to_world: Affine<R>,
         unscale: R,
         dir_factor: R,
         material: u8,
@@ -253,15 +254,16 @@ impl<R> Object<R> {
         eye_window: EyeWindow,
         shadow_window: ShadowWindow<R>,
     ) -> Self {
-        Object { shape, to_object, origin, unscale, dir_factor, material, composite, bounds, dir_scale, inv_dir_scale, eye_local, eye_window, shadow_window }
+        Object { shape, to_object, to_world, unscale, dir_factor, material, composite, bounds, dir_scale, inv_dir_scale, eye_local, eye_window, shadow_window }
     }
 }
 
 impl<R: Real> Object<R> {
-    /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` and the object-space normal.
+    /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` (the world ray's parameter) and
+    /// the object-space normal and point.
     #[inline]
-    pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
-        self.intersect_from(self.to_object.vector(ray.origin - self.origin) * self.unscale, ray, tmin, tmax)
+    pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
+        self.intersect_from(self.to_object.vector(ray.origin - self.origin()) * self.unscale, ray, tmin, tmax)
     }
 
     /// [`Object::intersect`] for an eye ray (its origin the camera's eye) through window
@@ -269,7 +271,7 @@ impl<R: Real> Object<R> {
     /// outside the object's window, else the same answer as `intersect`, with the eye's
     /// object-space position taken from the scene instead of transformed again.
     #[inline]
-    pub fn intersect_eye_ray(&self, ray: &Ray<R>, uv: [i32; 2], tmin: R, tmax: R) -> Result<Option<(R, Vec3<R>)>, Culled> {
+    pub fn intersect_eye_ray(&self, ray: &Ray<R>, uv: [i32; 2], tmin: R, tmax: R) -> Result<Option<ShapeHit<R>>, Culled> {
         let w = &self.eye_window;
         if uv[0] < w[0] || uv[0] > w[1] || uv[1] < w[2] || uv[1] > w[3] {
             return Err(Culled);
@@ -279,7 +281,7 @@ impl<R: Real> Object<R> {
 
     /// The intersection, given the ray's origin already in object space.
     #[inline(always)]
-    fn intersect_from(&self, origin: Vec3<R>, ray: &Ray<R>, tmin: R, tmax: R) -> Option<(R, Vec3<R>)> {
+    fn intersect_from(&self, origin: Vec3<R>, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
         let r = Ray::new(origin, self.to_object.vector(ray.dir) * self.dir_factor);
         // With the direction scaled by k, the object-space parameter is t / k. Multiplying by
         // a power of two is exact in floating point but rounds in fixed point, so the range is
@@ -293,9 +295,9 @@ impl<R: Real> Object<R> {
             let f = tmax * self.inv_dir_scale;
             f + (f.abs() + R::ONE) * R::pad_eps()
         };
-        let (t, n) = self.shape.intersect(&r, tmin * self.inv_dir_scale, far)?;
-        let t = t * self.dir_scale;
-        (t > tmin && t <= tmax).then_some((t, n))
+        let hit = self.shape.intersect(&r, tmin * self.inv_dir_scale, far)?;
+        let t = hit.t * self.dir_scale;
+        (t > tmin && t <= tmax).then_some(ShapeHit { t, ..hit })
     }
     /// The canonical primitive.
     pub fn shape(&self) -> Shape<R> {
@@ -314,8 +316,25 @@ impl<R: Real> Object<R> {
         self.bounds
     }
     /// The world point at the object's origin.
+    #[inline]
     pub fn origin(&self) -> Vec3<R> {
-        self.origin
+        let m = &self.to_world.m;
+        Vec3::new(m[0][3], m[1][3], m[2][3])
+    }
+    /// The world point of a hit found with [`Object::intersect`]: the object-space point put
+    /// on the surface ([`Shape::on_surface`]) and mapped through the placement. Its error is a
+    /// few units of the last place of the point and of the object's own size, wherever the ray
+    /// came from: `ray.at(t)` would carry the rounding of the ray's origin, which for an eye
+    /// 10^14 units away is more than a thin object is thick.
+    #[inline]
+    pub fn surface_point(&self, point: Vec3<R>, normal: Vec3<R>) -> Vec3<R> {
+        self.to_world.point(self.shape.on_surface(point, normal))
+    }
+    /// The largest side of the object's (padded) box: the size term of the offset of the
+    /// secondary rays that leave it ([`Real::offset`]).
+    #[inline]
+    pub fn size(&self) -> R {
+        self.bounds.extent()
     }
     /// The map from a world offset relative to [`Object::origin`] to object space (the
     /// inverse of the placement), without the scaling the stored copy carries for precision.

@@ -248,6 +248,10 @@ pub fn parse_number(tok: &str) -> Option<f64> {
         }
         exp10 += if eneg { -e } else { e };
     }
+    // Zero is zero whatever the exponent (`0e999` would otherwise be 0 * inf).
+    if mant == 0 {
+        return Some(if neg { -0.0 } else { 0.0 });
+    }
     // 10^|exp10| by squaring (exact up to 10^22), then one multiplication or division.
     let (mut p, mut base, mut k) = (1.0f64, 10.0f64, exp10.unsigned_abs());
     while k > 0 {
