@@ -33,11 +33,6 @@ fn gray<R: Real>(text: &str, frame: &Frame) -> Vec<u8> {
     gray_of(&Tracer::new(&scene, &lat), frame)
 }
 
-/// Share of pixels more than one gray level apart.
-fn share_off(a: &[u8], b: &[u8]) -> f64 {
-    a.iter().zip(b).filter(|(x, y)| x.abs_diff(**y) > 1).count() as f64 / a.len() as f64
-}
-
 /// A glass pane `thick` thick in front of a sphere on a floor.
 fn pane(thick: f64) -> String {
     format!(

@@ -29,11 +29,6 @@ fn gray<R: Real>(text: &str, accel: Accel, frame: &Frame) -> Vec<u8> {
     gray_of(&Tracer::new(&scene, a), frame)
 }
 
-/// Share of pixels more than one gray level (of 64) apart.
-fn share_off(a: &[u8], b: &[u8]) -> f64 {
-    a.iter().zip(b).filter(|(x, y)| x.abs_diff(**y) > 1).count() as f64 / a.len() as f64
-}
-
 /// The accuracy study's bound for `R` against f64: f32 0.05 % of pixels, fixed point 0.5 %.
 fn bound<R: Real>() -> f64 {
     match R::NAME {

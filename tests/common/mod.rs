@@ -111,3 +111,8 @@ pub fn gray_of<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, A>, fr
     render(t, frame, &mut target, &mut scratch.scratch(), &mut g).expect("render");
     g.0
 }
+
+/// Share of pixels more than one gray level (of 64) apart.
+pub fn share_off(a: &[u8], b: &[u8]) -> f64 {
+    a.iter().zip(b).filter(|(x, y)| x.abs_diff(**y) > 1).count() as f64 / a.len() as f64
+}
