@@ -157,7 +157,7 @@ mod writer {
     }
     impl<R: Literal> Literal for Camera<R> {
         fn literal(&self, out: &mut String) {
-            record(out, "Camera", &[("eye", &self.eye), ("forward", &self.forward), ("right", &self.right), ("up", &self.up)]);
+            record(out, "Camera", &[("eye", &self.eye), ("forward", &self.forward), ("right", &self.right), ("up", &self.up), ("resolves", &self.resolves)]);
         }
     }
     impl<R: Literal> Literal for SubLattice<R> {

@@ -13,7 +13,6 @@ use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
 use crate::outline::Apron;
 use crate::scalar::Real;
-use crate::math::Vec3;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
 use crate::scene::{Camera, Scene};
@@ -180,10 +179,8 @@ pub enum RenderError<E> {
     /// The angle between neighbouring pixels is below what the scalar resolves: the view is
     /// too narrow (a telephoto) for this scalar at this frame size.
     ViewTooNarrow {
-        /// The angle between neighbouring pixels (radians, the smaller of the two axes).
-        step: f64,
-        /// The smallest angle the scalar traces there.
-        smallest: f64,
+        /// The most pixels across and down the scalar resolves through the view.
+        most: [u32; 2],
         /// The scalar's name.
         scalar: &'static str,
     },
@@ -206,9 +203,10 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
             RenderError::BadShare => write!(f, "tile share out of range, or the frame carries state from tile to tile (error diffusion, edge sampling)"),
-            RenderError::ViewTooNarrow { step, smallest, scalar } => write!(
+            RenderError::ViewTooNarrow { most, scalar } => write!(
                 f,
-                "the view is too narrow for {scalar} at this size: neighbouring pixels are {step:.1e} radians apart, the smallest {scalar} traces is {smallest:.1e} (widen the field of view, render fewer pixels, or trace in f64)"
+                "the view is too narrow for {scalar} at this size: through it {scalar} resolves at most {}x{} pixels (widen the field of view, render fewer pixels, or trace in f64)",
+                most[0], most[1]
             ),
             RenderError::NotProgressive => write!(f, "progressive passes need tiles of a multiple of 8, one ray per pixel, a pass of 8, 4, 2 or 1 and room for the traced samples"),
         }
@@ -411,21 +409,13 @@ fn check<E>(frame: &Frame, share: Share) -> Result<(), RenderError<E>> {
     Ok(())
 }
 
-/// How many times the scalar's resolution the angle between neighbouring pixels must be: an
-/// eye ray's direction (and the eye itself, relative to its distance) is rounded to about one
-/// unit of the last place, so edges then move by at most 1/32 of a pixel.
-pub const VIEW_MARGIN: f64 = 32.0;
-
-/// Whether `R` resolves the angle between neighbouring pixels of `frame` through `camera`
-/// (whose `right` and `up` are scaled by the tangents of the half fields of view).
+/// Whether `R` resolves the angle between neighbouring pixels of `frame` through `camera`.
 fn resolves<R: Real, E>(camera: &Camera<R>, frame: &Frame) -> Result<(), RenderError<E>> {
-    let half = |v: Vec3<R>| v.cast::<f64>().length();
-    let step = (2.0 * half(camera.right) / f64::from(frame.width.max(1))).min(2.0 * half(camera.up) / f64::from(frame.height.max(1)));
-    let smallest = VIEW_MARGIN * R::RESOLUTION;
-    if step >= smallest {
+    let [w, h] = camera.resolves;
+    if u32::from(frame.width) <= w && u32::from(frame.height) <= h {
         Ok(())
     } else {
-        Err(RenderError::ViewTooNarrow { step, smallest, scalar: R::NAME })
+        Err(RenderError::ViewTooNarrow { most: camera.resolves, scalar: R::NAME })
     }
 }
 

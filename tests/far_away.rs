@@ -157,7 +157,7 @@ fn a_far_object_changes_nothing_in_fixed_point() {
 
 
 /// The far camera's distance in `R`, for a view about 7 units across at 128x64: up to where
-/// neighbouring pixels stay [`lattice_rt::render::VIEW_MARGIN`] units of the last place apart
+/// neighbouring pixels stay [`lattice_rt::scene::VIEW_MARGIN`] units of the last place apart
 /// (f64 about 9e12, f32 about 17,000).
 fn camera_range<R: Real>() -> (f64, f64) {
     match R::NAME {

@@ -117,7 +117,7 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Render(RenderError::EdgesNotCompiled) => defmt::write!(f, "edge sampling not compiled in"),
             AppError::Render(RenderError::BadShare) => defmt::write!(f, "bad tile share"),
             AppError::Render(RenderError::NotProgressive) => defmt::write!(f, "frame cannot be rendered progressively"),
-            AppError::Render(RenderError::ViewTooNarrow { .. }) => defmt::write!(f, "view too narrow for the scalar"),
+            AppError::Render(RenderError::ViewTooNarrow { most, .. }) => defmt::write!(f, "view too narrow for the scalar: at most {}x{} pixels", most[0], most[1]),
             AppError::Render(RenderError::ScratchTooSmall { needed }) => {
                 defmt::write!(f, "scratch storage too small: {} entries needed", needed)
             }

@@ -1,7 +1,7 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
+use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::Real;
 use crate::shape::Shape;
@@ -278,7 +278,13 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let tx = libm::tan(c.fov.0.to_radians_core() / 2.0);
         let ty = libm::tan(c.fov.1.to_radians_core() / 2.0);
         let camera =
-            Camera { eye: c.eye.cast(), forward: forward.cast(), right: (right * tx).cast(), up: (up * ty).cast() };
+            Camera {
+                eye: c.eye.cast(),
+                forward: forward.cast(),
+                right: (right * tx).cast(),
+                up: (up * ty).cast(),
+                resolves: [resolvable_pixels::<R>(tx), resolvable_pixels::<R>(ty)],
+            };
         let mut world = Aabb { min: camera.eye, max: camera.eye };
         for o in &self.storage[..self.len] {
             world = world.union(&o.bounds);

@@ -106,6 +106,26 @@ pub struct Camera<R> {
     pub right: Vec3<R>,
     /// Up vector scaled by `tan(fov_y / 2)`.
     pub up: Vec3<R>,
+    /// The most pixels across and down the scalar resolves through this view: neighbouring
+    /// pixels at least [`VIEW_MARGIN`] units of the scalar's last place apart (computed at
+    /// set-up, so the render checks a frame against it with integers).
+    pub resolves: [u32; 2],
+}
+
+/// How many times the scalar's resolution the angle between neighbouring pixels must be: an
+/// eye ray's direction (and the eye itself, relative to its distance) is rounded to about one
+/// unit of the last place, so edges then move by at most 1/32 of a pixel.
+pub const VIEW_MARGIN: f64 = 32.0;
+
+/// The most pixels a window side of half-width `tan_half` (the tangent of half the field of
+/// view) may be divided into in `R` (see [`Camera::resolves`]).
+pub fn resolvable_pixels<R: Real>(tan_half: f64) -> u32 {
+    let n = 2.0 * tan_half / (VIEW_MARGIN * R::RESOLUTION);
+    if n >= u32::MAX as f64 {
+        u32::MAX
+    } else {
+        n as u32
+    }
 }
 
 impl<R: Real> Camera<R> {
