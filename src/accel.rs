@@ -2,9 +2,11 @@
 //! method with its inside test. The lattice (in `lattice`) implements the same trait, so tests
 //! and benchmarks compare all three on the same rays.
 //!
-//! All accelerators share one rule for the nearest hit, [`offer`]: the smaller `t` wins and, at
-//! equal `t`, the smaller object index. Since every object test is exact for its interval, any
-//! accelerator that tests every object the ray can hit returns the brute-force answer bit for bit.
+//! All accelerators share one rule for the nearest hit, [`offer`]: the smaller `t` wins and, for
+//! hits within [`tie`] of each other (one point, up to rounding: the bottom of a glass box and
+//! the floor it stands on), the smaller object index. Since every object test is exact for its
+//! interval, any accelerator that tests every object the ray can hit up to the best hit's tie
+//! window returns the brute-force answer bit for bit.
 
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
@@ -22,6 +24,8 @@ pub struct Hit<R> {
     /// The point in object space, as the ray reached it ([`crate::Object::surface_point`] puts
     /// it on the surface and in the world).
     pub point: Vec3<R>,
+    /// How far beyond `t` another object's hit still counts as the same point ([`tie`]).
+    pub tie: R,
 }
 
 /// Kinds of rays counted by [`Stats`].
@@ -165,8 +169,24 @@ impl<'m> Query<'m> {
     }
 }
 
-/// Tests object `i` against `ray` on `(tmin, best.t or tmax]` and keeps the nearer hit (ties:
-/// the lower object index). Returns whether the object was hit at all in that range.
+/// How far apart two hits at about `p` may lie along a ray and still be one point: the offset a
+/// secondary ray takes there off a unit object ([`Real::offset`]). Faces of two objects that
+/// coincide (a glass box on a floor) meet within it, and which is hit then is decided by object
+/// index, not by how each scalar rounds, so f32, fixed point and f64 draw them alike.
+#[inline]
+pub fn tie<R: Real>(p: Vec3<R>) -> R {
+    R::offset(p.max_abs(), R::ONE)
+}
+
+/// The farthest `t` at which a hit can still win against `best` (its tie window), or `tmax`.
+#[inline]
+pub fn reach<R: Real>(best: &Option<Hit<R>>, tmax: R) -> R {
+    best.map_or(tmax, |b| (b.t + b.tie).min(tmax))
+}
+
+/// Tests object `i` against `ray` on `(tmin, reach]` ([`reach`]) and keeps the better hit: the
+/// nearer, or within [`tie`] of each other the lower object index. Returns whether the object
+/// was hit at all in that range.
 #[inline]
 pub fn offer<R: Real>(
     scene: &Scene<'_, R>,
@@ -177,7 +197,7 @@ pub fn offer<R: Real>(
     best: &mut Option<Hit<R>>,
     q: &mut Query<'_>,
 ) -> bool {
-    let limit = best.map_or(tmax, |b| b.t);
+    let limit = reach(best, tmax);
     let o = &scene.objects[i];
     let hit = match q.eye {
         Some(uv) => match o.intersect_eye_ray(ray, uv, tmin, limit) {
@@ -194,12 +214,14 @@ pub fn offer<R: Real>(
         Some(h) => {
             let t = h.t;
             q.last_hit = i as u32;
+            let tie = tie(ray.at(t));
             let better = match best {
-                Some(b) => t < b.t || (t == b.t && (i as u32) < b.object),
+                Some(b) if (t - b.t).abs() <= tie.max(b.tie) => (i as u32) < b.object,
+                Some(b) => t < b.t,
                 None => true,
             };
             if better {
-                *best = Some(Hit { t, object: i as u32, normal: h.normal, point: h.point });
+                *best = Some(Hit { t, object: i as u32, normal: h.normal, point: h.point, tie });
             }
             true
         }

@@ -109,10 +109,20 @@ fn matte(text: &str) -> String {
     text.replace("material glass\n", "material matte\n").replace("material mirror\n", "material matte\n")
 }
 
-/// With every material: the far object changes no pixel by more than a level. Matte: the picture
-/// in `R` is within the accuracy study's bound of f64's without the far object. (With mirrors
-/// and glass, f32 and fixed point drift from f64 on some of these scenes by more than that bound
-/// with or without a far object: chains of refraction amplify the scalar's own rounding.)
+/// The bound for any accepted scene against f64: at most 1 % of pixels more than a level
+/// off. With mirrors and glass f32 keeps the accuracy study's bound; fixed point's shading
+/// rounding takes it past 0.5 % on some of these scenes (0.83 % the most over 200 seeds).
+fn bound_with_glass<R: Real>() -> f64 {
+    match R::NAME {
+        "fixed" => 0.01,
+        _ => bound::<R>(),
+    }
+}
+
+/// With every material: the far object changes no pixel by more than a level, and the picture
+/// in `R` is within [`bound_with_glass`] of f64's (coincident faces, such as a glass box's bottom
+/// on the floor, are decided by object index, not rounding: `lattice_rt::accel::tie`). Matte:
+/// within the accuracy study's bound of f64's without the far object.
 fn far_object_changes_nothing<R: Real>() {
     let frame = Frame::new(128, 64);
     let (lo, hi) = far_range::<R>();
@@ -124,6 +134,8 @@ fn far_object_changes_nothing<R: Real>() {
         let dist = log_uniform(&mut rng, lo, hi);
         let far = far_object(&mut rng, dist);
         let (alone, dull) = (gray::<R>(&near, Accel::Lattice, &frame), gray::<f64>(&matte(&near), Accel::Lattice, &frame));
+        let off = share_off(&alone, &gray::<f64>(&near, Accel::Lattice, &frame));
+        assert!(off <= bound_with_glass::<R>(), "seed {seed}, {}: {:.2} % of pixels more than one level off f64\n{near}", R::NAME, off * 100.0);
         for accel in ACCELS {
             let with_far = format!("{near}{far}");
             let off = share_off(&gray::<R>(&with_far, accel, &frame), &alone);

@@ -2,7 +2,7 @@
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
 use super::{index, locate, Lattice, SubLattice, MAX_NESTING};
-use crate::accel::{offer, Hit, Query};
+use crate::accel::{offer, reach, Hit, Query};
 use crate::math::Ray;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -47,7 +47,7 @@ impl<R: Real> Lattice<'_, R> {
                     }
                     Err(composite) => {
                         let g = composite + 1;
-                        let limit = best.map_or(tmax, |b| b.t);
+                        let limit = reach(&best, tmax);
                         if depth < MAX_NESTING && q.first_visit(self.objects + composite) {
                             if let Some((a, b)) = self.lattices[g].bounds.clip(ray, tmin, limit) {
                                 stack[depth] = Some(Walker::start(self, g, ray, &inv, a, b));
@@ -59,8 +59,8 @@ impl<R: Real> Lattice<'_, R> {
                 }
                 continue;
             }
-            // The cell is done: stop if the best hit lies before its exit, else step.
-            let done = best.is_some_and(|b| b.t < w.exit());
+            // The cell is done: stop if the best hit's tie window ends before its exit, else step.
+            let done = best.is_some() && reach(&best, tmax) < w.exit();
             if done || !w.advance(self, ray, &inv) {
                 depth -= 1;
             } else {
