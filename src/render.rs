@@ -121,6 +121,22 @@ impl Frame {
         Ditherer::rows_len(self.dither, w) + Sampler::rows_len(self.sampling, self.dither.block(), w)
     }
 
+    /// Entries of `i16` scratch storage [`trace_share`] needs: [`Frame::scratch_len`] without
+    /// the dither's carries (the levels are dithered later, by [`dither_band`]).
+    pub fn trace_scratch_len(&self) -> usize {
+        self.scratch_len() - Ditherer::rows_len(self.dither, self.width as usize)
+    }
+
+    /// Entries of level storage [`trace_share`] needs for `share` in the frame's band of tile
+    /// rows: one per pixel of each of its tiles (whole tiles, `tile * tile` each).
+    pub const fn levels_len(&self, share: Share) -> usize {
+        let t = if self.tile == 0 { 1 } else { self.tile as usize };
+        let (tiles_x, tiles_y) = ((self.width as usize).div_ceil(t), (self.height as usize).div_ceil(t));
+        let end = if (self.rows.1 as usize) < tiles_y { self.rows.1 as usize } else { tiles_y };
+        let first = if (self.rows.0 as usize) < end { self.rows.0 as usize } else { end };
+        share.tiles_in(tiles_x, (first, end)) * t * t
+    }
+
     /// Whether the frame can be rendered progressively ([`render_pass`]): its tiles are a
     /// multiple of 8 pixels (whole 8x8 blocks) and its dither shows one ray per pixel.
     pub fn progressive(&self) -> bool {
@@ -242,7 +258,76 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
-    render_tiles(tracer, frame, share, None, target, scratch, hooks)
+    render_tiles(tracer, frame, share, None, Out::Draw(target), scratch, hooks)
+}
+
+/// The first half of a frame rendered **trace, then dither**: the gray levels of one share's
+/// tiles in the frame's band of tile rows (tone curve and silhouette lines applied), kept in
+/// `levels` for [`dither_band`] instead of dithered and drawn. Tile `k` of the share in the
+/// band (in the order the render visits them) is at `k * tile * tile`, row-major; `levels`
+/// holds at least [`Frame::levels_len`] entries. Unlike [`render_share`], frames whose
+/// dithering carries error from tile to tile (Floyd-Steinberg, Atkinson) can be traced in
+/// shares this way: the cores trace, and one dithers the finished bands in order.
+///
+/// `scratch` needs [`Frame::trace_scratch_len`] rows (no dither carries).
+pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
+    tracer: &Tracer<'_, '_, R, A, E>,
+    frame: &Frame,
+    share: Share,
+    levels: &mut [u8],
+    scratch: &mut Scratch<'_>,
+    hooks: &mut impl Hooks,
+) -> Result<Stats, RenderError<core::convert::Infallible>> {
+    if levels.len() < frame.levels_len(share) {
+        return Err(RenderError::ScratchTooSmall { needed: frame.levels_len(share) });
+    }
+    render_tiles::<_, _, Nowhere, E>(tracer, frame, share, None, Out::Keep(levels), scratch, hooks)
+}
+
+/// The second half of trace, then dither ([`trace_share`]): dithers tile row `ty` of `frame`
+/// from the levels its shares kept (`kept[s]`: share `s` of `kept.len()`, this band's tiles
+/// only) and draws it into `target`, tile by tile in the order [`render`] draws them, so bands
+/// dithered in order give [`render`]'s frame bit for bit. `ditherer` carries error between
+/// bands: make it once per frame ([`Ditherer::new`] over [`Ditherer::rows_len`] entries).
+pub fn dither_band<D: DrawTarget<Color = BinaryColor>>(frame: &Frame, ty: usize, kept: &[&[u8]], ditherer: &mut Ditherer<'_>, target: &mut D) -> Result<(), D::Error> {
+    let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
+    let of = kept.len().max(1);
+    let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
+    ditherer.next_band();
+    for tx in 0..w.div_ceil(t) {
+        // Share s holds the tiles tx = s - ty (mod of) of this row: this is its (tx / of)-th.
+        let (s, k) = ((tx + ty) % of, tx / of);
+        let (x0, y0) = (tx * t, ty * t);
+        let (tw, th) = (t.min(w - x0), t.min(h - y0));
+        let Some(levels) = kept.get(s).and_then(|l| l.get(k * t * t..k * t * t + tw * th)) else { break };
+        ditherer.tile(x0, y0, tw, th, levels, &mut bits);
+        let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
+        target.fill_contiguous(&area, bits[..tw * th].iter().copied())?;
+    }
+    Ok(())
+}
+
+/// Where the tile loop puts a finished tile: dithered and drawn, or kept as gray levels.
+enum Out<'o, D> {
+    Draw(&'o mut D),
+    Keep(&'o mut [u8]),
+}
+
+/// The draw target of a render that draws nothing ([`trace_share`]).
+struct Nowhere;
+
+impl embedded_graphics_core::geometry::OriginDimensions for Nowhere {
+    fn size(&self) -> Size {
+        Size::zero()
+    }
+}
+
+impl DrawTarget for Nowhere {
+    type Color = BinaryColor;
+    type Error = core::convert::Infallible;
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics_core::Pixel<BinaryColor>>>(&mut self, _: I) -> Result<(), Self::Error> {
+        Ok(())
+    }
 }
 
 /// What a progressive render keeps of one ray it traced on the 2x2 grid: its gray level and
@@ -278,7 +363,7 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
     if !frame.progressive() || ![8, 4, 2, 1].contains(&pass) || traced.len() < frame.traced_len(share) {
         return Err(RenderError::NotProgressive);
     }
-    render_tiles(tracer, frame, share, Some((pass, traced)), target, scratch, hooks)
+    render_tiles(tracer, frame, share, Some((pass, traced)), Out::Draw(target), scratch, hooks)
 }
 
 /// The tile loop of [`render_share`] and [`render_pass`].
@@ -287,18 +372,22 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     frame: &Frame,
     share: Share,
     mut pass: Option<(u8, &mut [Traced])>,
-    target: &mut D,
+    mut out: Out<'_, D>,
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<D::Error>> {
-    check(frame, share)?;
+    let keep = matches!(out, Out::Keep(_));
+    check(frame, share, !keep)?;
     resolves(tracer.scene().camera(), frame)?;
     let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let too_small = || RenderError::ScratchTooSmall { needed: frame.scratch_len() };
-    let rows = scratch.rows.get_mut(..frame.scratch_len()).ok_or_else(too_small)?;
-    let (carries, above) = rows.split_at_mut(Ditherer::rows_len(frame.dither, w));
-    let mut dither = Ditherer::new(frame.dither, w, carries).ok_or_else(too_small)?;
+    // Kept levels are dithered later: the trace needs no carries.
+    let needed = if keep { frame.trace_scratch_len() } else { frame.scratch_len() };
+    let too_small = || RenderError::ScratchTooSmall { needed };
+    let rows = scratch.rows.get_mut(..needed).ok_or_else(too_small)?;
+    let (carries, above) = rows.split_at_mut(needed - Sampler::rows_len(frame.sampling, frame.dither.block(), w));
+    // (Kept levels are not dithered here: an ordered mode stands in, which needs no storage.)
+    let mut dither = Ditherer::new(if keep { Dither::Bayer } else { frame.dither }, w, carries).ok_or_else(too_small)?;
     let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
     // The outline is drawn on finished frames: a progressive frame's last pass, not its previews.
     let outline = frame.outline && pass.as_ref().is_none_or(|(n, _)| *n == 1);
@@ -321,6 +410,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut hits = Hits::new();
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
+    let mut kept = 0;
     for ty in first..end {
         dither.next_band();
         sampler.next_band();
@@ -359,9 +449,17 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 };
                 outline_tile(Block { x0, y0, tw, th, t }, &mut probe, &hits, &mut levels[..tw * th]);
             }
-            dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
-            let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
-            target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
+            match &mut out {
+                Out::Keep(store) => {
+                    store[kept..kept + tw * th].copy_from_slice(&levels[..tw * th]);
+                    kept += t * t;
+                }
+                Out::Draw(target) => {
+                    dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
+                    let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
+                    target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
+                }
+            }
             done += 1;
             if !hooks.progress(done, total) {
                 return Err(RenderError::Cancelled);
@@ -394,8 +492,9 @@ fn pass_tile<R: Real>(n: u8, sampler: &mut Sampler<'_>, at: Block, kept: &mut [T
 }
 
 /// Whether `frame` can be rendered in `share`: its tile a multiple of its dither's block and at
-/// most [`MAX_TILE`], its sampling compiled in, and the share one of its independent bands.
-fn check<E>(frame: &Frame, share: Share) -> Result<(), RenderError<E>> {
+/// most [`MAX_TILE`], its sampling compiled in, and the share one of its independent bands
+/// (when it is `dithered` here; kept levels only need independent tracing).
+fn check<E>(frame: &Frame, share: Share, dithered: bool) -> Result<(), RenderError<E>> {
     let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
     if t == 0 || t > MAX_TILE || !t.is_multiple_of(block) {
         return Err(RenderError::BadTile);
@@ -403,7 +502,8 @@ fn check<E>(frame: &Frame, share: Share) -> Result<(), RenderError<E>> {
     if frame.edges() && !cfg!(feature = "edge-sampling") {
         return Err(RenderError::EdgesNotCompiled);
     }
-    if !share.valid() || (share.of > 1 && !frame.bands_independent()) {
+    let independent = if dithered { frame.bands_independent() } else { !frame.edges() };
+    if !share.valid() || (share.of > 1 && !independent) {
         return Err(RenderError::BadShare);
     }
     Ok(())

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, render, render_share, BitFrame, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
+use lattice_rt::{dither_band, parse, render, render_share, trace_share, BitFrame, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
 
 /// Renders `name` into a fresh 1-bit frame for each frame in `frames`, all into one bitmap.
 fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
@@ -119,4 +119,54 @@ fn shares_count_their_tiles_as_the_checkerboard_holds_them() {
     assert_eq!(frame.traced_len(Share { index: 0, of: 2 }), 64 * 16);
     assert_eq!(frame.traced_len(Share { index: 1, of: 2 }), 64 * 16);
     assert_eq!(frame.traced_len(Share::ALL), 128 * 16);
+}
+
+/// Trace, then dither: shares trace a frame's bands into kept levels (`trace_share`), and the
+/// bands dithered in order (`dither_band`) are the frame `render` draws, bit for bit, with
+/// error diffusion too (which cannot be shared out any other way).
+fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
+    let text = scene_text(name);
+    let mut storage = vec![Object::<R>::default(); 64];
+    let scene = parse::<R>(&text, &mut storage).unwrap();
+    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
+    let tracer = Tracer::new(&scene, &lat);
+    let (w, h) = (frame.width as u32, frame.height as u32);
+    let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+    let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+    let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
+    let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
+    let bands = (h as usize).div_ceil(frame.tile as usize) as u16;
+    for ty in 0..bands {
+        let band = Frame { rows: (ty, ty + 1), ..frame };
+        let kept: Vec<Vec<u8>> = (0..of)
+            .map(|index| {
+                let share = Share { index, of };
+                let mut levels = vec![0u8; band.levels_len(share)];
+                let mut scratch = HeapScratch::new(&scene, &band);
+                trace_share(&tracer, &band, share, &mut levels, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                levels
+            })
+            .collect();
+        let kept: Vec<&[u8]> = kept.iter().map(|l| &l[..]).collect();
+        dither_band(&frame, ty as usize, &kept, &mut ditherer, &mut target).unwrap();
+    }
+    bits
+}
+
+#[test]
+fn traced_shares_dithered_in_order_give_the_whole_frame() {
+    for name in ["chair", "desk", "whitted"] {
+        for dither in [Dither::FloydSteinberg, Dither::Atkinson, Dither::BlueNoise] {
+            for (width, height) in [(128, 64), (100, 60)] {
+                let frame = Frame { dither, outline: true, sampling: Sampling::Adaptive { contrast: 4 }, ..Frame::new(width, height) };
+                let (whole, _) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
+                for of in [1, 2, 3] {
+                    assert_eq!(whole, traced_then_dithered::<Fx>(name, frame, of), "{name}, {dither:?}, {width}x{height}, {of} shares");
+                }
+            }
+        }
+    }
+    let frame = Frame { dither: Dither::FloydSteinberg, outline: true, ..Frame::new(128, 64) };
+    assert_eq!(render_into::<f32>("spheres", &[(frame, Share::ALL)], true).0, traced_then_dithered::<f32>("spheres", frame, 2), "f32");
 }
