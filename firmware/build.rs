@@ -125,7 +125,9 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&st
     let scene = lattice_rt::parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let effects = lattice_rt::Effects::of(&scene).bits();
     let cfg = LatticeConfig::default();
-    let sizes = Sizes::of(&scene, Some(&cfg), &frame::FRAME);
+    // The frame this build renders, from its features (as `app::RENDERED` has it).
+    let has = |f: &str| env::var_os(format!("CARGO_FEATURE_{}", f.to_uppercase().replace('-', "_"))).is_some();
+    let sizes = Sizes::of(&scene, Some(&cfg), &frame::rendered(frame::Build::of(has)));
     if let Some((name, out)) = bake {
         let s = Lattice::plan(&scene, &cfg);
         let (mut lattices, mut coords, mut words) = (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);

@@ -42,7 +42,7 @@ impl Dither {
         }
     }
     /// Whether the mode needs carry buffers.
-    pub fn diffuses(&self) -> bool {
+    pub const fn diffuses(&self) -> bool {
         matches!(self, Dither::FloydSteinberg | Dither::Atkinson)
     }
 }

@@ -87,6 +87,14 @@ impl Share {
         n
     }
 
+    /// The share that holds tile `tx` alone of tile row `ty`, in a frame `tiles_x` tiles wide
+    /// (at most 255): [`trace_share`] of one band with it traces that one tile, so cores can
+    /// take tiles one at a time, as they come free.
+    pub const fn single(tx: usize, ty: usize, tiles_x: usize) -> Share {
+        let of = if tiles_x == 0 { 1 } else { tiles_x };
+        Share { index: ((tx + ty) % of) as u8, of: of as u8 }
+    }
+
     fn valid(self) -> bool {
         self.index < self.of
     }
@@ -206,6 +214,23 @@ pub enum RenderError<E> {
     NotProgressive,
 }
 
+impl RenderError<core::convert::Infallible> {
+    /// The same error for a render that draws into a target failing with `E` (a render that
+    /// draws nothing, [`trace_share`], cannot fail to draw).
+    pub fn widen<E>(self) -> RenderError<E> {
+        match self {
+            RenderError::Draw(never) => match never {},
+            RenderError::Cancelled => RenderError::Cancelled,
+            RenderError::BadTile => RenderError::BadTile,
+            RenderError::EdgesNotCompiled => RenderError::EdgesNotCompiled,
+            RenderError::ScratchTooSmall { needed } => RenderError::ScratchTooSmall { needed },
+            RenderError::BadShare => RenderError::BadShare,
+            RenderError::ViewTooNarrow { most, scalar } => RenderError::ViewTooNarrow { most, scalar },
+            RenderError::NotProgressive => RenderError::NotProgressive,
+        }
+    }
+}
+
 impl<E: fmt::Debug> fmt::Display for RenderError<E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -285,21 +310,19 @@ pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 }
 
 /// The second half of trace, then dither ([`trace_share`]): dithers tile row `ty` of `frame`
-/// from the levels its shares kept (`kept[s]`: share `s` of `kept.len()`, this band's tiles
-/// only) and draws it into `target`, tile by tile in the order [`render`] draws them, so bands
-/// dithered in order give [`render`]'s frame bit for bit. `ditherer` carries error between
-/// bands: make it once per frame ([`Ditherer::new`] over [`Ditherer::rows_len`] entries).
-pub fn dither_band<D: DrawTarget<Color = BinaryColor>>(frame: &Frame, ty: usize, kept: &[&[u8]], ditherer: &mut Ditherer<'_>, target: &mut D) -> Result<(), D::Error> {
+/// from the kept levels of its tiles (`tile(tx)`: tile `tx` of the row, `tile * tile` entries,
+/// row-major) and draws it into `target`, tile by tile in the order [`render`] draws them, so
+/// bands dithered in order give [`render`]'s frame bit for bit. The first tile `tile` has no levels for
+/// ends the band there. `ditherer` carries error between bands: make it once per frame
+/// ([`Ditherer::new`] over [`Ditherer::rows_len`] entries).
+pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(frame: &Frame, ty: usize, tile: impl Fn(usize) -> Option<&'l [u8]>, ditherer: &mut Ditherer<'_>, target: &mut D) -> Result<(), D::Error> {
     let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
-    let of = kept.len().max(1);
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     ditherer.next_band();
     for tx in 0..w.div_ceil(t) {
-        // Share s holds the tiles tx = s - ty (mod of) of this row: this is its (tx / of)-th.
-        let (s, k) = ((tx + ty) % of, tx / of);
         let (x0, y0) = (tx * t, ty * t);
         let (tw, th) = (t.min(w - x0), t.min(h - y0));
-        let Some(levels) = kept.get(s).and_then(|l| l.get(k * t * t..k * t * t + tw * th)) else { break };
+        let Some(levels) = tile(tx).and_then(|l| l.get(..tw * th)) else { break };
         ditherer.tile(x0, y0, tw, th, levels, &mut bits);
         let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
         target.fill_contiguous(&area, bits[..tw * th].iter().copied())?;

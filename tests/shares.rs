@@ -148,8 +148,10 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
                 levels
             })
             .collect();
-        let kept: Vec<&[u8]> = kept.iter().map(|l| &l[..]).collect();
-        dither_band(&frame, ty as usize, &kept, &mut ditherer, &mut target).unwrap();
+        // Share s holds the tiles tx = s - ty (mod of) of this row: tile tx is its (tx / of)-th.
+        let t = frame.tile as usize * frame.tile as usize;
+        let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize * t..);
+        dither_band(&frame, ty as usize, tile, &mut ditherer, &mut target).unwrap();
     }
     bits
 }
@@ -161,9 +163,11 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
             for (width, height) in [(128, 64), (100, 60)] {
                 let frame = Frame { dither, outline: true, sampling: Sampling::Adaptive { contrast: 4 }, ..Frame::new(width, height) };
                 let (whole, _) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
-                for of in [1, 2, 3] {
+                // 1 to 3 shares, and one tile at a time (`Share::single`: as many shares as tiles across).
+                for of in [1, 2, 3, (width as usize).div_ceil(8) as u8] {
                     assert_eq!(whole, traced_then_dithered::<Fx>(name, frame, of), "{name}, {dither:?}, {width}x{height}, {of} shares");
                 }
+                assert_eq!(Share::single(5, 3, 16), Share { index: 8, of: 16 });
             }
         }
     }

@@ -14,17 +14,31 @@ use lattice_rt::render::{Hooks, RenderError};
 #[cfg(not(feature = "baked"))]
 use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
-use lattice_rt::{render_pass, render_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
+use lattice_rt::dither::{Carry, Ditherer};
+use lattice_rt::{dither_band, render_pass, render_share, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 
-pub use board_records::frame::{Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
+pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
-/// The frame the firmware renders: [`FRAME`], with one eye ray per pixel under the
-/// `exact-sampling` feature and silhouette lines under the `outline` feature.
-pub const RENDERED: lattice_rt::Frame = lattice_rt::Frame {
-    sampling: if cfg!(feature = "exact-sampling") { lattice_rt::Sampling::Center } else { FRAME.sampling },
-    outline: cfg!(feature = "outline"),
-    ..FRAME
+/// What this build asks of its frame (its features; `board_records::frame::Build::of` reads
+/// the same names for build.rs and the checks).
+pub const BUILD: Build = Build {
+    panel: cfg!(feature = "rp"),
+    orbit: cfg!(feature = "orbit"),
+    progressive: cfg!(feature = "progressive"),
+    lines: if cfg!(feature = "outline") {
+        Some(true)
+    } else if cfg!(feature = "no-outline") {
+        Some(false)
+    } else {
+        None
+    },
+    exact_sampling: cfg!(feature = "exact-sampling"),
 };
+
+/// The frame the firmware renders ([`rendered`]): on the Raspberry Pi boards' panel a still in
+/// Floyd-Steinberg with silhouette lines, orbit and progressive frames in blue noise with lines;
+/// elsewhere [`FRAME`].
+pub const RENDERED: lattice_rt::Frame = rendered(BUILD);
 
 /// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).
 #[cfg(feature = "scalar-fixed")]
@@ -226,12 +240,33 @@ const fn second(n: usize) -> usize {
     }
 }
 
+/// Whether a two-core board renders trace, then dither ([`trace_then_dither`]): its frame's
+/// dithering carries error from tile to tile, so the cores cannot each draw their own tiles.
+const TRACE_THEN_DITHER: bool = SECOND_CORE && RENDERED.dither.diffuses();
+/// Entries of [`ShareMemory`]'s arrays when [`TRACE_THEN_DITHER`] (else none).
+const fn dithered(n: usize) -> usize {
+    if TRACE_THEN_DITHER {
+        n
+    } else {
+        0
+    }
+}
+/// Tiles across the frame.
+const TILES_X: usize = (WIDTH as usize).div_ceil(FRAME.tile as usize);
+/// Tiles of the frame.
+const TILES: usize = TILES_X * (HEIGHT as usize).div_ceil(FRAME.tile as usize);
+/// Gray levels a tile keeps between its trace and its dithering.
+const TILE_LEVELS: usize = FRAME.tile as usize * FRAME.tile as usize;
+
 /// The memory of the second tile share: on a board with two cores its own query scratch; and
-/// the rays both shares keep between progressive passes ([`TRACED`] each).
+/// the rays both shares keep between progressive passes ([`TRACED`] each). Where the two cores
+/// trace, then dither: every tile's gray levels (8 KiB) and the dither's carries.
 pub struct ShareMemory {
     mailbox: [u32; second(MAX_OBJECTS + MAX_LATTICES)],
     rows: [i16; second(MAX_ROWS)],
     traced: [[Traced; TRACED]; 2],
+    levels: [[u8; TILE_LEVELS]; dithered(TILES)],
+    carries: [i16; dithered(Carry::len(WIDTH as usize))],
 }
 
 impl ShareMemory {
@@ -242,6 +277,8 @@ impl ShareMemory {
             mailbox: [0; second(MAX_OBJECTS + MAX_LATTICES)],
             rows: [0; second(MAX_ROWS)],
             traced: [[NONE; TRACED]; 2],
+            levels: [[0; TILE_LEVELS]; dithered(TILES)],
+            carries: [0; dithered(Carry::len(WIDTH as usize))],
         }
     }
 }
@@ -336,10 +373,17 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
     let Board { cores, second, now, shown } = board;
-    let ShareMemory { mailbox, rows, traced } = second;
+    let ShareMemory { mailbox, rows, traced, levels, carries } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
+    if TRACE_THEN_DITHER {
+        let memory = DitherMemory { mailbox, rows, levels, carries };
+        let here = (&mut scratch, hooks, now);
+        let (stats, [there_us, here_us]) = trace_then_dither(tracer, pick(&tuned), cores, memory, here, target)?;
+        shown(0);
+        return Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [here_us, there_us] });
+    }
     for &pass in PASSES {
         if !SECOND_CORE {
             // One core: both shares straight to the display, one after the other.
@@ -377,6 +421,124 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
         shown(pass);
     }
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
+}
+
+/// Where [`trace_then_dither`] works: core 1's query scratch, every tile's levels and the
+/// dither's carries.
+struct DitherMemory<'m> {
+    mailbox: &'m mut [u32],
+    rows: &'m mut [i16],
+    levels: &'m mut [[u8; TILE_LEVELS]],
+    carries: &'m mut [i16],
+}
+
+/// The tiles of a frame traced, then dithered, as both cores see them: each tile's levels are
+/// free (to be traced), then done (to be dithered); `next` is the next tile to take, in raster
+/// order, so the bands finish in order.
+struct TileBoard<'l> {
+    free: [Option<&'l mut [u8; TILE_LEVELS]>; TILES],
+    done: [Option<&'l mut [u8; TILE_LEVELS]>; TILES],
+    next: usize,
+}
+
+/// Traces one tile of a frame: the band it is in, the share that holds it alone, its levels.
+type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, Frame, Share, &mut [u8]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
+
+/// A frame on two cores, trace then dither: the cores take the frame's tiles one at a time as
+/// they come free (`Share::single`), in raster order, and trace each into its levels
+/// (`trace_share`); core 0, between its tiles, dithers each band whose tiles are all traced,
+/// in order (`dither_band`), and sends it to `target`. Neither core waits for the other but at
+/// the frame's end, and core 0's time on the bus is made up by core 1 taking more tiles. The
+/// frame is bit for bit what `render` draws, error diffusion included. Returns both cores'
+/// statistics and their times, core 1's first.
+fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+    tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
+    frame: &Frame,
+    cores: &mut impl Cores,
+    memory: DitherMemory<'_>,
+    (scratch, hooks, now): (&mut lattice_rt::Scratch<'_>, &mut impl Hooks, &(dyn Fn() -> u64 + Sync)),
+    target: &mut D,
+) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
+    let DitherMemory { mailbox, rows, levels, carries } = memory;
+    let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
+    let tiles_x = w.div_ceil(t).min(TILES_X);
+    let tiles = (tiles_x * h.div_ceil(t)).min(TILES).min(levels.len());
+    let mut board = TileBoard { free: [const { None }; TILES], done: [const { None }; TILES], next: 0 };
+    for (slot, l) in board.free.iter_mut().zip(levels.iter_mut()).take(tiles) {
+        *slot = Some(l);
+    }
+    let board = critical_section::Mutex::new(core::cell::RefCell::new(board));
+    // Takes the next free tile, traces it and marks it done (handed over even when the trace
+    // failed, so no core waits for it); None once every tile is taken.
+    let take = |scratch: &mut lattice_rt::Scratch<'_>, trace: &mut TraceTile<'_>| {
+        let (k, l) = critical_section::with(|cs| {
+            let mut b = board.borrow(cs).borrow_mut();
+            let k = b.next;
+            b.next += 1;
+            b.free.get_mut(k).and_then(Option::take).map(|l| (k, l))
+        })?;
+        let (tx, ty) = (k % tiles_x, k / tiles_x);
+        let band = Frame { rows: (ty as u16, ty as u16 + 1), ..*frame };
+        let traced = trace(scratch, band, Share::single(tx, ty, tiles_x), &mut l[..]);
+        critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some(l));
+        Some(traced)
+    };
+    let mut ditherer = Ditherer::new(frame.dither, w, carries).ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
+    let mut there = (Stats::default(), None, 0);
+    let mut here: (Stats, Result<(), AppError<'t, D::Error>>, u64) = (Stats::default(), Ok(()), 0);
+    cores.join(
+        &mut || {
+            let t0 = now();
+            let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [u8]| trace_share(tracer, &band, share, l, scratch, &mut lattice_rt::NoHooks);
+            while let Some(traced) = take(&mut scratch, &mut trace) {
+                match traced {
+                    Ok(s) => there.0.add(&s),
+                    Err(e) => there.1 = there.1.or(Some(e)),
+                }
+            }
+            there.2 = now() - t0;
+        },
+        &mut || {
+            let t0 = now();
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [u8]| trace_share(tracer, &band, share, l, scratch, hooks);
+            let mut band = 0;
+            here.1 = (|| {
+                while band * tiles_x < tiles {
+                    // Every band whose tiles are all traced, in order, dithered and sent.
+                    let ready = critical_section::with(|cs| {
+                        let mut b = board.borrow(cs).borrow_mut();
+                        let row = &mut b.done[band * tiles_x..(band + 1) * tiles_x];
+                        if row.iter().all(Option::is_some) {
+                            let mut out: [Option<&mut [u8; TILE_LEVELS]>; TILES_X] = [const { None }; TILES_X];
+                            out.iter_mut().zip(row.iter_mut()).for_each(|(o, r)| *o = r.take());
+                            Some(out)
+                        } else {
+                            None
+                        }
+                    });
+                    if let Some(row) = ready {
+                        let tile = |tx: usize| row.get(tx).and_then(|l| l.as_deref()).map(|l| &l[..]);
+                        dither_band(frame, band, tile, &mut ditherer, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
+                        band += 1;
+                        continue;
+                    }
+                    match take(scratch, &mut trace) {
+                        Some(traced) => here.0.add(&traced.map_err(|e| AppError::Render(e.widen()))?),
+                        None => core::hint::spin_loop(),
+                    }
+                }
+                Ok(())
+            })();
+            here.2 = now() - t0;
+        },
+    );
+    here.1?;
+    if let Some(e) = there.1 {
+        return Err(AppError::Render(e.widen()));
+    }
+    here.0.add(&there.0);
+    Ok((here.0, [there.2, here.2]))
 }
 
 /// One share of a frame: pass `pass` of a progressive frame (`render_pass`), or, in a build

@@ -57,14 +57,14 @@ pub fn gif_bytes(frames: &[Vec<u8>], w: u16, h: u16) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// `host-sim orbit SCENE -o OUT.gif`: `frames` frames of the boards' frame (128x64, their
-/// sampling and dither) in fixed point, as a Pico shows them.
+/// `host-sim orbit SCENE -o OUT.gif`: `frames` frames of the Pico's orbit mode (128x64, its
+/// sampling, blue noise with silhouette lines) in fixed point, as a Pico shows them.
 pub fn orbit_cmd(scene: &Path, out: &Path, frames: u32) -> Result<()> {
     if frames == 0 || frames > 3600 {
         bail!("--frames must be from 1 to 3600");
     }
     let text = read(scene)?;
-    let frame = board_frame::FRAME;
+    let frame = board_frame::rendered(board_frame::Build { orbit: true, ..board_frame::PICO });
     let bits = orbit_frames::<lattice_rt::Fx>(scene, &text, frames, &frame)?;
     write_atomic(out, &gif_bytes(&bits, frame.width, frame.height)?)?;
     println!("wrote {} ({frames} frames at {FPS} fps, {}x{}, as the Pico renders them)", out.display(), frame.width, frame.height);

@@ -15,11 +15,10 @@ pub const HEIGHT: u16 = 64;
 /// (`app::RENDERED`).
 pub const SAMPLING: Sampling = Sampling::Adaptive { contrast: 4 };
 
-/// The frame every board renders: 128x64, 8x8 tiles (one SSD1306 page high), blue-noise
-/// ordered dither: of the dithers whose tiles the two cores can share out, the one that scores
-/// best in `cargo xtask display` (docs/display.md; error diffusion scores higher but carries error
-/// from tile to tile, so one core would have to render every tile). No silhouette lines: they
-/// cost about a fifth more cycles (the firmware's `outline` feature draws them).
+/// The frame of the boards without a panel (the QEMU machines and the micro:bit, whose frames
+/// only CI looks at): 128x64, 8x8 tiles (one SSD1306 page high), blue-noise ordered dither, no
+/// silhouette lines. It carries nothing from tile to tile and needs no dither carries (1 KiB of
+/// RAM the baked micro:bit builds keep). The `outline` feature adds the lines.
 pub const FRAME: Frame = Frame {
     width: WIDTH,
     height: HEIGHT,
@@ -30,6 +29,63 @@ pub const FRAME: Frame = Frame {
     tone: Tone::LINEAR,
     outline: false,
 };
+
+/// The dither of a still frame on a panel: Floyd-Steinberg error diffusion, which with lines
+/// scores best of every dither in `cargo xtask display` (docs/display.md). Two cores trace each
+/// band of tiles and one dithers the finished bands in order (`lattice_rt::trace_share`,
+/// `dither_band`), so error diffusion costs the boards no second core.
+pub const STILL_DITHER: Dither = Dither::FloydSteinberg;
+
+/// The dither of frames in motion (orbit mode, and the progressive frames' passes): blue noise,
+/// which flickers least from frame to frame in `cargo xtask motion` (docs/motion.md).
+pub const MOTION_DITHER: Dither = Dither::BlueNoise;
+
+/// What a firmware build asks of its frame: its features.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Build {
+    /// The board shows its frames to a person on a panel (the Raspberry Pi boards' SSD1306).
+    pub panel: bool,
+    /// Orbit mode (`orbit`): frames in motion.
+    pub orbit: bool,
+    /// Progressive frames (`progressive`): passes in motion.
+    pub progressive: bool,
+    /// Silhouette lines forced on (`outline`) or off (`no-outline`); `None`: on a panel, off
+    /// elsewhere.
+    pub lines: Option<bool>,
+    /// One eye ray per pixel (`exact-sampling`).
+    pub exact_sampling: bool,
+}
+
+impl Build {
+    /// The build of a firmware whose Cargo features `has` answers for by name (`rp` is a
+    /// panel).
+    pub fn of(has: impl Fn(&str) -> bool) -> Build {
+        let lines = if has("outline") {
+            Some(true)
+        } else if has("no-outline") {
+            Some(false)
+        } else {
+            None
+        };
+        Build { panel: has("rp"), orbit: has("orbit"), progressive: has("progressive"), lines, exact_sampling: has("exact-sampling") }
+    }
+}
+
+/// The frame a build renders. On a panel: stills in [`STILL_DITHER`], frames in motion in
+/// [`MOTION_DITHER`], both with silhouette lines, without which the chair's legs and seat vanish
+/// into a floor of the same gray. Without a panel: [`FRAME`].
+pub const fn rendered(b: Build) -> Frame {
+    let dither = if b.panel && !b.orbit && !b.progressive { STILL_DITHER } else { MOTION_DITHER };
+    let outline = match b.lines {
+        Some(on) => on,
+        None => b.panel,
+    };
+    let sampling = if b.exact_sampling { Sampling::Center } else { SAMPLING };
+    Frame { dither, outline, sampling, ..FRAME }
+}
+
+/// The Raspberry Pi Pico's default image: a still frame on a panel.
+pub const PICO: Build = Build { panel: true, orbit: false, progressive: false, lines: None, exact_sampling: false };
 
 /// Frames per turn of the camera in orbit mode (the firmware's `orbit` feature, `host-sim orbit`).
 pub const ORBIT_FRAMES: u32 = 36;

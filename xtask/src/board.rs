@@ -13,7 +13,7 @@
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
 use host_sim::uf2::{build_image, build_pico, kept_image, pico_built, pico_elf, write_uf2, Scenes};
-use board_frame::{LADDER, ORBIT_FRAMES};
+use board_frame::{Build, LADDER, ORBIT_FRAMES, PICO};
 use anyhow::{bail, Context, Result};
 use board_records::{FrameDone, Record};
 use lattice_rt::BitFrame;
@@ -416,9 +416,9 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let rungs = s.ladder_rows(&lrun)?;
     let prun = s.variant("progressive", true, PASSES * s.scenes.len())?;
     let progressive = s.progressive_rows(&prun, &rows)?;
-    let orun_outline = s.variant("outline", false, 1)?;
-    let plain_chair = rows.iter().find(|r| r.name == "chair");
-    let outline_row = s.outline_row(&orun_outline, out, plain_chair)?;
+    let plain_run = s.variant("no-outline", false, 1)?;
+    let lined_chair = rows.iter().find(|r| r.name == "chair");
+    let outline_row = s.outline_row(&plain_run, out, lined_chair)?;
 
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period };
     let profile = profile_shares(&s.elf, &frames_dir.join("profile.json"))?;
@@ -428,8 +428,8 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
     md.push_str(&progressive_report(&progressive, run.clk_sys_hz)?);
-    if let (Some((f, rays, same)), Some(plain)) = (outline_row, plain_chair) {
-        md.push_str(&outline_report(f, rays, same, &plain.frame, run.clk_sys_hz)?);
+    if let (Some((f, rays, same)), Some(lined)) = (outline_row, lined_chair) {
+        md.push_str(&outline_report(f, rays, same, &lined.frame, run.clk_sys_hz)?);
     }
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
@@ -500,7 +500,7 @@ impl<'a> Session<'a> {
     /// Scene `name`'s panel frame against host-sim's; on a difference, both and their
     /// difference are saved beside it.
     fn compare_scene(&mut self, name: &str, pixels: &[u8]) -> Result<()> {
-        let want = host_frame(&self.scenes_dir, name, PICO_SCALAR, false)?;
+        let want = host_frame(&self.scenes_dir, name, PICO_SCALAR, PICO)?;
         let dir = self.frames_dir;
         save_frame(pixels, &dir.join(format!("{name}.png")))?;
         let differ: u32 = want.iter().zip(pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
@@ -531,7 +531,7 @@ impl<'a> Session<'a> {
     /// The first scene's frame with each silicon model left out ([`MODELS`]).
     fn model_runs(&mut self) -> Result<Vec<(&'static str, PanelFrame)>> {
         let first = self.scenes.first().context("no scene")?.clone();
-        let want = host_frame(&self.scenes_dir, &first, PICO_SCALAR, false)?;
+        let want = host_frame(&self.scenes_dir, &first, PICO_SCALAR, PICO)?;
         let dir = self.frames_dir.join("models");
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let mut models = Vec::new();
@@ -549,7 +549,7 @@ impl<'a> Session<'a> {
 
     /// The chair from each build-time lever's image ([`LEVERS`]).
     fn lever_runs(&mut self) -> Result<Vec<(&'static str, &'static str, PanelFrame)>> {
-        let want = host_frame(&self.scenes_dir, "chair", PICO_SCALAR, false)?;
+        let want = host_frame(&self.scenes_dir, "chair", PICO_SCALAR, PICO)?;
         let mut levers = Vec::new();
         for (feature, what) in LEVERS {
             let (run, dir) = self.variant(feature, false, 1)?;
@@ -570,7 +570,7 @@ impl<'a> Session<'a> {
     /// many were identical.
     fn orbit_run(&mut self) -> Result<(BoardRun, usize)> {
         let (orun, dir) = self.variant("orbit", false, ORBIT_CHECKED)?;
-        let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(&self.chair, &self.chair_text, ORBIT_FRAMES, &board_frame::FRAME)?;
+        let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(&self.chair, &self.chair_text, ORBIT_FRAMES, &board_frame::rendered(Build { orbit: true, ..PICO }))?;
         let shown = orun.frames.len();
         self.checks.check(shown >= ORBIT_CHECKED, || format!("orbit mode: {shown} of {ORBIT_CHECKED} frames shown ({})", orun.reason));
         let mut same = 0;
@@ -613,7 +613,7 @@ impl<'a> Session<'a> {
         let mut progressive = Vec::new();
         for (name, passes) in self.scenes.clone().iter().zip(prun.frames.chunks(PASSES)) {
             let path = self.scenes_dir.join(format!("{name}.scene"));
-            let want = host_sim::run::progressive_passes::<lattice_rt::Fx>(&path, &host_sim::load::read(&path)?, &board_frame::FRAME)?;
+            let want = host_sim::run::progressive_passes::<lattice_rt::Fx>(&path, &host_sim::load::read(&path)?, &board_frame::rendered(Build { progressive: true, ..PICO }))?;
             let mut same = 0;
             for (f, p) in passes.iter().zip(&want) {
                 let file = dir.join(format!("{name}-pass{}.png", p.pass));
@@ -631,28 +631,29 @@ impl<'a> Session<'a> {
         Ok(progressive)
     }
 
-    /// Silhouette lines: the chair with `outline` against host-sim's; its frame, the eye rays
-    /// without and with lines, and whether it was identical. Saves the panel pictures README and
-    /// docs/board.md show beside `out`.
-    fn outline_row<'r>(&mut self, (run, dir): &'r (BoardRun, PathBuf), out: &Path, plain: Option<&SceneRow>) -> Result<Option<(&'r PanelFrame, [u64; 2], bool)>> {
+    /// Silhouette lines: the chair without them (`no-outline`) against host-sim's; its frame,
+    /// the eye rays without and with lines, and whether it was identical. Saves the panel
+    /// pictures README and docs/board.md show beside `out` (the default image's chair, with
+    /// lines, and this one).
+    fn outline_row<'r>(&mut self, (run, dir): &'r (BoardRun, PathBuf), out: &Path, lined: Option<&SceneRow>) -> Result<Option<(&'r PanelFrame, [u64; 2], bool)>> {
         let Some(f) = run.frames.first() else {
-            self.checks.fail(format!("outline: no frame shown ({})", run.reason));
+            self.checks.fail(format!("no-outline: no frame shown ({})", run.reason));
             return Ok(None);
         };
-        let lined = lattice_rt::Frame { outline: true, ..board_frame::FRAME };
-        let want = host_sim::run::render_text::<lattice_rt::Fx>(&self.chair, &self.chair_text, &lined, |_| {})?;
+        let plain = board_frame::rendered(Build { lines: Some(false), ..PICO });
+        let want = host_sim::run::render_text::<lattice_rt::Fx>(&self.chair, &self.chair_text, &plain, |_| {})?;
         let file = dir.join("chair.png");
         save_frame(&f.pixels, &file)?;
         if let Some(images) = out.parent().map(|p| p.join("images")) {
             std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
-            save_frame(&f.pixels, &images.join("board-chair-outline.png"))?;
-            if let Some(plain) = plain {
-                save_frame(&plain.frame.pixels, &images.join("board-chair.png"))?;
+            save_frame(&f.pixels, &images.join("board-chair-plain.png"))?;
+            if let Some(lined) = lined {
+                save_frame(&lined.frame.pixels, &images.join("board-chair.png"))?;
             }
         }
-        let same = self.checks.check(f.pixels == want.bits, || format!("outline: the chair differs from host-sim (see {})", file.display()));
-        let plain_rays = host_sim::run::render_text::<lattice_rt::Fx>(&self.chair, &self.chair_text, &board_frame::FRAME, |_| {})?.stats.rays[0];
-        Ok(Some((f, [plain_rays, want.stats.rays[0]], same)))
+        let same = self.checks.check(f.pixels == want.bits, || format!("no-outline: the chair differs from host-sim (see {})", file.display()));
+        let lined_rays = host_sim::run::render_text::<lattice_rt::Fx>(&self.chair, &self.chair_text, &board_frame::rendered(PICO), |_| {})?.stats.rays[0];
+        Ok(Some((f, [want.stats.rays[0], lined_rays], same)))
     }
 }
 
@@ -700,7 +701,8 @@ fn orbit_report(frames: &[PanelFrame], same: usize, clk_hz: f64) -> Result<Strin
     let mut md = String::new();
     writeln!(md, "\n## Orbit mode\n")?;
     writeln!(md, "The image built with `--features orbit` circles the camera around each scene, {ORBIT_FRAMES} frames per")?;
-    writeln!(md, "turn (`host-sim orbit` draws the same frames as a GIF). Built with the chair alone and run like the")?;
+    writeln!(md, "turn, in blue noise with silhouette lines (frames in motion, `board_frame::MOTION_DITHER`")?;
+    writeln!(md, "flickers least; `host-sim orbit` draws the same frames as a GIF). Built with the chair alone and run like the")?;
     writeln!(md, "image above, {same} of its first {} frames were bit-identical to host-sim's orbit. A frame here is", frames.len())?;
     writeln!(md, "whole: the scene parsed for the new camera, its lattice and windows built, every tile traced and sent.\n")?;
     writeln!(md, "| frame | cycles | frames per second at {:.0} MHz |\n|---:|---:|---:|", clk_hz / 1e6)?;
@@ -729,7 +731,8 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
     let mhz = clk_hz / 1e6;
     writeln!(md, "\n## Progressive frames\n")?;
     writeln!(md, "The image built with `--features progressive` (the default scenes) shows every frame in four")?;
-    writeln!(md, "passes (`render_pass`): one traced ray per 8x8 block, then 4x4, 2x2 and the finished frame,")?;
+    writeln!(md, "passes (`render_pass`, blue noise with lines: frames in motion, `board_frame::MOTION_DITHER`):")?;
+    writeln!(md, "one traced ray per 8x8 block, then 4x4, 2x2 and the finished frame,")?;
     writeln!(md, "each pass reusing every ray traced before it, so no eye ray is traced twice. The display is")?;
     writeln!(md, "updated after each pass (both tile shares of the pass), and the LED goes out for a moment as")?;
     writeln!(md, "each pass reaches the panel; every pass the panel showed is checked bit for bit against")?;
@@ -763,20 +766,21 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
     Ok(md)
 }
 
-/// The silhouette-line section of docs/board.md: the chair with lines (`rays`: eye rays
-/// without and with them, apron included; `same`: bit-identical to host-sim's) against the plain chair.
-fn outline_report(f: &PanelFrame, rays: [u64; 2], same: bool, plain: &PanelFrame, clk_hz: f64) -> Result<String> {
+/// The silhouette-line section of docs/board.md: the chair without lines (`f`; `rays`: eye rays
+/// without and with them, apron included; `same`: bit-identical to host-sim's) against the
+/// default image's chair, which has them.
+fn outline_report(f: &PanelFrame, rays: [u64; 2], same: bool, lined: &PanelFrame, clk_hz: f64) -> Result<String> {
     let mut md = String::new();
     writeln!(md, "\n## Silhouette lines\n")?;
-    writeln!(md, "The image built with `--features outline` (the chair alone) draws silhouette lines: where two")?;
-    writeln!(md, "neighbouring pixels hit different objects the farther one is black, so the chair's legs and")?;
-    writeln!(md, "seat stand out from a floor of the same gray. Each tile traces its own apron (hit-only eye rays")?;
-    writeln!(md, "through the column left of it and the row above), so the lines need nothing from the other")?;
-    writeln!(md, "core's tiles. The frame the panel showed was {} host-sim's.\n", if same { "bit-identical to" } else { "**not** the same as" })?;
+    writeln!(md, "The default image draws silhouette lines: where two neighbouring pixels hit different objects")?;
+    writeln!(md, "the farther one is black, so the chair's legs and seat stand out from a floor of the same gray.")?;
+    writeln!(md, "Each tile traces its own apron (hit-only eye rays through the column left of it and the row")?;
+    writeln!(md, "above), so the lines need nothing from the other core's tiles. The image built with")?;
+    writeln!(md, "`--features no-outline` (the chair alone) leaves them out; the frame its panel showed was {} host-sim's.\n", if same { "bit-identical to" } else { "**not** the same as" })?;
     writeln!(md, "| chair | cycles | eye rays | frames per second at {:.0} MHz |\n|---|---:|---:|---:|", clk_hz / 1e6)?;
-    writeln!(md, "| without lines (the default image) | {:.1} M | {} | {:.2} |", plain.cycles as f64 / 1e6, rays[0], clk_hz / plain.cycles.max(1) as f64)?;
-    writeln!(md, "| with lines | {:.1} M ({:.2}x) | {} | {:.2} |", f.cycles as f64 / 1e6, f.cycles as f64 / plain.cycles.max(1) as f64, rays[1], clk_hz / f.cycles.max(1) as f64)?;
-    writeln!(md, "\n![the chair on the emulated panel, without and with lines](images/board-chair.png) ![with lines](images/board-chair-outline.png)")?;
+    writeln!(md, "| without lines (`no-outline`) | {:.1} M | {} | {:.2} |", f.cycles as f64 / 1e6, rays[0], clk_hz / f.cycles.max(1) as f64)?;
+    writeln!(md, "| with lines (the default image) | {:.1} M ({:.2}x) | {} | {:.2} |", lined.cycles as f64 / 1e6, lined.cycles as f64 / f.cycles.max(1) as f64, rays[1], clk_hz / lined.cycles.max(1) as f64)?;
+    writeln!(md, "\n![the chair on the emulated panel, with lines](images/board-chair.png) ![without lines](images/board-chair-plain.png)")?;
     Ok(md)
 }
 
@@ -792,7 +796,7 @@ struct Rung<'f> {
 
 /// The host's frame of the chair traced with a rung's levers.
 fn ladder_frame(chair: &Path, tuning: &board_frame::Tuning) -> Result<Vec<u8>> {
-    let frame = lattice_rt::Frame { sampling: tuning.sampling, ..board_frame::FRAME };
+    let frame = lattice_rt::Frame { sampling: tuning.sampling, ..board_frame::rendered(PICO) };
     let text = host_sim::load::read(chair)?;
     Ok(host_sim::run::render_text::<lattice_rt::Fx>(chair, &text, &frame, |t| {
         if let Some(how) = tuning.eye_rays {
@@ -813,9 +817,9 @@ fn ladder_report(rungs: &[Rung<'_>], clk_hz: f64) -> Result<String> {
     writeln!(md, "switching one more lever on at run time; every frame is checked bit for bit against host-sim's")?;
     writeln!(md, "render with the same levers. *Cycles* are the whole frame as above (set-up, both cores, the bus;")?;
     writeln!(md, "target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz). Core 0 traces tile share 0 and")?;
-    writeln!(md, "core 1 share 1, each drawing its tiles straight to the display as it finishes them (one tile at a")?;
-    writeln!(md, "time under a lock); *share 0* and *share 1* are each core's time on its share as the device's")?;
-    writeln!(md, "timer measured it.\n")?;
+    writeln!(md, "core 1 share 1, band by band; core 0 dithers each band once both halves are traced and sends it")?;
+    writeln!(md, "(trace, then dither); *share 0* and *share 1* are each core's time on the frame as the device's")?;
+    writeln!(md, "timer measured it (core 0's with the dithering, sending and waiting for core 1).\n")?;
     writeln!(md, "| rung | cycles | frames per second at {mhz:.0} MHz | instructions | object tests | share 0 (core 0) | share 1 (core 1) | core 1 idle |")?;
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|")?;
     let mut first = None;
@@ -867,13 +871,15 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
     writeln!(md, "rp2040-hal's launch handshake, per-core SIO FIFOs, divider, NVIC and MPU stack guard), the **16 KiB")?;
     writeln!(md, "XIP flash cache** and the **I2C bus's timing**, with an SSD1306 model on I2C0. It decodes the defmt log")?;
     writeln!(md, "and requires every frame the panel shows to be bit-identical to host-sim's render of the scene")?;
-    writeln!(md, "(128x64, fixed point, blue-noise dither): core 0 traces one tile share, core 1 the other. Every")?;
+    writeln!(md, "(128x64, fixed point, Floyd-Steinberg error diffusion with silhouette lines, `board_frame::rendered`):")?;
+    writeln!(md, "core 0 traces one tile share of each band of tiles, core 1 the other, and core 0 dithers each band")?;
+    writeln!(md, "in order once both halves are traced, then sends it (trace, then dither). Every")?;
     writeln!(md, "figure below is what the emulated board ran; none is computed. Scenes embedded: {}.\n", scenes.join(", "))?;
     writeln!(md, "## Per frame\n")?;
     writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;
     writeln!(md, "frame on the panel: parsing the scene and building its lattice (*set-up*, core 0 alone, up to the")?;
     writeln!(md, "first byte of the first tile on the bus), then both cores tracing their tile shares and core 0")?;
-    writeln!(md, "sending every tile. *Busy* is cycles a core ran instructions (waiting for the bus or the other")?;
+    writeln!(md, "dithering and sending every band. *Busy* is cycles a core ran instructions (waiting for the bus or the other")?;
     writeln!(md, "core in a loop included), *idle* cycles it slept (`wfe`). *Misses* are flash reads that missed")?;
     writeln!(md, "the XIP cache ({} cycles each, queued when both cores miss); *bus* is the time the I2C bus was busy", s.xip_miss_cycles)?;
     writeln!(md, "({} cycles per SCL period, {:.1} kHz).\n", s.scl_period, s.clk_hz / s.scl_period.max(1) as f64 / 1e3)?;

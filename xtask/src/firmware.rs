@@ -287,24 +287,21 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
 /// The frame the boards render (the records crate the firmware compiles too).
 pub use board_records::frame as board_frame;
 
-/// The host's 1-bit frame of a scene with the firmware's settings, in scalar `R` (`exact`: one
-/// eye ray per pixel, as the `exact-sampling` feature renders).
-fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str, exact: bool) -> Result<Vec<u8>> {
+/// The host's 1-bit frame of scene `name` as `frame`, in scalar `R`.
+fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str, frame: &lattice_rt::Frame) -> Result<Vec<u8>> {
     let path = scenes.join(format!("{name}.scene"));
-    let mut frame = board_frame::FRAME;
-    if exact {
-        frame.sampling = lattice_rt::Sampling::Center;
-    }
-    Ok(render_text::<R>(&path, &read(&path)?, &frame, |_| {})?.bits)
+    Ok(render_text::<R>(&path, &read(&path)?, frame, |_| {})?.bits)
 }
 
-/// [`host_frame_in`] for a scalar named as in [`SCALARS`].
-pub fn host_frame(scenes: &Path, name: &str, scalar: &str, exact: bool) -> Result<Vec<u8>> {
+/// The host's 1-bit frame of scene `name` as the firmware `build` renders it
+/// (`board_frame::rendered`), in a scalar named as in [`SCALARS`].
+pub fn host_frame(scenes: &Path, name: &str, scalar: &str, build: board_frame::Build) -> Result<Vec<u8>> {
+    let frame = board_frame::rendered(build);
     match scalar {
-        "fixed" => host_frame_in::<lattice_rt::Fx>(scenes, name, exact),
-        "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(scenes, name, exact),
-        "f32-micromath-newton" => host_frame_in::<lattice_rt::F32MicroNewton>(scenes, name, exact),
-        _ => host_frame_in::<f32>(scenes, name, exact),
+        "fixed" => host_frame_in::<lattice_rt::Fx>(scenes, name, &frame),
+        "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(scenes, name, &frame),
+        "f32-micromath-newton" => host_frame_in::<lattice_rt::F32MicroNewton>(scenes, name, &frame),
+        _ => host_frame_in::<f32>(scenes, name, &frame),
     }
 }
 
@@ -494,7 +491,8 @@ fn check_frames(root: &Path, runs: &[(&Variant, Run)], tally: &mut Tally) -> Res
             tally.failed += 1;
         }
         for s in &r.scenes {
-            let want = host_frame(&scenes_dir, &s.name, v.scalar, v.features.contains("exact-sampling"))?;
+            let build = board_frame::Build::of(|f| v.features.split([',', ' ']).any(|g| g == f));
+            let want = host_frame(&scenes_dir, &s.name, v.scalar, build)?;
             let same = want == s.rows;
             if same {
                 tally.passed += 1;
