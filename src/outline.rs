@@ -24,10 +24,31 @@ pub struct Apron<'a> {
     pub up: Option<&'a [(u16, u16)]>,
 }
 
+/// Whether two pixels' hits (object, depth key) make a line between them: other objects at
+/// other depths.
+fn differ(a: (u16, u16), b: (u16, u16)) -> bool {
+    a.0 != b.0 && a.1 != b.1
+}
+
+/// The lines across a `tw x th` tile's left and top borders alone, drawn into its `levels`
+/// (level 0): where its left column's and top row's hits (`left`, `top`) differ from the
+/// apron's. With the lines inside the tile ([`tile`] with no apron) these are [`tile`]'s lines.
+pub fn apron(tw: usize, th: usize, left: &[(u16, u16)], top: &[(u16, u16)], apron: Apron<'_>, levels: &mut [u8]) {
+    for (y, &here) in left.iter().enumerate().take(th) {
+        if apron.left.and_then(|l| l.get(y)).is_some_and(|&n| differ(n, here)) {
+            levels[y * tw] = 0;
+        }
+    }
+    for (x, &here) in top.iter().enumerate().take(tw) {
+        if apron.up.and_then(|u| u.get(x)).is_some_and(|&n| differ(n, here)) {
+            levels[x] = 0;
+        }
+    }
+}
+
 /// Draws the silhouettes of a `tw x th` tile into its `levels` (level 0 where a line runs),
 /// from what its pixels hit and what its apron hit.
 pub fn tile(tw: usize, th: usize, hits: &Hits, apron: Apron<'_>, levels: &mut [u8]) {
-    let differ = |a: (u16, u16), b: (u16, u16)| a.0 != b.0 && a.1 != b.1;
     let mut line = [false; crate::dither::MAX_TILE * crate::dither::MAX_TILE];
     for y in 0..th {
         for x in 0..tw {

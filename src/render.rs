@@ -135,14 +135,13 @@ impl Frame {
         self.scratch_len() - Ditherer::rows_len(self.dither, self.width as usize)
     }
 
-    /// Entries of level storage [`trace_share`] needs for `share` in the frame's band of tile
-    /// rows: one per pixel of each of its tiles (whole tiles, `tile * tile` each).
-    pub const fn levels_len(&self, share: Share) -> usize {
+    /// Tiles [`trace_share`] keeps for `share` in the frame's band of tile rows.
+    pub const fn tiles_len(&self, share: Share) -> usize {
         let t = if self.tile == 0 { 1 } else { self.tile as usize };
         let (tiles_x, tiles_y) = ((self.width as usize).div_ceil(t), (self.height as usize).div_ceil(t));
         let end = if (self.rows.1 as usize) < tiles_y { self.rows.1 as usize } else { tiles_y };
         let first = if (self.rows.0 as usize) < end { self.rows.0 as usize } else { end };
-        share.tiles_in(tiles_x, (first, end)) * t * t
+        share.tiles_in(tiles_x, (first, end))
     }
 
     /// Whether the frame can be rendered progressively ([`render_pass`]): its tiles are a
@@ -286,46 +285,98 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
     render_tiles(tracer, frame, share, None, Out::Draw(target), scratch, hooks)
 }
 
-/// The first half of a frame rendered **trace, then dither**: the gray levels of one share's
-/// tiles in the frame's band of tile rows (tone curve and silhouette lines applied), kept in
-/// `levels` for [`dither_band`] instead of dithered and drawn. Tile `k` of the share in the
-/// band (in the order the render visits them) is at `k * tile * tile`, row-major; `levels`
-/// holds at least [`Frame::levels_len`] entries. Unlike [`render_share`], frames whose
-/// dithering carries error from tile to tile (Floyd-Steinberg, Atkinson) can be traced in
-/// shares this way: the cores trace, and one dithers the finished bands in order.
+/// What trace, then dither keeps of a traced tile until it is dithered ([`trace_share`],
+/// [`dither_band`]): its gray levels (tone curve and the silhouette lines inside it applied),
+/// and for the lines across its borders what its pixels hit (object and depth key) along its
+/// four sides: the left column and top row as sampled, and the right column and bottom row as
+/// the eye rays through their centres hit them (the apron of the tiles right of it and below).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KeptTile {
+    /// Gray levels, row-major, `tw * th` of them.
+    pub levels: [u8; MAX_TILE * MAX_TILE],
+    /// The left column's hits, one per tile row.
+    pub left: [(u16, u16); MAX_TILE],
+    /// The top row's hits, one per tile column.
+    pub top: [(u16, u16); MAX_TILE],
+    /// The right column's rays through the centres, one per tile row.
+    pub right: [(u16, u16); MAX_TILE],
+    /// The bottom row's rays through the centres, one per tile column.
+    pub bottom: [(u16, u16); MAX_TILE],
+}
+
+impl KeptTile {
+    /// Nothing kept yet.
+    pub const EMPTY: KeptTile = KeptTile { levels: [0; MAX_TILE * MAX_TILE], left: [(0, 0); MAX_TILE], top: [(0, 0); MAX_TILE], right: [(0, 0); MAX_TILE], bottom: [(0, 0); MAX_TILE] };
+}
+
+impl Default for KeptTile {
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
+/// The first half of a frame rendered **trace, then dither**: one share's tiles in the frame's
+/// band of tile rows, traced and kept ([`KeptTile`]) for [`dither_band`] instead of dithered
+/// and drawn: tile `k` of the share in the band (in the order the render visits them) in
+/// `kept[k]`; `kept` holds at least [`Frame::tiles_len`] tiles. Unlike [`render_share`],
+/// frames whose dithering carries error from tile to tile (Floyd-Steinberg, Atkinson) can be
+/// traced in shares this way: the cores trace, and one dithers the finished bands in order.
+/// Silhouette lines across a tile's borders need no apron rays here: [`dither_band`] takes
+/// them from the neighbours' kept edges, which are exact (rays through the pixels' centres,
+/// traced again where sampling filled a pixel).
 ///
 /// `scratch` needs [`Frame::trace_scratch_len`] rows (no dither carries).
 pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     share: Share,
-    levels: &mut [u8],
+    kept: &mut [KeptTile],
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<core::convert::Infallible>> {
-    if levels.len() < frame.levels_len(share) {
-        return Err(RenderError::ScratchTooSmall { needed: frame.levels_len(share) });
+    if kept.len() < frame.tiles_len(share) {
+        return Err(RenderError::ScratchTooSmall { needed: frame.tiles_len(share) });
     }
-    render_tiles::<_, _, Nowhere, E>(tracer, frame, share, None, Out::Keep(levels), scratch, hooks)
+    render_tiles::<_, _, Nowhere, E>(tracer, frame, share, None, Out::Keep(kept), scratch, hooks)
 }
 
 /// The second half of trace, then dither ([`trace_share`]): dithers tile row `ty` of `frame`
-/// from the kept levels of its tiles (`tile(tx)`: tile `tx` of the row, `tile * tile` entries,
-/// row-major) and draws it into `target`, tile by tile in the order [`render`] draws them, so
-/// bands dithered in order give [`render`]'s frame bit for bit. The first tile `tile` has no levels for
-/// ends the band there. `ditherer` carries error between bands: make it once per frame
+/// from its kept tiles (`tile(tx)`: tile `tx` of the row) and draws it into `target`, tile by
+/// tile in the order [`render`] draws them, so bands dithered in order give [`render`]'s frame
+/// bit for bit. The band ends at the first tile `tile` has nothing for. With silhouette lines,
+/// `above` (the frame's width of entries) holds what the bottom row of the band above hit and
+/// is left holding this band's. `ditherer` carries error between bands: make it once per frame
 /// ([`Ditherer::new`] over [`Ditherer::rows_len`] entries).
-pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(frame: &Frame, ty: usize, tile: impl Fn(usize) -> Option<&'l [u8]>, ditherer: &mut Ditherer<'_>, target: &mut D) -> Result<(), D::Error> {
+pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
+    frame: &Frame,
+    ty: usize,
+    tile: impl Fn(usize) -> Option<&'l KeptTile>,
+    above: &mut [(u16, u16)],
+    ditherer: &mut Ditherer<'_>,
+    target: &mut D,
+) -> Result<(), D::Error> {
     let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
+    let mut levels = [0u8; MAX_TILE * MAX_TILE];
+    let mut left: Option<&KeptTile> = None;
     ditherer.next_band();
     for tx in 0..w.div_ceil(t) {
         let (x0, y0) = (tx * t, ty * t);
         let (tw, th) = (t.min(w - x0), t.min(h - y0));
-        let Some(levels) = tile(tx).and_then(|l| l.get(..tw * th)) else { break };
-        ditherer.tile(x0, y0, tw, th, levels, &mut bits);
+        let Some(kept) = tile(tx) else { break };
+        levels[..tw * th].copy_from_slice(&kept.levels[..tw * th]);
+        if frame.outline {
+            let up = above.get(x0..x0 + tw).filter(|_| ty > 0);
+            let apron = Apron { left: left.map(|l| &l.right[..th]), up };
+            crate::outline::apron(tw, th, &kept.left[..th], &kept.top[..tw], apron, &mut levels[..tw * th]);
+            if let Some(row) = above.get_mut(x0..x0 + tw) {
+                row.copy_from_slice(&kept.bottom[..tw]);
+            }
+        }
+        ditherer.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
         let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
         target.fill_contiguous(&area, bits[..tw * th].iter().copied())?;
+        left = Some(kept);
     }
     Ok(())
 }
@@ -333,7 +384,7 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(frame: &Frame, ty: us
 /// Where the tile loop puts a finished tile: dithered and drawn, or kept as gray levels.
 enum Out<'o, D> {
     Draw(&'o mut D),
-    Keep(&'o mut [u8]),
+    Keep(&'o mut [KeptTile]),
 }
 
 /// The draw target of a render that draws nothing ([`trace_share`]).
@@ -462,6 +513,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
             if !frame.tone.is_linear() {
                 levels[..tw * th].iter_mut().for_each(|l| *l = frame.tone.apply(*l));
             }
+            let mut sides = KeptTile::EMPTY;
             if outline {
                 // The apron: what the eye rays through the column left of the tile and the row
                 // above it hit (the tile's eye candidates cover them: they are a pixel away).
@@ -470,12 +522,24 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                     let (id, depth) = tracer.eye_hit(ray, &mut q);
                     (id as u16, depth.depth_key())
                 };
-                outline_tile(Block { x0, y0, tw, th, t }, &mut probe, &hits, &mut levels[..tw * th]);
+                if keep {
+                    // Lines across the borders are drawn when the band is dithered, from the
+                    // sides kept here: no apron rays, only the right column's and bottom row's
+                    // pixels that sampling did not trace through their centres.
+                    let hit = |x: usize, y: usize| (hits.object[y * tw + x], hits.depth[y * tw + x]);
+                    let mut exact = |x: usize, y: usize| if sampler.exact(x, y, tw, th) { hit(x, y) } else { probe(x0 + x, y0 + y) };
+                    (0..th).for_each(|y| (sides.left[y], sides.right[y]) = (hit(0, y), exact(tw - 1, y)));
+                    (0..tw).for_each(|x| (sides.top[x], sides.bottom[x]) = (hit(x, 0), exact(x, th - 1)));
+                    crate::outline::tile(tw, th, &hits, Apron { left: None, up: None }, &mut levels[..tw * th]);
+                } else {
+                    outline_tile(Block { x0, y0, tw, th, t }, &mut probe, &hits, &mut levels[..tw * th]);
+                }
             }
             match &mut out {
                 Out::Keep(store) => {
-                    store[kept..kept + tw * th].copy_from_slice(&levels[..tw * th]);
-                    kept += t * t;
+                    sides.levels[..tw * th].copy_from_slice(&levels[..tw * th]);
+                    store[kept] = sides;
+                    kept += 1;
                 }
                 Out::Draw(target) => {
                     dither.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);

@@ -149,6 +149,17 @@ impl<'r> Sampler<'r> {
         }
     }
 
+    /// Whether what pixel `(x, y)` of a `tw x th` tile hit ([`Hits`]) is what the eye ray through
+    /// its centre hits, whatever the scene: one ray per pixel through its centre, or a pixel the
+    /// adaptive first pass traces. (Filled pixels, blocks and 2x2 grids are not.)
+    pub fn exact(&self, x: usize, y: usize, tw: usize, th: usize) -> bool {
+        match (self.mode, self.block) {
+            (Sampling::Adaptive { .. }, 1) => traced(x, tw) && traced(y, th),
+            (Sampling::Grid2x2, _) => false,
+            (_, block) => block == 1,
+        }
+    }
+
     /// Re-samples pixels on an edge with the 2x2 grid. A pixel is on an edge if its eye ray
     /// hit another object than a neighbour's: left and above come from the tiles already
     /// drawn, right and below from this tile; a pair split by a later tile's border is caught

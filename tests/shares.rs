@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;
-use lattice_rt::{dither_band, parse, render, render_share, trace_share, BitFrame, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
+use lattice_rt::{dither_band, parse, KeptTile, render, render_share, trace_share, BitFrame, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
 
 /// Renders `name` into a fresh 1-bit frame for each frame in `frames`, all into one bitmap.
 fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
@@ -137,21 +137,21 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
     let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
     let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
     let bands = (h as usize).div_ceil(frame.tile as usize) as u16;
+    let mut above = vec![(0u16, 0u16); w as usize];
     for ty in 0..bands {
         let band = Frame { rows: (ty, ty + 1), ..frame };
-        let kept: Vec<Vec<u8>> = (0..of)
+        let kept: Vec<Vec<KeptTile>> = (0..of)
             .map(|index| {
                 let share = Share { index, of };
-                let mut levels = vec![0u8; band.levels_len(share)];
+                let mut kept = vec![KeptTile::EMPTY; band.tiles_len(share)];
                 let mut scratch = HeapScratch::new(&scene, &band);
-                trace_share(&tracer, &band, share, &mut levels, &mut scratch.scratch(), &mut NoHooks).unwrap();
-                levels
+                trace_share(&tracer, &band, share, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                kept
             })
             .collect();
         // Share s holds the tiles tx = s - ty (mod of) of this row: tile tx is its (tx / of)-th.
-        let t = frame.tile as usize * frame.tile as usize;
-        let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize * t..);
-        dither_band(&frame, ty as usize, tile, &mut ditherer, &mut target).unwrap();
+        let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
+        dither_band(&frame, ty as usize, tile, &mut above, &mut ditherer, &mut target).unwrap();
     }
     bits
 }
@@ -159,13 +159,14 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
 #[test]
 fn traced_shares_dithered_in_order_give_the_whole_frame() {
     for name in ["chair", "desk", "whitted"] {
-        for dither in [Dither::FloydSteinberg, Dither::Atkinson, Dither::BlueNoise] {
-            for (width, height) in [(128, 64), (100, 60)] {
-                let frame = Frame { dither, outline: true, sampling: Sampling::Adaptive { contrast: 4 }, ..Frame::new(width, height) };
+        let samplings = [Sampling::Adaptive { contrast: 4 }, Sampling::Center, Sampling::Grid2x2];
+        for (dither, sampling) in [Dither::FloydSteinberg, Dither::Atkinson, Dither::BlueNoise].into_iter().zip(samplings) {
+            for (width, height, outline) in [(128, 64, true), (100, 60, true), (100, 60, false)] {
+                let frame = Frame { dither, outline, sampling, ..Frame::new(width, height) };
                 let (whole, _) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
                 // 1 to 3 shares, and one tile at a time (`Share::single`: as many shares as tiles across).
                 for of in [1, 2, 3, (width as usize).div_ceil(8) as u8] {
-                    assert_eq!(whole, traced_then_dithered::<Fx>(name, frame, of), "{name}, {dither:?}, {width}x{height}, {of} shares");
+                    assert_eq!(whole, traced_then_dithered::<Fx>(name, frame, of), "{name}, {dither:?}, {sampling:?}, {width}x{height}, lines {outline}, {of} shares");
                 }
                 assert_eq!(Share::single(5, 3, 16), Share { index: 8, of: 16 });
             }

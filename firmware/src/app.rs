@@ -15,7 +15,7 @@ use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::dither::{Carry, Ditherer};
-use lattice_rt::{dither_band, render_pass, render_share, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
+use lattice_rt::{dither_band, KeptTile, render_pass, render_share, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 
 pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
@@ -240,9 +240,10 @@ const fn second(n: usize) -> usize {
     }
 }
 
-/// Whether a two-core board renders trace, then dither ([`trace_then_dither`]): its frame's
-/// dithering carries error from tile to tile, so the cores cannot each draw their own tiles.
-const TRACE_THEN_DITHER: bool = SECOND_CORE && RENDERED.dither.diffuses();
+/// Whether a two-core board renders trace, then dither ([`trace_then_dither`]): every frame
+/// but a progressive one's passes. Error diffusion carries error from tile to tile, so the
+/// cores cannot each draw their own tiles, and silhouette lines then need no apron rays.
+const TRACE_THEN_DITHER: bool = SECOND_CORE && !cfg!(feature = "progressive");
 /// Entries of [`ShareMemory`]'s arrays when [`TRACE_THEN_DITHER`] (else none).
 const fn dithered(n: usize) -> usize {
     if TRACE_THEN_DITHER {
@@ -255,17 +256,17 @@ const fn dithered(n: usize) -> usize {
 const TILES_X: usize = (WIDTH as usize).div_ceil(FRAME.tile as usize);
 /// Tiles of the frame.
 const TILES: usize = TILES_X * (HEIGHT as usize).div_ceil(FRAME.tile as usize);
-/// Gray levels a tile keeps between its trace and its dithering.
-const TILE_LEVELS: usize = FRAME.tile as usize * FRAME.tile as usize;
 
 /// The memory of the second tile share: on a board with two cores its own query scratch; and
 /// the rays both shares keep between progressive passes ([`TRACED`] each). Where the two cores
-/// trace, then dither: every tile's gray levels (8 KiB) and the dither's carries.
+/// trace, then dither: what every tile keeps between its trace and its dithering (24 KiB), the
+/// bottom row's hits of the band last dithered, and the dither's carries.
 pub struct ShareMemory {
     mailbox: [u32; second(MAX_OBJECTS + MAX_LATTICES)],
     rows: [i16; second(MAX_ROWS)],
     traced: [[Traced; TRACED]; 2],
-    levels: [[u8; TILE_LEVELS]; dithered(TILES)],
+    kept: [KeptTile; dithered(TILES)],
+    above: [(u16, u16); dithered(WIDTH as usize)],
     carries: [i16; dithered(Carry::len(WIDTH as usize))],
 }
 
@@ -277,7 +278,8 @@ impl ShareMemory {
             mailbox: [0; second(MAX_OBJECTS + MAX_LATTICES)],
             rows: [0; second(MAX_ROWS)],
             traced: [[NONE; TRACED]; 2],
-            levels: [[0; TILE_LEVELS]; dithered(TILES)],
+            kept: [KeptTile::EMPTY; dithered(TILES)],
+            above: [(0, 0); dithered(WIDTH as usize)],
             carries: [0; dithered(Carry::len(WIDTH as usize))],
         }
     }
@@ -373,12 +375,12 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
     let Board { cores, second, now, shown } = board;
-    let ShareMemory { mailbox, rows, traced, levels, carries } = second;
+    let ShareMemory { mailbox, rows, traced, kept, above, carries } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
     if TRACE_THEN_DITHER {
-        let memory = DitherMemory { mailbox, rows, levels, carries };
+        let memory = DitherMemory { mailbox, rows, kept, above, carries };
         let here = (&mut scratch, hooks, now);
         let (stats, [there_us, here_us]) = trace_then_dither(tracer, pick(&tuned), cores, memory, here, target)?;
         shown(0);
@@ -423,26 +425,27 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
 }
 
-/// Where [`trace_then_dither`] works: core 1's query scratch, every tile's levels and the
-/// dither's carries.
+/// Where [`trace_then_dither`] works: core 1's query scratch, what every tile keeps, the
+/// bottom row's hits of the band last dithered and the dither's carries.
 struct DitherMemory<'m> {
     mailbox: &'m mut [u32],
     rows: &'m mut [i16],
-    levels: &'m mut [[u8; TILE_LEVELS]],
+    kept: &'m mut [KeptTile],
+    above: &'m mut [(u16, u16)],
     carries: &'m mut [i16],
 }
 
-/// The tiles of a frame traced, then dithered, as both cores see them: each tile's levels are
+/// The tiles of a frame traced, then dithered, as both cores see them: each tile's storage is
 /// free (to be traced), then done (to be dithered); `next` is the next tile to take, in raster
 /// order, so the bands finish in order.
 struct TileBoard<'l> {
-    free: [Option<&'l mut [u8; TILE_LEVELS]>; TILES],
-    done: [Option<&'l mut [u8; TILE_LEVELS]>; TILES],
+    free: [Option<&'l mut KeptTile>; TILES],
+    done: [Option<&'l mut KeptTile>; TILES],
     next: usize,
 }
 
-/// Traces one tile of a frame: the band it is in, the share that holds it alone, its levels.
-type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, Frame, Share, &mut [u8]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
+/// Traces one tile of a frame: the band it is in, the share that holds it alone, what it keeps.
+type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, Frame, Share, &mut [KeptTile]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
 
 /// A frame on two cores, trace then dither: the cores take the frame's tiles one at a time as
 /// they come free (`Share::single`), in raster order, and trace each into its levels
@@ -459,12 +462,12 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
     (scratch, hooks, now): (&mut lattice_rt::Scratch<'_>, &mut impl Hooks, &(dyn Fn() -> u64 + Sync)),
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
-    let DitherMemory { mailbox, rows, levels, carries } = memory;
+    let DitherMemory { mailbox, rows, kept, above, carries } = memory;
     let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
     let tiles_x = w.div_ceil(t).min(TILES_X);
-    let tiles = (tiles_x * h.div_ceil(t)).min(TILES).min(levels.len());
+    let tiles = (tiles_x * h.div_ceil(t)).min(TILES).min(kept.len());
     let mut board = TileBoard { free: [const { None }; TILES], done: [const { None }; TILES], next: 0 };
-    for (slot, l) in board.free.iter_mut().zip(levels.iter_mut()).take(tiles) {
+    for (slot, l) in board.free.iter_mut().zip(kept.iter_mut()).take(tiles) {
         *slot = Some(l);
     }
     let board = critical_section::Mutex::new(core::cell::RefCell::new(board));
@@ -479,7 +482,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
         })?;
         let (tx, ty) = (k % tiles_x, k / tiles_x);
         let band = Frame { rows: (ty as u16, ty as u16 + 1), ..*frame };
-        let traced = trace(scratch, band, Share::single(tx, ty, tiles_x), &mut l[..]);
+        let traced = trace(scratch, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l));
         critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some(l));
         Some(traced)
     };
@@ -490,7 +493,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
         &mut || {
             let t0 = now();
             let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [u8]| trace_share(tracer, &band, share, l, scratch, &mut lattice_rt::NoHooks);
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile]| trace_share(tracer, &band, share, l, scratch, &mut lattice_rt::NoHooks);
             while let Some(traced) = take(&mut scratch, &mut trace) {
                 match traced {
                     Ok(s) => there.0.add(&s),
@@ -501,7 +504,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
         },
         &mut || {
             let t0 = now();
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [u8]| trace_share(tracer, &band, share, l, scratch, hooks);
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile]| trace_share(tracer, &band, share, l, scratch, hooks);
             let mut band = 0;
             here.1 = (|| {
                 while band * tiles_x < tiles {
@@ -510,7 +513,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                         let mut b = board.borrow(cs).borrow_mut();
                         let row = &mut b.done[band * tiles_x..(band + 1) * tiles_x];
                         if row.iter().all(Option::is_some) {
-                            let mut out: [Option<&mut [u8; TILE_LEVELS]>; TILES_X] = [const { None }; TILES_X];
+                            let mut out: [Option<&mut KeptTile>; TILES_X] = [const { None }; TILES_X];
                             out.iter_mut().zip(row.iter_mut()).for_each(|(o, r)| *o = r.take());
                             Some(out)
                         } else {
@@ -518,8 +521,8 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                         }
                     });
                     if let Some(row) = ready {
-                        let tile = |tx: usize| row.get(tx).and_then(|l| l.as_deref()).map(|l| &l[..]);
-                        dither_band(frame, band, tile, &mut ditherer, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
+                        let tile = |tx: usize| row.get(tx).and_then(|l| l.as_deref());
+                        dither_band(frame, band, tile, above, &mut ditherer, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
                         band += 1;
                         continue;
                     }

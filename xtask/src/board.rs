@@ -356,6 +356,8 @@ struct SceneRow {
     name: String,
     frame: PanelFrame,
     stack: Option<u64>,
+    /// Eye rays the board reported for the frame (silhouette lines' rays included).
+    eye_rays: Option<u64>,
 }
 
 /// What the board reported for the frame of scene `index`.
@@ -409,6 +411,13 @@ struct Session<'a> {
 pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> Result<()> {
     let mut s = Session::prepare(root, frames_dir, no_build)?;
     let (run, rows) = s.scenes_run()?;
+    // The panel's frame of every scene, for README and the display study.
+    if let Some(images) = out.parent().map(|p| p.join("images")) {
+        std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
+        for r in &rows {
+            save_frame(&r.frame.pixels, &images.join(format!("board-{}.png", r.name)))?;
+        }
+    }
     let bare = s.no_display_run()?;
     let (models, levers) = (s.model_runs()?, s.lever_runs()?);
     let (orun, orbit_same) = s.orbit_run()?;
@@ -490,9 +499,10 @@ impl<'a> Session<'a> {
                 continue;
             }
             self.compare_scene(&name, &frame.pixels)?;
-            let stack = reported_frame(&run.records, index).map(|f| u64::from(f.stack));
+            let reported = reported_frame(&run.records, index);
+            let (stack, eye_rays) = (reported.map(|f| u64::from(f.stack)), reported.map(|f| f.rays[0]));
             self.checks.check(stack.is_some(), || format!("{name}: the board reported no frame record"));
-            rows.push(SceneRow { name, frame, stack });
+            rows.push(SceneRow { name, frame, stack, eye_rays });
         }
         Ok((run, rows))
     }
@@ -503,6 +513,10 @@ impl<'a> Session<'a> {
         let want = host_frame(&self.scenes_dir, name, PICO_SCALAR, PICO)?;
         let dir = self.frames_dir;
         save_frame(pixels, &dir.join(format!("{name}.png")))?;
+        // The panel's bits as a PBM, for `cargo xtask display`.
+        let mut raster = pixels.to_vec();
+        raster.resize(BitFrame::bytes(PANEL.0, PANEL.1), 0);
+        host_sim::output::write_pbm(&BitFrame::wrap(PANEL.0, PANEL.1, &mut raster).context("frame size")?, &dir.join(format!("{name}.pbm")))?;
         let differ: u32 = want.iter().zip(pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
         if want != pixels {
             save_frame(&want, &dir.join(format!("{name}-host.png")))?;
@@ -652,8 +666,9 @@ impl<'a> Session<'a> {
             }
         }
         let same = self.checks.check(f.pixels == want.bits, || format!("no-outline: the chair differs from host-sim (see {})", file.display()));
-        let lined_rays = host_sim::run::render_text::<lattice_rt::Fx>(&self.chair, &self.chair_text, &board_frame::rendered(PICO), |_| {})?.stats.rays[0];
-        Ok(Some((f, [want.stats.rays[0], lined_rays], same)))
+        let rays = [reported_frame(&run.records, 0).map(|r| r.rays[0]), lined.and_then(|l| l.eye_rays)];
+        self.checks.check(rays.iter().all(Option::is_some), || "no-outline: the board reported no frame record".into());
+        Ok(Some((f, rays.map(|r| r.unwrap_or(0)), same)))
     }
 }
 
@@ -767,15 +782,18 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
 }
 
 /// The silhouette-line section of docs/board.md: the chair without lines (`f`; `rays`: eye rays
-/// without and with them, apron included; `same`: bit-identical to host-sim's) against the
-/// default image's chair, which has them.
+/// without and with them as the board reported them, the lines' hit-only rays included; `same`:
+/// bit-identical to host-sim's) against the default image's chair, which has them.
 fn outline_report(f: &PanelFrame, rays: [u64; 2], same: bool, lined: &PanelFrame, clk_hz: f64) -> Result<String> {
     let mut md = String::new();
     writeln!(md, "\n## Silhouette lines\n")?;
     writeln!(md, "The default image draws silhouette lines: where two neighbouring pixels hit different objects")?;
     writeln!(md, "the farther one is black, so the chair's legs and seat stand out from a floor of the same gray.")?;
-    writeln!(md, "Each tile traces its own apron (hit-only eye rays through the column left of it and the row")?;
-    writeln!(md, "above), so the lines need nothing from the other core's tiles. The image built with")?;
+    writeln!(md, "A line across a tile's border compares the tile's pixel with its neighbour's: core 0 draws those")?;
+    writeln!(md, "lines as it dithers the band, from what each traced tile kept of its sides; the neighbour's")?;
+    writeln!(md, "pixel is what the eye ray through its centre hits, so where sampling filled it in, the tile")?;
+    writeln!(md, "traces a hit-only ray there (host-sim's render traces such rays for every pixel around a tile:")?;
+    writeln!(md, "the same lines). *Eye rays* are what the board reported, those rays included. The image built with")?;
     writeln!(md, "`--features no-outline` (the chair alone) leaves them out; the frame its panel showed was {} host-sim's.\n", if same { "bit-identical to" } else { "**not** the same as" })?;
     writeln!(md, "| chair | cycles | eye rays | frames per second at {:.0} MHz |\n|---|---:|---:|---:|", clk_hz / 1e6)?;
     writeln!(md, "| without lines (`no-outline`) | {:.1} M | {} | {:.2} |", f.cycles as f64 / 1e6, rays[0], clk_hz / f.cycles.max(1) as f64)?;

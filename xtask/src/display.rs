@@ -9,7 +9,8 @@ use host_sim::load::read;
 use host_sim::output::write_atomic;
 use host_sim::run::{progressive_passes, render_text};
 use crate::tradeoff::reference;
-use anyhow::Result;
+use anyhow::{Context, Result};
+use crate::firmware::board_frame;
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Gray8;
 use embedded_graphics::prelude::*;
@@ -163,7 +164,7 @@ fn link(out: &Path, file: &Path) -> String {
 }
 
 /// The command.
-pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> {
+pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path, board: &Path) -> Result<()> {
     let mut looks = Vec::new();
     for dither in 0..DITHERS.len() {
         for outline in [false, true] {
@@ -181,7 +182,9 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
     std::fs::create_dir_all(images)?;
     let sheet_links = contact_sheets(&names, &looks, &scores, &frames, &references, best, images)?;
     let (prog_rows, strip_file) = progressive_rows(scenes, &names, &references, best, images)?;
-    let md = report(out, &names, &looks, &scores, &order, &sheet_links, &prog_rows, &strip_file)?;
+    let mut md = report(out, &names, &looks, &scores, &order, &sheet_links, &prog_rows, &strip_file)?;
+    let still = looks.iter().position(|l| DITHERS[l.dither].1 == board_frame::STILL_DITHER && l.outline && l.gamma == 10).context("the board's look is in the grid")?;
+    md.push_str(&panel_section(&names, board, &references, &frames, still)?);
     write_atomic(out, md.as_bytes())?;
     println!("wrote {} (best: {}), contact sheets and passes in {}", out.display(), best.label(), images.display());
     Ok(())
@@ -189,6 +192,43 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path) -> Result<()> 
 
 /// The panel's size.
 const PANEL: (u16, u16) = (128, 64);
+
+/// The frames of the emulated Pico's panel (`board/<scene>.pbm`, from `cargo xtask board`)
+/// scored like the looks above, beside the host's frame of the board's look (`still`): the
+/// section of docs/display.md, or a line saying they are missing.
+fn panel_section(names: &[String], board: &Path, references: &[Vec<f64>], frames: &[Vec<Vec<u8>>], still: usize) -> Result<String> {
+    let (wu, hu) = (PANEL.0 as usize, PANEL.1 as usize);
+    let mut md = String::from("\n## The Pico's panel\n\n");
+    let mut rows = Vec::new();
+    for (i, name) in names.iter().enumerate() {
+        let file = board.join(format!("{name}.pbm"));
+        let Ok(bytes) = std::fs::read(&file) else {
+            writeln!(md, "No panel frame of {name} in {} (run `cargo xtask board` first).", board.display())?;
+            return Ok(md);
+        };
+        // A PBM's 1 is black: lit pixels are its 0 bits (128 pixels a row: no padding).
+        let raster = bytes.get(bytes.len().saturating_sub(lattice_rt::BitFrame::bytes(PANEL.0 as u32, PANEL.1 as u32))..).context("short PBM")?;
+        let bits: Vec<u8> = raster.iter().map(|b| !b).collect();
+        let score = |b: &[u8]| SIGMAS.map(|s| measure(b, &references[i], wu, hu, s).1);
+        rows.push((name, score(&bits), score(&frames[i][still]), bits == frames[i][still]));
+    }
+    writeln!(md, "The frames the emulated Pico's panel showed (`cargo xtask board`: its default still, {} + outline), scored as above against", DITHERS.iter().find(|d| d.1 == board_frame::STILL_DITHER).map_or("?", |d| d.0))?;
+    writeln!(md, "the same references, beside the host's frame of the same look.\n")?;
+    writeln!(md, "| scene | panel SSIM (sigma 1) | panel SSIM (sigma 2) | host SSIM (sigma 1) | bit-identical |\n|---|---:|---:|---:|---|")?;
+    let n = rows.len().max(1) as f64;
+    let mut sums = [0.0; 3];
+    for (name, panel, host, same) in &rows {
+        writeln!(md, "| {name} | {:.3} | {:.3} | {:.3} | {} |", panel[0], panel[1], host[0], if *same { "yes" } else { "**no**" })?;
+        sums = [sums[0] + panel[0], sums[1] + panel[1], sums[2] + host[0]];
+    }
+    writeln!(md, "| mean | {:.3} | {:.3} | {:.3} | |", sums[0] / n, sums[1] / n, sums[2] / n)?;
+    md.push('\n');
+    for (name, ..) in &rows {
+        write!(md, "![{name} on the Pico's panel](images/board-{name}.png) ")?;
+    }
+    md.push('\n');
+    Ok(md)
+}
 
 /// Every look rendered on every scene and scored against the scene's reference; the scores,
 /// the frames (per scene, per look) and the references.

@@ -141,6 +141,10 @@ enum Command {
         /// Folder for the contact sheets.
         #[arg(long, default_value = "docs/images")]
         images: PathBuf,
+        /// Where `cargo xtask board` left the frames the emulated Pico's panel showed
+        /// (`<scene>.pbm`), scored beside the host's.
+        #[arg(long, default_value = "target/board")]
+        board: PathBuf,
     },
     /// Flicker of each dither while the camera orbits the scenes: docs/motion.md.
     Motion {
@@ -171,7 +175,7 @@ fn real_main() -> Result<()> {
         Command::Memory { quick, runs, out, plot, tests_plot } => memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot }),
         Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv } => tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv),
         Command::Effects { scenes, runs, out, firmware_csv } => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
-        Command::Display { scenes, out, images } => display::display_cmd(&default_scenes(scenes), &out, &images),
+        Command::Display { scenes, out, images, board } => display::display_cmd(&default_scenes(scenes), &out, &images, &board),
         Command::Motion { scenes, frames, out } => motion::motion_cmd(&default_scenes(scenes), frames, &out),
     }
 }

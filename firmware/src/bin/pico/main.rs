@@ -117,7 +117,11 @@ fn main() -> ! {
         BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz(), Wiring::I2C_HZ / 1000
     );
     let mut st = Storage::new();
-    let mut second = ShareMemory::new();
+    // The second share's memory (with what trace, then dither keeps of every tile: 24 KiB) is a
+    // static, counted in the image's RAM, not on core 0's stack.
+    let Some(second) = cortex_m::singleton!(: ShareMemory = ShareMemory::new()) else {
+        defmt::panic!("the second share's memory is taken")
+    };
     let target = display::PageTiles { display };
-    modes::run(modes::Panel { target, led, timer, alarm, cores, st: &mut st, second: &mut second })
+    modes::run(modes::Panel { target, led, timer, alarm, cores, st: &mut st, second })
 }
