@@ -345,8 +345,9 @@ pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 /// tile in the order [`render`] draws them, so bands dithered in order give [`render`]'s frame
 /// bit for bit. The band ends at the first tile `tile` has nothing for. With silhouette lines,
 /// `above` (the frame's width of entries) holds what the bottom row of the band above hit and
-/// is left holding this band's. `ditherer` carries error between bands: make it once per frame
-/// ([`Ditherer::new`] over [`Ditherer::rows_len`] entries).
+/// is left holding this band's (shorter storage is refused: `ScratchTooSmall`). `ditherer`
+/// carries error between bands: make it once per frame ([`Ditherer::new`] over
+/// [`Ditherer::rows_len`] entries).
 pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
     frame: &Frame,
     ty: usize,
@@ -354,8 +355,11 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
     above: &mut [(u16, u16)],
     ditherer: &mut Ditherer<'_>,
     target: &mut D,
-) -> Result<(), D::Error> {
+) -> Result<(), RenderError<D::Error>> {
     let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
+    if frame.outline && above.len() < w {
+        return Err(RenderError::ScratchTooSmall { needed: w });
+    }
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut left: Option<&KeptTile> = None;
@@ -375,7 +379,7 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
         }
         ditherer.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
         let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
-        target.fill_contiguous(&area, bits[..tw * th].iter().copied())?;
+        target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
         left = Some(kept);
     }
     Ok(())

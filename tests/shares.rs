@@ -174,4 +174,12 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
     }
     let frame = Frame { dither: Dither::FloydSteinberg, outline: true, ..Frame::new(128, 64) };
     assert_eq!(render_into::<f32>("spheres", &[(frame, Share::ALL)], true).0, traced_then_dithered::<f32>("spheres", frame, 2), "f32");
+    // Lines need the row above: too short a row is refused, not drawn without them.
+    let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, 128)];
+    let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, 128, &mut carries).unwrap();
+    let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
+    let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
+    let kept = KeptTile::EMPTY;
+    let err = dither_band(&frame, 1, |_| Some(&kept), &mut [(0, 0); 100], &mut ditherer, &mut target).unwrap_err();
+    assert_eq!(err, RenderError::ScratchTooSmall { needed: 128 });
 }

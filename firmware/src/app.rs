@@ -522,7 +522,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                     });
                     if let Some(row) = ready {
                         let tile = |tx: usize| row.get(tx).and_then(|l| l.as_deref());
-                        dither_band(frame, band, tile, above, &mut ditherer, target).map_err(|e| AppError::Render(RenderError::Draw(e)))?;
+                        dither_band(frame, band, tile, above, &mut ditherer, target).map_err(AppError::Render)?;
                         band += 1;
                         continue;
                     }
