@@ -834,8 +834,8 @@ fn ladder_report(rungs: &[Rung<'_>], clk_hz: f64) -> Result<String> {
     writeln!(md, "`LADDER` (`records/src/frame.rs`), from the paper's method to what the boards run, each rung")?;
     writeln!(md, "switching one more lever on at run time; every frame is checked bit for bit against host-sim's")?;
     writeln!(md, "render with the same levers. *Cycles* are the whole frame as above (set-up, both cores, the bus;")?;
-    writeln!(md, "target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz). Core 0 traces tile share 0 and")?;
-    writeln!(md, "core 1 share 1, band by band; core 0 dithers each band once both halves are traced and sends it")?;
+    writeln!(md, "target for the chair: 12.5 M, 10 frames per second at {mhz:.0} MHz). The two cores take the tiles")?;
+    writeln!(md, "one at a time as they come free; core 0 dithers each band once its tiles are traced and sends it")?;
     writeln!(md, "(trace, then dither); *share 0* and *share 1* are each core's time on the frame as the device's")?;
     writeln!(md, "timer measured it (core 0's with the dithering, sending and waiting for core 1).\n")?;
     writeln!(md, "| rung | cycles | frames per second at {mhz:.0} MHz | instructions | object tests | share 0 (core 0) | share 1 (core 1) | core 1 idle |")?;
@@ -890,13 +890,13 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
     writeln!(md, "XIP flash cache** and the **I2C bus's timing**, with an SSD1306 model on I2C0. It decodes the defmt log")?;
     writeln!(md, "and requires every frame the panel shows to be bit-identical to host-sim's render of the scene")?;
     writeln!(md, "(128x64, fixed point, Floyd-Steinberg error diffusion with silhouette lines, `board_frame::rendered`):")?;
-    writeln!(md, "core 0 traces one tile share of each band of tiles, core 1 the other, and core 0 dithers each band")?;
-    writeln!(md, "in order once both halves are traced, then sends it (trace, then dither). Every")?;
+    writeln!(md, "the two cores take the tiles one at a time as they come free, and core 0 dithers each band of tiles")?;
+    writeln!(md, "in order once all its tiles are traced, then sends it (trace, then dither). Every")?;
     writeln!(md, "figure below is what the emulated board ran; none is computed. Scenes embedded: {}.\n", scenes.join(", "))?;
     writeln!(md, "## Per frame\n")?;
     writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;
     writeln!(md, "frame on the panel: parsing the scene and building its lattice (*set-up*, core 0 alone, up to the")?;
-    writeln!(md, "first byte of the first tile on the bus), then both cores tracing their tile shares and core 0")?;
+    writeln!(md, "first byte of the first tile on the bus, so here the first band's tracing too), then both cores tracing tiles and core 0")?;
     writeln!(md, "dithering and sending every band. *Busy* is cycles a core ran instructions (waiting for the bus or the other")?;
     writeln!(md, "core in a loop included), *idle* cycles it slept (`wfe`). *Misses* are flash reads that missed")?;
     writeln!(md, "the XIP cache ({} cycles each, queued when both cores miss); *bus* is the time the I2C bus was busy", s.xip_miss_cycles)?;
