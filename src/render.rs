@@ -345,14 +345,16 @@ pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 /// tile in the order [`render`] draws them, so bands dithered in order give [`render`]'s frame
 /// bit for bit. The band ends at the first tile `tile` has nothing for. With silhouette lines,
 /// `above` (the frame's width of entries) holds what the bottom row of the band above hit and
-/// is left holding this band's (shorter storage is refused: `ScratchTooSmall`). `ditherer`
+/// is left holding this band's (shorter storage is refused: `ScratchTooSmall`). The band is
+/// drawn in one `fill_contiguous` call (a display then gets it in one transfer, not one per
+/// tile), from `band`, at least the frame's width times the tile side of pixels. `ditherer`
 /// carries error between bands: make it once per frame ([`Ditherer::new`] over
 /// [`Ditherer::rows_len`] entries).
 pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
     frame: &Frame,
     ty: usize,
     tile: impl Fn(usize) -> Option<&'l KeptTile>,
-    above: &mut [(u16, u16)],
+    (above, band): (&mut [(u16, u16)], &mut [BinaryColor]),
     ditherer: &mut Ditherer<'_>,
     target: &mut D,
 ) -> Result<(), RenderError<D::Error>> {
@@ -360,6 +362,11 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
     if frame.outline && above.len() < w {
         return Err(RenderError::ScratchTooSmall { needed: w });
     }
+    let rows = t.min(h.saturating_sub(ty * t));
+    let Some(band) = band.get_mut(..w * rows) else {
+        return Err(RenderError::ScratchTooSmall { needed: w * rows });
+    };
+    let mut end = 0;
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut left: Option<&KeptTile> = None;
@@ -378,11 +385,16 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
             }
         }
         ditherer.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
-        let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
-        target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
+        for (y, row) in bits[..tw * th].chunks(tw).enumerate() {
+            band[y * w + x0..y * w + x0 + tw].copy_from_slice(row);
+        }
         left = Some(kept);
+        end = x0 + tw;
     }
-    Ok(())
+    // The band as far as it was kept (whole unless `tile` ran out), row by row.
+    let area = Rectangle::new(Point::new(0, (ty * t) as i32), Size::new(end as u32, rows as u32));
+    let pixels = band.chunks(w).flat_map(|row| row[..end].iter().copied());
+    target.fill_contiguous(&area, pixels).map_err(RenderError::Draw)
 }
 
 /// Where the tile loop puts a finished tile: dithered and drawn, or kept as gray levels.

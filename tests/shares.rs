@@ -138,6 +138,7 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
     let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
     let bands = (h as usize).div_ceil(frame.tile as usize) as u16;
     let mut above = vec![(0u16, 0u16); w as usize];
+    let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * frame.tile as usize];
     for ty in 0..bands {
         let band = Frame { rows: (ty, ty + 1), ..frame };
         let kept: Vec<Vec<KeptTile>> = (0..of)
@@ -151,7 +152,7 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
             .collect();
         // Share s holds the tiles tx = s - ty (mod of) of this row: tile tx is its (tx / of)-th.
         let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
-        dither_band(&frame, ty as usize, tile, &mut above, &mut ditherer, &mut target).unwrap();
+        dither_band(&frame, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap();
     }
     bits
 }
@@ -180,6 +181,9 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
     let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
     let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
     let kept = KeptTile::EMPTY;
-    let err = dither_band(&frame, 1, |_| Some(&kept), &mut [(0, 0); 100], &mut ditherer, &mut target).unwrap_err();
+    let mut band_bits = [embedded_graphics::pixelcolor::BinaryColor::Off; 128 * 8];
+    let err = dither_band(&frame, 1, |_| Some(&kept), (&mut [(0, 0); 100], &mut band_bits), &mut ditherer, &mut target).unwrap_err();
     assert_eq!(err, RenderError::ScratchTooSmall { needed: 128 });
+    let err = dither_band(&frame, 1, |_| Some(&kept), (&mut [(0, 0); 128], &mut band_bits[..1000]), &mut ditherer, &mut target).unwrap_err();
+    assert_eq!(err, RenderError::ScratchTooSmall { needed: 1024 });
 }

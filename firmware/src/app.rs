@@ -260,13 +260,14 @@ const TILES: usize = TILES_X * (HEIGHT as usize).div_ceil(FRAME.tile as usize);
 /// The memory of the second tile share: on a board with two cores its own query scratch; and
 /// the rays both shares keep between progressive passes ([`TRACED`] each). Where the two cores
 /// trace, then dither: what every tile keeps between its trace and its dithering (24 KiB), the
-/// bottom row's hits of the band last dithered, and the dither's carries.
+/// bottom row's hits of the band last dithered, the band's pixels and the dither's carries.
 pub struct ShareMemory {
     mailbox: [u32; second(MAX_OBJECTS + MAX_LATTICES)],
     rows: [i16; second(MAX_ROWS)],
     traced: [[Traced; TRACED]; 2],
     kept: [KeptTile; dithered(TILES)],
     above: [(u16, u16); dithered(WIDTH as usize)],
+    band: [BinaryColor; dithered(WIDTH as usize * FRAME.tile as usize)],
     carries: [i16; dithered(Carry::len(WIDTH as usize))],
 }
 
@@ -280,6 +281,7 @@ impl ShareMemory {
             traced: [[NONE; TRACED]; 2],
             kept: [KeptTile::EMPTY; dithered(TILES)],
             above: [(0, 0); dithered(WIDTH as usize)],
+            band: [BinaryColor::Off; dithered(WIDTH as usize * FRAME.tile as usize)],
             carries: [0; dithered(Carry::len(WIDTH as usize))],
         }
     }
@@ -375,12 +377,12 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
     let Board { cores, second, now, shown } = board;
-    let ShareMemory { mailbox, rows, traced, kept, above, carries } = second;
+    let ShareMemory { mailbox, rows, traced, kept, above, band, carries } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
     if TRACE_THEN_DITHER {
-        let memory = DitherMemory { mailbox, rows, kept, above, carries };
+        let memory = DitherMemory { mailbox, rows, kept, above, band, carries };
         let here = (&mut scratch, hooks, now);
         let (stats, [there_us, here_us]) = trace_then_dither(tracer, pick(&tuned), cores, memory, here, target)?;
         shown(0);
@@ -426,12 +428,13 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
 }
 
 /// Where [`trace_then_dither`] works: core 1's query scratch, what every tile keeps, the
-/// bottom row's hits of the band last dithered and the dither's carries.
+/// bottom row's hits of the band last dithered, the band's pixels and the dither's carries.
 struct DitherMemory<'m> {
     mailbox: &'m mut [u32],
     rows: &'m mut [i16],
     kept: &'m mut [KeptTile],
     above: &'m mut [(u16, u16)],
+    band: &'m mut [BinaryColor],
     carries: &'m mut [i16],
 }
 
@@ -462,7 +465,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
     (scratch, hooks, now): (&mut lattice_rt::Scratch<'_>, &mut impl Hooks, &(dyn Fn() -> u64 + Sync)),
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
-    let DitherMemory { mailbox, rows, kept, above, carries } = memory;
+    let DitherMemory { mailbox, rows, kept, above, band: band_bits, carries } = memory;
     let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
     let tiles_x = w.div_ceil(t).min(TILES_X);
     let tiles = (tiles_x * h.div_ceil(t)).min(TILES).min(kept.len());
@@ -522,7 +525,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                     });
                     if let Some(row) = ready {
                         let tile = |tx: usize| row.get(tx).and_then(|l| l.as_deref());
-                        dither_band(frame, band, tile, above, &mut ditherer, target).map_err(AppError::Render)?;
+                        dither_band(frame, band, tile, (&mut *above, &mut *band_bits), &mut ditherer, target).map_err(AppError::Render)?;
                         band += 1;
                         continue;
                     }

@@ -1,4 +1,4 @@
-//! The SSD1306 as the render loop's draw target: whole 8-row tiles sent as page bytes (no
+//! The SSD1306 as the render loop's draw target: 8-row tiles or whole bands sent as page bytes (no
 //! framebuffer), over an I2C bus that reports a display that does not answer.
 
 use crate::hal;
@@ -36,11 +36,11 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
     fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Self::Error> {
         let (x0, y0) = (area.top_left.x, area.top_left.y);
         let (w, h) = (area.size.width as usize, area.size.height as usize);
-        if y0 < 0 || x0 < 0 || y0 % 8 != 0 || h > 8 || w > 16 || x0 as usize + w > WIDTH as usize {
+        if y0 < 0 || x0 < 0 || y0 % 8 != 0 || h > 8 || x0 as usize + w > WIDTH as usize {
             return Err(display_interface::DisplayError::OutOfBoundsError);
         }
         // One byte per column, bit k = row k of the page (LSB on top).
-        let mut cols = [0u8; 16];
+        let mut cols = [0u8; WIDTH as usize];
         let mut colors = colors.into_iter();
         for bit in (0..h).map(|y| 1u8 << y) {
             for col in cols[..w].iter_mut() {
