@@ -471,13 +471,15 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     resolves(tracer.scene().camera(), frame)?;
     let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
     let (w, h) = (frame.width as usize, frame.height as usize);
-    // Kept levels are dithered later: the trace needs no carries.
-    let needed = if keep { frame.trace_scratch_len() } else { frame.scratch_len() };
+    // Kept levels are dithered later (by `dither_band`): the trace needs no carries, and an
+    // ordered mode, which needs no storage, stands in for the frame's dither.
+    let mode = if keep { Dither::Bayer } else { frame.dither };
+    let carries_len = Ditherer::rows_len(mode, w);
+    let needed = carries_len + Sampler::rows_len(frame.sampling, frame.dither.block(), w);
     let too_small = || RenderError::ScratchTooSmall { needed };
     let rows = scratch.rows.get_mut(..needed).ok_or_else(too_small)?;
-    let (carries, above) = rows.split_at_mut(needed - Sampler::rows_len(frame.sampling, frame.dither.block(), w));
-    // (Kept levels are not dithered here: an ordered mode stands in, which needs no storage.)
-    let mut dither = Ditherer::new(if keep { Dither::Bayer } else { frame.dither }, w, carries).ok_or_else(too_small)?;
+    let (carries, above) = rows.split_at_mut(carries_len);
+    let mut dither = Ditherer::new(mode, w, carries).ok_or_else(too_small)?;
     let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
     // The outline is drawn on finished frames: a progressive frame's last pass, not its previews.
     let outline = frame.outline && pass.as_ref().is_none_or(|(n, _)| *n == 1);

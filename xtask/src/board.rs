@@ -340,10 +340,14 @@ fn section_size(elf: &Path, name: &str) -> Result<u64> {
 
 /// Writes a panel frame (rows MSB first, lit = 1) as a PNG the way the OLED shows it.
 fn save_frame(bits: &[u8], path: &Path) -> Result<()> {
+    with_panel(bits, |frame| host_sim::output::write_png(frame, path, host_sim::output::Theme::OledWhite, 4))
+}
+
+/// Calls `f` with a panel frame's bits (rows MSB first, lit = 1) as a [`BitFrame`].
+fn with_panel<T>(bits: &[u8], f: impl FnOnce(&BitFrame<'_>) -> Result<T>) -> Result<T> {
     let mut raster = bits.to_vec();
     raster.resize(BitFrame::bytes(PANEL.0, PANEL.1), 0);
-    let frame = BitFrame::wrap(PANEL.0, PANEL.1, &mut raster).context("frame size")?;
-    host_sim::output::write_png(&frame, path, host_sim::output::Theme::OledWhite, 4)
+    f(&BitFrame::wrap(PANEL.0, PANEL.1, &mut raster).context("frame size")?)
 }
 
 /// A picture of where two frames differ: lit where they do.
@@ -514,9 +518,7 @@ impl<'a> Session<'a> {
         let dir = self.frames_dir;
         save_frame(pixels, &dir.join(format!("{name}.png")))?;
         // The panel's bits as a PBM, for `cargo xtask display`.
-        let mut raster = pixels.to_vec();
-        raster.resize(BitFrame::bytes(PANEL.0, PANEL.1), 0);
-        host_sim::output::write_pbm(&BitFrame::wrap(PANEL.0, PANEL.1, &mut raster).context("frame size")?, &dir.join(format!("{name}.pbm")))?;
+        with_panel(pixels, |frame| host_sim::output::write_pbm(frame, &dir.join(format!("{name}.pbm"))))?;
         let differ: u32 = want.iter().zip(pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
         if want != pixels {
             save_frame(&want, &dir.join(format!("{name}-host.png")))?;
