@@ -28,10 +28,9 @@
 //                     [--no-display] [--until-ms T] [--profile FILE]
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 import { readFileSync, writeFileSync } from 'node:fs';
-import { SiliconBoard, GPIOPinState } from './silicon.mjs';
+import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
 
-const FLASH = 0x10000000;
 const LED_PIN = 25;
 // Every how many instructions --profile samples the program counter (a prime, so no loop of
 // the renderer beats in step with it).
@@ -66,27 +65,6 @@ function parseArgs(argv) {
   if ((o.records === undefined) !== (o.recordsLog === undefined)) throw new Error('--records ADDR and --records-log FILE go together');
   if (!Number.isInteger(o.rtt)) throw new Error('--rtt ADDR (the _SEGGER_RTT symbol) is required');
   return o;
-}
-
-/** Writes the blocks of a UF2 file (microsoft/uf2) into flash; returns the bytes written. */
-function loadUf2(mcu, data) {
-  let written = 0;
-  for (let off = 0; off + 512 <= data.length; off += 512) {
-    const v = new DataView(data.buffer, data.byteOffset + off, 512);
-    if (v.getUint32(0, true) !== 0x0a324655 || v.getUint32(4, true) !== 0x9e5d5157 || v.getUint32(508, true) !== 0x0ab16f30) {
-      throw new Error(`UF2 block at byte ${off}: bad magic`);
-    }
-    const flags = v.getUint32(8, true);
-    if (flags & 1) continue; // not for the main flash
-    if ((flags & 0x2000) && v.getUint32(28, true) !== 0xe48bff56) throw new Error(`UF2 block at byte ${off}: not for the RP2040 family`);
-    const addr = v.getUint32(12, true);
-    const size = v.getUint32(16, true);
-    if (addr < FLASH || addr + size > FLASH + mcu.flash.length || size > 476) throw new Error(`UF2 block at byte ${off}: ${size} bytes at ${addr.toString(16)} outside the flash`);
-    mcu.flash.set(data.subarray(off + 32, off + 32 + size), addr - FLASH);
-    written += size;
-  }
-  if (written === 0) throw new Error('UF2 file holds no flash blocks');
-  return written;
 }
 
 /** Reads what the firmware wrote to the RTT up channel since the last call, as a probe does. */

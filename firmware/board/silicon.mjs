@@ -33,6 +33,8 @@ import { RP2040, GPIOPinState } from 'rp2040js';
 
 const SIO_BASE = 0xd0000000;
 const PPB_PAGE = 0xe000e;
+/** Where the RP2040's XIP flash starts. */
+export const FLASH = 0x10000000;
 const FLASH_REGION = 0x1; // 0x10000000..0x1fffffff; the XIP aliases are 0x10..0x13
 const PSM_FRCE_OFF = 0x40010004;
 const PROC1 = 1 << 16;
@@ -617,6 +619,27 @@ export class SiliconBoard {
       xip: this.xip ? this.xip.counters() : { hits: 0, misses: 0, uncached: 0, stallCycles: 0 },
     };
   }
+}
+
+/** Writes the blocks of a UF2 file (microsoft/uf2) into flash; returns the bytes written. */
+export function loadUf2(mcu, data) {
+  let written = 0;
+  for (let off = 0; off + 512 <= data.length; off += 512) {
+    const v = new DataView(data.buffer, data.byteOffset + off, 512);
+    if (v.getUint32(0, true) !== 0x0a324655 || v.getUint32(4, true) !== 0x9e5d5157 || v.getUint32(508, true) !== 0x0ab16f30) {
+      throw new Error(`UF2 block at byte ${off}: bad magic`);
+    }
+    const flags = v.getUint32(8, true);
+    if (flags & 1) continue; // not for the main flash
+    if ((flags & 0x2000) && v.getUint32(28, true) !== 0xe48bff56) throw new Error(`UF2 block at byte ${off}: not for the RP2040 family`);
+    const addr = v.getUint32(12, true);
+    const size = v.getUint32(16, true);
+    if (addr < FLASH || addr + size > FLASH + mcu.flash.length || size > 476) throw new Error(`UF2 block at byte ${off}: ${size} bytes at ${addr.toString(16)} outside the flash`);
+    mcu.flash.set(data.subarray(off + 32, off + 32 + size), addr - FLASH);
+    written += size;
+  }
+  if (written === 0) throw new Error('UF2 file holds no flash blocks');
+  return written;
 }
 
 export { GPIOPinState };

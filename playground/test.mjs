@@ -1,0 +1,164 @@
+#!/usr/bin/env node
+// The playground in a real browser: serves the built page (`cargo xtask playground`), opens it
+// in headless Chromium (puppeteer-core) and requires
+//   - the first panel within 1 s of the page's load (the time is printed);
+//   - each scene's panel, read back from the canvas, bit-identical to `host-sim render` with the
+//     same settings (the Pico's: fixed point, adaptive sampling, Floyd-Steinberg, lines; and one
+//     other set of switches);
+//   - a scene typed with a mistake on line 3 to show the error at line 3, column 15;
+//   - the exact Pico image, run in the page, to show a first frame bit-identical to host-sim's.
+// Usage: node playground/test.mjs --dist DIR --host-sim BIN [--chromium BIN] [--screenshot PNG]
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, renameSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import puppeteer from 'puppeteer-core';
+import { serve } from './serve.mjs';
+
+const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '..');
+const FIRST_PANEL_MS = 1000;
+// The emulated board is slower than silicon: the chair's first frame takes a minute or two here.
+const BOARD_TIMEOUT_MS = 15 * 60 * 1000;
+
+function args() {
+  const o = { chromium: null };
+  const a = process.argv.slice(2);
+  for (let i = 0; i < a.length; i++) {
+    const next = () => a[++i] ?? (() => { throw new Error(`${a[i - 1]} needs a value`); })();
+    if (a[i] === '--dist') o.dist = next();
+    else if (a[i] === '--host-sim') o.hostSim = next();
+    else if (a[i] === '--chromium') o.chromium = next();
+    else if (a[i] === '--screenshot') o.screenshot = next();
+    else throw new Error(`unknown argument ${a[i]}`);
+  }
+  if (!o.dist || !o.hostSim) throw new Error('usage: node playground/test.mjs --dist DIR --host-sim BIN [--chromium BIN] [--screenshot PNG]');
+  if (!o.chromium) {
+    for (const name of ['chromium', 'chromium-browser', 'google-chrome']) {
+      try {
+        o.chromium = execFileSync('sh', ['-c', `command -v ${name}`]).toString().trim();
+        break;
+      } catch { /* not this one */ }
+    }
+    if (!o.chromium) throw new Error('no Chromium found (apt-get install chromium, or --chromium BIN)');
+  }
+  return o;
+}
+
+/** host-sim's 1-bit frame of `scene` with `flags`, packed as the page packs it (1 lit). */
+function hostFrame(hostSim, scene, flags, work) {
+  const pbm = join(work, `${scene}.pbm`);
+  execFileSync(hostSim, ['render', join(ROOT, `scenes/${scene}.scene`), '-o', join(work, `${scene}.png`), '--pbm', pbm, ...flags], { stdio: ['ignore', 'ignore', 'inherit'] });
+  const bytes = readFileSync(pbm);
+  const header = '128 64\n';
+  const start = bytes.indexOf(header) + header.length;
+  if (!bytes.subarray(0, 3).equals(Buffer.from('P4\n')) || start < header.length) throw new Error(`${pbm}: not a 128x64 P4 file`);
+  return Array.from(bytes.subarray(start, start + 1024), (b) => b ^ 0xff); // PBM: 1 is black
+}
+
+/** The canvas `id` read back as a packed 1-bit frame (a pixel is lit when it is bright). */
+const readCanvas = (page, id) =>
+  page.evaluate((id) => {
+    const data = document.getElementById(id).getContext('2d').getImageData(0, 0, 128, 64).data;
+    const bits = new Array(1024).fill(0);
+    for (let p = 0; p < 128 * 64; p++) if (data[p * 4] > 127) bits[p >> 3] |= 0x80 >> (p & 7);
+    return bits;
+  }, id);
+
+const differing = (a, b) => a.reduce((n, x, i) => n + popcount(x ^ b[i]), 0);
+const popcount = (x) => x.toString(2).split('1').length - 1;
+
+let failures = 0;
+function check(ok, what) {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures++;
+}
+
+async function main() {
+  const o = args();
+  const work = mkdtempSync(join(tmpdir(), 'playground-test-'));
+  const server = await serve(o.dist, '127.0.0.1', 0);
+  const url = `http://127.0.0.1:${server.address().port}/`;
+  const browser = await puppeteer.launch({ executablePath: o.chromium, headless: true, args: ['--no-sandbox', '--disable-gpu'] });
+  try {
+    const page = await browser.newPage();
+    await page.setViewport({ width: 1500, height: 1180 });
+    const problems = [];
+    page.on('pageerror', (e) => problems.push(String(e)));
+    await page.goto(url, { waitUntil: 'load' });
+    await page.waitForFunction(() => window.playground?.firstPanelMs !== null && window.playground?.firstPanelMs !== undefined, { timeout: 30000 });
+    const firstPanel = await page.evaluate(() => window.playground.firstPanelMs);
+    check(firstPanel <= FIRST_PANEL_MS, `page load to first panel: ${firstPanel.toFixed(0)} ms (at most ${FIRST_PANEL_MS})`);
+
+    // The Pico image first: it runs in a worker while the scenes are checked.
+    await page.click('#run-board');
+    const boardStart = Date.now();
+
+    const pico = ['--scalar', 'fixed', '--sampling', 'adaptive', '--dither', 'fs'];
+    const scenes = await page.evaluate(() => Array.from(document.querySelectorAll('#scene option'), (o) => o.value));
+    check(scenes.length === 5, `the page offers ${scenes.length} scenes: ${scenes.join(', ')}`);
+    for (const scene of scenes) {
+      await page.select('#scene', scene);
+      await page.waitForFunction(() => window.playground.error === null);
+      const want = hostFrame(o.hostSim, scene, pico, work);
+      const got = await readCanvas(page, 'panel');
+      const ms = await page.evaluate(() => window.playground.renderMs);
+      check(differing(got, want) === 0, `${scene}: the panel equals host-sim render ${pico.join(' ')} (${differing(got, want)} pixels differ; ${ms.toFixed(1)} ms in the page)`);
+    }
+    // Other switches: f32, blue noise, no lines, gamma 0.8, one ray per pixel, on the desk.
+    await page.select('#scene', 'desk');
+    await page.select('#scalar', 'f32');
+    await page.select('#dither', 'blue-noise');
+    await page.click('#lines');
+    await page.select('#gamma', '8');
+    await page.select('#sampling', 'one');
+    await page.waitForFunction(() => JSON.stringify(window.playground.settings) === JSON.stringify({ scalar: 'f32', dither: 'blue-noise', lines: false, gamma: 8, sampling: 'one', turn: 0 }));
+    const other = ['--scalar', 'f32', '--sampling', 'one', '--dither', 'blue-noise', '--no-outline', '--gamma', '8'];
+    const wantOther = hostFrame(o.hostSim, 'desk', other, work);
+    const gotOther = await readCanvas(page, 'panel');
+    check(differing(gotOther, wantOther) === 0, `desk: the panel equals host-sim render ${other.join(' ')} (${differing(gotOther, wantOther)} pixels differ)`);
+    await page.click('#pico-settings');
+
+    // A mistake typed into the editor.
+    await page.$eval('#text', (t) => { t.value = ''; });
+    await page.type('#text', 'camera eye 0 0 -4\nlight directional dir -1 -1 1\nsphere radius -1\n');
+    await page.waitForFunction(() => window.playground.error?.message.includes('positive'), { timeout: 10000 }).catch(() => {});
+    const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
+    const at = await page.evaluate(() => window.playground.error && [window.playground.error.line, window.playground.error.col]);
+    check(shown.startsWith('line 3, column 15') && shown.includes('size must be positive') && at?.join(':') === '3:15', `a typed mistake shows where: "${shown}"`);
+    await page.select('#scene', 'chair');
+    await page.waitForFunction(() => window.playground.error === null);
+
+    // The Pico image's first frame (the chair, the Pico's settings).
+    await page.waitForFunction(() => window.playground.board.frames.length > 0 || window.playground.board.ended, { timeout: BOARD_TIMEOUT_MS, polling: 500 });
+    const board = await page.evaluate(() => window.playground.board);
+    const secs = ((Date.now() - boardStart) / 1000).toFixed(0);
+    if (board.frames.length === 0) {
+      check(false, `the Pico image showed no frame: ${board.status}`);
+    } else {
+      const f = board.frames[0];
+      const want = hostFrame(o.hostSim, f.scene, pico, work);
+      const canvas = await readCanvas(page, 'board-panel');
+      check(f.scene === 'chair' && differing(f.pixels, want) === 0, `the Pico image's first frame (${f.scene}, ${(f.cycles / 1e6).toFixed(1)} M cycles, shown after ${secs} s in the page) equals host-sim's (${differing(f.pixels, want)} pixels differ)`);
+      check(differing(canvas, f.pixels) === 0, 'the board canvas shows the frame the emulated panel showed');
+    }
+    check(problems.length === 0, `no uncaught errors in the page${problems.length ? ': ' + problems.join('; ') : ''}`);
+    if (o.screenshot) {
+      const tmp = `${o.screenshot}.partial.png`;
+      await page.screenshot({ path: tmp, fullPage: true });
+      renameSync(tmp, o.screenshot);
+      console.log(`wrote ${o.screenshot}`);
+    }
+  } finally {
+    await browser.close();
+    server.close();
+    rmSync(work, { recursive: true, force: true });
+  }
+  if (failures) throw new Error(`${failures} checks failed`);
+  console.log('playground: every check passed');
+}
+
+main().catch((e) => {
+  console.error(`playground test: ${e.message ?? e}`);
+  process.exit(1);
+});

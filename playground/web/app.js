@@ -1,0 +1,206 @@
+// The playground page: the scene editor, the panel the core renders (WebAssembly, built from
+// playground/src/lib.rs) and the exact Pico image on an emulated RP2040 (board-worker.js).
+// `window.playground` holds what the browser test (playground/test.mjs) reads.
+import init, { panel, scene_names, scene_text, default_settings } from './pkg/playground.js';
+
+const W = 128;
+const H = 64;
+const $ = (id) => document.getElementById(id);
+const state = { settings: null, bits: null, report: null, error: null, renderMs: null, firstPanelMs: null, board: { frames: [], status: 'not started' } };
+window.playground = state;
+
+/** Draws a packed 1-bit frame (16 bytes a row, MSB first, 1 lit) on a 128x64 canvas. */
+function draw(canvas, bits) {
+  const ctx = canvas.getContext('2d');
+  const img = ctx.createImageData(W, H);
+  for (let y = 0; y < H; y++) {
+    for (let x = 0; x < W; x++) {
+      const on = (bits[y * (W / 8) + (x >> 3)] >> (7 - (x & 7))) & 1;
+      const i = (y * W + x) * 4;
+      img.data[i] = on ? 235 : 0;
+      img.data[i + 1] = on ? 242 : 0;
+      img.data[i + 2] = on ? 255 : 0;
+      img.data[i + 3] = 255;
+    }
+  }
+  ctx.putImageData(img, 0, 0);
+}
+
+function settings() {
+  return {
+    scalar: $('scalar').value,
+    dither: $('dither').value,
+    lines: $('lines').checked,
+    gamma: Number($('gamma').value),
+    sampling: $('sampling').value,
+    turn: Number($('orbit').value) / 36,
+  };
+}
+
+function applySettings(s) {
+  $('scalar').value = s.scalar;
+  $('dither').value = s.dither;
+  $('lines').checked = s.lines;
+  $('gamma').value = String(s.gamma);
+  $('sampling').value = s.sampling;
+  $('orbit').value = String(Math.round(s.turn * 36));
+}
+
+const fmt = (n) => n.toLocaleString('en-US');
+
+/** Estimated instructions on the Pico's Cortex-M0+ (cost.json: per ray and per object test, fitted to the firmware report). */
+function boardCost(cost, r) {
+  if (!cost) return 'unknown (cost.json missing)';
+  const rays = r.rays.reduce((a, b) => a + b, 0);
+  const instr = rays * cost.perRay + r.objectTests * cost.perTest;
+  return `≈ ${(instr / 1e6).toFixed(1)} M instructions on its Cortex-M0+ (${fmt(Math.round(cost.perRay))} per ray and ${fmt(Math.round(cost.perTest))} per object test, ${cost.source})`;
+}
+
+function showReport(r, ms, cost) {
+  const rays = r.rays.reduce((a, b) => a + b, 0);
+  const rows = [
+    ['objects', `${r.objects} (${r.composites} composites), ${r.lights} lights`],
+    ['effects the scene calls for', r.effects],
+    ['lattices (cells per axis)', r.lattices.map((n, i) => `${i === 0 ? 'world' : 'sub ' + (i - 1)} ${n.join('×')}`).join(', ')],
+    ['cells, references', `${fmt(r.cells)}, ${fmt(r.references)}`],
+    ['lattice bytes', `${fmt(r.bytes)} (${r.scalar})`],
+    ['rays', `${fmt(rays)}: eye ${fmt(r.rays[0])}, shadow ${fmt(r.rays[1])}, reflection ${fmt(r.rays[2])}, refraction ${fmt(r.rays[3])}`],
+    ['object tests per ray', (r.objectTests / Math.max(rays, 1)).toFixed(2) + ` (${fmt(r.objectTests)} tests, ${fmt(r.culled)} skipped by eye windows)`],
+    ['cells visited per ray', (r.cellsVisited / Math.max(rays, 1)).toFixed(2)],
+    ['on the Pico', boardCost(cost, r)],
+    ['in this page', `${ms.toFixed(1)} ms`],
+  ];
+  const body = $('report').tBodies[0];
+  body.replaceChildren(...rows.map(([k, v]) => {
+    const tr = document.createElement('tr');
+    for (const t of [k, v]) {
+      const td = document.createElement('td');
+      td.textContent = t;
+      tr.append(td);
+    }
+    return tr;
+  }));
+}
+
+function showError(e) {
+  const box = $('error');
+  if (!e) {
+    box.hidden = true;
+    box.textContent = '';
+    return;
+  }
+  box.hidden = false;
+  // The core's message says the line and column, as host-sim's does.
+  box.textContent = e.message;
+}
+
+/** Selects line `line` of the editor (where a mistake is). */
+function selectLine(line) {
+  const t = $('text');
+  const lines = t.value.split('\n');
+  const start = lines.slice(0, line - 1).reduce((n, l) => n + l.length + 1, 0);
+  t.focus();
+  t.setSelectionRange(start, start + (lines[line - 1] ?? '').length);
+}
+
+function rerender(cost) {
+  const s = settings();
+  $('orbit-at').textContent = `${$('orbit').value} / 36`;
+  const t0 = performance.now();
+  try {
+    const p = panel($('text').value, s.scalar, s.dither, s.lines, s.gamma, s.sampling, s.turn);
+    const ms = performance.now() - t0;
+    state.bits = p.bits();
+    state.report = JSON.parse(p.report());
+    state.error = null;
+    state.renderMs = ms;
+    state.settings = s;
+    p.free();
+    draw($('panel'), state.bits);
+    showReport(state.report, ms, cost);
+    showError(null);
+  } catch (err) {
+    // A scene's mistake (ScriptError) keeps the last good panel on screen.
+    state.error = typeof err.message === 'function' ? { line: err.line(), col: err.col(), message: err.message() } : { line: 0, col: 0, message: String(err) };
+    showError(state.error);
+  }
+  if (state.firstPanelMs === null && state.bits) state.firstPanelMs = performance.now();
+}
+
+function startBoard(info) {
+  const status = $('board-status');
+  $('run-board').disabled = true;
+  state.board = { frames: [], status: 'loading' };
+  const worker = new Worker('board-worker.js');
+  Promise.all([info.uf2, info.bootrom].map((f) => fetch(f).then((r) => {
+    if (!r.ok) throw new Error(`${f}: ${r.status}`);
+    return r.arrayBuffer();
+  }))).then(([uf2, bootrom]) => {
+    worker.postMessage({ uf2, bootrom, frames: info.scenes.length });
+  }, (e) => {
+    state.board.status = `cannot load the image: ${e.message}`;
+    status.textContent = state.board.status;
+  });
+  const t0 = performance.now();
+  worker.onmessage = ({ data: m }) => {
+    const secs = ((performance.now() - t0) / 1e3).toFixed(1);
+    if (m.kind === 'panel') {
+      if (m.pixels) draw($('board-panel'), m.pixels);
+      state.board.status = `running: ${fmt(m.cycles)} cycles, ${m.ms.toFixed(1)} ms of board time (${secs} s in this page), ${m.frames} frames shown`;
+    } else if (m.kind === 'frame') {
+      const scene = info.scenes[m.index] ?? `frame ${m.index}`;
+      state.board.frames.push({ scene, pixels: Array.from(m.pixels), cycles: m.cycles });
+      draw($('board-panel'), m.pixels);
+      state.board.last = `${scene}: ${fmt(m.cycles)} cycles, ${(125e6 / m.cycles).toFixed(2)} frames per second at 125 MHz`;
+    } else if (m.kind === 'end') {
+      state.board.status = `${m.ok ? 'done' : 'stopped'}: ${m.reason}`;
+      state.board.ended = true;
+      $('run-board').disabled = false;
+      worker.terminate();
+    }
+    status.textContent = state.board.status + (state.board.last ? ` — last frame ${state.board.last}` : '');
+  };
+}
+
+async function main() {
+  await init();
+  const [info, cost] = await Promise.all([
+    fetch('board.json').then((r) => r.json()),
+    fetch('cost.json').then((r) => (r.ok ? r.json() : null)).catch(() => null),
+  ]);
+  const defaults = JSON.parse(default_settings());
+  for (const d of defaults.dithers.split(',')) $('dither').append(new Option(d, d));
+  for (const n of scene_names().split(',')) $('scene').append(new Option(n, n));
+  applySettings(defaults);
+  $('text').value = scene_text($('scene').value);
+  $('board-scenes').textContent = info.scenes.join(', ');
+  const go = () => rerender(cost);
+  // Redraw as the user types, once per animation frame at most.
+  let pending = false;
+  const soon = () => {
+    if (pending) return;
+    pending = true;
+    requestAnimationFrame(() => {
+      pending = false;
+      go();
+    });
+  };
+  $('text').addEventListener('input', soon);
+  for (const id of ['dither', 'lines', 'gamma', 'scalar', 'sampling', 'orbit']) $(id).addEventListener('input', soon);
+  $('scene').addEventListener('change', () => {
+    $('text').value = scene_text($('scene').value);
+    go();
+  });
+  $('pico-settings').addEventListener('click', () => {
+    applySettings(defaults);
+    go();
+  });
+  $('error').addEventListener('click', () => state.error?.line && selectLine(state.error.line));
+  $('run-board').addEventListener('click', () => startBoard(info));
+  go();
+}
+
+state.ready = main().catch((e) => {
+  showError({ line: 0, col: 0, message: `the playground did not start: ${e.message ?? e}` });
+  throw e;
+});
