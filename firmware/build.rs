@@ -68,7 +68,15 @@ fn main() {
     let mut list = String::new();
     let mut sizes = Sizes { objects: 1, lattices: 1, coords: 1, words: 1, rows: 0 };
     let mut effects = 0u8;
-    let baked = env::var_os("CARGO_FEATURE_BAKED").is_some();
+    // Baked scenes: asked for (`baked`), or the Raspberry Pi boards' default: their frames are
+    // shown from the scenes' own cameras, so nothing needs parsing on the board, unless the
+    // camera moves (`orbit`) or run-time parsing is asked for (`parse`).
+    let has = |f: &str| env::var_os(format!("CARGO_FEATURE_{f}")).is_some();
+    let baked = has("BAKED") || (has("RP") && !has("ORBIT") && !has("PARSE"));
+    println!("cargo::rustc-check-cfg=cfg(baked_scenes)");
+    if baked {
+        println!("cargo:rustc-cfg=baked_scenes");
+    }
     let mut tables = String::new();
     for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));

@@ -6,12 +6,12 @@ use embedded_graphics_core::geometry::Dimensions;
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-#[cfg(not(feature = "baked"))]
+#[cfg(not(baked_scenes))]
 use lattice_rt::lattice::LatticeError;
-#[cfg(not(feature = "baked"))]
+#[cfg(not(baked_scenes))]
 use lattice_rt::scene::text::ParseError;
 use lattice_rt::render::{Hooks, RenderError};
-#[cfg(not(feature = "baked"))]
+#[cfg(not(baked_scenes))]
 use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::dither::{Carry, Ditherer};
@@ -56,8 +56,9 @@ pub type Scalar = f32;
 // SCENES and the capacities, computed by build.rs from the scenes chosen for this build.
 include!(concat!(env!("OUT_DIR"), "/capacities.rs"));
 
-/// The embedded scenes baked into flash (the `baked` feature): tables `build.rs` wrote.
-#[cfg(feature = "baked")]
+/// The embedded scenes baked into flash (the `baked` feature, and the Raspberry Pi boards'
+/// default): tables `build.rs` wrote.
+#[cfg(baked_scenes)]
 pub mod baked {
     use lattice_rt::bake::prelude::*;
     /// The scalar of the tables.
@@ -65,10 +66,8 @@ pub mod baked {
     include!(concat!(env!("OUT_DIR"), "/baked.rs"));
 }
 
-#[cfg(all(feature = "baked", feature = "orbit"))]
+#[cfg(all(baked_scenes, feature = "orbit"))]
 compile_error!("the `baked` scenes are shown from their own cameras: `orbit` needs run-time set-up");
-#[cfg(all(feature = "baked", feature = "rp"))]
-compile_error!("`baked` is for the `qemu` binary (the emulated boards and the micro:bit) so far; the Raspberry Pi boards parse their scenes");
 
 /// All memory a frame of any embedded scene needs, with the capacities build.rs computed.
 pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_LATTICES, MAX_COORDS, MAX_WORDS, MAX_ROWS>;
@@ -78,15 +77,15 @@ pub type Storage<R> = lattice_rt::Storage<R, MAX_OBJECTS, MAX_LATTICES, MAX_COOR
 pub enum AppError<'t, E> {
     /// The scene text is invalid or exceeds the object capacity (not in a `baked` build, which
     /// parses nothing: the variant and its messages stay out of its flash).
-    #[cfg(not(feature = "baked"))]
+    #[cfg(not(baked_scenes))]
     Parse(ParseError<'t>),
     /// The lattice exceeds a compiled capacity.
-    #[cfg(not(feature = "baked"))]
+    #[cfg(not(baked_scenes))]
     Lattice(LatticeError),
     /// The scene needs an effect this build leaves out.
     Effects(MissingEffects),
     /// Only a `baked` build borrows the scene text: the lifetime `'t` of the other builds.
-    #[cfg(feature = "baked")]
+    #[cfg(baked_scenes)]
     #[doc(hidden)]
     Text(core::marker::PhantomData<&'t str>),
     /// A baked scene is shown from its own camera only.
@@ -98,11 +97,11 @@ pub enum AppError<'t, E> {
 impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            #[cfg(not(feature = "baked"))]
+            #[cfg(not(baked_scenes))]
             AppError::Parse(e) => write!(f, "scene: {e}"),
-            #[cfg(not(feature = "baked"))]
+            #[cfg(not(baked_scenes))]
             AppError::Lattice(e) => write!(f, "{e}"),
-            #[cfg(feature = "baked")]
+            #[cfg(baked_scenes)]
             AppError::Text(_) => Ok(()),
             AppError::Effects(e) => write!(f, "{e}"),
             AppError::BakedCamera => write!(f, "a baked scene is shown from its own camera only"),
@@ -117,11 +116,11 @@ impl<E: fmt::Debug> fmt::Display for AppError<'_, E> {
 impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
     fn format(&self, f: defmt::Formatter<'_>) {
         match self {
-            #[cfg(not(feature = "baked"))]
+            #[cfg(not(baked_scenes))]
             AppError::Parse(e) => defmt::write!(f, "scene: {}", e),
-            #[cfg(not(feature = "baked"))]
+            #[cfg(not(baked_scenes))]
             AppError::Lattice(e) => defmt::write!(f, "{}", e),
-            #[cfg(feature = "baked")]
+            #[cfg(baked_scenes)]
             AppError::Text(_) => {}
             AppError::Effects(e) => defmt::write!(f, "{}", e),
             AppError::BakedCamera => defmt::write!(f, "a baked scene is shown from its own camera only"),
@@ -168,7 +167,7 @@ pub const TRACED: usize = if cfg!(feature = "progressive") {
 };
 
 /// Parses `text`, builds its lattice and renders [`RENDERED`] into `target`, tile by tile.
-#[cfg(not(feature = "baked"))]
+#[cfg(not(baked_scenes))]
 pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     text: &'t str,
     st: &mut Storage<R>,
@@ -298,7 +297,7 @@ impl Default for ShareMemory {
 /// finishes them, one tile at a time under the board's critical section (a one-core board draws
 /// both shares, one after the other). The board's clock times each share. The frame is shown in [`PASSES`]; the board's `shown` is
 /// called with each pass once it is on `target`.
-#[cfg(not(feature = "baked"))]
+#[cfg(not(baked_scenes))]
 pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     text: &'t str,
     st: &mut Storage<R>,
@@ -349,6 +348,44 @@ pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Se
     }
     let scratch = lattice_rt::Scratch::new(&mut memory.mailbox[..], &mut memory.rows[..]);
     render_loaded(&baked.scene, &baked.lattice, scratch, target, hooks, shot, board)
+}
+
+/// An embedded scene as this build holds it: its text, parsed and set up for every frame.
+#[cfg(not(baked_scenes))]
+pub type Embedded = &'static str;
+/// An embedded scene as this build holds it: its tables baked into flash.
+#[cfg(baked_scenes)]
+pub type Embedded = &'static lattice_rt::Baked<Scalar>;
+
+/// The memory a frame of an [`Embedded`] scene needs: the storage a scene is parsed and its
+/// lattice built in.
+#[cfg(not(baked_scenes))]
+pub type SceneMemory = Storage<Scalar>;
+/// The memory a frame of an [`Embedded`] scene needs: the render's query scratch.
+#[cfg(baked_scenes)]
+pub type SceneMemory = BakedMemory;
+
+/// The embedded scenes by name, as this build holds them.
+#[cfg(not(baked_scenes))]
+pub const EMBEDDED: [(&str, Embedded); SCENES.len()] = SCENES;
+/// The embedded scenes by name, as this build holds them.
+#[cfg(baked_scenes)]
+pub static EMBEDDED: [(&str, Embedded); SCENES.len()] = baked::BAKED;
+
+/// A frame of an embedded scene: [`render_scene_at`] for its text, or [`render_baked_at`] for
+/// its tables.
+pub fn render_embedded_at<D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+    scene: Embedded,
+    memory: &mut SceneMemory,
+    target: &mut D,
+    hooks: &mut impl Hooks,
+    shot: &Shot,
+    board: Board<'_, impl Cores>,
+) -> Result<Report, AppError<'static, D::Error>> {
+    #[cfg(not(baked_scenes))]
+    return render_scene_at(scene, memory, target, hooks, shot, board);
+    #[cfg(baked_scenes)]
+    return render_baked_at(scene, memory, target, hooks, shot, board);
 }
 
 /// The frame of a scene loaded or baked: its tracer, then every pass of both tile shares.
@@ -604,7 +641,7 @@ impl<D: DrawTarget<Color = BinaryColor>> DrawTarget for &Shared<'_, D> {
     }
 }
 
-#[cfg(not(feature = "baked"))]
+#[cfg(not(baked_scenes))]
 impl<'t, E> From<LoadError<'t>> for AppError<'t, E> {
     fn from(e: LoadError<'t>) -> Self {
         match e {

@@ -47,6 +47,7 @@ const MODELS: &[(&str, &[&str])] = &[
 const LEVERS: &[(&str, &str)] = &[
     ("code-in-flash", "the code in flash, behind the 16 KiB XIP cache (the default image runs its hot code from SRAM)"),
     ("i2c-1mhz", "the display's bus at 1 MHz (fast mode plus) instead of 400 kHz"),
+    ("parse", "the scene parsed and its lattice built on the board every frame (the default image bakes them into flash at build time)"),
 ];
 
 /// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).
@@ -893,12 +894,14 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
     writeln!(md, "and requires every frame the panel shows to be bit-identical to host-sim's render of the scene")?;
     writeln!(md, "(128x64, fixed point, Floyd-Steinberg error diffusion with silhouette lines, `board_frame::rendered`):")?;
     writeln!(md, "the two cores take the tiles one at a time as they come free, and core 0 dithers each band of tiles")?;
-    writeln!(md, "in order once all its tiles are traced, then sends it (trace, then dither). Every")?;
+    writeln!(md, "in order once all its tiles are traced, then sends it (trace, then dither). The scenes are baked")?;
+    writeln!(md, "into flash at build time (each parsed and its lattice built by `firmware/build.rs`, in fixed point as")?;
+    writeln!(md, "the board would), so a frame starts tracing at once; the `parse` image below does that on the board. Every")?;
     writeln!(md, "figure below is what the emulated board ran; none is computed. Scenes embedded: {}.\n", scenes.join(", "))?;
     writeln!(md, "## Per frame\n")?;
     writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;
-    writeln!(md, "frame on the panel: parsing the scene and building its lattice (*set-up*, core 0 alone, up to the")?;
-    writeln!(md, "first byte of the first tile on the bus, so here the first band's tracing too), then both cores tracing tiles and core 0")?;
+    writeln!(md, "frame on the panel: *set-up* is the time up to the first byte of the first tile on the bus (the")?;
+    writeln!(md, "tracer's set-up and the first band's tracing on both cores), then both cores tracing tiles and core 0")?;
     writeln!(md, "dithering and sending every band. *Busy* is cycles a core ran instructions (waiting for the bus or the other")?;
     writeln!(md, "core in a loop included), *idle* cycles it slept (`wfe`). *Misses* are flash reads that missed")?;
     writeln!(md, "the XIP cache ({} cycles each, queued when both cores miss); *bus* is the time the I2C bus was busy", s.xip_miss_cycles)?;

@@ -138,7 +138,7 @@ fn variants() -> Vec<Variant> {
         machine: None,
         scenes: None,
         scalar: "fixed",
-        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes (run on an emulated board by `cargo xtask board`: docs/board.md)".into(),
+        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes baked (run on an emulated board by `cargo xtask board`: docs/board.md)".into(),
     });
     v.push(Variant {
         name: "pico2".into(),
@@ -149,7 +149,7 @@ fn variants() -> Vec<Variant> {
         machine: None,
         scenes: None,
         scalar: "f32",
-        what: "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32)".into(),
+        what: "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes baked (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32)".into(),
     });
     v
 }

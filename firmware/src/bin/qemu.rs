@@ -17,9 +17,7 @@ use cortex_m::interrupt::{free, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln};
-use firmware::app::{Board, OneCore, Scalar, ShareMemory, Shot, FRAME};
-#[cfg(not(feature = "baked"))]
-use firmware::app::{render_scene_at, Storage, SCENES};
+use firmware::app::{render_embedded_at, Board, OneCore, Scalar, SceneMemory, ShareMemory, Shot, EMBEDDED, FRAME};
 use firmware::stack;
 use lattice_rt::{BitFrame, NoHooks};
 
@@ -77,28 +75,16 @@ fn main() -> ! {
     let t0 = ticks();
     spin(CALIBRATE_INSTRUCTIONS / 2);
     hprintln!("CALIBRATE instructions {} ticks {}", CALIBRATE_INSTRUCTIONS, ticks() - t0);
-    // One statement each: built in a tuple, the storage would be made twice on the stack.
-    #[cfg(not(feature = "baked"))]
-    let mut st = Storage::<Scalar>::new();
-    #[cfg(not(feature = "baked"))]
-    let scenes = SCENES;
-    #[cfg(feature = "baked")]
-    let mut st = firmware::app::BakedMemory::new();
-    #[cfg(feature = "baked")]
-    let scenes = firmware::app::baked::BAKED;
+    let mut st = SceneMemory::new();
     let mut second = ShareMemory::new();
     let mut bits = [0u8; BitFrame::bytes(FRAME.width as u32, FRAME.height as u32)];
     let mut failed = false;
-    for (name, scene) in scenes {
+    for (name, scene) in EMBEDDED.iter().copied() {
         let mut frame = BitFrame::new(FRAME.width as u32, FRAME.height as u32, &mut bits).unwrap();
         let t0 = ticks();
         let shot = Shot::default();
         let board = Board { cores: &mut OneCore, second: &mut second, now: &ticks, shown: &mut |_| {} };
-        #[cfg(not(feature = "baked"))]
-        let shown = render_scene_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, board);
-        #[cfg(feature = "baked")]
-        let shown = firmware::app::render_baked_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, board);
-        match shown {
+        match render_embedded_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, board) {
             Ok(r) => {
                 let t = ticks() - t0;
                 let s = r.stats;

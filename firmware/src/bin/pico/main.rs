@@ -25,7 +25,7 @@ mod sleep;
 mod wiring;
 
 use defmt_rtt as _;
-use firmware::app::{ShareMemory, Storage, HEIGHT, SCENES, WIDTH};
+use firmware::app::{SceneMemory, ShareMemory, HEIGHT, SCENES, WIDTH};
 use hal::pac;
 use hal::Clock;
 use panic_probe as _;
@@ -116,7 +116,7 @@ fn main() -> ! {
         "lattice-rt on the {}: {} scenes, {}x{}, {} MHz, I2C at {} kHz, both cores",
         BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz(), Wiring::I2C_HZ / 1000
     );
-    let mut st = Storage::new();
+    let mut st = SceneMemory::new();
     // The second share's memory (with what trace, then dither keeps of every tile: 24 KiB) is a
     // static, counted in the image's RAM, not on core 0's stack.
     let Some(second) = cortex_m::singleton!(: ShareMemory = ShareMemory::new()) else {

@@ -6,9 +6,9 @@ use crate::cores::TwoCores;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_hal::digital::OutputPin;
-use firmware::app::{render_scene_at, AppError, Board, Report, Scalar, ShareMemory, Shot, Storage};
+use firmware::app::{render_embedded_at, AppError, Board, Embedded, Report, SceneMemory, ShareMemory, Shot};
 #[cfg(not(feature = "ladder"))]
-use firmware::app::SCENES;
+use firmware::app::EMBEDDED;
 #[cfg(not(feature = "ladder"))]
 use firmware::stack;
 use display_interface::DisplayError;
@@ -60,8 +60,9 @@ pub struct Panel<'m, T, L> {
     pub alarm: Alarm0,
     /// Core 1, which traces the second tile share of every frame.
     pub cores: TwoCores,
-    /// The scene, its lattice and core 0's scratch.
-    pub st: &'m mut Storage<Scalar>,
+    /// Core 0's memory for a frame: the scene and its lattice when they are parsed and built at
+    /// run time, and its scratch.
+    pub st: &'m mut SceneMemory,
     /// Core 1's scratch and 1-bit frame.
     pub second: &'m mut ShareMemory,
 }
@@ -70,7 +71,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
     /// One frame, with the LED lit while it renders; its report and microseconds. A progressive
     /// frame (the `progressive` feature) puts the LED out for a moment as each pass but the last
     /// reaches the display, so the LED goes out once per picture the panel shows.
-    pub fn show(&mut self, text: &'static str, shot: &Shot) -> Result<(Report, u64), AppError<'static, T::Error>> {
+    pub fn show(&mut self, scene: Embedded, shot: &Shot) -> Result<(Report, u64), AppError<'static, T::Error>> {
         let timer = self.timer;
         let t0 = timer.get_counter();
         let _ = self.led.set_high();
@@ -84,7 +85,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         };
         let now = || timer.get_counter().ticks();
         let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut shown };
-        let result = render_scene_at(text, self.st, &mut self.target, &mut NoHooks, shot, board);
+        let result = render_embedded_at(scene, self.st, &mut self.target, &mut NoHooks, shot, board);
         // The frame is on the panel once the bus has sent its last queued byte.
         let sent = crate::display::flush();
         let _ = self.led.set_low();
@@ -102,8 +103,8 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
 #[cfg(not(any(feature = "orbit", feature = "ladder")))]
 pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     loop {
-        for (i, (name, text)) in SCENES.iter().enumerate() {
-            match panel.show(text, &Shot::default()) {
+        for (i, (name, scene)) in EMBEDDED.iter().copied().enumerate() {
+            match panel.show(scene, &Shot::default()) {
                 Ok((r, us)) => {
                     report(Record::Frame(frame_done(i, &r, us)));
                     let (s, shares) = (r.stats, r.share_us);
@@ -128,7 +129,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
 pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     use firmware::app::ORBIT_FRAMES;
     loop {
-        for (scene, (name, text)) in SCENES.iter().enumerate() {
+        for (scene, (name, text)) in EMBEDDED.iter().copied().enumerate() {
             let t0 = panel.timer.get_counter();
             for i in 0..ORBIT_FRAMES {
                 let shot = Shot { turn: i as f64 / ORBIT_FRAMES as f64, ..Shot::default() };
@@ -152,9 +153,9 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
 /// The ladder: the first scene once per rung, from the paper's method to the default.
 #[cfg(feature = "ladder")]
 pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
-    use firmware::app::{LADDER, SCENES};
+    use firmware::app::{EMBEDDED, LADDER};
     loop {
-        let (name, text) = SCENES[0];
+        let (name, text) = EMBEDDED[0];
         for (rung, (what, tuning)) in LADDER.iter().enumerate() {
             match panel.show(text, &Shot { turn: 0.0, tuning: *tuning }) {
                 Ok((r, us)) => {
