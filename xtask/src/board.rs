@@ -363,6 +363,9 @@ struct SceneRow {
     stack: Option<u64>,
     /// Eye rays the board reported for the frame (silhouette lines' rays included).
     eye_rays: Option<u64>,
+    /// Microseconds of the frame outside core 0's share of the tiles, by the board's timer:
+    /// the tracer's set-up before it, the wait for the last bytes on the bus after it.
+    outside_us: Option<u64>,
 }
 
 /// What the board reported for the frame of scene `index`.
@@ -506,8 +509,9 @@ impl<'a> Session<'a> {
             self.compare_scene(&name, &frame.pixels)?;
             let reported = reported_frame(&run.records, index);
             let (stack, eye_rays) = (reported.map(|f| u64::from(f.stack)), reported.map(|f| f.rays[0]));
+            let outside_us = reported.map(|f| f.us.saturating_sub(f.share_us[0]));
             self.checks.check(stack.is_some(), || format!("{name}: the board reported no frame record"));
-            rows.push(SceneRow { name, frame, stack, eye_rays });
+            rows.push(SceneRow { name, frame, stack, eye_rays, outside_us });
         }
         Ok((run, rows))
     }
@@ -905,9 +909,12 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
     writeln!(md, "dithering and sending every band. *Busy* is cycles a core ran instructions (waiting for the bus or the other")?;
     writeln!(md, "core in a loop included), *idle* cycles it slept (`wfe`). *Misses* are flash reads that missed")?;
     writeln!(md, "the XIP cache ({} cycles each, queued when both cores miss); *bus* is the time the I2C bus was busy", s.xip_miss_cycles)?;
-    writeln!(md, "({} cycles per SCL period, {:.1} kHz).\n", s.scl_period, s.clk_hz / s.scl_period.max(1) as f64 / 1e3)?;
-    writeln!(md, "| scene | cycles | frames per second at {mhz:.0} MHz | target | set-up | core 0 busy | core 1 busy / idle | instructions | XIP misses (stall) | I2C bytes | bus | stack high-water |")?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    writeln!(md, "({} cycles per SCL period, {:.1} kHz). *Outside the tiles* is the frame's time outside core 0's share", s.scl_period, s.clk_hz / s.scl_period.max(1) as f64 / 1e3)?;
+    writeln!(md, "of the tiles, as the board's own timer measured it (`FrameDone`: its frame time less its share's):")?;
+    writeln!(md, "the tracer's set-up (eye windows, the effect set) before the tiles and the wait for the last band's")?;
+    writeln!(md, "bytes on the bus after them.\n")?;
+    writeln!(md, "| scene | cycles | frames per second at {mhz:.0} MHz | target | set-up | outside the tiles | core 0 busy | core 1 busy / idle | instructions | XIP misses (stall) | I2C bytes | bus | stack high-water |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     for r in rows {
         let f = &r.frame;
         let target = TARGETS.iter().find(|t| t.0 == r.name).map_or("-".to_string(), |t| {
@@ -915,11 +922,12 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
         });
         writeln!(
             md,
-            "| {} | {} | {:.2} | {target} | {} | {} | {} / {} | {} | {} ({}) | {} | {} | {} |",
+            "| {} | {} | {:.2} | {target} | {} | {} | {} | {} / {} | {} | {} ({}) | {} | {} | {} |",
             r.name,
             m(f.cycles),
             s.clk_hz / f.cycles.max(1) as f64,
             m(f.setup_cycles),
+            r.outside_us.map_or("-".to_string(), |us| m((us as f64 * s.clk_hz / 1e6) as u64)),
             m(f.busy[0]),
             m(f.busy[1]),
             m(f.idle[1]),
