@@ -16,7 +16,6 @@ use lattice_rt::render::RenderError;
 #[cfg(any(feature = "ladder", not(feature = "orbit")))]
 use board_records::FrameDone;
 use board_records::{Channel, Record};
-use lattice_rt::NoHooks;
 
 /// The pause between two scenes.
 const PAUSE_MS: u32 = 3000;
@@ -85,7 +84,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         };
         let now = || timer.get_counter().ticks();
         let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut shown };
-        let result = render_embedded_at(scene, self.st, &mut self.target, &mut NoHooks, shot, board);
+        let result = render_embedded_at(scene, self.st, &mut self.target, &mut crate::display::Pump, shot, board);
         // The frame is on the panel once the bus has sent its last queued byte.
         let sent = crate::display::flush();
         let _ = self.led.set_low();
