@@ -163,7 +163,18 @@ impl<'c> Carry<'c> {
 
     /// Error-diffuses one tile at `(x0, y0)`, `w x h` levels in row-major order, into `out`.
     pub fn tile(&mut self, mode: Dither, x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
-        let (kernel, div) = if mode == Dither::Atkinson { ATKINSON } else { FLOYD_STEINBERG };
+        // Each kernel inlined as a constant: its weights unrolled and its divisor a shift, not
+        // a division call per neighbour (a Cortex-M0+ has no divide instruction).
+        if mode == Dither::Atkinson {
+            self.diffuse(ATKINSON, x0, w, h, levels, out);
+        } else {
+            self.diffuse(FLOYD_STEINBERG, x0, w, h, levels, out);
+        }
+    }
+
+    /// [`Carry::tile`] with one kernel.
+    #[inline(always)]
+    fn diffuse(&mut self, (kernel, div): Kernel, x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
         let mut acc = [[0i16; MAX_TILE]; MAX_TILE];
         // Gather what earlier tiles sent here.
         let inc = self.incoming;
