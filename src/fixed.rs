@@ -39,24 +39,18 @@ impl Sub for Fx {
 impl Mul for Fx {
     type Output = Fx;
     /// `|a| * |b|` from 16-bit halves with 32-bit multiplies only (a Cortex-M0+ has no
-    /// 32x32->64 multiply), rounded half away from zero, then signed; saturates.
+    /// 32x32->64 multiply), rounded half away from zero, then signed; saturates. The partial
+    /// products are summed in 64 bits (two instructions an add on a Cortex-M0+), so no step
+    /// needs an overflow check.
     #[inline]
     fn mul(self, o: Fx) -> Fx {
-        let neg = (self.0 < 0) != (o.0 < 0);
+        let neg = (self.0 ^ o.0) < 0;
         let (a, b) = (self.0.unsigned_abs(), o.0.unsigned_abs());
         let (ah, al, bh, bl) = (a >> 16, a & 0xFFFF, b >> 16, b & 0xFFFF);
-        // (a * b + 2^15) >> 16 = ah*bh << 16 + ah*bl + al*bh + (al*bl + 2^15) >> 16
-        let top = ah * bh;
-        let m = if top >= 1 << 15 {
-            None
-        } else {
-            (top << 16)
-                .checked_add(ah * bl)
-                .and_then(|v| v.checked_add(al * bh))
-                .and_then(|v| v.checked_add((al * bl + 0x8000) >> 16))
-                .filter(|&v| v <= i32::MAX as u32)
-        };
-        let m = m.unwrap_or(i32::MAX as u32) as i32;
+        // (a * b + 2^15) >> 16 = ah*bh << 16 + ah*bl + al*bh + (al*bl + 2^15) >> 16; each product
+        // fits 32 bits (ah, bh <= 2^15), and al*bl + 2^15 < 2^32.
+        let m = (u64::from(ah * bh) << 16) + u64::from(ah * bl) + u64::from(al * bh) + u64::from((al * bl + 0x8000) >> 16);
+        let m = if m > i32::MAX as u64 { i32::MAX } else { m as i32 };
         Fx(if neg { -m } else { m })
     }
 }
