@@ -194,6 +194,24 @@ impl Real for Fx {
         let mantissa = ((raw << lz) >> 20) & 0x7ff;
         (((31 - lz) << 11) | mantissa) as u16
     }
+    #[inline]
+    fn recip(self) -> Self {
+        // 2^32 / |b| rounded half away from zero, as `ONE / self` divides: 2^32 = q b + r from
+        // the one division of 2^32 - 1. |b| <= 2 saturates (and 1 / 0 is the largest value).
+        let b = self.0.unsigned_abs();
+        if b <= 2 {
+            return Fx::ONE / self;
+        }
+        let (mut q, mut r) = (u32::MAX / b, u32::MAX % b + 1);
+        if r == b {
+            (q, r) = (q + 1, 0);
+        }
+        if r >= b - r {
+            q += 1;
+        }
+        let q = q as i32;
+        Fx(if self.0 < 0 { -q } else { q })
+    }
     fn div_pow2(self, k: u32) -> Self {
         // Division rounds half away from zero: a rounded shift of the magnitude.
         let k = k.min(14);
@@ -316,6 +334,21 @@ mod tests {
             let q = q.min(i32::MAX as i64);
             let want = if (a < 0) != (b < 0) { -q } else { q } as i32;
             assert_eq!((Fx(a) / Fx(b)).0, want, "{a} / {b}");
+        }
+    }
+
+    #[test]
+    fn recip_is_one_divided_by() {
+        let mut x = 0x2468_ace1u64;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let b = ((x as i32) >> (x % 31) as i32).max(-i32::MAX);
+            assert_eq!(Fx(b).recip(), Fx::ONE / Fx(b), "1 / {b}");
+        }
+        for b in (-70_000..=70_000).chain([i32::MAX, -i32::MAX, i32::MAX - 1, 1 << 30, -(1 << 30), 3 << 20, 65_537 * 3]) {
+            assert_eq!(Fx(b).recip(), Fx::ONE / Fx(b), "1 / {b}");
         }
     }
 

@@ -61,8 +61,8 @@ impl<R: Real> Vec3<R> {
         if m == R::ZERO {
             return self;
         }
-        let v = self * (R::ONE / m);
-        v * (R::ONE / v.length())
+        let v = self * m.recip();
+        v * v.length().recip()
     }
     /// Largest absolute component.
     pub fn max_abs(self) -> R {
@@ -180,7 +180,7 @@ impl<R: Real> Aabb<R> {
                 }
                 continue;
             }
-            let inv = R::ONE / d;
+            let inv = d.recip();
             let (mut ta, mut tb) = ((lo - o) * inv, (hi - o) * inv);
             if ta > tb {
                 core::mem::swap(&mut ta, &mut tb);
