@@ -193,12 +193,23 @@ impl<'c> Carry<'c> {
         }
         self.right = [[0; 2]; MAX_TILE];
         let out_rows = 1 - inc;
+        // How far the kernel reaches left, right and down: a pixel whose reach stays inside the
+        // tile sends all its error to the tile's own accumulator.
+        let reach_left = kernel.iter().map(|k| -k.0).max().unwrap_or(0).max(0) as usize;
+        let reach_x = kernel.iter().map(|k| k.0).max().unwrap_or(0) as usize;
+        let reach_y = kernel.iter().map(|k| k.1).max().unwrap_or(0) as usize;
         for y in 0..h {
             for x in 0..w {
                 let v = levels[y * w + x] as i16 * SCALE + acc[y][x];
                 let on = v >= (LEVELS as i16 / 2) * SCALE;
                 out[y * w + x] = BinaryColor::from(on);
                 let err = v - if on { LEVELS as i16 * SCALE } else { 0 };
+                if x >= reach_left && x + reach_x < w && y + reach_y < h {
+                    for &(dx, dy, wgt) in kernel {
+                        acc[y + dy as usize][(x as isize + dx as isize) as usize] += err * wgt / div;
+                    }
+                    continue;
+                }
                 for &(dx, dy, wgt) in kernel {
                     let e = err * wgt / div;
                     let (tx, ty) = (x as isize + dx as isize, y + dy as usize);
