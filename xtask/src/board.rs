@@ -525,9 +525,17 @@ impl<'a> Session<'a> {
         // The panel's bits as a PBM, for `cargo xtask display`.
         with_panel(pixels, |frame| host_sim::output::write_pbm(frame, &dir.join(format!("{name}.pbm"))))?;
         let differ: u32 = want.iter().zip(pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
+        let (host, diff) = (dir.join(format!("{name}-host.png")), dir.join(format!("{name}-diff.png")));
         if want != pixels {
-            save_frame(&want, &dir.join(format!("{name}-host.png")))?;
-            save_frame(&diff_frame(&want, pixels), &dir.join(format!("{name}-diff.png")))?;
+            save_frame(&want, &host)?;
+            save_frame(&diff_frame(&want, pixels), &diff)?;
+        } else {
+            // A difference an earlier run saved is gone.
+            for stale in [host, diff] {
+                if stale.exists() {
+                    std::fs::remove_file(&stale).with_context(|| format!("cannot remove {}", stale.display()))?;
+                }
+            }
         }
         self.checks.check(want == pixels, || {
             let (all, dir) = (PANEL.0 * PANEL.1, dir.display());
