@@ -12,7 +12,7 @@ impl<R: Real> Lattice<'_, R> {
     /// ray enters, in order, without testing objects (for tests and statistics).
     pub fn walk_cells(&self, ray: &Ray<R>, tmin: R, tmax: R, mut visit: impl FnMut([usize; 3], R, R)) {
         let inv = Inverse::new(ray);
-        let Some((t0, t1)) = self.lattices[0].bounds.clip(ray, tmin, tmax) else { return };
+        let Some((t0, t1)) = self.lattices[0].bounds.padded(slack(ray)).clip(ray, tmin, tmax) else { return };
         let mut w = Walker::start(self, 0, ray, &inv, t0, t1);
         let mut enter = t0;
         loop {
@@ -26,7 +26,8 @@ impl<R: Real> Lattice<'_, R> {
     }
 
     pub(super) fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
-        let (t0, t1) = self.lattices[0].bounds.clip(ray, tmin, tmax)?;
+        let slack = slack(ray);
+        let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
         let inv = Inverse::new(ray);
         let mut best: Option<Hit<R>> = None;
@@ -49,7 +50,7 @@ impl<R: Real> Lattice<'_, R> {
                         let g = composite + 1;
                         let limit = reach(&best, tmax);
                         if depth < MAX_NESTING && q.first_visit(self.objects + composite) {
-                            if let Some((a, b)) = self.lattices[g].bounds.clip(ray, tmin, limit) {
+                            if let Some((a, b)) = self.lattices[g].bounds.padded(slack).clip(ray, tmin, limit) {
                                 stack[depth] = Some(Walker::start(self, g, ray, &inv, a, b));
                                 depth += 1;
                                 q.stats.cells_visited += 1;
@@ -69,6 +70,16 @@ impl<R: Real> Lattice<'_, R> {
         }
         best
     }
+}
+
+/// How much wider than its box a lattice is entered by `ray`. An object test rounds its hit's
+/// `t`, in fixed point to 2^-16 of the object's own scale, so a ray that grazes a box can hit an
+/// object inside it at a point a few units of `t` (each `|dir|` long) outside the box, which
+/// brute force would find and the walk would miss. Entering a little early or late is safe: the
+/// walk only chooses which objects are tested.
+#[inline]
+fn slack<R: Real>(ray: &Ray<R>) -> R {
+    ray.dir.max_abs() * R::pad_eps()
 }
 
 /// Which axes a ray steps along (a zero component, +0.0 or -0.0, never steps).
