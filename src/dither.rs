@@ -162,6 +162,9 @@ impl<'c> Carry<'c> {
     }
 
     /// Error-diffuses one tile at `(x0, y0)`, `w x h` levels in row-major order, into `out`.
+    /// Never inlined: its accumulators then take stack only while a tile is dithered, not for
+    /// the whole of its caller's render loop (the deepest stack is the tracer's, below it).
+    #[inline(never)]
     pub fn tile(&mut self, mode: Dither, x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
         // Each kernel inlined as a constant: its weights unrolled and its divisor a shift, not
         // a division call per neighbour (a Cortex-M0+ has no divide instruction).
