@@ -9,6 +9,14 @@ const $ = (id) => document.getElementById(id);
 const state = { settings: null, bits: null, report: null, error: null, renderMs: null, firstPanelMs: null, board: { frames: [], status: 'not started' } };
 window.playground = state;
 
+/** What a 128x64 canvas shows, as a packed 1-bit frame (a pixel is lit when it is bright). */
+function readBits(canvas) {
+  const data = canvas.getContext('2d').getImageData(0, 0, W, H).data;
+  const bits = new Array((W / 8) * H).fill(0);
+  for (let p = 0; p < W * H; p++) if (data[p * 4] > 127) bits[p >> 3] |= 0x80 >> (p & 7);
+  return bits;
+}
+
 /** Draws a packed 1-bit frame (16 bytes a row, MSB first, 1 lit) on a 128x64 canvas. */
 function draw(canvas, bits) {
   const ctx = canvas.getContext('2d');
@@ -149,8 +157,9 @@ function startBoard(info) {
       state.board.status = `running: ${fmt(m.cycles)} cycles, ${m.ms.toFixed(1)} ms of board time (${secs} s in this page), ${m.frames} frames shown`;
     } else if (m.kind === 'frame') {
       const scene = info.scenes[m.index] ?? `frame ${m.index}`;
-      state.board.frames.push({ scene, pixels: Array.from(m.pixels), cycles: m.cycles });
       draw($('board-panel'), m.pixels);
+      // What the canvas showed when the frame was done (the board goes straight on to the next).
+      state.board.frames.push({ scene, pixels: Array.from(m.pixels), cycles: m.cycles, canvas: readBits($('board-panel')) });
       state.board.last = `${scene}: ${fmt(m.cycles)} cycles, ${(125e6 / m.cycles).toFixed(2)} frames per second at 125 MHz`;
     } else if (m.kind === 'end') {
       state.board.status = `${m.ok ? 'done' : 'stopped'}: ${m.reason}`;
