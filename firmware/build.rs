@@ -20,9 +20,7 @@ use std::{env, fs, path::PathBuf};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
-    let pico = env::var_os("CARGO_FEATURE_PICO").is_some();
-    let pico2 = env::var_os("CARGO_FEATURE_PICO2").is_some();
-    let microbit = env::var_os("CARGO_FEATURE_MICROBIT").is_some();
+    let (pico, pico2, microbit) = (has("pico"), has("pico2"), has("microbit"));
     let target = env::var("TARGET").unwrap_or_default();
     let m33 = target.starts_with("thumbv8m");
     let src = match (pico, pico2, m33, microbit) {
@@ -45,7 +43,7 @@ fn main() {
     // flash behind the XIP cache (to measure what that costs). Its script comes before link.x,
     // so that its sections claim their input sections before link.x's `.text` can.
     println!("cargo:rerun-if-changed=pico/ram-code.x");
-    if pico && env::var_os("CARGO_FEATURE_CODE_IN_FLASH").is_none() {
+    if pico && !has("code-in-flash") {
         fs::copy("pico/ram-code.x", out.join("ram-code.x")).expect("ram-code.x");
         println!("cargo:rustc-link-arg-bins=-Tram-code.x");
         println!("cargo:rustc-cfg=ram_code");
@@ -71,8 +69,7 @@ fn main() {
     // Baked scenes: asked for (`baked`), or the Raspberry Pi boards' default: their frames are
     // shown from the scenes' own cameras, so nothing needs parsing on the board, unless the
     // camera moves (`orbit`) or run-time parsing is asked for (`parse`).
-    let has = |f: &str| env::var_os(format!("CARGO_FEATURE_{f}")).is_some();
-    let baked = has("BAKED") || (has("RP") && !has("ORBIT") && !has("PARSE"));
+    let baked = has("baked") || (has("rp") && !has("orbit") && !has("parse"));
     println!("cargo::rustc-check-cfg=cfg(baked_scenes)");
     if baked {
         println!("cargo:rustc-cfg=baked_scenes");
@@ -82,13 +79,12 @@ fn main() {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));
         println!("cargo:rerun-if-changed={}", path.display());
         let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
-        let feature = |f: &str| env::var_os(format!("CARGO_FEATURE_{f}")).is_some();
         let bake = baked.then_some((name, &mut tables));
-        let (s, e) = if feature("SCALAR_FIXED") {
+        let (s, e) = if has("scalar-fixed") {
             plan::<lattice_rt::Fx>(&path, &text, bake)
-        } else if feature("SCALAR_MICROMATH") {
+        } else if has("scalar-micromath") {
             plan::<lattice_rt::F32Micro>(&path, &text, bake)
-        } else if feature("SCALAR_MICROMATH_NEWTON") {
+        } else if has("scalar-micromath-newton") {
             plan::<lattice_rt::F32MicroNewton>(&path, &text, bake)
         } else {
             plan::<f32>(&path, &text, bake)
@@ -99,7 +95,7 @@ fn main() {
         writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
     }
     let count = list.lines().count();
-    if env::var_os("CARGO_FEATURE_EFFECTS_ALL").is_some() {
+    if has("effects-all") {
         effects = lattice_rt::Effects::ALL.bits();
     }
     let code = format!(
@@ -121,6 +117,11 @@ fn main() {
     }
 }
 
+/// Whether the firmware is built with Cargo feature `feature` (its name as in Cargo.toml).
+fn has(feature: &str) -> bool {
+    env::var_os(format!("CARGO_FEATURE_{}", feature.to_uppercase().replace('-', "_"))).is_some()
+}
+
 /// The static a baked scene's tables are named by.
 fn table_name(scene: &str) -> String {
     scene.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect()
@@ -134,7 +135,6 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&st
     let effects = lattice_rt::Effects::of(&scene).bits();
     let cfg = LatticeConfig::default();
     // The frame this build renders, from its features (as `app::RENDERED` has it).
-    let has = |f: &str| env::var_os(format!("CARGO_FEATURE_{}", f.to_uppercase().replace('-', "_"))).is_some();
     let sizes = Sizes::of(&scene, Some(&cfg), &frame::rendered(frame::Build::of(has)));
     if let Some((name, out)) = bake {
         let s = Lattice::plan(&scene, &cfg);
