@@ -116,37 +116,20 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     Ok(())
 }
 
-/// Least squares: the coefficients `c` that minimise the sum over `rows` of
-/// `(sum_i c[i] x[i] / y - 1)^2` (relative errors, so the large scene does not decide alone), by
-/// Gaussian elimination on the normal equations; `None` when the columns cannot be told apart.
-fn fit(rows: &[(Vec<f64>, f64)]) -> Option<Vec<f64>> {
-    let n = rows.first()?.0.len();
-    let mut m = vec![vec![0.0f64; n + 1]; n];
-    for (x, y) in rows {
-        for i in 0..n {
-            m[i][n] += x[i] / y;
-            for j in 0..n {
-                m[i][j] += x[i] * x[j] / (y * y);
-            }
-        }
+/// Least squares for two unknowns: the `[a, b]` that minimise the sum over `rows` of
+/// `((a x + b z) / y - 1)^2` (relative errors, so the large scene does not decide alone), from
+/// the 2x2 normal equations; `None` when the two columns cannot be told apart.
+fn fit(rows: &[([f64; 2], f64)]) -> Option<[f64; 2]> {
+    let (mut xx, mut xz, mut zz, mut x1, mut z1) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for ([x, z], y) in rows {
+        let (x, z) = (x / y, z / y);
+        (xx, xz, zz, x1, z1) = (xx + x * x, xz + x * z, zz + z * z, x1 + x, z1 + z);
     }
-    for c in 0..n {
-        let p = (c..n).max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()))?;
-        m.swap(c, p);
-        if m[c][c].abs() < 1e-12 * m.iter().map(|r| r[c].abs()).fold(0.0, f64::max).max(1e-300) {
-            return None;
-        }
-        let pivot = m[c].clone();
-        for (r, row) in m.iter_mut().enumerate() {
-            if r != c {
-                let k = row[c] / pivot[c];
-                for (x, p) in row.iter_mut().zip(&pivot).skip(c) {
-                    *x -= k * p;
-                }
-            }
-        }
+    let det = xx * zz - xz * xz;
+    if det.abs() <= 1e-12 * xx * zz {
+        return None;
     }
-    Some((0..n).map(|i| m[i][n] / m[i][i]).collect())
+    Some([(x1 * zz - z1 * xz) / det, (z1 * xx - x1 * xz) / det])
 }
 
 /// The board's cost model: instructions on the Pico's core per ray and per object test, the
@@ -167,7 +150,7 @@ fn cost_fit(root: &Path) -> Result<serde_json::Value> {
         let path = root.join(format!("scenes/{}.scene", f[0]));
         let text = host_sim::load::read(&path)?;
         let s = host_sim::run::render_text::<lattice_rt::Fx>(&path, &text, &board_records::frame::FRAME, |_| {})?.stats;
-        rows.push((vec![s.total_rays() as f64, s.object_tests as f64], instr));
+        rows.push(([s.total_rays() as f64, s.object_tests as f64], instr));
         names.push(f[0].to_string());
     }
     let coef = fit(&rows).with_context(|| format!("{}: the qemu-m0-fixed rows cannot tell rays from object tests apart (run cargo xtask firmware)", csv_path.display()))?;
