@@ -262,7 +262,7 @@ function main() {
       nextPoll = steps + 200000;
       rtt.poll();
       records?.poll();
-      for (const [i, c] of board.cores.entries()) if (c.IPSR === 3) board.stop ??= `HardFault on core ${i} at pc 0x${(c.PC >>> 0).toString(16)}`;
+      board.stop ??= board.fault();
       if (board.time > opt.maxCycles) board.stop ??= `no result within ${opt.maxCycles} cycles`;
       else if (display?.error) board.stop ??= `display: ${display.error}`;
       if (mcu.clock.nanos >= untilNanos && board.stop === null) {

@@ -491,6 +491,12 @@ export class SiliconBoard {
     this.stop ??= `core ${core} touched its stack guard at 0x${address.toString(16)} (pc 0x${(this.cores[core].PC >>> 0).toString(16)}): a stack overflow`;
   }
 
+  /** A HardFault on either core as a sentence (where it stopped), or null. */
+  fault() {
+    for (const [i, c] of this.cores.entries()) if (c.IPSR === 3) return `HardFault on core ${i} at pc 0x${(c.PC >>> 0).toString(16)}`;
+    return null;
+  }
+
   /** Whether core `i` can run an instruction now. */
   runnable(i) {
     return !this.held[i] && !this.cores[i].waiting && (i === 0 || this.dualCore);

@@ -50,7 +50,7 @@ function run({ uf2, bootrom, frames = 1 }) {
     for (let i = 0; i < CHUNK && board.stop === null; i++) {
       if (board.step() < 0 && !board.wake()) board.stop = 'both cores sleep with nothing to wake them';
     }
-    for (const [i, c] of board.cores.entries()) if (c.IPSR === 3) board.stop ??= `HardFault on core ${i}`;
+    board.stop ??= board.fault();
     if (display.error) board.stop ??= `display: ${display.error}`;
     postMessage({ kind: 'panel', pixels: display.everOn ? display.shown() : null, cycles: board.time, ms: ms(), frames: shown });
     if (board.stop === null) setTimeout(chunk, 0);
