@@ -300,13 +300,18 @@ mod tests {
         assert_eq!(Fx::from_f64(1e12), Fx::MAX);
     }
 
+    /// One step of the 64-bit xorshift generator the randomised tests draw their operands from.
+    fn xorshift(x: &mut u64) {
+        *x ^= *x << 13;
+        *x ^= *x >> 7;
+        *x ^= *x << 17;
+    }
+
     #[test]
     fn multiply_matches_the_wide_product_everywhere() {
         let mut x = 0x1234_5678u64;
         for _ in 0..100_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            xorshift(&mut x);
             let (a, b) = ((x as i32) >> (x % 17) as i32, ((x >> 32) as i32) >> ((x >> 40) % 19) as i32);
             let (a, b) = (a.max(-i32::MAX), b.max(-i32::MAX));
             let p = a as i64 * b as i64;
@@ -320,9 +325,7 @@ mod tests {
     fn divide_matches_the_wide_quotient_everywhere() {
         let mut x = 0x9876_5432u64;
         for _ in 0..100_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            xorshift(&mut x);
             let (a, b) = ((x as i32) >> (x % 23) as i32, ((x >> 32) as i32) >> ((x >> 40) % 29) as i32);
             let (a, b) = (a.max(-i32::MAX), b.max(-i32::MAX));
             if b == 0 {
@@ -341,9 +344,7 @@ mod tests {
     fn recip_is_one_divided_by() {
         let mut x = 0x2468_ace1u64;
         for _ in 0..200_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            xorshift(&mut x);
             let b = ((x as i32) >> (x % 31) as i32).max(-i32::MAX);
             assert_eq!(Fx(b).recip(), Fx::ONE / Fx(b), "1 / {b}");
         }
@@ -356,9 +357,7 @@ mod tests {
     fn div_pow2_is_the_division_by_the_power_of_two() {
         let mut x = 0x1234_5678u64;
         for _ in 0..20_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            xorshift(&mut x);
             let a = ((x as i32) >> (x % 31) as i32).max(-i32::MAX);
             for k in 0..=14 {
                 assert_eq!(Fx(a).div_pow2(k), Fx(a) / Fx::from_i32(1 << k), "{a} / 2^{k}");
