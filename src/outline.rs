@@ -6,7 +6,8 @@
 //! Pairs inside a tile use what the tile's eye rays returned ([`Hits`]: object and depth per
 //! pixel). Pairs split by the tile's left or top border compare with its **apron**: the column
 //! of pixels left of the tile and the row above it, found by hit-only eye rays (the nearest
-//! object and its distance, no shading) that the tile traces itself. A tile therefore needs
+//! object and its distance, no shading) that the tile traces itself (with adaptive sampling
+//! only where the neighbour tile traced a ray: `Sampler::side`). A tile therefore needs
 //! nothing from any other tile, so frames with an outline split into bands and tile shares (two
 //! cores) like any other; the pixel inside the tile gets the line of such a pair, so it stays
 //! unbroken. Pairs split by the right and bottom borders are the next tiles' apron pairs.

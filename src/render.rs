@@ -289,7 +289,9 @@ pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = B
 /// [`dither_band`]): its gray levels (tone curve and the silhouette lines inside it applied),
 /// and for the lines across its borders what its pixels hit (object and depth key) along its
 /// four sides: the left column and top row as sampled, and the right column and bottom row as
-/// the eye rays through their centres hit them (the apron of the tiles right of it and below).
+/// the apron of the tiles right of it and below takes them ([`Sampler::side`]: the eye rays
+/// through their centres, or with adaptive sampling the fill between two traced pixels that
+/// hit the same object).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct KeptTile {
     /// Gray levels, row-major, `tw * th` of them.
@@ -322,8 +324,8 @@ impl Default for KeptTile {
 /// frames whose dithering carries error from tile to tile (Floyd-Steinberg, Atkinson) can be
 /// traced in shares this way: the cores trace, and one dithers the finished bands in order.
 /// Silhouette lines across a tile's borders need no apron rays here: [`dither_band`] takes
-/// them from the neighbours' kept edges, which are exact (rays through the pixels' centres,
-/// traced again where sampling filled a pixel).
+/// them from the neighbours' kept edges (as [`Sampler::side`] gives them: the same apron
+/// [`render`] finds with its hit-only rays).
 ///
 /// `scratch` needs [`Frame::trace_scratch_len`] rows (no dither carries).
 pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
@@ -545,12 +547,14 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                     // sides kept here: no apron rays, only the right column's and bottom row's
                     // pixels that sampling did not trace through their centres.
                     let hit = |x: usize, y: usize| (hits.object[y * tw + x], hits.depth[y * tw + x]);
-                    let mut exact = |x: usize, y: usize| if sampler.exact(x, y, tw, th) { hit(x, y) } else { probe(x0 + x, y0 + y) };
-                    (0..th).for_each(|y| (sides.left[y], sides.right[y]) = (hit(0, y), exact(tw - 1, y)));
-                    (0..tw).for_each(|x| (sides.top[x], sides.bottom[x]) = (hit(x, 0), exact(x, th - 1)));
+                    let mut exact = |x: usize, y: usize| if sampler.exact(x, y, tw, th, &hits) { hit(x, y) } else { probe(x0 + x, y0 + y) };
+                    (0..th).for_each(|y| sides.left[y] = hit(0, y));
+                    (0..tw).for_each(|x| sides.top[x] = hit(x, 0));
+                    sampler.side(th, |y| exact(tw - 1, y), &mut sides.right);
+                    sampler.side(tw, |x| exact(x, th - 1), &mut sides.bottom);
                     crate::outline::tile(tw, th, &hits, Apron { left: None, up: None }, &mut levels[..tw * th]);
                 } else {
-                    outline_tile(Block { x0, y0, tw, th, t }, &mut probe, &hits, &mut levels[..tw * th]);
+                    outline_tile(Block { x0, y0, tw, th, t }, &sampler, &mut probe, &hits, &mut levels[..tw * th]);
                 }
             }
             match &mut out {
@@ -624,16 +628,17 @@ fn resolves<R: Real, E>(camera: &Camera<R>, frame: &Frame) -> Result<(), RenderE
     }
 }
 
-/// Silhouette lines on a tile's `levels`: its own `hits`, and the apron `probe` answers (what
-/// the eye rays through the column left of the tile and the row above it hit).
-fn outline_tile(at: Block, probe: &mut impl FnMut(usize, usize) -> (u16, u16), hits: &Hits, levels: &mut [u8]) {
+/// Silhouette lines on a tile's `levels`: its own `hits`, and its apron: the right column of
+/// the tile left of it and the bottom row of the tile above, as those tiles keep their sides
+/// ([`Sampler::side`]), from what `probe` answers (the eye ray through a pixel's centre).
+fn outline_tile(at: Block, sampler: &Sampler<'_>, probe: &mut impl FnMut(usize, usize) -> (u16, u16), hits: &Hits, levels: &mut [u8]) {
     let Block { x0, y0, tw, th, .. } = at;
     let (mut left, mut up) = ([(0u16, 0u16); MAX_TILE], [(0u16, 0u16); MAX_TILE]);
     if x0 > 0 {
-        (0..th).for_each(|y| left[y] = probe(x0 - 1, y0 + y));
+        sampler.side(th, |y| probe(x0 - 1, y0 + y), &mut left);
     }
     if y0 > 0 {
-        (0..tw).for_each(|x| up[x] = probe(x0 + x, y0 - 1));
+        sampler.side(tw, |x| probe(x0 + x, y0 - 1), &mut up);
     }
     let apron = Apron { left: (x0 > 0).then_some(&left[..th]), up: (y0 > 0).then_some(&up[..tw]) };
     crate::outline::tile(tw, th, hits, apron, levels);

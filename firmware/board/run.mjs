@@ -1,11 +1,14 @@
 #!/usr/bin/env node
 // Runs the Pico image a user flashes (its UF2 file) on an RP2040 as silicon runs it
-// (silicon.mjs: rp2040js with core 1, the XIP cache and a timed I2C bus), with the B1 bootrom
-// and an SSD1306 on I2C0 at 0x3C, and reports on stdout, one JSON object a line:
+// (silicon.mjs: rp2040js with core 1, the XIP cache and timed display buses), with the B1
+// bootrom and one SSD1306 wired both ways a module can be: on I2C0 at 0x3C, and on SPI0 with
+// chip select on GP17, data/command on GP20 and reset on GP21 (the `spi` build's wiring,
+// firmware/src/bin/pico/wiring.rs); the image drives whichever it was built for. It reports on
+// stdout, one JSON object a line:
 //   {"event":"frame", ...}  each frame the panel shows: the moment the board's LED (GP25, lit
 //                           while a frame is being rendered) goes out, with the cycles the frame
 //                           took, each core's busy and idle cycles, the XIP cache's hits,
-//                           misses and stall, the I2C bus's bytes and busy cycles, and the
+//                           misses and stall, the display bus's bytes and busy cycles, and the
 //                           panel's pixels as hex rows
 //   {"event":"end", ...}    why the run ended, with totals
 // The device's defmt log (the RTT up channel, read as a probe reads it) goes to --log as raw
@@ -32,6 +35,8 @@ import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
 
 const LED_PIN = 25;
+/** The SPI display's control pins (firmware/src/bin/pico/wiring.rs, `spi`). */
+const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
 // Every how many instructions --profile samples the program counter (a prime, so no loop of
 // the renderer beats in step with it).
 const PROFILE_EVERY = 97;
@@ -154,15 +159,19 @@ function main() {
   const warnings = [];
   mcu.logger = { debug() {}, info() {}, warn() {}, error: (c, m) => warnings.push(`${c}: ${m}`) };
 
-  // I2C0 with the display model (or nothing: every address NACKs), bytes delivered when the bus
-  // would deliver them.
+  // The display model on I2C0 and SPI0 (or nothing: every I2C address NACKs), bytes delivered
+  // when the bus would deliver them.
   const display = opt.display ? new Ssd1306(0x3c) : null;
-  let i2cBytes = 0; // bytes after the address byte
+  let busBytes = 0; // bytes the display heard (on I2C, those after an address byte)
   let i2cTransfers = 0; // address bytes sent (each START or repeated START)
   let naks = 0;
   let ledOn = false;
   let firstByteOfFrame = null;
-  const snapshot = () => ({ ...board.snapshot(), i2cBytes, i2cTransfers });
+  const snapshot = () => ({ ...board.snapshot(), busBytes, i2cTransfers });
+  const byte = () => {
+    if (ledOn && firstByteOfFrame === null) firstByteOfFrame = snapshot();
+    busBytes++;
+  };
   board.attachI2c(0, display, {
     timed: opt.timedBus,
     listen: {
@@ -170,12 +179,10 @@ function main() {
         i2cTransfers++;
         if (!ack) naks++;
       },
-      byte: () => {
-        if (ledOn && firstByteOfFrame === null) firstByteOfFrame = snapshot();
-        i2cBytes++;
-      },
+      byte,
     },
   });
+  board.attachSpi(0, display, { ...SPI_DISPLAY, timed: opt.timedBus, listen: { byte } });
 
   const rtt = new RttReader(mcu, opt.rtt);
   const records = opt.records === undefined ? null : new RecordReader(mcu, opt.records);
@@ -217,8 +224,8 @@ function main() {
       xipStallCycles: end.xip.stallCycles - frameStart.xip.stallCycles,
       setupCycles: first.cycles - frameStart.cycles,
       setupInstructions: first.instructions - frameStart.instructions,
-      i2cBytes: d('i2cBytes'),
-      i2cBusCycles: d('busCycles'),
+      busBytes: d('busBytes'),
+      busCycles: d('busCycles'),
       i2cTransfers: d('i2cTransfers'),
       startMs: frameStart.nanos / 1e6,
       endMs: end.nanos / 1e6,
@@ -290,6 +297,7 @@ function main() {
     xip: total.xip,
     xipMissCycles: board.xip ? board.xip.missCycles() : 0,
     sclPeriodCycles: board.sclPeriod(0),
+    spiByteCycles: board.spiFrameCycles(0),
     models: { core1: opt.core1, cache: opt.cache, timedBus: opt.timedBus },
     emulatedMs: mcu.clock.nanos / 1e6,
     idleMs: (Math.min(...total.idle.slice(0, opt.core1 ? 2 : 1)) * 1e3) / mcu.clkSys,
@@ -297,7 +305,7 @@ function main() {
     flashBytes,
     logBytes: rtt.bytes,
     recordsDropped: records ? records.dropped() : 0,
-    i2cBytes,
+    busBytes,
     naks,
     ledToggles,
     displayInitialised: display ? display.everOn : false,

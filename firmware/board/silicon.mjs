@@ -25,6 +25,9 @@
 //   periods) and STOP take the time the controller's SCL counts give, at the configured clock;
 //   the 16-entry TX FIFO fills while the bus is busy, exactly as rp2040js's controller has it,
 //   and the display model receives each byte when the bus has delivered it.
+// - SPI timing (4.4 "SPI"): each frame of SPI0/SPI1 takes DSS + 1 periods of the clock the
+//   controller's CPSDVSR and SCR give; the display model on it hears a byte when its last bit
+//   is on the wire, with the chip-select and data/command pins as they are then.
 //
 // Not modelled: bus contention between the cores on SRAM and APB (the RP2040's striped SRAM
 // banks make it rare), flash writes, DMA, and the cache's own maintenance registers.
@@ -390,7 +393,7 @@ class CoreBus {
 }
 
 /**
- * An RP2040 with both cores, the XIP cache and a timed I2C bus around rp2040js's chip.
+ * An RP2040 with both cores, the XIP cache and timed I2C and SPI buses around rp2040js's chip.
  * `step()` runs one instruction of the core that is behind; `cores[i].cycles` is each core's
  * time, `busy[i]`/`idle[i]` what it did with it.
  */
@@ -422,7 +425,7 @@ export class SiliconBoard {
     this.instructions = [0, 0];
     this.time = 0; // cycles both cores have reached
     this.spklen = [7, 7]; // IC_FS_SPKLEN as written (rp2040js drops odd values)
-    this.busCycles = 0; // cycles the I2C buses spent on START, bytes and STOP
+    this.busCycles = 0; // cycles the display buses spent: I2C START, bytes and STOP; SPI frames
     this.stop = null; // why the run must end
   }
 
@@ -606,6 +609,46 @@ export class SiliconBoard {
         i2c.completeStop();
       });
     };
+  }
+
+  /** Clock cycles (clk_sys) one frame of SPI controller `n` takes on its bus, from its registers. */
+  spiFrameCycles(n) {
+    const spi = this.mcu.spi[n];
+    // PL022: SSPCLKOUT = clk_peri / (CPSDVSR * (1 + SCR)); a frame is DSS + 1 of its periods.
+    const scr = (spi.control0 >> 8) & 0xff;
+    const periCycles = spi.dataBits * spi.clockDivisor * (1 + scr);
+    return Math.ceil((periCycles * this.mcu.clkSys) / this.mcu.clkPeri);
+  }
+
+  /**
+   * Puts `device` (spiByte, reset; see ssd1306.mjs) on SPI controller `n` as a 4-wire module
+   * wires it: chip select on GPIO `cs` (active low: bytes sent while it is high are not heard),
+   * data/command on GPIO `dc` (sampled as each byte completes, as the SSD1306 latches it on the
+   * last SCLK edge) and reset on GPIO `res` (low resets the controller). Each byte takes the
+   * time the controller's clock divisors give, unless `timed` is false; `listen.byte` hears each
+   * byte as the bus finishes it.
+   */
+  attachSpi(n, device, { cs, dc, res, timed = true, listen = {} }) {
+    const spi = this.mcu.spi[n];
+    const high = (pin) => this.mcu.gpio[pin].value === GPIOPinState.High;
+    spi.onTransmit = (value) => {
+      const deliver = () => {
+        if (device && !high(cs)) {
+          listen.byte?.(value);
+          device.spiByte(value & 0xff, high(dc));
+        }
+        spi.completeTransmit(0);
+      };
+      if (!timed) return deliver();
+      const cycles = this.spiFrameCycles(n);
+      this.busCycles += cycles;
+      this.mcu.clock.createAlarm(deliver).schedule((cycles * 1e9) / this.mcu.clkSys);
+    };
+    if (device) {
+      this.mcu.gpio[res].addListener((state) => {
+        if (state === GPIOPinState.Low) device.reset();
+      });
+    }
   }
 
   gpio(pin) {

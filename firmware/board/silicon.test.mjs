@@ -3,7 +3,7 @@
 // test: `cargo xtask board` requires its two-core frames to be bit-identical to host-sim's.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { Divider, Fifos, XipCache } from './silicon.mjs';
+import { Divider, Fifos, SiliconBoard, XipCache } from './silicon.mjs';
 
 test('each core reads what the other wrote, in order, 8 words deep', () => {
   const f = new Fifos();
@@ -70,4 +70,40 @@ test('no-allocate and no-cache aliases, and misses queue on the one flash interf
   // Two misses at the same moment (one per core): the second waits for the first.
   assert.equal(c.access(0x10002000, 5000), 56);
   assert.equal(c.access(0x10003000, 5000), 112);
+});
+
+test('an SPI byte reaches the display 8 SCK periods later, with chip select and D/C as they are then', () => {
+  const board = new SiliconBoard({ dualCore: false });
+  const mcu = board.mcu;
+  const got = [];
+  let resets = 0;
+  const device = { spiByte: (b, dc) => got.push([b, dc]), reset: () => resets++ };
+  board.attachSpi(0, device, { cs: 17, dc: 20, res: 21 });
+  // GP17, GP20 and GP21 as SIO outputs (IO_BANK0 FUNCSEL 5); CS low, D/C high, RES high.
+  for (const pin of [17, 20, 21]) mcu.writeUint32(0x40014004 + 8 * pin, 5);
+  mcu.writeUint32(0xd0000010, (1 << 20) | (1 << 21)); // GPIO_OUT, then GPIO_OE: no glitch on RES
+  mcu.writeUint32(0xd0000020, (1 << 17) | (1 << 20) | (1 << 21));
+  assert.equal(resets, 0);
+  // SPI0 as rp2040-hal sets 10 MHz from 125 MHz: 8-bit frames, CPSDVSR 2, SCR 6 (8.9 MHz).
+  mcu.writeUint32(0x4003c000, (6 << 8) | 7);
+  mcu.writeUint32(0x4003c010, 2);
+  mcu.writeUint32(0x4003c004, 2);
+  assert.equal(board.spiFrameCycles(0), 8 * 2 * 7);
+  const nanos = (cycles) => (cycles * 1e9) / mcu.clkSys;
+  mcu.writeUint32(0x4003c008, 0x5a);
+  mcu.clock.tick(nanos(111));
+  assert.deepEqual(got, [], 'not before its 8 bits are on the wire');
+  mcu.clock.tick(nanos(1));
+  assert.deepEqual(got, [[0x5a, true]]);
+  mcu.writeUint32(0xd0000010, 1 << 21); // D/C low: a command
+  mcu.writeUint32(0x4003c008, 0xaf);
+  mcu.clock.tick(nanos(112));
+  assert.deepEqual(got[1], [0xaf, false]);
+  mcu.writeUint32(0xd0000010, (1 << 17) | (1 << 21)); // CS high: the display does not listen
+  mcu.writeUint32(0x4003c008, 0x11);
+  mcu.clock.tick(nanos(112));
+  assert.equal(got.length, 2);
+  assert.equal(board.busCycles, 3 * 112);
+  mcu.writeUint32(0xd0000010, 0); // RES low
+  assert.equal(resets, 1);
 });

@@ -1,9 +1,10 @@
-// An SSD1306 128x64 OLED controller on I2C, as its datasheet (rev 1.1) describes it: the
-// control byte after the address (Co and D/C# bits), the fundamental, addressing, hardware
-// configuration, timing and scrolling commands with their arguments, and the 1 KiB GDDRAM
-// written through the page/horizontal/vertical addressing modes. `shown()` is what the panel
-// displays, as a packed 1-bit raster (rows MSB first, lit pixel = 1: the raster of host-sim's
-// BitFrame), after segment remap, COM scan direction, start line, offset and inversion.
+// An SSD1306 128x64 OLED controller on I2C or 4-wire SPI, as its datasheet (rev 1.1) describes
+// it: on I2C the control byte after the address (Co and D/C# bits), on SPI the D/C# pin and
+// RES#; the fundamental, addressing, hardware configuration, timing and scrolling commands with
+// their arguments, and the 1 KiB GDDRAM written through the page/horizontal/vertical addressing
+// modes. `shown()` is what the panel displays, as a packed 1-bit raster (rows MSB first, lit
+// pixel = 1: the raster of host-sim's BitFrame), after segment remap, COM scan direction, start
+// line, offset and inversion.
 //
 // Anything the model does not understand is an error, never silently ignored: an unknown
 // command byte, a command cut off by a STOP, a data byte before any display set-up, a read.
@@ -58,6 +59,20 @@ export class Ssd1306 {
   constructor(address = 0x3c) {
     this.address = address;
     this.gddram = new Uint8Array(WIDTH * PAGES); // [page * 128 + column], bit k = COM row 8*page + k
+    this.commands = 0; // command bytes received (arguments included)
+    this.dataBytes = 0; // GDDRAM bytes received
+    this.bytes = 0; // every byte addressed to the display, control bytes included
+    this.transfers = 0;
+    this.resets = 0; // RES# pulses (SPI modules)
+    this.everOn = false; // the display has been switched on with its charge pump
+    this.error = null; // the first protocol error
+    this.reset();
+    this.resets = 0;
+  }
+
+  /** RES# low: every register to its reset value (GDDRAM keeps what it holds), as after power-on. */
+  reset() {
+    this.resets++;
     this.displayOn = false;
     this.chargePump = false;
     this.mode = 2; // page addressing after reset
@@ -76,13 +91,8 @@ export class Ssd1306 {
     this.entireOn = false;
     this.scrolling = false;
     this.comPins = 0x12;
-    this.commands = 0; // command bytes received (arguments included)
-    this.dataBytes = 0; // GDDRAM bytes received
-    this.bytes = 0; // every byte addressed to the display, control bytes included
-    this.transfers = 0;
-    this.everOn = false; // the display has been switched on with its charge pump
-    this.error = null; // the first protocol error
     this.endTransfer();
+    this.cmd = null;
   }
 
   endTransfer() {
@@ -130,6 +140,18 @@ export class Ssd1306 {
     else this.command(byte);
     if (this.continuation && this.cmd === null) this.expectControl = true;
     return true;
+  }
+
+  /**
+   * A byte on the 4-wire SPI interface (chip selected): a GDDRAM byte when D/C# is high, a
+   * command or command argument when it is low (no control bytes on SPI).
+   */
+  spiByte(byte, isData) {
+    this.bytes++;
+    if (isData) {
+      if (this.cmd !== null) this.fail(`data byte while command ${hex(this.cmd)} waits for ${argumentCount(this.cmd) - this.args.length} more argument bytes`);
+      this.data(byte);
+    } else this.command(byte);
   }
 
   /** An I2C STOP. */

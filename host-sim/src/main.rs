@@ -72,6 +72,10 @@ enum Command {
         /// The board: pico (RP2040, fixed point) or pico2 (RP2350, f32).
         #[arg(long, value_enum, default_value = "pico")]
         board: uf2::Board,
+        /// The firmware's build options, comma-separated (docs/flashing.md): `spi` for a 7-pin SPI
+        /// module, `i2c-1mhz`, `orbit`, `progressive`, `no-outline`, ...
+        #[arg(long, value_name = "LIST")]
+        features: Option<String>,
         /// UF2 file to write [default: out/lattice-rt-<board>.uf2].
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -121,7 +125,7 @@ fn real_main() -> Result<()> {
             Ok(())
         }
         Some(Command::Orbit { scene, output, frames }) => orbit::orbit_cmd(&scene, &output, frames),
-        Some(Command::Uf2 { board, output }) => uf2::uf2_cmd(&std::env::current_dir()?, board, output.as_deref()),
+        Some(Command::Uf2 { board, features, output }) => uf2::uf2_cmd(&std::env::current_dir()?, board, features.as_deref(), output.as_deref()),
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),
             Scalar::F32 => run::stats_cmd::<f32>(&a),

@@ -66,15 +66,24 @@ impl Board {
 
 /// Builds the Pico image with the repository's own alias, so it is the image `cargo pico` flashes.
 pub fn build_pico(root: &Path) -> Result<PathBuf> {
-    build_board(root, Board::Pico)
+    build_board(root, Board::Pico, None)
 }
 
 /// Builds `board`'s image with the repository's own alias (`cargo pico-build`,
-/// `cargo pico2-build`), so it is the image `cargo pico` / `cargo pico2` flashes.
-pub fn build_board(root: &Path, board: Board) -> Result<PathBuf> {
+/// `cargo pico2-build`), so it is the image `cargo pico` / `cargo pico2` flashes; with
+/// `features` (the firmware's, comma-separated) it is kept as `<board>-<features>`.
+pub fn build_board(root: &Path, board: Board, features: Option<&str>) -> Result<PathBuf> {
     let alias = format!("{}-build", board.name());
-    eprintln!("building the {} image (cargo {alias})", board.name());
-    build_image(root, board.name(), &[&alias], Scenes::Inherited, &board.built())
+    let mut args = vec![alias.as_str()];
+    let name = match features {
+        Some(f) => {
+            args.extend(["--features", f]);
+            format!("{}-{}", board.name(), f.replace(',', "-"))
+        }
+        None => board.name().to_string(),
+    };
+    eprintln!("building the {} image (cargo {})", board.name(), args.join(" "));
+    build_image(root, &name, &args, Scenes::Inherited, &board.built())
         .with_context(|| format!("`cargo {alias}` failed (it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target()))
 }
 
@@ -134,9 +143,10 @@ pub fn write_uf2(elf: &Path, out: &Path) -> Result<()> {
     Board::Pico.write_uf2(elf, out)
 }
 
-/// The command `host-sim uf2`: `out` defaults to `out/lattice-rt-<board>.uf2`.
-pub fn uf2_cmd(root: &Path, board: Board, out: Option<&Path>) -> Result<()> {
-    let elf = build_board(root, board)?;
+/// The command `host-sim uf2`: the image with the firmware's `features` (comma-separated, such
+/// as `spi`), if any; `out` defaults to `out/lattice-rt-<board>.uf2`.
+pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, out: Option<&Path>) -> Result<()> {
+    let elf = build_board(root, board, features)?;
     let out = out.map_or_else(|| PathBuf::from(format!("out/lattice-rt-{}.uf2", board.name())), Path::to_path_buf);
     board.write_uf2(&elf, &out)?;
     println!("wrote {}: hold BOOTSEL while plugging the board in, then copy this file onto the {} drive", out.display(), board.drive());

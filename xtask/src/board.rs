@@ -47,25 +47,42 @@ const MODELS: &[(&str, &[&str])] = &[
 const LEVERS: &[(&str, &str)] = &[
     ("code-in-flash", "the code in flash, behind the 16 KiB XIP cache (the default image runs its hot code from SRAM)"),
     ("i2c-1mhz", "the display's bus at 1 MHz (fast mode plus) instead of 400 kHz"),
+    ("spi", "the display on a 4-wire SPI module (10 MHz asked, 8.9 MHz set) instead of I2C at 400 kHz"),
     ("parse", "the scene parsed and its lattice built on the board every frame (the default image bakes them into flash at build time)"),
 ];
 
 /// Orbit frames the emulated run checks against host-sim (each takes a full frame of emulation).
 const ORBIT_CHECKED: usize = 4;
 
-/// Builds the Pico image with an extra `feature` beside the default image (kept as
-/// `firmware/target/images/pico-<feature>`), with the chair alone or (`all_scenes`) the scenes of
-/// the default image.
+/// The feature of the variant that has none: the default image built with the chair alone, the
+/// baseline of the build-time levers and of the silhouette lines, which are chair-alone images
+/// too (an image with one scene traces it faster than the image with all of them: the frame
+/// cannot be compared across the two).
+const CHAIR_ALONE: &str = "";
+
+/// Builds the Pico image with an extra `feature` ([`CHAIR_ALONE`]: none) beside the default image
+/// (kept as `firmware/target/images/pico-<variant_name>`), with the chair alone or
+/// (`all_scenes`) the scenes of the default image.
 fn build_pico_with(root: &Path, feature: &str, all_scenes: bool) -> Result<PathBuf> {
     let which = if all_scenes { "the default scenes" } else { "the chair alone" };
-    eprintln!("building the Pico image with `{feature}` (cargo pico-build --features {feature}, {which})");
+    let args: &[&str] = if feature == CHAIR_ALONE { &["pico-build"] } else { &["pico-build", "--features", feature] };
+    eprintln!("building the Pico image `{}` (cargo {}, {which})", variant_name(feature), args.join(" "));
     let scenes = if all_scenes { Scenes::Inherited } else { Scenes::Listed("chair") };
-    build_image(root, &variant_image(feature), &["pico-build", "--features", feature], scenes, &pico_built())
+    build_image(root, &variant_image(feature), args, scenes, &pico_built())
+}
+
+/// What the variant with `feature` is called in folders and messages.
+fn variant_name(feature: &str) -> &str {
+    if feature == CHAIR_ALONE {
+        "chair-alone"
+    } else {
+        feature
+    }
 }
 
 /// The name the image with `feature` is kept under.
 fn variant_image(feature: &str) -> String {
-    format!("pico-{feature}")
+    format!("pico-{}", variant_name(feature))
 }
 
 /// Builds (unless `no_build`) the image with `feature` and the chair alone (or `all_scenes`),
@@ -73,9 +90,9 @@ fn variant_image(feature: &str) -> String {
 /// run and that folder.
 fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, frames_dir: &Path, bootrom: &Path, frames: usize) -> Result<(BoardRun, PathBuf)> {
     let elf = if no_build { kept_image(root, &variant_image(feature)) } else { build_pico_with(root, feature, all_scenes)? };
-    let dir = frames_dir.join(feature);
+    let dir = frames_dir.join(variant_name(feature));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let uf2 = dir.join(format!("lattice-rt-pico-{feature}.uf2"));
+    let uf2 = dir.join(format!("lattice-rt-{}.uf2", variant_image(feature)));
     write_uf2(&elf, &uf2)?;
     eprintln!("running {} ({frames} frames)", uf2.display());
     let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir, &[])?;
@@ -129,10 +146,11 @@ struct PanelFrame {
     xip_misses: u64,
     #[serde(rename = "xipStallCycles")]
     xip_stall: u64,
-    /// Cycles the I2C bus was busy (START, bytes, STOP).
-    i2c_bus_cycles: u64,
+    /// Cycles the display bus was busy (I2C: START, bytes, STOP; SPI: frames).
+    bus_cycles: u64,
     setup_cycles: u64,
-    i2c_bytes: u64,
+    /// Bytes the display heard.
+    bus_bytes: u64,
     error: Option<String>,
     /// The panel's pixels (rows MSB first, lit = 1), sent as hex.
     #[serde(deserialize_with = "hex_pixels")]
@@ -361,8 +379,6 @@ struct SceneRow {
     name: String,
     frame: PanelFrame,
     stack: Option<u64>,
-    /// Eye rays the board reported for the frame (silhouette lines' rays included).
-    eye_rays: Option<u64>,
     /// Microseconds of the frame outside core 0's share of the tiles, by the board's timer:
     /// the tracer's set-up before it, the wait for the last bytes on the bus after it.
     outside_us: Option<u64>,
@@ -427,26 +443,26 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         }
     }
     let bare = s.no_display_run()?;
-    let (models, levers) = (s.model_runs()?, s.lever_runs()?);
+    let (models, (alone, levers)) = (s.model_runs()?, s.lever_runs()?);
     let (orun, orbit_same) = s.orbit_run()?;
     let lrun = s.variant("ladder", false, LADDER.len())?.0;
     let rungs = s.ladder_rows(&lrun)?;
     let prun = s.variant("progressive", true, PASSES * s.scenes.len())?;
     let progressive = s.progressive_rows(&prun, &rows)?;
     let plain_run = s.variant("no-outline", false, 1)?;
-    let lined_chair = rows.iter().find(|r| r.name == "chair");
-    let outline_row = s.outline_row(&plain_run, out, lined_chair)?;
+    let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays)| *rays))?;
 
-    let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period };
+    let spi_byte = levers.iter().find(|(feature, ..)| *feature == "spi").map_or(0, |(_, _, f)| f.bus_cycles / f.bus_bytes.max(1));
+    let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period, spi_byte };
     let profile = profile_shares(&s.elf, &frames_dir.join("profile.json"))?;
     let (flash, static_ram) = elf_sizes(&s.elf)?;
     let mut md = report(&summary, &rows, (flash, static_ram, section_size(&s.elf, ".ram_code")?), &bare, &s.scenes, &profile)?;
-    md.push_str(&silicon_report(&summary, rows.first().map(|r| &r.frame), &models, &levers)?);
+    md.push_str(&silicon_report(&summary, rows.first().map(|r| &r.frame), &models, alone.as_ref().map(|(f, _)| f), &levers)?);
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
     md.push_str(&progressive_report(&progressive, run.clk_sys_hz)?);
-    if let (Some((f, rays, same)), Some(lined)) = (outline_row, lined_chair) {
-        md.push_str(&outline_report(f, rays, same, &lined.frame, run.clk_sys_hz)?);
+    if let (Some((f, rays, same)), Some((lined, _))) = (outline_row, &alone) {
+        md.push_str(&outline_report(f, rays, same, lined, run.clk_sys_hz)?);
     }
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
@@ -508,10 +524,10 @@ impl<'a> Session<'a> {
             }
             self.compare_scene(&name, &frame.pixels)?;
             let reported = reported_frame(&run.records, index);
-            let (stack, eye_rays) = (reported.map(|f| u64::from(f.stack)), reported.map(|f| f.rays[0]));
+            let stack = reported.map(|f| u64::from(f.stack));
             let outside_us = reported.map(|f| f.us.saturating_sub(f.share_us[0]));
             self.checks.check(stack.is_some(), || format!("{name}: the board reported no frame record"));
-            rows.push(SceneRow { name, frame, stack, eye_rays, outside_us });
+            rows.push(SceneRow { name, frame, stack, outside_us });
         }
         Ok((run, rows))
     }
@@ -576,23 +592,31 @@ impl<'a> Session<'a> {
         Ok(models)
     }
 
-    /// The chair from each build-time lever's image ([`LEVERS`]).
-    fn lever_runs(&mut self) -> Result<Vec<(&'static str, &'static str, PanelFrame)>> {
+    /// The chair from the default image built with it alone ([`CHAIR_ALONE`], with the eye rays
+    /// it reported) and from each build-time lever's image ([`LEVERS`]).
+    #[allow(clippy::type_complexity)]
+    fn lever_runs(&mut self) -> Result<(Option<(PanelFrame, Option<u64>)>, Vec<(&'static str, &'static str, PanelFrame)>)> {
         let want = host_frame(&self.scenes_dir, "chair", PICO_SCALAR, PICO)?;
-        let mut levers = Vec::new();
-        for (feature, what) in LEVERS {
+        let (mut alone, mut levers) = (None, Vec::new());
+        for (feature, what) in std::iter::once(&(CHAIR_ALONE, "")).chain(LEVERS) {
             let (run, dir) = self.variant(feature, false, 1)?;
+            let name = variant_name(feature);
+            let rays = reported_frame(&run.records, 0).map(|r| r.rays[0]);
             match run.frames.into_iter().next() {
                 Some(f) => {
                     save_frame(&f.pixels, &dir.join("chair.png"))?;
-                    if self.checks.check(f.pixels == want, || format!("`{feature}`: the chair differs from host-sim (see {}/chair.png)", dir.display())) {
-                        levers.push((*feature, *what, f));
+                    if self.checks.check(f.pixels == want, || format!("`{name}`: the chair differs from host-sim (see {}/chair.png)", dir.display())) {
+                        if feature == &CHAIR_ALONE {
+                            alone = Some((f, rays));
+                        } else {
+                            levers.push((*feature, *what, f));
+                        }
                     }
                 }
-                None => self.checks.fail(format!("`{feature}`: no frame shown ({})", run.reason)),
+                None => self.checks.fail(format!("`{name}`: no frame shown ({})", run.reason)),
             }
         }
-        Ok(levers)
+        Ok((alone, levers))
     }
 
     /// Orbit mode: the first frames of the chair's orbit against host-sim's; the run and how
@@ -661,10 +685,10 @@ impl<'a> Session<'a> {
     }
 
     /// Silhouette lines: the chair without them (`no-outline`) against host-sim's; its frame,
-    /// the eye rays without and with lines, and whether it was identical. Saves the panel
-    /// pictures README and docs/board.md show beside `out` (the default image's chair, with
-    /// lines, and this one).
-    fn outline_row<'r>(&mut self, (run, dir): &'r (BoardRun, PathBuf), out: &Path, lined: Option<&SceneRow>) -> Result<Option<(&'r PanelFrame, [u64; 2], bool)>> {
+    /// the eye rays without and with lines (`lined_rays`: what the chair-alone default image
+    /// reported), and whether it was identical. Saves the panel picture docs/board.md shows
+    /// beside `out` (beside the default image's chair, with lines).
+    fn outline_row<'r>(&mut self, (run, dir): &'r (BoardRun, PathBuf), out: &Path, lined_rays: Option<Option<u64>>) -> Result<Option<(&'r PanelFrame, [u64; 2], bool)>> {
         let Some(f) = run.frames.first() else {
             self.checks.fail(format!("no-outline: no frame shown ({})", run.reason));
             return Ok(None);
@@ -676,12 +700,9 @@ impl<'a> Session<'a> {
         if let Some(images) = out.parent().map(|p| p.join("images")) {
             std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
             save_frame(&f.pixels, &images.join("board-chair-plain.png"))?;
-            if let Some(lined) = lined {
-                save_frame(&lined.frame.pixels, &images.join("board-chair.png"))?;
-            }
         }
         let same = self.checks.check(f.pixels == want.bits, || format!("no-outline: the chair differs from host-sim (see {})", file.display()));
-        let rays = [reported_frame(&run.records, 0).map(|r| r.rays[0]), lined.and_then(|l| l.eye_rays)];
+        let rays = [reported_frame(&run.records, 0).map(|r| r.rays[0]), lined_rays.flatten()];
         self.checks.check(rays.iter().all(Option::is_some), || "no-outline: the board reported no frame record".into());
         Ok(Some((f, rays.map(|r| r.unwrap_or(0)), same)))
     }
@@ -788,7 +809,7 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
             total as f64 / r.plain.cycles.max(1) as f64,
             100.0 * cumulative.first().copied().unwrap_or(0) as f64 / r.plain.cycles.max(1) as f64,
             r.rays.iter().map(u64::to_string).collect::<Vec<_>>().join(" / "),
-            r.passes.iter().map(|f| f.i2c_bytes).sum::<u64>(),
+            r.passes.iter().map(|f| f.bus_bytes).sum::<u64>(),
         )?;
     }
     writeln!(md, "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The I2C bytes are four frames' worth, each on the", 1e3 / mhz)?;
@@ -805,14 +826,15 @@ fn outline_report(f: &PanelFrame, rays: [u64; 2], same: bool, lined: &PanelFrame
     writeln!(md, "The default image draws silhouette lines: where two neighbouring pixels hit different objects")?;
     writeln!(md, "the farther one is black, so the chair's legs and seat stand out from a floor of the same gray.")?;
     writeln!(md, "A line across a tile's border compares the tile's pixel with its neighbour's: core 0 draws those")?;
-    writeln!(md, "lines as it dithers the band, from what each traced tile kept of its sides; the neighbour's")?;
-    writeln!(md, "pixel is what the eye ray through its centre hits, so where sampling filled it in, the tile")?;
-    writeln!(md, "traces a hit-only ray there (host-sim's render traces such rays for every pixel around a tile:")?;
-    writeln!(md, "the same lines). *Eye rays* are what the board reported, those rays included. The image built with")?;
-    writeln!(md, "`--features no-outline` (the chair alone) leaves them out; the frame its panel showed was {} host-sim's.\n", if same { "bit-identical to" } else { "**not** the same as" })?;
+    writeln!(md, "lines as it dithers the band, from what each traced tile kept of its sides (`Sampler::side`: the")?;
+    writeln!(md, "pixels its eye rays traced, and between two traced pixels that hit the same object the fill, as")?;
+    writeln!(md, "inside a tile), so no ray is traced for the lines alone (host-sim's render traces hit-only rays")?;
+    writeln!(md, "around a tile where the neighbour traced: the same lines). *Eye rays* are what the board reported.")?;
+    writeln!(md, "Both rows are images built with the chair alone: `--features no-outline` leaves the lines out;")?;
+    writeln!(md, "the frame its panel showed was {} host-sim's.\n", if same { "bit-identical to" } else { "**not** the same as" })?;
     writeln!(md, "| chair | cycles | eye rays | frames per second at {:.0} MHz |\n|---|---:|---:|---:|", clk_hz / 1e6)?;
     writeln!(md, "| without lines (`no-outline`) | {:.1} M | {} | {:.2} |", f.cycles as f64 / 1e6, rays[0], clk_hz / f.cycles.max(1) as f64)?;
-    writeln!(md, "| with lines (the default image) | {:.1} M ({:.2}x) | {} | {:.2} |", lined.cycles as f64 / 1e6, lined.cycles as f64 / f.cycles.max(1) as f64, rays[1], clk_hz / lined.cycles.max(1) as f64)?;
+    writeln!(md, "| with lines (the default image, the chair alone) | {:.1} M ({:.2}x) | {} | {:.2} |", lined.cycles as f64 / 1e6, lined.cycles as f64 / f.cycles.max(1) as f64, rays[1], clk_hz / lined.cycles.max(1) as f64)?;
     writeln!(md, "\n![the chair on the emulated panel, with lines](images/board-chair.png) ![without lines](images/board-chair-plain.png)")?;
     Ok(md)
 }
@@ -884,6 +906,8 @@ struct Summary {
     idle_ms: f64,
     xip_miss_cycles: u64,
     scl_period: u64,
+    /// Cycles one byte takes on the SPI bus (the `spi` lever's bus cycles per byte; 0 without it).
+    spi_byte: u64,
 }
 
 /// Millions, one decimal.
@@ -942,8 +966,8 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
             m(f.instructions),
             f.xip_misses,
             m(f.xip_stall),
-            f.i2c_bytes,
-            m(f.i2c_bus_cycles),
+            f.bus_bytes,
+            m(f.bus_cycles),
             r.stack.map_or("-".to_string(), |b| format!("{b} B")),
         )?;
     }
@@ -969,7 +993,7 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
 
 /// The section on the silicon models: how each is derived, what each adds, and the build-time
 /// levers against the default image.
-fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, PanelFrame)], levers: &[(&str, &str, PanelFrame)]) -> Result<String> {
+fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, PanelFrame)], alone: Option<&PanelFrame>, levers: &[(&str, &str, PanelFrame)]) -> Result<String> {
     let mut md = String::new();
     writeln!(md, "## The board as silicon runs it\n")?;
     writeln!(md, "- **Core 1** starts in the bootrom at the reset vector and waits there for the launch sequence;")?;
@@ -990,16 +1014,19 @@ fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, Pane
     writeln!(md, "  STOP take one period, every byte, address included, nine (eight bits and the acknowledge). The")?;
     writeln!(md, "  16-entry TX FIFO fills while the bus is busy and a write waits for room, as on silicon; the display")?;
     writeln!(md, "  model receives each byte when the bus has delivered it.")?;
+    writeln!(md, "- **The SPI bus** (the `spi` build): each byte takes DSS + 1 periods of clk_peri / (CPSDVSR x (1 +")?;
+    writeln!(md, "  SCR)), as the firmware set the PL022 up: **{} cycles a byte**. The display model hears a byte when", s.spi_byte)?;
+    writeln!(md, "  its last bit is on the wire, with chip select and data/command as the GPIOs are then; RES low resets it.")?;
     writeln!(md, "- Not modelled: contention between the cores on SRAM and the peripheral bus (the RP2040's striped")?;
     writeln!(md, "  SRAM banks make it rare), and the bootrom's own flash set-up (there is no SSI flash model, so the")?;
     writeln!(md, "  run starts at boot2 as the bootrom leaves it).\n")?;
     let Some(plain) = plain else { return Ok(md) };
-    let row = |md: &mut String, what: &str, f: &PanelFrame| -> Result<()> {
+    let row = |md: &mut String, what: &str, f: &PanelFrame, base: &PanelFrame| -> Result<()> {
         writeln!(
             md,
             "| {what} | {} ({:.2}x) | {:.2} | {} / {} | {} / {} | {} ({}) | {} |",
             m(f.cycles),
-            f.cycles as f64 / plain.cycles.max(1) as f64,
+            f.cycles as f64 / base.cycles.max(1) as f64,
             s.clk_hz / f.cycles.max(1) as f64,
             m(f.busy[0]),
             m(f.idle[0]),
@@ -1007,7 +1034,7 @@ fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, Pane
             m(f.idle[1]),
             f.xip_misses,
             m(f.xip_stall),
-            m(f.i2c_bus_cycles),
+            m(f.bus_cycles),
         )?;
         Ok(())
     };
@@ -1020,17 +1047,19 @@ fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, Pane
     writeln!(md, "The first scene's frame from the same image with a model left out (`run.mjs --no-cache`,")?;
     writeln!(md, "`--untimed-bus`); each frame bit-identical to host-sim's.\n")?;
     header(&mut md)?;
-    row(&mut md, "the board as silicon runs it", plain)?;
+    row(&mut md, "the board as silicon runs it", plain, plain)?;
     for (what, f) in models {
-        row(&mut md, &format!("without {what}"), f)?;
+        row(&mut md, &format!("without {what}"), f, plain)?;
     }
+    let Some(alone) = alone else { return Ok(md) };
     writeln!(md, "\n### Build-time levers\n")?;
-    writeln!(md, "The chair alone from images built with a firmware feature, against the default image's chair")?;
-    writeln!(md, "above; each frame bit-identical to host-sim's.\n")?;
+    writeln!(md, "The chair alone from images built with a firmware feature, against the default image built")?;
+    writeln!(md, "with the chair alone (an image with one scene traces it faster than the image with all of them);")?;
+    writeln!(md, "each frame bit-identical to host-sim's.\n")?;
     header(&mut md)?;
-    row(&mut md, "the default image", plain)?;
+    row(&mut md, "the default image, the chair alone", alone, alone)?;
     for (feature, what, f) in levers {
-        row(&mut md, &format!("`{feature}`: {what}"), f)?;
+        row(&mut md, &format!("`{feature}`: {what}"), f, alone)?;
     }
     Ok(md)
 }
@@ -1041,7 +1070,7 @@ mod tests {
 
     #[test]
     fn the_runners_events_deserialize_into_their_types() {
-        let end = r#"{"event":"end","ok":true,"reason":"5 frames shown","frames":5,"cycles":1877839334,"instructions":482013801,"coreInstructions":[255689711,226324090],"busy":[377728246,334422558],"idle":[1500111032,1543416647],"xip":{"hits":123470883,"misses":11294,"uncached":0,"stallCycles":633658},"xipMissCycles":56,"sclPeriodCycles":332,"models":{"core1":true,"cache":true,"timedBus":true},"emulatedMs":15023.034306153846,"idleMs":12000.888256,"clkSysHz":125000000,"flashBytes":104704,"logBytes":328,"recordsDropped":0,"i2cBytes":10923,"naks":0,"ledToggles":10,"displayInitialised":true,"displayCommands":3866,"warnings":[]}"#;
+        let end = r#"{"event":"end","ok":true,"reason":"5 frames shown","frames":5,"cycles":1877839334,"instructions":482013801,"coreInstructions":[255689711,226324090],"busy":[377728246,334422558],"idle":[1500111032,1543416647],"xip":{"hits":123470883,"misses":11294,"uncached":0,"stallCycles":633658},"xipMissCycles":56,"sclPeriodCycles":332,"models":{"core1":true,"cache":true,"timedBus":true},"emulatedMs":15023.034306153846,"idleMs":12000.888256,"clkSysHz":125000000,"flashBytes":104704,"logBytes":328,"recordsDropped":0,"busBytes":10923,"naks":0,"ledToggles":10,"displayInitialised":true,"displayCommands":3866,"warnings":[]}"#;
         match Event::parse(end).unwrap() {
             Event::End(e) => {
                 assert!(e.ok);
@@ -1050,10 +1079,10 @@ mod tests {
             }
             Event::Frame(_) => panic!("an end event read as a frame"),
         }
-        let frame = r#"{"event":"frame","index":0,"cycles":31447325,"instructions":39300000,"busy":[31447325,26591316],"idle":[0,4856009],"coreInstructions":[1,2],"xipHits":5,"xipMisses":519,"xipStallCycles":29104,"setupCycles":3594371,"setupInstructions":1,"i2cBytes":2176,"i2cBusCycles":7900000,"i2cTransfers":384,"startMs":1,"endMs":2,"error":null,"pixels":"00ff"}"#;
+        let frame = r#"{"event":"frame","index":0,"cycles":31447325,"instructions":39300000,"busy":[31447325,26591316],"idle":[0,4856009],"coreInstructions":[1,2],"xipHits":5,"xipMisses":519,"xipStallCycles":29104,"setupCycles":3594371,"setupInstructions":1,"busBytes":2176,"busCycles":7900000,"i2cTransfers":384,"startMs":1,"endMs":2,"error":null,"pixels":"00ff"}"#;
         match Event::parse(frame).unwrap() {
             Event::Frame(f) => {
-                assert_eq!((f.cycles, f.busy, f.idle, f.xip_stall, f.i2c_bytes), (31447325, [31447325, 26591316], [0, 4856009], 29104, 2176));
+                assert_eq!((f.cycles, f.busy, f.idle, f.xip_stall, f.bus_bytes), (31447325, [31447325, 26591316], [0, 4856009], 29104, 2176));
                 assert_eq!(f.pixels, vec![0x00, 0xff]);
                 assert!(f.error.is_none());
             }

@@ -1,5 +1,5 @@
 //! Raspberry Pi Pico (RP2040, `--features pico`, fixed point) or Pico 2 (RP2350, Cortex-M33
-//! with an FPU, `--features pico2`, f32) + SSD1306 128x64 OLED on I2C: renders the embedded
+//! with an FPU, `--features pico2`, f32) + SSD1306 128x64 OLED on I2C (or SPI, `spi`): renders the embedded
 //! scenes in turn, tile by tile straight to the display (each 8x8 tile is one SSD1306 page high,
 //! so it is sent as eight column bytes; no framebuffer), core 1 tracing every second tile, and
 //! logs per-frame time and statistics over defmt-rtt.
@@ -8,7 +8,7 @@
 //! the display; between scenes the core sleeps (`wfi`) until a timer alarm. With no display
 //! answering, the log says so and the LED blinks quickly while the firmware retries every
 //! second. `cargo xtask board` runs this image on an emulated RP2040 (both cores, the flash cache,
-//! the I2C bus's timing) and relies on that LED protocol.
+//! the display bus's timing) and relies on that LED protocol.
 //!
 //! The rooms: [`wiring`] (the pins, address and bus clock: the one place to change them),
 //! [`display`] (the SSD1306 as a draw target), [`cores`] (core 1), [`sleep`] (the timer alarm),
@@ -90,15 +90,15 @@ fn main() -> ! {
     };
     let sio = hal::Sio::new(pac.SIO);
     let pins = hal::gpio::Pins::new(pac.IO_BANK0, pac.PADS_BANK0, sio.gpio_bank0, &mut pac.RESETS);
-    let (bus, mut led) = wiring::connect(pins, pac.I2C0, &mut pac.RESETS, &clocks.system_clock);
+    let wiring::Connected { display: interface, mut led, mut reset } = wiring::connect(pins, pac.I2C0, pac.SPI0, &mut pac.RESETS, &clocks);
     #[cfg(feature = "pico")]
     let timer_block = pac.TIMER;
     #[cfg(feature = "pico2")]
     let timer_block = pac.TIMER0;
     let (timer, mut alarm) = sleep::start(timer_block, &mut pac.RESETS, &clocks);
 
-    let interface = ssd1306::I2CDisplayInterface::new_custom_address(display::QueuedI2c::new(bus, Wiring::ADDRESS), Wiring::ADDRESS);
     let mut display = ssd1306::Ssd1306::new(interface, DisplaySize128x64, DisplayRotation::Rotate0);
+    display::reset(&mut display, &mut reset, &mut { timer });
     while display.init().is_err() || display::flush().is_err() {
         defmt::error!(
             "no SSD1306 answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
@@ -106,15 +106,20 @@ fn main() -> ! {
         );
         sleep::blink(&mut led, &mut alarm, 5);
     }
+    #[cfg(feature = "spi")]
+    defmt::info!(
+        "the display on SPI0: SCK GP{}, MOSI GP{}, CS GP{}, DC GP{}, RES GP{}",
+        Wiring::SCK, Wiring::MOSI, Wiring::CS, Wiring::DC, Wiring::RES
+    );
     let cores = cores::TwoCores::start(&mut pac.PSM, &mut pac.PPB, sio.fifo);
     modes::report(board_records::Record::Started {
         scenes: SCENES.len() as u8,
         clk_mhz: clocks.system_clock.freq().to_MHz() as u16,
-        bus_khz: (Wiring::I2C_HZ / 1000) as u16,
+        bus_khz: Wiring::BUS_KHZ as u16,
     });
     defmt::info!(
-        "lattice-rt on the {}: {} scenes, {}x{}, {} MHz, I2C at {} kHz, both cores",
-        BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz(), Wiring::I2C_HZ / 1000
+        "lattice-rt on the {}: {} scenes, {}x{}, {} MHz, {} at {} kHz, both cores",
+        BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz(), Wiring::BUS, Wiring::BUS_KHZ
     );
     let mut st = SceneMemory::new();
     // The second share's memory (with what trace, then dither keeps of every tile: 24 KiB) is a
