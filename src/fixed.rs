@@ -41,7 +41,8 @@ impl Mul for Fx {
     /// `|a| * |b|` from 16-bit halves with 32-bit multiplies only (a Cortex-M0+ has no
     /// 32x32->64 multiply), rounded half away from zero, then signed; saturates. The partial
     /// products are summed in 64 bits (two instructions an add on a Cortex-M0+), so no step
-    /// needs an overflow check.
+    /// needs an overflow check. (Summing in 32 bits with the overflow checks instead is 3 KB
+    /// smaller on the M0 but 5 % more instructions a frame: the checks are branches.)
     #[inline]
     fn mul(self, o: Fx) -> Fx {
         let neg = (self.0 ^ o.0) < 0;
@@ -309,15 +310,29 @@ mod tests {
 
     #[test]
     fn multiply_matches_the_wide_product_everywhere() {
-        let mut x = 0x1234_5678u64;
-        for _ in 0..100_000 {
-            xorshift(&mut x);
-            let (a, b) = ((x as i32) >> (x % 17) as i32, ((x >> 32) as i32) >> ((x >> 40) % 19) as i32);
-            let (a, b) = (a.max(-i32::MAX), b.max(-i32::MAX));
+        let check = |a: i32, b: i32| {
             let p = a as i64 * b as i64;
             let r = (p.abs() + (1 << 15)) >> 16;
             let want = (if p < 0 { -r } else { r }).clamp(-(i32::MAX as i64), i32::MAX as i64) as i32;
             assert_eq!((Fx(a) * Fx(b)).0, want, "{a} * {b}");
+        };
+        let mut x = 0x1234_5678u64;
+        for _ in 0..100_000 {
+            xorshift(&mut x);
+            let (a, b) = ((x as i32) >> (x % 17) as i32, ((x >> 32) as i32) >> ((x >> 40) % 19) as i32);
+            check(a.max(-i32::MAX), b.max(-i32::MAX));
+        }
+        // Around the products that just fit and just saturate, and the halves' extremes.
+        let edges: [i32; 13] = [0, 1, 0x7FFF, 0x8000, 0xFFFF, 0x1_0000, 0x1_FFFF, 0xB504_F3, 0xB505_00, 0x7FFF_0000, 0x7FFF_FFFF, 0x00FF_FFFF, 0x0100_0000];
+        for &a in &edges {
+            for &b in &edges {
+                for (da, db) in [(0, 0), (-1, 1), (1, -1), (2, 3)] {
+                    let (a, b) = (a.saturating_add(da).max(0), b.saturating_add(db).max(0));
+                    for (sa, sb) in [(1, 1), (-1, 1), (1, -1), (-1, -1)] {
+                        check(a * sa, b * sb);
+                    }
+                }
+            }
         }
     }
 
