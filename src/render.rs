@@ -342,6 +342,31 @@ pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     render_tiles::<_, _, Nowhere, E>(tracer, frame, share, None, Out::Keep(kept), scratch, hooks)
 }
 
+/// [`trace_share`] for pass `pass` of a progressive frame ([`render_pass`]): the pass's tiles
+/// kept for [`dither_band`], the rays it traces kept in `traced` for the next pass (the same
+/// `traced` storage through passes 8, 4, 2 and 1, at least [`Frame::traced_len`] entries).
+/// Only the last pass has silhouette lines: dither the others with the frame's `outline` off.
+/// Bands traced and dithered in order give [`render_pass`]'s picture of the pass, bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_pass<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
+    tracer: &Tracer<'_, '_, R, A, E>,
+    frame: &Frame,
+    share: Share,
+    pass: u8,
+    traced: &mut [Traced],
+    kept: &mut [KeptTile],
+    scratch: &mut Scratch<'_>,
+    hooks: &mut impl Hooks,
+) -> Result<Stats, RenderError<core::convert::Infallible>> {
+    if !frame.progressive() || ![8, 4, 2, 1].contains(&pass) || traced.len() < frame.traced_len(share) {
+        return Err(RenderError::NotProgressive);
+    }
+    if kept.len() < frame.tiles_len(share) {
+        return Err(RenderError::ScratchTooSmall { needed: frame.tiles_len(share) });
+    }
+    render_tiles::<_, _, Nowhere, E>(tracer, frame, share, Some((pass, traced)), Out::Keep(kept), scratch, hooks)
+}
+
 /// The second half of trace, then dither ([`trace_share`]): dithers tile row `ty` of `frame`
 /// from its kept tiles (`tile(tx)`: tile `tx` of the row) and draws it into `target`, tile by
 /// tile in the order [`render`] draws them, so bands dithered in order give [`render`]'s frame

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;
-use lattice_rt::{dither_band, parse, KeptTile, render, render_share, trace_share, BitFrame, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
+use lattice_rt::{dither_band, parse, render_pass, trace_pass, KeptTile, render, render_share, trace_share, BitFrame, Traced, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
 
 /// Renders `name` into a fresh 1-bit frame for each frame in `frames`, all into one bitmap.
 fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
@@ -186,4 +186,63 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
     assert_eq!(err, RenderError::ScratchTooSmall { needed: 128 });
     let err = dither_band(&frame, 1, |_| Some(&kept), (&mut [(0, 0); 128], &mut band_bits[..1000]), &mut ditherer, &mut target).unwrap_err();
     assert_eq!(err, RenderError::ScratchTooSmall { needed: 1024 });
+}
+
+/// The passes of a progressive frame traced in shares band by band (`trace_pass`) and each
+/// band dithered in order (`dither_band`, lines on the last pass alone) are the pictures
+/// `render_pass` draws, pass by pass, bit for bit.
+#[test]
+fn traced_passes_dithered_in_order_give_every_pass() {
+    for name in ["chair", "whitted"] {
+        let text = scene_text(name);
+        let mut storage = vec![Object::<Fx>::default(); 64];
+        let scene = parse::<Fx>(&text, &mut storage).unwrap();
+        let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
+        let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
+        let tracer = Tracer::new(&scene, &lat);
+        let frame = Frame { dither: Dither::BlueNoise, outline: true, sampling: Sampling::Adaptive { contrast: 4 }, ..Frame::new(128, 64) };
+        let (w, h) = (128u32, 64u32);
+        // What render_pass draws, pass by pass.
+        let mut want = Vec::new();
+        let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+        let mut traced = vec![Traced::default(); frame.traced_len(Share::ALL)];
+        for pass in [8, 4, 2, 1] {
+            let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+            let mut scratch = HeapScratch::new(&scene, &frame);
+            render_pass(&tracer, &frame, Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
+            want.push(bits.clone());
+        }
+        for of in [1u8, 2] {
+            let mut traced: Vec<Vec<Traced>> = (0..of).map(|index| vec![Traced::default(); frame.traced_len(Share { index, of })]).collect();
+            for (k, pass) in [8, 4, 2, 1].into_iter().enumerate() {
+                let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+                let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+                let shown = Frame { outline: frame.outline && pass == 1, ..frame };
+                let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
+                let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
+                let mut above = vec![(0u16, 0u16); w as usize];
+                let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * 8];
+                for ty in 0..(h / 8) as u16 {
+                    let band = Frame { rows: (ty, ty + 1), ..frame };
+                    let kept: Vec<Vec<KeptTile>> = (0..of)
+                        .map(|index| {
+                            let share = Share { index, of };
+                            let mut kept = vec![KeptTile::EMPTY; band.tiles_len(share)];
+                            let mut scratch = HeapScratch::new(&scene, &band);
+                            trace_pass(&tracer, &band, share, pass, &mut traced[index as usize], &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                            kept
+                        })
+                        .collect();
+                    let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
+                    dither_band(&shown, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap();
+                }
+                assert_eq!(bits, want[k], "{name}, pass {pass}, {of} shares");
+            }
+        }
+        // A frame that cannot be progressive, or a pass that is not one, is refused.
+        let mut kept = vec![KeptTile::EMPTY; frame.tiles_len(Share::ALL)];
+        let mut scratch = HeapScratch::new(&scene, &frame);
+        let err = trace_pass(&tracer, &frame, Share::ALL, 3, &mut traced, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap_err();
+        assert_eq!(err, RenderError::NotProgressive);
+    }
 }
