@@ -323,7 +323,7 @@ mod tests {
             check(a.max(-i32::MAX), b.max(-i32::MAX));
         }
         // Around the products that just fit and just saturate, and the halves' extremes.
-        let edges: [i32; 13] = [0, 1, 0x7FFF, 0x8000, 0xFFFF, 0x1_0000, 0x1_FFFF, 0xB504_F3, 0xB505_00, 0x7FFF_0000, 0x7FFF_FFFF, 0x00FF_FFFF, 0x0100_0000];
+        let edges: [i32; 13] = [0, 1, 0x7FFF, 0x8000, 0xFFFF, 0x1_0000, 0x1_FFFF, 0x00B5_04F3, 0x00B5_0500, 0x7FFF_0000, 0x7FFF_FFFF, 0x00FF_FFFF, 0x0100_0000];
         for &a in &edges {
             for &b in &edges {
                 for (da, db) in [(0, 0), (-1, 1), (1, -1), (2, 3)] {

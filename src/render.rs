@@ -343,10 +343,12 @@ pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 }
 
 /// [`trace_share`] for pass `pass` of a progressive frame ([`render_pass`]): the pass's tiles
-/// kept for [`dither_band`], the rays it traces kept in `traced` for the next pass (the same
-/// `traced` storage through passes 8, 4, 2 and 1, at least [`Frame::traced_len`] entries).
-/// Only the last pass has silhouette lines: dither the others with the frame's `outline` off.
-/// Bands traced and dithered in order give [`render_pass`]'s picture of the pass, bit for bit.
+/// kept for [`dither_band`], the rays it traces kept in `traced` for the next pass. `traced`
+/// holds the rays of `share`'s tiles in `frame`'s rows alone, in the order they are traced (at
+/// least [`Frame::tiles_len`] times `(tile / 2)^2` entries), the same storage through passes 8,
+/// 4, 2 and 1; so each tile can have its own. Only the last pass has silhouette lines: dither
+/// the others with the frame's `outline` off. Bands traced and dithered in order give
+/// [`render_pass`]'s picture of the pass, bit for bit.
 #[allow(clippy::too_many_arguments)]
 pub fn trace_pass<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
@@ -358,13 +360,14 @@ pub fn trace_pass<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
 ) -> Result<Stats, RenderError<core::convert::Infallible>> {
-    if !frame.progressive() || ![8, 4, 2, 1].contains(&pass) || traced.len() < frame.traced_len(share) {
+    let per_tile = (frame.tile as usize / 2) * (frame.tile as usize / 2);
+    if !frame.progressive() || ![8, 4, 2, 1].contains(&pass) || traced.len() < frame.tiles_len(share) * per_tile {
         return Err(RenderError::NotProgressive);
     }
     if kept.len() < frame.tiles_len(share) {
         return Err(RenderError::ScratchTooSmall { needed: frame.tiles_len(share) });
     }
-    render_tiles::<_, _, Nowhere, E>(tracer, frame, share, Some((pass, traced)), Out::Keep(kept), scratch, hooks)
+    render_tiles::<_, _, Nowhere, E>(tracer, frame, share, Some(Pass { n: pass, traced, whole_share: false }), Out::Keep(kept), scratch, hooks)
 }
 
 /// The second half of trace, then dither ([`trace_share`]): dithers tile row `ty` of `frame`
@@ -480,7 +483,16 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
     if !frame.progressive() || ![8, 4, 2, 1].contains(&pass) || traced.len() < frame.traced_len(share) {
         return Err(RenderError::NotProgressive);
     }
-    render_tiles(tracer, frame, share, Some((pass, traced)), Out::Draw(target), scratch, hooks)
+    render_tiles(tracer, frame, share, Some(Pass { n: pass, traced, whole_share: true }), Out::Draw(target), scratch, hooks)
+}
+
+/// A pass of a progressive frame as the tile loop takes it: which pass, and the rays kept
+/// between passes, for the whole share (its tiles before `frame`'s rows first) or for the tiles
+/// of `frame`'s rows alone.
+struct Pass<'t> {
+    n: u8,
+    traced: &'t mut [Traced],
+    whole_share: bool,
 }
 
 /// The tile loop of [`render_share`] and [`render_pass`].
@@ -488,7 +500,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     share: Share,
-    mut pass: Option<(u8, &mut [Traced])>,
+    mut pass: Option<Pass<'_>>,
     mut out: Out<'_, D>,
     scratch: &mut Scratch<'_>,
     hooks: &mut impl Hooks,
@@ -509,7 +521,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let mut dither = Ditherer::new(mode, w, carries).ok_or_else(too_small)?;
     let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
     // The outline is drawn on finished frames: a progressive frame's last pass, not its previews.
-    let outline = frame.outline && pass.as_ref().is_none_or(|(n, _)| *n == 1);
+    let outline = frame.outline && pass.as_ref().is_none_or(|p| p.n == 1);
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
     let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
@@ -549,8 +561,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
             };
             match pass.as_mut() {
                 None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels, &mut hits),
-                Some((n, traced)) => {
-                    let k = skipped + done as usize;
+                Some(Pass { n, traced, whole_share }) => {
+                    let k = if *whole_share { skipped } else { 0 } + done as usize;
                     pass_tile(*n, &mut sampler, at, &mut traced[k * per_tile..(k + 1) * per_tile], &mut shoot, &mut levels, &mut hits);
                 }
             }

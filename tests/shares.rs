@@ -188,8 +188,9 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
     assert_eq!(err, RenderError::ScratchTooSmall { needed: 1024 });
 }
 
-/// The passes of a progressive frame traced in shares band by band (`trace_pass`) and each
-/// band dithered in order (`dither_band`, lines on the last pass alone) are the pictures
+/// The passes of a progressive frame traced tile by tile (`trace_pass`, each tile its own
+/// share and its own rays between passes, as the two-core board takes them) and each band
+/// dithered in order (`dither_band`, lines on the last pass alone) are the pictures
 /// `render_pass` draws, pass by pass, bit for bit.
 #[test]
 fn traced_passes_dithered_in_order_give_every_pass() {
@@ -212,8 +213,9 @@ fn traced_passes_dithered_in_order_give_every_pass() {
             render_pass(&tracer, &frame, Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
             want.push(bits.clone());
         }
-        for of in [1u8, 2] {
-            let mut traced: Vec<Vec<Traced>> = (0..of).map(|index| vec![Traced::default(); frame.traced_len(Share { index, of })]).collect();
+        {
+            // Each tile keeps its own rays between passes (16 per 8x8 tile), as the board's do.
+            let mut traced = vec![vec![Traced::default(); 16]; frame.tiles_len(Share::ALL)];
             for (k, pass) in [8, 4, 2, 1].into_iter().enumerate() {
                 let mut bits = vec![0u8; BitFrame::bytes(w, h)];
                 let mut target = BitFrame::new(w, h, &mut bits).unwrap();
@@ -224,19 +226,22 @@ fn traced_passes_dithered_in_order_give_every_pass() {
                 let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * 8];
                 for ty in 0..(h / 8) as u16 {
                     let band = Frame { rows: (ty, ty + 1), ..frame };
-                    let kept: Vec<Vec<KeptTile>> = (0..of)
-                        .map(|index| {
-                            let share = Share { index, of };
-                            let mut kept = vec![KeptTile::EMPTY; band.tiles_len(share)];
+                    // The band's tiles in `of` shares, each tile traced alone (`Share::single`).
+                    let tiles_x = 16;
+                    let kept: Vec<KeptTile> = (0..tiles_x)
+                        .map(|tx| {
+                            let share = Share::single(tx, ty as usize, tiles_x);
+                            let mut kept = [KeptTile::EMPTY];
                             let mut scratch = HeapScratch::new(&scene, &band);
-                            trace_pass(&tracer, &band, share, pass, &mut traced[index as usize], &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
-                            kept
+                            let rays = &mut traced[ty as usize * tiles_x + tx];
+                            trace_pass(&tracer, &band, share, pass, rays, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                            kept[0]
                         })
                         .collect();
-                    let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
+                    let tile = |tx: usize| kept.get(tx);
                     dither_band(&shown, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap();
                 }
-                assert_eq!(bits, want[k], "{name}, pass {pass}, {of} shares");
+                assert_eq!(bits, want[k], "{name}, pass {pass}");
             }
         }
         // A frame that cannot be progressive, or a pass that is not one, is refused.

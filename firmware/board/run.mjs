@@ -22,6 +22,8 @@
 //
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
+// --pass-bytes N shows a picture every N GDDRAM bytes the display receives while the LED is lit
+// (1024: a progressive frame's passes, each a whole panel), instead of when the LED goes out.
 // With --profile FILE it also samples core 0's program counter every 97th instruction of the
 // first frame (--profile-frames N: of the first N frames; while the LED is lit) and writes the
 // counts as JSON pairs [pc, samples].
@@ -30,6 +32,7 @@
 //                     [--records ADDR --records-log FILE] [--frames N] [--max-cycles N]
 //                     [--no-display] [--until-ms T] [--profile FILE]
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
+//                     [--pass-bytes N]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
@@ -63,6 +66,7 @@ function parseArgs(argv) {
     else if (a === '--profile-frames') o.profileFrames = Number(next());
     else if (a === '--no-core1') o.core1 = false;
     else if (a === '--no-cache') o.cache = false;
+    else if (a === '--pass-bytes') o.passBytes = Number(next());
     else if (a === '--untimed-bus') o.timedBus = false;
     else throw new Error(`unknown argument ${a}`);
   }
@@ -195,18 +199,10 @@ function main() {
   let draining = false;
   let drainLeft = 50_000_000;
 
-  board.gpio(LED_PIN).addListener((state) => {
-    const on = state === GPIOPinState.High;
-    if (on === ledOn) return;
-    ledOn = on;
-    ledToggles++;
-    if (!display) return;
-    if (on) {
-      frameStart = snapshot();
-      firstByteOfFrame = null;
-      return;
-    }
-    if (!frameStart) return;
+  // A picture the panel shows: from `frameStart` to now. With --pass-bytes N, every N GDDRAM
+  // bytes the display receives while the LED is lit is one (a progressive frame's passes, each
+  // a whole panel of page bytes); else the LED going out ends one.
+  const capture = () => {
     const end = snapshot();
     const why = display.notShowable();
     const first = firstByteOfFrame ?? end;
@@ -234,9 +230,36 @@ function main() {
     };
     frames.push(frame);
     emit(frame);
-    frameStart = null;
+    frameStart = opt.passBytes ? end : null;
+    firstByteOfFrame = null;
     if (why) board.stop = `display: ${why}`;
+    else if (frames.length >= opt.frames && !opt.passBytes) draining = true;
+  };
+  let passData = 0; // GDDRAM bytes since the LED went on (--pass-bytes)
+  if (display && opt.passBytes) {
+    const data = display.data.bind(display);
+    display.data = (b) => {
+      data(b);
+      if (ledOn && frameStart && ++passData % opt.passBytes === 0) capture();
+    };
+  }
+
+  board.gpio(LED_PIN).addListener((state) => {
+    const on = state === GPIOPinState.High;
+    if (on === ledOn) return;
+    ledOn = on;
+    ledToggles++;
+    if (!display) return;
+    if (on) {
+      frameStart = snapshot();
+      firstByteOfFrame = null;
+      passData = 0;
+      return;
+    }
+    if (!frameStart) return;
+    if (!opt.passBytes) capture();
     else if (frames.length >= opt.frames) draining = true;
+    frameStart = null;
   });
 
   // Core 0 at boot2 with the stack pointer the bootrom would leave; core 1 in the bootrom.

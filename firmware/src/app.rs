@@ -2,10 +2,7 @@
 
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::Dimensions;
 use embedded_graphics_core::pixelcolor::BinaryColor;
-use embedded_graphics_core::primitives::Rectangle;
-use embedded_graphics_core::Pixel;
 #[cfg(not(baked_scenes))]
 use lattice_rt::lattice::LatticeError;
 #[cfg(not(baked_scenes))]
@@ -15,7 +12,7 @@ use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::dither::{Carry, Ditherer};
-use lattice_rt::{dither_band, KeptTile, render_pass, render_share, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
+use lattice_rt::{dither_band, KeptTile, render_pass, render_share, trace_pass, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 
 pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
@@ -157,9 +154,10 @@ pub struct Report {
 /// `0`, the frame drawn at once (`render_share`).
 pub const PASSES: &[u8] = if cfg!(feature = "progressive") { &[8, 4, 2, 1] } else { &[0] };
 
-/// Entries of [`Traced`] storage each tile share keeps between passes (none without the
-/// `progressive` feature).
-pub const TRACED: usize = if cfg!(feature = "progressive") {
+/// Entries of [`Traced`] storage each tile share keeps between passes on a one-core board
+/// (`render_pass`; none without the `progressive` feature, and none on a two-core board, whose
+/// tiles each keep their own: [`TILE_RAYS`]).
+pub const TRACED: usize = if cfg!(feature = "progressive") && !SECOND_CORE {
     let (a, b) = (RENDERED.traced_len(Share { index: 0, of: SHARES }), RENDERED.traced_len(Share { index: 1, of: SHARES }));
     if a > b { a } else { b }
 } else {
@@ -239,10 +237,16 @@ const fn second(n: usize) -> usize {
     }
 }
 
-/// Whether a two-core board renders trace, then dither ([`trace_then_dither`]): every frame
-/// but a progressive one's passes. Error diffusion carries error from tile to tile, so the
-/// cores cannot each draw their own tiles, and silhouette lines then need no apron rays.
-const TRACE_THEN_DITHER: bool = SECOND_CORE && !cfg!(feature = "progressive");
+/// Whether a two-core board renders trace, then dither ([`trace_then_dither`]): every frame,
+/// and every pass of a progressive one. Error diffusion carries error from tile to tile, so the
+/// cores cannot each draw their own tiles; silhouette lines then need no apron rays; and a band
+/// goes to the display in one transfer (a progressive pass's 128 tiles sent one by one took
+/// twice the bytes).
+const TRACE_THEN_DITHER: bool = SECOND_CORE;
+/// Rays each tile keeps between the passes of a progressive frame on a two-core board (the
+/// cores take tiles one at a time, so each has its own: one per pixel of its 2x2 grid); none
+/// otherwise.
+const TILE_RAYS: usize = if cfg!(feature = "progressive") && SECOND_CORE { (FRAME.tile as usize / 2) * (FRAME.tile as usize / 2) } else { 0 };
 /// Entries of [`ShareMemory`]'s arrays when [`TRACE_THEN_DITHER`] (else none).
 const fn dithered(n: usize) -> usize {
     if TRACE_THEN_DITHER {
@@ -257,14 +261,16 @@ const TILES_X: usize = (WIDTH as usize).div_ceil(FRAME.tile as usize);
 const TILES: usize = TILES_X * (HEIGHT as usize).div_ceil(FRAME.tile as usize);
 
 /// The memory of the second tile share: on a board with two cores its own query scratch; and
-/// the rays both shares keep between progressive passes ([`TRACED`] each). Where the two cores
-/// trace, then dither: what every tile keeps between its trace and its dithering (24 KiB), the
-/// bottom row's hits of the band last dithered, the band's pixels and the dither's carries.
+/// the rays both shares keep between progressive passes ([`TRACED`] each) on one core. Where
+/// the two cores trace, then dither: what every tile keeps between its trace and its dithering
+/// (24 KiB) and between progressive passes ([`TILE_RAYS`]), the bottom row's hits of the band
+/// last dithered, the band's pixels and the dither's carries.
 pub struct ShareMemory {
     mailbox: [u32; second(MAX_OBJECTS + MAX_LATTICES)],
     rows: [i16; second(MAX_ROWS)],
     traced: [[Traced; TRACED]; 2],
     kept: [KeptTile; dithered(TILES)],
+    rays: [[Traced; TILE_RAYS]; TILES],
     above: [(u16, u16); dithered(WIDTH as usize)],
     band: [BinaryColor; dithered(WIDTH as usize * FRAME.tile as usize)],
     carries: [i16; dithered(Carry::len(WIDTH as usize))],
@@ -279,6 +285,7 @@ impl ShareMemory {
             rows: [0; second(MAX_ROWS)],
             traced: [[NONE; TRACED]; 2],
             kept: [KeptTile::EMPTY; dithered(TILES)],
+            rays: [[NONE; TILE_RAYS]; TILES],
             above: [(0, 0); dithered(WIDTH as usize)],
             band: [BinaryColor::Off; dithered(WIDTH as usize * FRAME.tile as usize)],
             carries: [0; dithered(Carry::len(WIDTH as usize))],
@@ -414,51 +421,27 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
     let Board { cores, second, now, shown } = board;
-    let ShareMemory { mailbox, rows, traced, kept, above, band, carries } = second;
+    let ShareMemory { mailbox, rows, traced, kept, rays, above, band, carries } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
-    if TRACE_THEN_DITHER {
-        let memory = DitherMemory { mailbox, rows, kept, above, band, carries };
-        let here = (&mut scratch, hooks, now);
-        let (stats, [there_us, here_us]) = trace_then_dither(tracer, pick(&tuned), cores, memory, here, target)?;
-        shown(0);
-        return Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [here_us, there_us] });
-    }
     for &pass in PASSES {
-        if !SECOND_CORE {
+        let [there_us, here_us] = &mut times;
+        if TRACE_THEN_DITHER {
+            let memory = DitherMemory { mailbox: &mut *mailbox, rows: &mut *rows, kept: &mut *kept, rays: &mut *rays, above: &mut *above, band: &mut *band, carries: &mut *carries };
+            let here = (&mut scratch, &mut *hooks, now);
+            let (s, [there, mine]) = trace_then_dither(tracer, pick(&tuned), pass, cores, memory, here, target)?;
+            stats.add(&s);
+            (*here_us, *there_us) = (*here_us + mine, *there_us + there);
+        } else {
             // One core: both shares straight to the display, one after the other.
-            let [there_us, here_us] = &mut times;
             let t0 = now();
             stats.add(&draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks).map_err(AppError::Render)?);
             let t1 = now();
             let more = draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], target, &mut scratch, &mut lattice_rt::NoHooks);
             stats.add(&more.map_err(AppError::Render)?);
             (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
-            shown(pass);
-            continue;
         }
-        // Two cores: each draws its own tiles straight to the display as it finishes them,
-        // one tile at a time under a lock (`Shared`), so the bus carries one core's tiles while
-        // the other traces, and no tile waits for the other share to finish.
-        let shared = Shared::new(&mut *target);
-        let (mut there_result, mut here_result) = (None, None);
-        let [there_us, here_us] = &mut times;
-        cores.join(
-            &mut || {
-                let t0 = now();
-                let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-                there_result = Some(draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], &mut &shared, &mut scratch, &mut lattice_rt::NoHooks));
-                *there_us += now() - t0;
-            },
-            &mut || {
-                let t0 = now();
-                here_result = Some(draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], &mut &shared, &mut scratch, hooks));
-                *here_us += now() - t0;
-            },
-        );
-        stats.add(&here_result.unwrap_or(Err(RenderError::Cancelled)).map_err(AppError::Render)?);
-        stats.add(&there_result.unwrap_or(Err(RenderError::Cancelled)).map_err(AppError::Render)?);
         shown(pass);
     }
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
@@ -470,6 +453,7 @@ struct DitherMemory<'m> {
     mailbox: &'m mut [u32],
     rows: &'m mut [i16],
     kept: &'m mut [KeptTile],
+    rays: &'m mut [[Traced; TILE_RAYS]],
     above: &'m mut [(u16, u16)],
     band: &'m mut [BinaryColor],
     carries: &'m mut [i16],
@@ -479,42 +463,46 @@ struct DitherMemory<'m> {
 /// free (to be traced), then done (to be dithered); `next` is the next tile to take, in raster
 /// order, so the bands finish in order.
 struct TileBoard<'l> {
-    free: [Option<&'l mut KeptTile>; TILES],
+    free: [Option<(&'l mut KeptTile, &'l mut [Traced])>; TILES],
     done: [Option<&'l mut KeptTile>; TILES],
     next: usize,
 }
 
-/// Traces one tile of a frame: the band it is in, the share that holds it alone, what it keeps.
-type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, Frame, Share, &mut [KeptTile]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
+/// Traces one tile of a frame: the band it is in, the share that holds it alone, what it keeps,
+/// and the rays it keeps between progressive passes.
+type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, Frame, Share, &mut [KeptTile], &mut [Traced]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
 
 /// A frame on two cores, trace then dither: the cores take the frame's tiles one at a time as
 /// they come free (`Share::single`), in raster order, and trace each into its levels
 /// (`trace_share`); core 0, between its tiles, dithers each band whose tiles are all traced,
 /// in order (`dither_band`), and sends it to `target`. Neither core waits for the other but at
 /// the frame's end, and core 0's time on the bus is made up by core 1 taking more tiles. The
-/// frame is bit for bit what `render` draws, error diffusion included. Returns both cores'
+/// frame is bit for bit what `render` draws, error diffusion included; pass `pass` of a
+/// progressive frame (8, 4, 2, 1; 0 is a whole frame) bit for bit what `render_pass` draws
+/// (`trace_pass`, each tile's rays kept in `memory` for the next pass). Returns both cores'
 /// statistics and their times, core 1's first.
 fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
     frame: &Frame,
+    pass: u8,
     cores: &mut impl Cores,
     memory: DitherMemory<'_>,
     (scratch, hooks, now): (&mut lattice_rt::Scratch<'_>, &mut impl Hooks, &(dyn Fn() -> u64 + Sync)),
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
-    let DitherMemory { mailbox, rows, kept, above, band: band_bits, carries } = memory;
+    let DitherMemory { mailbox, rows, kept, rays, above, band: band_bits, carries } = memory;
     let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
     let tiles_x = w.div_ceil(t).min(TILES_X);
     let tiles = (tiles_x * h.div_ceil(t)).min(TILES).min(kept.len());
     let mut board = TileBoard { free: [const { None }; TILES], done: [const { None }; TILES], next: 0 };
-    for (slot, l) in board.free.iter_mut().zip(kept.iter_mut()).take(tiles) {
-        *slot = Some(l);
+    for (slot, (l, r)) in board.free.iter_mut().zip(kept.iter_mut().zip(rays.iter_mut())).take(tiles) {
+        *slot = Some((l, &mut r[..]));
     }
     let board = critical_section::Mutex::new(core::cell::RefCell::new(board));
     // Takes the next free tile, traces it and marks it done (handed over even when the trace
     // failed, so no core waits for it); None once every tile is taken.
     let take = |scratch: &mut lattice_rt::Scratch<'_>, trace: &mut TraceTile<'_>| {
-        let (k, l) = critical_section::with(|cs| {
+        let (k, (l, r)) = critical_section::with(|cs| {
             let mut b = board.borrow(cs).borrow_mut();
             let k = b.next;
             b.next += 1;
@@ -522,7 +510,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
         })?;
         let (tx, ty) = (k % tiles_x, k / tiles_x);
         let band = Frame { rows: (ty as u16, ty as u16 + 1), ..*frame };
-        let traced = trace(scratch, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l));
+        let traced = trace(scratch, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l), r);
         critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some(l));
         Some(traced)
     };
@@ -533,7 +521,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
         &mut || {
             let t0 = now();
             let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile]| trace_share(tracer, &band, share, l, scratch, &mut lattice_rt::NoHooks);
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, pass, (l, r), scratch, &mut lattice_rt::NoHooks);
             while let Some(traced) = take(&mut scratch, &mut trace) {
                 match traced {
                     Ok(s) => there.0.add(&s),
@@ -544,7 +532,9 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
         },
         &mut || {
             let t0 = now();
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile]| trace_share(tracer, &band, share, l, scratch, hooks);
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, pass, (l, r), scratch, hooks);
+            // Only a finished frame (a progressive one's last pass) has silhouette lines.
+            let shown = Frame { outline: frame.outline && pass <= 1, ..*frame };
             let mut band = 0;
             here.1 = (|| {
                 while band * tiles_x < tiles {
@@ -562,7 +552,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                     });
                     if let Some(row) = ready {
                         let tile = |tx: usize| row.get(tx).and_then(|l| l.as_deref());
-                        dither_band(frame, band, tile, (&mut *above, &mut *band_bits), &mut ditherer, target).map_err(AppError::Render)?;
+                        dither_band(&shown, band, tile, (&mut *above, &mut *band_bits), &mut ditherer, target).map_err(AppError::Render)?;
                         band += 1;
                         continue;
                     }
@@ -582,6 +572,25 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
     }
     here.0.add(&there.0);
     Ok((here.0, [there.2, here.2]))
+}
+
+/// One tile traced for trace, then dither: pass `pass` of a progressive frame (`trace_pass`,
+/// its rays kept in the tile's own storage), or, in a build without the `progressive` feature,
+/// the whole frame's tile (`trace_share`).
+fn trace_tile<R: Real>(
+    tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
+    band: &Frame,
+    share: Share,
+    pass: u8,
+    (kept, rays): (&mut [KeptTile], &mut [Traced]),
+    scratch: &mut lattice_rt::Scratch<'_>,
+    hooks: &mut impl Hooks,
+) -> Result<Stats, RenderError<core::convert::Infallible>> {
+    if cfg!(feature = "progressive") {
+        trace_pass(tracer, band, share, pass, rays, kept, scratch, hooks)
+    } else {
+        trace_share(tracer, band, share, kept, scratch, hooks)
+    }
 }
 
 /// One share of a frame: pass `pass` of a progressive frame (`render_pass`), or, in a build
@@ -605,39 +614,6 @@ fn draw<R: Real, D: DrawTarget<Color = BinaryColor>>(
         render_pass(tracer, frame, share, pass, traced, target, scratch, hooks)
     } else {
         render_share(tracer, frame, share, target, scratch, hooks)
-    }
-}
-
-/// A draw target both cores draw into, one tile (`fill_contiguous`) at a time: each call holds
-/// the board's critical section (on the RP2040 a hardware spinlock shared by the cores, with
-/// interrupts off) while it hands the tile to the target, so one core's tile commands and pixels
-/// never interleave with the other's.
-struct Shared<'d, D> {
-    target: critical_section::Mutex<core::cell::RefCell<&'d mut D>>,
-}
-
-impl<'d, D> Shared<'d, D> {
-    fn new(target: &'d mut D) -> Self {
-        Shared { target: critical_section::Mutex::new(core::cell::RefCell::new(target)) }
-    }
-}
-
-impl<D: Dimensions> Dimensions for &Shared<'_, D> {
-    fn bounding_box(&self) -> Rectangle {
-        critical_section::with(|cs| self.target.borrow_ref(cs).bounding_box())
-    }
-}
-
-impl<D: DrawTarget<Color = BinaryColor>> DrawTarget for &Shared<'_, D> {
-    type Color = BinaryColor;
-    type Error = D::Error;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<BinaryColor>>>(&mut self, pixels: I) -> Result<(), D::Error> {
-        critical_section::with(|cs| self.target.borrow_ref_mut(cs).draw_iter(pixels))
-    }
-
-    fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(&mut self, area: &Rectangle, colors: I) -> Result<(), D::Error> {
-        critical_section::with(|cs| self.target.borrow_ref_mut(cs).fill_contiguous(area, colors))
     }
 }
 

@@ -86,16 +86,17 @@ fn variant_image(feature: &str) -> String {
 }
 
 /// Builds (unless `no_build`) the image with `feature` and the chair alone (or `all_scenes`),
-/// writes its UF2 file into `frames_dir/<feature>` and runs it for `frames` frames; returns the
-/// run and that folder.
-fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, frames_dir: &Path, bootrom: &Path, frames: usize) -> Result<(BoardRun, PathBuf)> {
+/// writes its UF2 file into `frames_dir/<feature>` and runs it for `frames` frames (with `run.mjs`
+/// switches `extra`); returns the run and that folder.
+#[allow(clippy::too_many_arguments)]
+fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, frames_dir: &Path, bootrom: &Path, frames: usize, extra: &[&str]) -> Result<(BoardRun, PathBuf)> {
     let elf = if no_build { kept_image(root, &variant_image(feature)) } else { build_pico_with(root, feature, all_scenes)? };
     let dir = frames_dir.join(variant_name(feature));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let uf2 = dir.join(format!("lattice-rt-{}.uf2", variant_image(feature)));
     write_uf2(&elf, &uf2)?;
     eprintln!("running {} ({frames} frames)", uf2.display());
-    let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir, &[])?;
+    let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir, extra)?;
     Ok((run, dir))
 }
 
@@ -447,7 +448,9 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let (orun, orbit_same) = s.orbit_run()?;
     let lrun = s.variant("ladder", false, LADDER.len())?.0;
     let rungs = s.ladder_rows(&lrun)?;
-    let prun = s.variant("progressive", true, PASSES * s.scenes.len())?;
+    // A progressive frame's passes follow each other without waiting for the bus: each is
+    // checked when a panel's worth of page bytes (128 x 8) has reached the display.
+    let prun = run_variant(s.root, s.no_build, "progressive", true, s.frames_dir, &s.bootrom, PASSES * s.scenes.len(), &["--pass-bytes", "1024"])?;
     let progressive = s.progressive_rows(&prun, &rows)?;
     let plain_run = s.variant("no-outline", false, 1)?;
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays)| *rays))?;
@@ -497,7 +500,7 @@ impl<'a> Session<'a> {
 
     /// Runs the image with `feature` (the chair alone, or `all_scenes`) for `frames` frames.
     fn variant(&self, feature: &str, all_scenes: bool, frames: usize) -> Result<(BoardRun, PathBuf)> {
-        run_variant(self.root, self.no_build, feature, all_scenes, self.frames_dir, &self.bootrom, frames)
+        run_variant(self.root, self.no_build, feature, all_scenes, self.frames_dir, &self.bootrom, frames, &[])
     }
 
     /// The default image on every embedded scene: each frame against host-sim's, the log's
@@ -784,13 +787,16 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
     writeln!(md, "The image built with `--features progressive` (the default scenes) shows every frame in four")?;
     writeln!(md, "passes (`render_pass`, blue noise with lines: frames in motion, `board_frame::MOTION_DITHER`):")?;
     writeln!(md, "one traced ray per 8x8 block, then 4x4, 2x2 and the finished frame,")?;
-    writeln!(md, "each pass reusing every ray traced before it, so no eye ray is traced twice. The display is")?;
-    writeln!(md, "updated after each pass (both tile shares of the pass), and the LED goes out for a moment as")?;
-    writeln!(md, "each pass reaches the panel; every pass the panel showed is checked bit for bit against")?;
-    writeln!(md, "host-sim's (`cargo xtask display` draws the same passes). *At* is cycles from the LED going on")?;
-    writeln!(md, "(set-up included) to the pass on the panel; *plain* is the same scene's frame in the default")?;
-    writeln!(md, "image above, and *cost* the whole progressive frame against it (target: at most 1.05x).\n")?;
-    writeln!(md, "| scene | passes identical | pass 8 at | pass 4 at | pass 2 at | finished at | plain | cost | first picture: share of the plain frame's time | eye rays per pass | I2C bytes |")?;
+    writeln!(md, "each pass reusing every ray traced before it, so no eye ray is traced twice. Each pass is traced,")?;
+    writeln!(md, "then dithered as the still frame is (`trace_pass`: both cores take its tiles, core 0 dithers and")?;
+    writeln!(md, "sends each finished band in one transfer), and the passes follow each other without waiting for")?;
+    writeln!(md, "the bus: the cores trace the next pass while the bus sends the last (the I2C queue holds two")?;
+    writeln!(md, "frames' bytes in this image). The run (`run.mjs --pass-bytes 1024`) takes the panel's picture")?;
+    writeln!(md, "each time a whole panel of page bytes has reached it, and every pass is checked bit for bit")?;
+    writeln!(md, "against host-sim's (`cargo xtask display` draws the same passes). *At* is cycles from the LED")?;
+    writeln!(md, "going on (set-up included) to the pass on the panel; *plain* is the same scene's frame in the")?;
+    writeln!(md, "default image above, and *cost* the whole progressive frame against it (target: at most 1.05x).\n")?;
+    writeln!(md, "| scene | passes identical | pass 8 at | pass 4 at | pass 2 at | finished at | plain | cost | first picture: share of the plain frame's time | eye rays per pass | bus bytes |")?;
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|")?;
     for r in rows {
         let mut at = 0u64;
@@ -812,7 +818,7 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
             r.passes.iter().map(|f| f.bus_bytes).sum::<u64>(),
         )?;
     }
-    writeln!(md, "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The I2C bytes are four frames' worth, each on the", 1e3 / mhz)?;
+    writeln!(md, "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The bus bytes are four panels' worth, each on the", 1e3 / mhz)?;
     writeln!(md, "emulated bus for the time it takes there.")?;
     Ok(md)
 }

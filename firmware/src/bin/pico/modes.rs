@@ -67,23 +67,16 @@ pub struct Panel<'m, T, L> {
 }
 
 impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin> Panel<'_, T, L> {
-    /// One frame, with the LED lit while it renders; its report and microseconds. A progressive
-    /// frame (the `progressive` feature) puts the LED out for a moment as each pass but the last
-    /// reaches the display, so the LED goes out once per picture the panel shows.
+    /// One frame, with the LED lit while it renders; its report and microseconds. The passes of
+    /// a progressive frame (the `progressive` feature) follow each other without waiting for the
+    /// bus: each reaches the panel as its bytes do, while the cores trace the next, and the LED
+    /// goes out when the last is on the panel.
     pub fn show(&mut self, scene: Embedded, shot: &Shot) -> Result<(Report, u64), AppError<'static, T::Error>> {
         let timer = self.timer;
         let t0 = timer.get_counter();
         let _ = self.led.set_high();
-        let led = &mut self.led;
-        let mut shown = |pass: u8| {
-            let _ = crate::display::flush();
-            if pass > 1 {
-                let _ = led.set_low();
-                let _ = led.set_high();
-            }
-        };
         let now = || timer.get_counter().ticks();
-        let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut shown };
+        let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut |_| {} };
         let result = render_embedded_at(scene, self.st, &mut self.target, &mut crate::display::Pump, shot, board);
         // The frame is on the panel once the bus has sent its last queued byte.
         let sent = crate::display::flush();

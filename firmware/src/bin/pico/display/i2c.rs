@@ -23,7 +23,10 @@ pub struct QueuedI2c<P> {
 /// Words the queue holds: IC_DATA_CMD values (the byte, and the STOP bit on a transaction's
 /// last). A frame is 1,152 bytes (8 page rows of 128 column bytes and their addressing); the
 /// queue holds two bands' worth, so a band is queued whole while the last is still on the bus.
-const QUEUED: usize = 320;
+/// A progressive frame's first passes are traced in a fraction of the time their bytes take on
+/// the bus: its queue holds two frames' worth (4.6 KB), so the cores trace the later passes
+/// while the bus sends the earlier ones.
+const QUEUED: usize = if cfg!(feature = "progressive") { 2 * 1152 + 96 } else { 320 };
 
 /// The bytes on their way to the bus: a ring of IC_DATA_CMD words, and the abort the controller
 /// reported while the queue was being moved into its FIFO.
