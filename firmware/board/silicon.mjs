@@ -24,7 +24,8 @@
 // - I2C timing (4.3 "I2C"): START, each address or data byte (8 bits and the acknowledge: 9 SCL
 //   periods) and STOP take the time the controller's SCL counts give, at the configured clock;
 //   the 16-entry TX FIFO fills while the bus is busy, exactly as rp2040js's controller has it,
-//   and the display model receives each byte when the bus has delivered it.
+//   and the display model receives each byte when the bus has delivered it. IC_INTR_MASK is
+//   writable and TX_EMPTY follows the FIFO's level (rp2040js keeps every interrupt masked).
 // - SPI timing (4.4 "SPI"): each frame of SPI0/SPI1 takes DSS + 1 periods of the clock the
 //   controller's CPSDVSR and SCR give; the display model on it hears a byte when its last bit
 //   is on the wire, with the chip-select and data/command pins as they are then.
@@ -392,6 +393,32 @@ class CoreBus {
   }
 }
 
+const IC_DATA_CMD = 0x10;
+const IC_INTR_MASK = 0x30;
+const IC_TX_TL = 0x3c;
+const R_TX_EMPTY = 1 << 4;
+
+/**
+ * The I2C interrupts as DW_apb_i2c raises them (4.3.17 IC_INTR_MASK, IC_RAW_INTR_STAT): rp2040js
+ * keeps IC_INTR_MASK at reset (every interrupt masked) and raises TX_EMPTY only when the
+ * controller takes a byte from its FIFO. Here IC_INTR_MASK takes what is written, and TX_EMPTY
+ * follows the FIFO's level after every write that can change it: set while at most IC_TX_TL
+ * entries wait, clear above, so an interrupt-driven driver that refills the FIFO sees what it
+ * would on silicon.
+ */
+function levelTxEmpty(i2c) {
+  const write = i2c.writeUint32.bind(i2c);
+  i2c.writeUint32 = (offset, value) => {
+    write(offset, value);
+    if (offset === IC_INTR_MASK) i2c.intEnable = value & 0x1fff;
+    if (offset === IC_INTR_MASK || offset === IC_DATA_CMD || offset === IC_TX_TL) {
+      if (i2c.txFIFO.itemCount <= i2c.txThreshold) i2c.setInterrupts(R_TX_EMPTY);
+      else i2c.clearInterrupts(R_TX_EMPTY);
+      i2c.checkInterrupts();
+    }
+  };
+}
+
 /**
  * An RP2040 with both cores, the XIP cache and timed I2C and SPI buses around rp2040js's chip.
  * `step()` runs one instruction of the core that is behind; `cores[i].cycles` is each core's
@@ -427,6 +454,7 @@ export class SiliconBoard {
     this.spklen = [7, 7]; // IC_FS_SPKLEN as written (rp2040js drops odd values)
     this.busCycles = 0; // cycles the display buses spent: I2C START, bytes and STOP; SPI frames
     this.stop = null; // why the run must end
+    for (const i2c of mcu.i2c) levelTxEmpty(i2c);
   }
 
   loadBootrom(words) {

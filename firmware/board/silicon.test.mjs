@@ -107,3 +107,19 @@ test('an SPI byte reaches the display 8 SCK periods later, with chip select and 
   mcu.writeUint32(0xd0000010, 0); // RES low
   assert.equal(resets, 1);
 });
+
+test('I2C TX_EMPTY follows the FIFO level and reaches the NVIC when IC_INTR_MASK lets it', () => {
+  const board = new SiliconBoard({ dualCore: false });
+  const i2c = board.mcu.i2c[0];
+  const base = 0x40044000;
+  board.mcu.writeUint32(base + 0x3c, 2); // IC_TX_TL: at most 2 entries waiting
+  assert.equal(i2c.intRaw & 0x10, 0x10, 'an empty FIFO is at or below the threshold');
+  assert.equal(i2c.intStatus, 0, 'masked at first');
+  board.mcu.writeUint32(base + 0x30, 0x10); // IC_INTR_MASK: TX_EMPTY on
+  assert.equal(i2c.intStatus, 0x10);
+  // The controller is disabled, so the FIFO only fills: three entries are above the threshold.
+  for (let i = 0; i < 3; i++) board.mcu.writeUint32(base + 0x10, 0x41);
+  assert.equal(i2c.intRaw & 0x10, 0, 'above the threshold: clear');
+  board.mcu.writeUint32(base + 0x30, 0);
+  assert.equal(i2c.intStatus, 0);
+});

@@ -1,8 +1,10 @@
-//! The display on I2C0: a queue in RAM in front of the controller's TX FIFO, moved on after each
-//! tile core 0 traces, so the bus sends a band while the cores trace the next.
+//! The display on I2C0: a queue in RAM in front of the controller's TX FIFO, refilled by the
+//! controller's TX_EMPTY interrupt on core 0 (and after each tile core 0 traces), so the bus
+//! sends a band while the cores trace the next, and never waits for a tile to end.
 
 use crate::hal;
 use hal::pac;
+use hal::pac::interrupt;
 
 /// I2C0 driven through a queue in RAM ([`QUEUED`] words) in front of its 16-entry TX FIFO: a
 /// transaction is queued and returns at once (it waits only while the queue is full), and the
@@ -24,9 +26,10 @@ pub struct QueuedI2c<P> {
 /// last). A frame is 1,152 bytes (8 page rows of 128 column bytes and their addressing); the
 /// queue holds two bands' worth, so a band is queued whole while the last is still on the bus.
 /// A progressive frame's first passes are traced in a fraction of the time their bytes take on
-/// the bus: its queue holds two frames' worth (4.6 KB), so the cores trace the later passes
-/// while the bus sends the earlier ones.
-const QUEUED: usize = if cfg!(feature = "progressive") { 2 * 1152 + 96 } else { 320 };
+/// the bus: its queue holds all four passes' bytes (9.4 KB), so the cores never wait for the
+/// bus and trace the later passes while it sends the earlier ones (with two passes' worth, core
+/// 0 waited for room during the third pass: the chair took 1.06x the still frame).
+const QUEUED: usize = if cfg!(feature = "progressive") { 4 * 1152 + 96 } else { 320 };
 
 /// The bytes on their way to the bus: a ring of IC_DATA_CMD words, and the abort the controller
 /// reported while the queue was being moved into its FIFO.
@@ -52,9 +55,16 @@ fn regs() -> &'static pac::i2c0::RegisterBlock {
     }
 }
 
-/// Moves queued words into the TX FIFO while it has room (inside the queue's critical section).
-/// An abort empties the queue (the controller dropped its FIFO) and is kept for the next call
-/// that can report it.
+/// IC_INTR_MASK's TX_EMPTY bit (1: the interrupt is on).
+const M_TX_EMPTY: u32 = 1 << 4;
+/// TX_EMPTY is raised when this many entries or fewer wait in the 16-entry TX FIFO: at 400 kHz
+/// the 4 left take 48,000 cycles, time enough for the interrupt to refill it.
+const TX_THRESHOLD: u8 = 4;
+
+/// Moves queued words into the TX FIFO while it has room (inside the queue's critical section),
+/// and leaves TX_EMPTY's interrupt on while words wait in the queue, off once it is empty. An
+/// abort empties the queue (the controller dropped its FIFO) and is kept for the next call that
+/// can report it.
 fn pump_queue(q: &mut Queue) {
     let r = regs();
     let reason = r.ic_tx_abrt_source().read().bits();
@@ -63,7 +73,6 @@ fn pump_queue(q: &mut Queue) {
         r.ic_clr_tx_abrt().read();
         q.abort = q.abort.or(Some(reason));
         q.len = 0;
-        return;
     }
     while q.len > 0 && r.ic_status().read().tfnf().bit_is_set() {
         // SAFETY: IC_DATA_CMD takes any byte with its STOP bit (bit 9), as queued.
@@ -72,6 +81,16 @@ fn pump_queue(q: &mut Queue) {
         q.head = (q.head + 1) % QUEUED;
         q.len -= 1;
     }
+    // SAFETY: TX_EMPTY alone or no interrupt at all; every other source stays masked.
+    #[allow(unsafe_code)]
+    r.ic_intr_mask().write(|w| unsafe { w.bits(if q.len > 0 { M_TX_EMPTY } else { 0 }) });
+}
+
+/// I2C0's interrupt (TX_EMPTY, on core 0 alone): the FIFO is running low, refill it from the
+/// queue.
+#[interrupt]
+fn I2C0_IRQ() {
+    pump();
 }
 
 /// Moves what is queued into the controller's TX FIFO as far as it has room, without waiting.
@@ -121,7 +140,18 @@ impl<P> QueuedI2c<P> {
         // SAFETY: any 7-bit address is a valid IC_TAR value.
         #[allow(unsafe_code)]
         r.ic_tar().write(|w| unsafe { w.ic_tar().bits(u16::from(address)) });
+        // SAFETY: any threshold up to the FIFO's 16 entries is valid; 0 masks every interrupt.
+        #[allow(unsafe_code)]
+        {
+            r.ic_tx_tl().write(|w| unsafe { w.tx_tl().bits(TX_THRESHOLD) });
+            r.ic_intr_mask().write(|w| unsafe { w.bits(0) });
+        }
         r.ic_enable().write(|w| w.enable().set_bit());
+        // SAFETY: the handler only takes the queue's critical section, as every other user does.
+        #[allow(unsafe_code)]
+        unsafe {
+            cortex_m::peripheral::NVIC::unmask(pac::Interrupt::I2C0_IRQ)
+        };
         QueuedI2c { _bus: bus, address }
     }
 }
