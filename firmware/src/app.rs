@@ -425,23 +425,20 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
+    if TRACE_THEN_DITHER {
+        let memory = DitherMemory { mailbox, rows, kept, rays, above, band, carries };
+        let (s, [there, mine]) = trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown), target)?;
+        return Ok(Report { stats: s, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [mine, there] });
+    }
     for &pass in PASSES {
+        // One core: both shares straight to the display, one after the other.
         let [there_us, here_us] = &mut times;
-        if TRACE_THEN_DITHER {
-            let memory = DitherMemory { mailbox: &mut *mailbox, rows: &mut *rows, kept: &mut *kept, rays: &mut *rays, above: &mut *above, band: &mut *band, carries: &mut *carries };
-            let here = (&mut scratch, &mut *hooks, now);
-            let (s, [there, mine]) = trace_then_dither(tracer, pick(&tuned), pass, cores, memory, here, target)?;
-            stats.add(&s);
-            (*here_us, *there_us) = (*here_us + mine, *there_us + there);
-        } else {
-            // One core: both shares straight to the display, one after the other.
-            let t0 = now();
-            stats.add(&draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks).map_err(AppError::Render)?);
-            let t1 = now();
-            let more = draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], target, &mut scratch, &mut lattice_rt::NoHooks);
-            stats.add(&more.map_err(AppError::Render)?);
-            (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
-        }
+        let t0 = now();
+        stats.add(&draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks).map_err(AppError::Render)?);
+        let t1 = now();
+        let more = draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], target, &mut scratch, &mut lattice_rt::NoHooks);
+        stats.add(&more.map_err(AppError::Render)?);
+        (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
         shown(pass);
     }
     Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
@@ -460,34 +457,48 @@ struct DitherMemory<'m> {
 }
 
 /// The tiles of a frame traced, then dithered, as both cores see them: each tile's storage is
-/// free (to be traced), then done (to be dithered); `next` is the next tile to take, in raster
+/// free (to be traced), then done (to be dithered), then free again for the next progressive
+/// pass; `next` is the next of the frame's tiles to trace, pass after pass, each pass in raster
 /// order, so the bands finish in order.
 struct TileBoard<'l> {
     free: [Option<(&'l mut KeptTile, &'l mut [Traced])>; TILES],
-    done: [Option<&'l mut KeptTile>; TILES],
+    done: [Option<(&'l mut KeptTile, &'l mut [Traced])>; TILES],
     next: usize,
 }
 
-/// Traces one tile of a frame: the band it is in, the share that holds it alone, what it keeps,
-/// and the rays it keeps between progressive passes.
-type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, Frame, Share, &mut [KeptTile], &mut [Traced]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
+/// What a core gets when it asks for a tile to trace.
+enum Take<'l> {
+    /// Tile `k` of the frame in pass `PASSES[p]`: `(p, k, its storage)`.
+    Tile(usize, usize, (&'l mut KeptTile, &'l mut [Traced])),
+    /// The next tile's last pass is not dithered yet: ask again.
+    Wait,
+    /// Every tile of every pass is taken.
+    Finished,
+}
+
+/// Traces one tile of a frame: pass `PASSES[p]`, the band it is in, the share that holds it
+/// alone, what it keeps, and the rays it keeps between progressive passes.
+type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, usize, Frame, Share, &mut [KeptTile], &mut [Traced]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
 
 /// A frame on two cores, trace then dither: the cores take the frame's tiles one at a time as
 /// they come free (`Share::single`), in raster order, and trace each into its levels
 /// (`trace_share`); core 0, between its tiles, dithers each band whose tiles are all traced,
 /// in order (`dither_band`), and sends it to `target`. Neither core waits for the other but at
 /// the frame's end, and core 0's time on the bus is made up by core 1 taking more tiles. The
-/// frame is bit for bit what `render` draws, error diffusion included; pass `pass` of a
-/// progressive frame (8, 4, 2, 1; 0 is a whole frame) bit for bit what `render_pass` draws
-/// (`trace_pass`, each tile's rays kept in `memory` for the next pass). Returns both cores'
-/// statistics and their times, core 1's first.
+/// frame is bit for bit what `render` draws, error diffusion included. A progressive frame's
+/// passes ([`PASSES`]) run in the same way without a pause between them: a tile of the next
+/// pass is free to trace as soon as its band of the last has been dithered (`trace_pass`, each
+/// tile's rays kept in `memory` from pass to pass), so neither core waits at a pass's end; each
+/// pass is bit for bit what `render_pass` draws. `here` is core 0's side: its query scratch,
+/// the render's hooks, the board's clock and what to do once each pass is on the display.
+/// Returns both cores' statistics and their times, core 1's first.
+#[allow(clippy::type_complexity)]
 fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
     frame: &Frame,
-    pass: u8,
     cores: &mut impl Cores,
     memory: DitherMemory<'_>,
-    (scratch, hooks, now): (&mut lattice_rt::Scratch<'_>, &mut impl Hooks, &(dyn Fn() -> u64 + Sync)),
+    (scratch, hooks, now, shown): (&mut lattice_rt::Scratch<'_>, &mut impl Hooks, &(dyn Fn() -> u64 + Sync), &mut dyn FnMut(u8)),
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
     let DitherMemory { mailbox, rows, kept, rays, above, band: band_bits, carries } = memory;
@@ -499,67 +510,88 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
         *slot = Some((l, &mut r[..]));
     }
     let board = critical_section::Mutex::new(core::cell::RefCell::new(board));
-    // Takes the next free tile, traces it and marks it done (handed over even when the trace
-    // failed, so no core waits for it); None once every tile is taken.
+    // Takes the next tile if it is free, traces it and marks it done (handed over even when the
+    // trace failed, so no core waits for it).
     let take = |scratch: &mut lattice_rt::Scratch<'_>, trace: &mut TraceTile<'_>| {
-        let (k, (l, r)) = critical_section::with(|cs| {
+        let taken = critical_section::with(|cs| {
             let mut b = board.borrow(cs).borrow_mut();
-            let k = b.next;
-            b.next += 1;
-            b.free.get_mut(k).and_then(Option::take).map(|l| (k, l))
-        })?;
+            let i = b.next;
+            if i >= PASSES.len() * tiles {
+                return Take::Finished;
+            }
+            match b.free[i % tiles].take() {
+                Some(slot) => {
+                    b.next += 1;
+                    Take::Tile(i / tiles, i % tiles, slot)
+                }
+                None => Take::Wait,
+            }
+        });
+        let Take::Tile(p, k, (l, r)) = taken else { return taken.map_none() };
         let (tx, ty) = (k % tiles_x, k / tiles_x);
         let band = Frame { rows: (ty as u16, ty as u16 + 1), ..*frame };
-        let traced = trace(scratch, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l), r);
-        critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some(l));
-        Some(traced)
+        let traced = trace(scratch, p, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l), r);
+        critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some((l, r)));
+        Some(Some(traced))
     };
-    let mut ditherer = Ditherer::new(frame.dither, w, carries).ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
     let mut there = (Stats::default(), None, 0);
     let mut here: (Stats, Result<(), AppError<'t, D::Error>>, u64) = (Stats::default(), Ok(()), 0);
     cores.join(
         &mut || {
             let t0 = now();
             let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, pass, (l, r), scratch, &mut lattice_rt::NoHooks);
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, p: usize, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, &mut lattice_rt::NoHooks);
             while let Some(traced) = take(&mut scratch, &mut trace) {
                 match traced {
-                    Ok(s) => there.0.add(&s),
-                    Err(e) => there.1 = there.1.or(Some(e)),
+                    Some(Ok(s)) => there.0.add(&s),
+                    Some(Err(e)) => there.1 = there.1.or(Some(e)),
+                    None => core::hint::spin_loop(),
                 }
             }
             there.2 = now() - t0;
         },
         &mut || {
             let t0 = now();
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, pass, (l, r), scratch, hooks);
-            // Only a finished frame (a progressive one's last pass) has silhouette lines.
-            let shown = Frame { outline: frame.outline && pass <= 1, ..*frame };
-            let mut band = 0;
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, p: usize, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, hooks);
+            let bands = tiles.div_ceil(tiles_x);
             here.1 = (|| {
-                while band * tiles_x < tiles {
-                    // Every band whose tiles are all traced, in order, dithered and sent.
-                    let ready = critical_section::with(|cs| {
-                        let mut b = board.borrow(cs).borrow_mut();
-                        let row = &mut b.done[band * tiles_x..(band + 1) * tiles_x];
-                        if row.iter().all(Option::is_some) {
-                            let mut out: [Option<&mut KeptTile>; TILES_X] = [const { None }; TILES_X];
-                            out.iter_mut().zip(row.iter_mut()).for_each(|(o, r)| *o = r.take());
-                            Some(out)
-                        } else {
-                            None
+                for &pass in PASSES {
+                    // Only a finished frame (a progressive one's last pass) has silhouette lines.
+                    let shows = Frame { outline: frame.outline && pass <= 1, ..*frame };
+                    let mut ditherer = Ditherer::new(frame.dither, w, &mut *carries).ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
+                    let mut band = 0;
+                    while band < bands {
+                        // Every band whose tiles are all traced, in order, dithered and sent,
+                        // and its tiles freed for the next pass.
+                        let ready = critical_section::with(|cs| {
+                            let mut b = board.borrow(cs).borrow_mut();
+                            let row = &mut b.done[band * tiles_x..(band + 1) * tiles_x];
+                            if row.iter().all(Option::is_some) {
+                                let mut out: [Option<(&mut KeptTile, &mut [Traced])>; TILES_X] = [const { None }; TILES_X];
+                                out.iter_mut().zip(row.iter_mut()).for_each(|(o, r)| *o = r.take());
+                                Some(out)
+                            } else {
+                                None
+                            }
+                        });
+                        if let Some(mut row) = ready {
+                            let tile = |tx: usize| row.get(tx).and_then(|l| l.as_ref()).map(|(l, _)| &**l);
+                            dither_band(&shows, band, tile, (&mut *above, &mut *band_bits), &mut ditherer, target).map_err(AppError::Render)?;
+                            critical_section::with(|cs| {
+                                let mut b = board.borrow(cs).borrow_mut();
+                                for (tx, slot) in row.iter_mut().enumerate() {
+                                    b.free[band * tiles_x + tx] = slot.take();
+                                }
+                            });
+                            band += 1;
+                            continue;
                         }
-                    });
-                    if let Some(row) = ready {
-                        let tile = |tx: usize| row.get(tx).and_then(|l| l.as_deref());
-                        dither_band(&shown, band, tile, (&mut *above, &mut *band_bits), &mut ditherer, target).map_err(AppError::Render)?;
-                        band += 1;
-                        continue;
+                        match take(scratch, &mut trace) {
+                            Some(Some(traced)) => here.0.add(&traced.map_err(|e| AppError::Render(e.widen()))?),
+                            _ => core::hint::spin_loop(),
+                        }
                     }
-                    match take(scratch, &mut trace) {
-                        Some(traced) => here.0.add(&traced.map_err(|e| AppError::Render(e.widen()))?),
-                        None => core::hint::spin_loop(),
-                    }
+                    shown(pass);
                 }
                 Ok(())
             })();
@@ -572,6 +604,17 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
     }
     here.0.add(&there.0);
     Ok((here.0, [there.2, here.2]))
+}
+
+impl Take<'_> {
+    /// What `take` answers for anything but a tile: nothing to trace now (`Some(None)`), or
+    /// nothing left (`None`).
+    fn map_none<T>(self) -> Option<Option<T>> {
+        match self {
+            Take::Finished => None,
+            _ => Some(None),
+        }
+    }
 }
 
 /// One tile traced for trace, then dither: pass `pass` of a progressive frame (`trace_pass`,
