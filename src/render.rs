@@ -421,10 +421,15 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
         left = Some(kept);
         end = x0 + tw;
     }
-    // The band as far as it was kept (whole unless `tile` ran out), row by row.
+    // The band as far as it was kept (whole unless `tile` ran out), row by row: a whole band
+    // as one slice (the common case, and the cheapest iterator to draw from).
     let area = Rectangle::new(Point::new(0, (ty * t) as i32), Size::new(end as u32, rows as u32));
-    let pixels = band.chunks(w).flat_map(|row| row[..end].iter().copied());
-    target.fill_contiguous(&area, pixels).map_err(RenderError::Draw)
+    let drawn = if end == w {
+        target.fill_contiguous(&area, band.iter().copied())
+    } else {
+        target.fill_contiguous(&area, band.chunks(w).flat_map(|row| row[..end].iter().copied()))
+    };
+    drawn.map_err(RenderError::Draw)
 }
 
 /// Where the tile loop puts a finished tile: dithered and drawn, or kept as gray levels.
