@@ -461,15 +461,44 @@ struct DitherMemory<'m> {
 /// pass; `next` is the next of the frame's tiles to trace, pass after pass, each pass in raster
 /// order, so the bands finish in order.
 struct TileBoard<'l> {
-    free: [Option<(&'l mut KeptTile, &'l mut [Traced])>; TILES],
-    done: [Option<(&'l mut KeptTile, &'l mut [Traced])>; TILES],
+    free: [Option<Slot<'l>>; TILES],
+    done: [Option<Slot<'l>>; TILES],
     next: usize,
+}
+
+/// One tile's storage in trace, then dither: what it keeps for its dithering, and in a
+/// progressive build its rays between passes (a build without passes keeps the board's arrays
+/// of slots at one pointer each: they are on core 0's stack).
+struct Slot<'l> {
+    kept: &'l mut KeptTile,
+    #[cfg(feature = "progressive")]
+    rays: &'l mut [Traced; TILE_RAYS],
+}
+
+impl<'l> Slot<'l> {
+    /// The slot of `kept` and `rays`.
+    #[allow(unused_variables)]
+    fn new(kept: &'l mut KeptTile, rays: &'l mut [Traced; TILE_RAYS]) -> Self {
+        Slot {
+            kept,
+            #[cfg(feature = "progressive")]
+            rays,
+        }
+    }
+
+    /// What the tile keeps and its rays (none without passes).
+    fn parts(&mut self) -> (&mut KeptTile, &mut [Traced]) {
+        #[cfg(feature = "progressive")]
+        return (&mut *self.kept, &mut self.rays[..]);
+        #[cfg(not(feature = "progressive"))]
+        (&mut *self.kept, &mut [])
+    }
 }
 
 /// What a core gets when it asks for a tile to trace.
 enum Take<'l> {
     /// Tile `k` of the frame in pass `PASSES[p]`: `(p, k, its storage)`.
-    Tile(usize, usize, (&'l mut KeptTile, &'l mut [Traced])),
+    Tile(usize, usize, Slot<'l>),
     /// The next tile's last pass is not dithered yet: ask again.
     Wait,
     /// Every tile of every pass is taken.
@@ -507,7 +536,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
     let tiles = (tiles_x * h.div_ceil(t)).min(TILES).min(kept.len());
     let mut board = TileBoard { free: [const { None }; TILES], done: [const { None }; TILES], next: 0 };
     for (slot, (l, r)) in board.free.iter_mut().zip(kept.iter_mut().zip(rays.iter_mut())).take(tiles) {
-        *slot = Some((l, &mut r[..]));
+        *slot = Some(Slot::new(l, r));
     }
     let board = critical_section::Mutex::new(core::cell::RefCell::new(board));
     // Takes the next tile if it is free, traces it and marks it done (handed over even when the
@@ -527,11 +556,12 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                 None => Take::Wait,
             }
         });
-        let Take::Tile(p, k, (l, r)) = taken else { return taken.map_none() };
+        let Take::Tile(p, k, mut slot) = taken else { return taken.map_none() };
         let (tx, ty) = (k % tiles_x, k / tiles_x);
         let band = Frame { rows: (ty as u16, ty as u16 + 1), ..*frame };
+        let (l, r) = slot.parts();
         let traced = trace(scratch, p, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l), r);
-        critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some((l, r)));
+        critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some(slot));
         Some(Some(traced))
     };
     let mut there = (Stats::default(), None, 0);
@@ -567,7 +597,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                             let mut b = board.borrow(cs).borrow_mut();
                             let row = &mut b.done[band * tiles_x..(band + 1) * tiles_x];
                             if row.iter().all(Option::is_some) {
-                                let mut out: [Option<(&mut KeptTile, &mut [Traced])>; TILES_X] = [const { None }; TILES_X];
+                                let mut out: [Option<Slot<'_>>; TILES_X] = [const { None }; TILES_X];
                                 out.iter_mut().zip(row.iter_mut()).for_each(|(o, r)| *o = r.take());
                                 Some(out)
                             } else {
@@ -575,7 +605,7 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                             }
                         });
                         if let Some(mut row) = ready {
-                            let tile = |tx: usize| row.get(tx).and_then(|l| l.as_ref()).map(|(l, _)| &**l);
+                            let tile = |tx: usize| row.get(tx).and_then(|l| l.as_ref()).map(|l| &*l.kept);
                             dither_band(&shows, band, tile, (&mut *above, &mut *band_bits), &mut ditherer, target).map_err(AppError::Render)?;
                             critical_section::with(|cs| {
                                 let mut b = board.borrow(cs).borrow_mut();
