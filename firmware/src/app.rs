@@ -299,11 +299,11 @@ impl Default for ShareMemory {
     }
 }
 
-/// [`render_scene`] for a [`Shot`], in [`SHARES`] tile shares: share 0 traced by this core,
-/// share 1 by the board's other core, each drawing its tiles straight to `target` as it
-/// finishes them, one tile at a time under the board's critical section (a one-core board draws
-/// both shares, one after the other). The board's clock times each share. The frame is shown in [`PASSES`]; the board's `shown` is
-/// called with each pass once it is on `target`.
+/// [`render_scene`] for a [`Shot`], on the board's cores: with two, both trace the tiles and
+/// this one dithers and draws each finished band ([`trace_then_dither`]); a one-core board
+/// draws [`SHARES`] tile shares straight to `target`, one after the other. The board's clock
+/// times each core's work. The frame is shown in [`PASSES`]; the board's `shown` is called with
+/// each pass once it is on `target`.
 #[cfg(not(baked_scenes))]
 pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     text: &'t str,
