@@ -8,8 +8,9 @@ use hal::pac::interrupt;
 
 /// I2C0 driven through a queue in RAM ([`QUEUED`] words) in front of its 16-entry TX FIFO: a
 /// transaction is queued and returns at once (it waits only while the queue is full), and the
-/// queue moves into the FIFO whenever core 0 finishes a tile ([`Pump`]), so the bus sends a band
-/// while the cores trace the next; each transaction ends with a STOP, and the controller starts
+/// queue moves into the FIFO whenever the FIFO runs low (its TX_EMPTY interrupt) and whenever
+/// core 0 finishes a tile ([`Pump`]), so the bus sends a band while the cores trace the next;
+/// each transaction ends with a STOP, and the controller starts
 /// the next on its own when more bytes follow. (rp2040-hal's own `transaction` waits for the STOP
 /// after every transaction, and a write straight to the FIFO waits while it is full: either keeps
 /// core 0 from tracing while the bus is busy.) A display that does not answer aborts the
@@ -40,7 +41,7 @@ struct Queue {
     abort: Option<u32>,
 }
 
-/// The one queue (both cores may draw: progressive frames draw tiles from either core).
+/// The one queue, shared by the code that draws and the interrupt that refills the FIFO.
 static QUEUE: critical_section::Mutex<core::cell::RefCell<Queue>> =
     critical_section::Mutex::new(core::cell::RefCell::new(Queue { words: [0; QUEUED], head: 0, len: 0, abort: None }));
 
