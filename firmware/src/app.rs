@@ -625,6 +625,11 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                 }
                 Ok(())
             })();
+            if here.1.is_err() {
+                // Core 0 stops at the error: no tile of a later pass will be freed, so core 1,
+                // which may be waiting for one, is told that every tile is taken.
+                critical_section::with(|cs| board.borrow(cs).borrow_mut().next = usize::MAX);
+            }
             here.2 = now() - t0;
         },
     );
