@@ -586,8 +586,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 };
                 if keep {
                     // Lines across the borders are drawn when the band is dithered, from the
-                    // sides kept here: no apron rays, only the right column's and bottom row's
-                    // pixels that sampling did not trace through their centres.
+                    // sides kept here: no apron rays (2x2 grids and pattern blocks alone trace
+                    // their right column's and bottom row's pixels again, through the centres).
                     let hit = |x: usize, y: usize| (hits.object[y * tw + x], hits.depth[y * tw + x]);
                     let mut exact = |x: usize, y: usize| if sampler.exact(x, y, tw, th, &hits) { hit(x, y) } else { probe(x0 + x, y0 + y) };
                     (0..th).for_each(|y| sides.left[y] = hit(0, y));

@@ -160,8 +160,7 @@ impl<'r> Sampler<'r> {
                 if traced(x, tw) && traced(y, th) {
                     return true;
                 }
-                let xs = if traced(x, tw) { [x, x] } else { [x - 1, x + 1] };
-                let ys = if traced(y, th) { [y, y] } else { [y - 1, y + 1] };
+                let (xs, ys) = around(x, y, tw, th);
                 let id = |(nx, ny): (usize, usize)| hits.object[ny * tw + nx];
                 let first = id((xs[0], ys[0]));
                 (0..4).any(|i| id((xs[i % 2], ys[i / 2])) != first)
@@ -247,6 +246,15 @@ fn traced(i: usize, n: usize) -> bool {
     i.is_multiple_of(2) || i + 1 == n
 }
 
+/// The traced pixels an untraced pixel `(x, y)` of a `tw x th` tile is filled from, as columns
+/// and rows (each pair repeats a line the pixel is on): left and right, above and below, or
+/// the four corners.
+fn around(x: usize, y: usize, tw: usize, th: usize) -> ([usize; 2], [usize; 2]) {
+    let xs = if traced(x, tw) { [x, x] } else { [x - 1, x + 1] };
+    let ys = if traced(y, th) { [y, y] } else { [y - 1, y + 1] };
+    (xs, ys)
+}
+
 /// [`Sampling::Adaptive`] over one tile: the first pass traces the pixels of traced rows and
 /// columns, the second fills or traces each other pixel from its two or four traced
 /// neighbours (they are one pixel away: traced lines are at most two apart). A filled pixel
@@ -279,9 +287,7 @@ fn adaptive<R: Real>(
             if traced(x, tw) && traced(y, th) {
                 continue;
             }
-            // Neighbours on traced lines: left and right, above and below, or the four corners.
-            let xs = if traced(x, tw) { [x, x] } else { [x - 1, x + 1] };
-            let ys = if traced(y, th) { [y, y] } else { [y - 1, y + 1] };
+            let (xs, ys) = around(x, y, tw, th);
             let at = |i: usize| (xs[i % 2], ys[i / 2]);
             let first = ids[ys[0] * tw + xs[0]];
             let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);

@@ -495,10 +495,11 @@ impl<'l> Slot<'l> {
     }
 }
 
-/// What a core gets when it asks for a tile to trace.
-enum Take<'l> {
-    /// Tile `k` of the frame in pass `PASSES[p]`: `(p, k, its storage)`.
-    Tile(usize, usize, Slot<'l>),
+/// What a core gets when it asks for the next tile: the tile (its pass, its index and its
+/// storage; once traced, the trace's result), or why there is none.
+enum Take<T> {
+    /// The next tile, or what tracing it gave.
+    Tile(T),
     /// The next tile's last pass is not dithered yet: ask again.
     Wait,
     /// Every tile of every pass is taken.
@@ -551,18 +552,22 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
             match b.free[i % tiles].take() {
                 Some(slot) => {
                     b.next += 1;
-                    Take::Tile(i / tiles, i % tiles, slot)
+                    Take::Tile((i / tiles, i % tiles, slot))
                 }
                 None => Take::Wait,
             }
         });
-        let Take::Tile(p, k, mut slot) = taken else { return taken.map_none() };
+        let (p, k, mut slot) = match taken {
+            Take::Tile(tile) => tile,
+            Take::Wait => return Take::Wait,
+            Take::Finished => return Take::Finished,
+        };
         let (tx, ty) = (k % tiles_x, k / tiles_x);
         let band = Frame { rows: (ty as u16, ty as u16 + 1), ..*frame };
         let (l, r) = slot.parts();
         let traced = trace(scratch, p, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l), r);
         critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some(slot));
-        Some(Some(traced))
+        Take::Tile(traced)
     };
     let mut there = (Stats::default(), None, 0);
     let mut here: (Stats, Result<(), AppError<'t, D::Error>>, u64) = (Stats::default(), Ok(()), 0);
@@ -571,11 +576,12 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
             let t0 = now();
             let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
             let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, p: usize, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, &mut lattice_rt::NoHooks);
-            while let Some(traced) = take(&mut scratch, &mut trace) {
-                match traced {
-                    Some(Ok(s)) => there.0.add(&s),
-                    Some(Err(e)) => there.1 = there.1.or(Some(e)),
-                    None => core::hint::spin_loop(),
+            loop {
+                match take(&mut scratch, &mut trace) {
+                    Take::Tile(Ok(s)) => there.0.add(&s),
+                    Take::Tile(Err(e)) => there.1 = there.1.or(Some(e)),
+                    Take::Wait => core::hint::spin_loop(),
+                    Take::Finished => break,
                 }
             }
             there.2 = now() - t0;
@@ -617,8 +623,8 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                             continue;
                         }
                         match take(scratch, &mut trace) {
-                            Some(Some(traced)) => here.0.add(&traced.map_err(|e| AppError::Render(e.widen()))?),
-                            _ => core::hint::spin_loop(),
+                            Take::Tile(traced) => here.0.add(&traced.map_err(|e| AppError::Render(e.widen()))?),
+                            Take::Wait | Take::Finished => core::hint::spin_loop(),
                         }
                     }
                     shown(pass);
@@ -639,17 +645,6 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
     }
     here.0.add(&there.0);
     Ok((here.0, [there.2, here.2]))
-}
-
-impl Take<'_> {
-    /// What `take` answers for anything but a tile: nothing to trace now (`Some(None)`), or
-    /// nothing left (`None`).
-    fn map_none<T>(self) -> Option<Option<T>> {
-        match self {
-            Take::Finished => None,
-            _ => Some(None),
-        }
-    }
 }
 
 /// One tile traced for trace, then dither: pass `pass` of a progressive frame (`trace_pass`,
