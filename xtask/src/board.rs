@@ -446,13 +446,13 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let bare = s.no_display_run()?;
     let (models, (alone, levers)) = (s.model_runs()?, s.lever_runs()?);
     let (orun, orbit_same) = s.orbit_run()?;
-    let lrun = s.variant("ladder", false, LADDER.len())?.0;
+    let lrun = s.variant("ladder", false, LADDER.len(), &[])?.0;
     let rungs = s.ladder_rows(&lrun)?;
     // A progressive frame's passes follow each other without waiting for the bus: each is
     // checked when a panel's worth of page bytes (128 x 8) has reached the display.
-    let prun = run_variant(s.root, s.no_build, "progressive", true, s.frames_dir, &s.bootrom, PASSES * s.scenes.len(), &["--pass-bytes", "1024"])?;
+    let prun = s.variant("progressive", true, PASSES * s.scenes.len(), &["--pass-bytes", "1024"])?;
     let progressive = s.progressive_rows(&prun, &rows)?;
-    let plain_run = s.variant("no-outline", false, 1)?;
+    let plain_run = s.variant("no-outline", false, 1, &[])?;
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays)| *rays))?;
 
     let spi_byte = levers.iter().find(|(feature, ..)| *feature == "spi").map_or(0, |(_, _, f)| f.bus_cycles / f.bus_bytes.max(1));
@@ -498,9 +498,10 @@ impl<'a> Session<'a> {
         Ok(Session { root, frames_dir, no_build, elf, uf2, bootrom, scenes, scenes_dir, chair, chair_text, checks: Checks::default() })
     }
 
-    /// Runs the image with `feature` (the chair alone, or `all_scenes`) for `frames` frames.
-    fn variant(&self, feature: &str, all_scenes: bool, frames: usize) -> Result<(BoardRun, PathBuf)> {
-        run_variant(self.root, self.no_build, feature, all_scenes, self.frames_dir, &self.bootrom, frames, &[])
+    /// Runs the image with `feature` (the chair alone, or `all_scenes`) for `frames` frames, with
+    /// `run.mjs` switches `extra`.
+    fn variant(&self, feature: &str, all_scenes: bool, frames: usize, extra: &[&str]) -> Result<(BoardRun, PathBuf)> {
+        run_variant(self.root, self.no_build, feature, all_scenes, self.frames_dir, &self.bootrom, frames, extra)
     }
 
     /// The default image on every embedded scene: each frame against host-sim's, the log's
@@ -602,7 +603,7 @@ impl<'a> Session<'a> {
         let want = host_frame(&self.scenes_dir, "chair", PICO_SCALAR, PICO)?;
         let (mut alone, mut levers) = (None, Vec::new());
         for (feature, what) in std::iter::once(&(CHAIR_ALONE, "")).chain(LEVERS) {
-            let (run, dir) = self.variant(feature, false, 1)?;
+            let (run, dir) = self.variant(feature, false, 1, &[])?;
             let name = variant_name(feature);
             let rays = reported_frame(&run.records, 0).map(|r| r.rays[0]);
             match run.frames.into_iter().next() {
@@ -625,7 +626,7 @@ impl<'a> Session<'a> {
     /// Orbit mode: the first frames of the chair's orbit against host-sim's; the run and how
     /// many were identical.
     fn orbit_run(&mut self) -> Result<(BoardRun, usize)> {
-        let (orun, dir) = self.variant("orbit", false, ORBIT_CHECKED)?;
+        let (orun, dir) = self.variant("orbit", false, ORBIT_CHECKED, &[])?;
         let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(&self.chair, &self.chair_text, ORBIT_FRAMES, &board_frame::rendered(Build { orbit: true, ..PICO }))?;
         let shown = orun.frames.len();
         self.checks.check(shown >= ORBIT_CHECKED, || format!("orbit mode: {shown} of {ORBIT_CHECKED} frames shown ({})", orun.reason));
