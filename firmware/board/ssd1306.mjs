@@ -63,16 +63,13 @@ export class Ssd1306 {
     this.dataBytes = 0; // GDDRAM bytes received
     this.bytes = 0; // every byte addressed to the display, control bytes included
     this.transfers = 0;
-    this.resets = 0; // RES# pulses (SPI modules)
     this.everOn = false; // the display has been switched on with its charge pump
     this.error = null; // the first protocol error
     this.reset();
-    this.resets = 0;
   }
 
   /** RES# low: every register to its reset value (GDDRAM keeps what it holds), as after power-on. */
   reset() {
-    this.resets++;
     this.displayOn = false;
     this.chargePump = false;
     this.mode = 2; // page addressing after reset
