@@ -104,9 +104,17 @@ pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeCon
     resolution(b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis)
 }
 
+/// The region lattice `sub` covers: a composite's box, or for the world lattice the box of
+/// every object. The paper's world range also holds the viewpoint, but no ray needs a cell
+/// without objects: a ray from outside enters at the box (the walk clips every ray to it), and
+/// the empty space between the eye and the scene costs no steps.
 pub(super) fn lattice_bounds<R: Real>(scene: &Scene<'_, R>, sub: usize) -> Aabb<R> {
     if sub == 0 {
-        scene.world
+        let mut objects = scene.objects.iter().map(|o| o.bounds);
+        match objects.next() {
+            Some(first) => objects.fold(first, |b, o| b.union(&o)),
+            None => scene.world,
+        }
     } else {
         scene.composites[sub - 1].bounds
     }
