@@ -108,6 +108,12 @@ pub trait Real:
     fn recip(self) -> Self {
         Self::ONE / self
     }
+    /// Whether a lattice walk finds where a ray crosses a cell plane by multiplying with the
+    /// reciprocal of the direction component (made once per ray) instead of dividing at every
+    /// step. Floats do: the product is within two roundings of the exact crossing, far inside
+    /// the padding every box has. Fixed point divides: the reciprocal of a small component is
+    /// coarse there.
+    const WALK_BY_RECIPROCAL: bool = false;
     /// `self / 2^k` for `k` in `0..=14`: the same value as dividing by `from_i32(1 << k)`, which
     /// is what the default does; fixed point shifts instead of dividing.
     fn div_pow2(self, k: u32) -> Self {
@@ -140,6 +146,7 @@ fn f32_key(v: f32) -> u16 {
 }
 
 impl Real for f64 {
+    const WALK_BY_RECIPROCAL: bool = true;
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     const HALF: Self = 0.5;
@@ -219,6 +226,7 @@ fn sqrt_f32(x: f32) -> f32 {
 }
 
 impl Real for f32 {
+    const WALK_BY_RECIPROCAL: bool = true;
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     const HALF: Self = 0.5;
@@ -389,6 +397,7 @@ macro_rules! f32_with_sqrt {
             }
         }
         impl Real for $name {
+            const WALK_BY_RECIPROCAL: bool = true;
             const ZERO: Self = $name(0.0);
             const ONE: Self = $name(1.0);
             const HALF: Self = $name(0.5);

@@ -1,7 +1,7 @@
 //! Walking a lattice: from cell to neighbouring cell by index arithmetic (3D-DDA), with an
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
-use super::{index, locate, Lattice, SubLattice, MAX_NESTING};
+use super::{index, locate, Lattice, MAX_NESTING};
 use crate::accel::{offer, reach, Hit, Query};
 use crate::math::Ray;
 use crate::scalar::Real;
@@ -19,7 +19,7 @@ impl<R: Real> Lattice<'_, R> {
             let exit = w.exit();
             visit(w.idx.map(|v| v as usize), enter, exit.min(t1));
             enter = exit;
-            if !w.advance(self, ray, &inv) {
+            if !w.advance(self, &inv) {
                 break;
             }
         }
@@ -62,7 +62,7 @@ impl<R: Real> Lattice<'_, R> {
             }
             // The cell is done: stop if the best hit's tie window ends before its exit, else step.
             let done = best.is_some() && reach(&best, tmax) < w.exit();
-            if done || !w.advance(self, ray, &inv) {
+            if done || !w.advance(self, &inv) {
                 depth -= 1;
             } else {
                 q.stats.cells_visited += 1;
@@ -82,29 +82,54 @@ fn slack<R: Real>(ray: &Ray<R>) -> R {
     ray.dir.max_abs() * R::pad_eps()
 }
 
-/// Which axes a ray steps along (a zero component, +0.0 or -0.0, never steps).
+/// What a walk keeps of a ray for its crossings: which axes it steps along (a zero
+/// component, +0.0 or -0.0, never steps), and per axis the factor a crossing uses.
 ///
-/// Crossings are `(plane - o) / d`, one correctly rounded division, rather than a product with
-/// a precomputed reciprocal: the reciprocal of a small component is coarse in fixed point, and
-/// the division keeps every scalar's crossing within one rounding of the exact one.
+/// A crossing is `(plane - o) * (1 / d)` in floats and `(plane - o) / d` in fixed point
+/// ([`Real::WALK_BY_RECIPROCAL`]): either keeps every scalar's crossing within a rounding or two
+/// of the exact one, and the walk only chooses which objects are tested.
 struct Inverse<R> {
     moves: [bool; 3],
-    _r: core::marker::PhantomData<R>,
+    origin: [R; 3],
+    factor: [R; 3],
 }
 
 impl<R: Real> Inverse<R> {
     fn new(ray: &Ray<R>) -> Self {
         let d = [ray.dir.x, ray.dir.y, ray.dir.z];
-        Inverse { moves: d.map(|v| v != R::ZERO), _r: core::marker::PhantomData }
+        Inverse {
+            moves: d.map(|v| v != R::ZERO),
+            origin: [ray.origin.x, ray.origin.y, ray.origin.z],
+            factor: d.map(|v| if R::WALK_BY_RECIPROCAL && v != R::ZERO { v.recip() } else { v }),
+        }
+    }
+
+    /// The ray parameter where the ray crosses `plane` on axis `a` (which it moves along).
+    #[inline(always)]
+    fn crossing(&self, a: usize, plane: R) -> R {
+        if R::WALK_BY_RECIPROCAL {
+            (plane - self.origin[a]) * self.factor[a]
+        } else {
+            (plane - self.origin[a]) / self.factor[a]
+        }
     }
 }
 
 /// The state of a walk through one lattice (one entry of the explicit stack).
 #[derive(Clone, Copy, Debug)]
 struct Walker<R> {
-    sub: u16,
     idx: [i32; 3],
+    /// Cells on each axis.
+    n: [i32; 3],
+    /// Per axis +1 or -1 (0 on an axis the ray does not move along).
     step: [i32; 3],
+    /// What a step on each axis adds to the cell number (the axis' stride times its step).
+    stride: [i32; 3],
+    /// Where each axis' coordinate list starts in the coordinate storage, moved one on for an
+    /// axis stepped forward: the next plane is then always `coords[plane_at[a] + idx[a]]`.
+    plane_at: [i32; 3],
+    /// Number of the current cell in the cell storage.
+    cell: u32,
     t_next: [R; 3],
     t_end: R,
     ref_i: u32,
@@ -115,37 +140,43 @@ impl<R: Real> Walker<R> {
     fn start(l: &Lattice<'_, R>, sub: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> Self {
         let g = &l.lattices[sub];
         let p = ray.at(t0);
+        let n = g.n.map(i32::from);
         let mut w = Walker {
-            sub: sub as u16,
             idx: [0; 3],
+            n,
             step: [0; 3],
+            stride: [0; 3],
+            plane_at: g.coord_start.map(|v| v as i32),
+            cell: g.cell_start,
             t_next: [R::MAX; 3],
             t_end: t1,
             ref_i: 0,
             ref_end: 0,
         };
+        let strides = [1, n[0], n[0] * n[1]];
         for a in 0..3 {
             let c = l.coordinate_list(sub, a);
             // With a zero direction component the coordinate is the origin's, exactly.
             let x = if inv.moves[a] { p.axis(a) } else { ray.origin.axis(a) };
             let i = locate(c, x);
             w.idx[a] = i as i32;
+            w.cell += (i as i32 * strides[a]) as u32;
             if inv.moves[a] {
                 let forward = ray.dir.axis(a) > R::ZERO;
                 w.step[a] = if forward { 1 } else { -1 };
-                let plane = if forward { c[i + 1] } else { c[i] };
-                w.t_next[a] = (plane - ray.origin.axis(a)) / ray.dir.axis(a);
+                w.stride[a] = w.step[a] * strides[a];
+                w.plane_at[a] += i32::from(forward);
+                w.t_next[a] = inv.crossing(a, l.coords[(w.plane_at[a] + w.idx[a]) as usize]);
             }
         }
-        w.load_cell(l, g);
+        w.load_cell(l);
         w
     }
 
-    fn load_cell(&mut self, l: &Lattice<'_, R>, g: &SubLattice<R>) {
-        let (nx, ny) = (g.n[0] as usize, g.n[1] as usize);
-        let c = g.cell_start as usize + self.idx[0] as usize + nx * (self.idx[1] as usize + ny * self.idx[2] as usize);
-        self.ref_i = l.cell_start(c);
-        self.ref_end = l.cell_start(c + 1);
+    #[inline(always)]
+    fn load_cell(&mut self, l: &Lattice<'_, R>) {
+        self.ref_i = l.cell_start(self.cell as usize);
+        self.ref_end = l.cell_start(self.cell as usize + 1);
     }
 
     /// Parameter where the ray leaves the current cell.
@@ -155,28 +186,26 @@ impl<R: Real> Walker<R> {
     }
 
     /// Steps to the neighbouring cell; false when the ray leaves the lattice or its range.
-    fn advance(&mut self, l: &Lattice<'_, R>, ray: &Ray<R>, inv: &Inverse<R>) -> bool {
+    #[inline]
+    fn advance(&mut self, l: &Lattice<'_, R>, inv: &Inverse<R>) -> bool {
         // Tie rule: x before y before z (strict comparisons keep the earlier axis).
-        let mut a = 0;
-        if self.t_next[1] < self.t_next[a] {
-            a = 1;
-        }
+        let mut a = usize::from(self.t_next[1] < self.t_next[0]);
         if self.t_next[2] < self.t_next[a] {
             a = 2;
         }
-        if !inv.moves[a] || self.t_next[a] > self.t_end {
+        // An axis the ray does not move along has `t_next = R::MAX`, never below `t_end`
+        // unless the range is unbounded; `step == 0` stops it then.
+        if self.step[a] == 0 || self.t_next[a] > self.t_end {
             return false;
         }
-        let g = &l.lattices[self.sub as usize];
         let i = self.idx[a] + self.step[a];
-        if i < 0 || i >= g.n[a] as i32 {
+        if i < 0 || i >= self.n[a] {
             return false;
         }
         self.idx[a] = i;
-        let c = l.coordinate_list(self.sub as usize, a);
-        let plane = if self.step[a] > 0 { c[i as usize + 1] } else { c[i as usize] };
-        self.t_next[a] = (plane - ray.origin.axis(a)) / ray.dir.axis(a);
-        self.load_cell(l, g);
+        self.cell = self.cell.wrapping_add(self.stride[a] as u32);
+        self.t_next[a] = inv.crossing(a, l.coords[(self.plane_at[a] + i) as usize]);
+        self.load_cell(l);
         true
     }
 }
