@@ -162,7 +162,7 @@ mod writer {
     }
     impl<R: Literal> Literal for SubLattice<R> {
         fn literal(&self, out: &mut String) {
-            record(out, "SubLattice", &[("bounds", &self.bounds), ("n", &self.n), ("coord_start", &self.coord_start), ("cell_start", &self.cell_start)])
+            record(out, "SubLattice", &[("bounds", &self.bounds), ("n", &self.n), ("coord_start", &self.coord_start), ("cell_start", &self.cell_start), ("dense_cell", &self.dense_cell)])
         }
     }
     impl<R: Literal> Literal for Object<R> {

@@ -61,23 +61,26 @@ fn check<R: Real>(p: &RandomScene, cfg: &LatticeConfig, nrays: usize) -> Result<
     let mut storage = vec![Object::<R>::default(); p.objects];
     let mut b = SceneBuilder::new(&mut storage);
     random_scene(&mut b, p).unwrap();
-    let scene = b.finish().unwrap();
-    let mut bufs = lattice_storage(&scene, cfg);
-    let lat = build_lattice(&scene, cfg, &mut bufs);
-    let mut rng = Rng::new(p.seed ^ 0xABCD);
-    let rays = adversarial_rays(&lat, &scene, &mut rng, nrays);
-    let mut mb = vec![0; Query::mailbox_len(&scene)];
+    check_scene(&b.finish().unwrap(), cfg, p.seed, nrays)
+}
+
+fn check_scene<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, seed: u64, nrays: usize) -> Result<(), TestCaseError> {
+    let mut bufs = lattice_storage(scene, cfg);
+    let lat = build_lattice(scene, cfg, &mut bufs);
+    let mut rng = Rng::new(seed ^ 0xABCD);
+    let rays = adversarial_rays(&lat, scene, &mut rng, nrays);
+    let mut mb = vec![0; Query::mailbox_len(scene)];
     let mut q = Query::new(&mut mb);
     for ray in &rays {
-        let want = BruteForce.nearest(&scene, ray, R::ZERO, R::MAX, &mut q);
-        let got_l = lat.nearest(&scene, ray, R::ZERO, R::MAX, &mut q);
-        let got_b = BoundingBox.nearest(&scene, ray, R::ZERO, R::MAX, &mut q);
+        let want = BruteForce.nearest(scene, ray, R::ZERO, R::MAX, &mut q);
+        let got_l = lat.nearest(scene, ray, R::ZERO, R::MAX, &mut q);
+        let got_b = BoundingBox.nearest(scene, ray, R::ZERO, R::MAX, &mut q);
         prop_assert_eq!(want, got_l, "lattice differs from brute force for {:?}", ray);
         prop_assert_eq!(want, got_b, "bbox differs from brute force for {:?}", ray);
         let reach = R::from_f64(3.0);
-        let occ = BruteForce.occluded(&scene, ray, R::ZERO, reach, &mut q);
-        prop_assert_eq!(occ, lat.occluded(&scene, ray, R::ZERO, reach, &mut q), "lattice occlusion, {:?}", ray);
-        prop_assert_eq!(occ, BoundingBox.occluded(&scene, ray, R::ZERO, reach, &mut q), "bbox occlusion, {:?}", ray);
+        let occ = BruteForce.occluded(scene, ray, R::ZERO, reach, &mut q);
+        prop_assert_eq!(occ, lat.occluded(scene, ray, R::ZERO, reach, &mut q), "lattice occlusion, {:?}", ray);
+        prop_assert_eq!(occ, BoundingBox.occluded(scene, ray, R::ZERO, reach, &mut q), "bbox occlusion, {:?}", ray);
     }
     Ok(())
 }
@@ -130,6 +133,61 @@ proptest! {
         check::<f32>(&p, &cfg, 200)?;
         check::<lattice_rt::Fx>(&p, &cfg, 200)?;
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Crowded world cells get lattices of their own (`LatticeConfig::split`); composites and
+    /// free objects mix in them, and every scalar still answers as brute force does.
+    #[test]
+    fn dense_cells_split_into_their_own_lattices_and_agree_too(
+        seed in any::<u64>(), n in 10usize..70, split in 1u16..6, group in prop_oneof![Just(0usize), Just(4)], adaptive in any::<bool>(),
+    ) {
+        use lattice_rt::lattice::{Resolution, Spacing};
+        let spacing = if adaptive { Spacing::Adaptive } else { Spacing::Uniform };
+        let cfg = LatticeConfig { top: Resolution::Uniform([2, 3, 2]), split, spacing, ..LatticeConfig::default() };
+        check_crowded::<f64>(seed, n, group, &cfg)?;
+        check_crowded::<f32>(seed, n, group, &cfg)?;
+        check_crowded::<lattice_rt::Fx>(seed, n, group, &cfg)?;
+    }
+}
+
+/// `n` free objects crowded into a cube of side 3 and, with `group`, a composite of `group`
+/// objects among them: checked as [`check`] does, after making sure a world cell of `cfg`'s 12
+/// that must be dense got a lattice of its own.
+fn check_crowded<R: Real>(seed: u64, n: usize, group: usize, cfg: &LatticeConfig) -> Result<(), TestCaseError> {
+    use lattice_rt::generate::random_object;
+    let mut storage = vec![Object::<R>::default(); n + group];
+    let mut b = SceneBuilder::new(&mut storage);
+    let mut rng = Rng::new(seed);
+    b.add_material(lattice_rt::scene::Material::DEFAULT).unwrap();
+    b.add_light(lattice_rt::scene::Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 }).unwrap();
+    let place = |b: &mut SceneBuilder<'_, R>, rng: &mut Rng| {
+        let c = Vec3::new(rng.range(0.0, 3.0), rng.range(0.0, 3.0), rng.range(0.0, 3.0));
+        let (s, t) = random_object(rng, c, 0.5);
+        b.add_object(s, t, 0).unwrap();
+    };
+    for _ in 0..n {
+        place(&mut b, &mut rng);
+    }
+    if group > 0 {
+        b.begin_composite(lattice_rt::Affine::translate(Vec3::new(0.5, 0.5, 0.5))).unwrap();
+        for _ in 0..group {
+            place(&mut b, &mut rng);
+        }
+        b.end_composite().unwrap();
+    }
+    b.camera.eye = Vec3::new(1.5, 2.0, -6.0);
+    b.camera.look = Vec3::new(1.5, 1.5, 1.5);
+    let scene = b.finish().unwrap();
+    let mut bufs = lattice_storage(&scene, cfg);
+    let lat = build_lattice(&scene, cfg, &mut bufs);
+    // With more than 12 * split free objects some world cell holds more than split.
+    if n > 12 * cfg.split as usize {
+        prop_assert!(lat.lattices().len() > 1 + scene.composites().len(), "no dense cell got its own lattice");
+    }
+    check_scene(&scene, cfg, seed, 400)
 }
 
 /// A scene of `lead` ungrouped objects followed by one composite of `members` objects, so that

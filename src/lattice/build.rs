@@ -1,8 +1,8 @@
 //! Building a lattice into caller-provided storage: coordinate lists, then cells and references
 //! in two passes (count, then fill).
 
-use super::plan::{axis_planes, lattice_bounds, lattice_resolution};
-use super::{for_each_item, index, locate, Lattice, LatticeConfig, SubLattice};
+use super::plan::{axis_planes, items_of, lattice_bounds, lattice_resolution, uniform_coord};
+use super::{cluster, for_each_item, index, locate, Items, Lattice, LatticeConfig, SubLattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -71,36 +71,63 @@ impl<'a, R: Real> Lattice<'a, R> {
         #[cfg(feature = "budget")]
         let cfg = &super::budget::resolve(scene, cfg)?;
         let LatticeStorage { lattices, coords, words } = storage;
-        let nlattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
-        if lattices.len() < nlattices {
-            return Err(LatticeError { capacity: "lattices", needed: nlattices, available: lattices.len() });
-        }
-        // Coordinate lists and cell ranges.
-        let (mut nc, mut ncells) = (0usize, 0usize);
-        for (g, slot) in lattices.iter_mut().enumerate().take(nlattices) {
-            let b = lattice_bounds(scene, g);
-            let n = lattice_resolution(scene, cfg, g, &b);
-            let mut sub = SubLattice { bounds: b, n, coord_start: [0; 3], cell_start: ncells as u32 };
+        let short = |capacity: &'static str, available: usize| {
+            let s = Lattice::plan_exact(scene, cfg, |_, _, _, _| {});
+            LatticeError { capacity, needed: if capacity == "lattices" { s.lattices } else { s.coords }, available }
+        };
+        // Coordinate lists and cell ranges: the world, the composites, then the dense cells.
+        let (mut nc, mut ncells, mut nlattices, all_coords) = (0usize, 0usize, 0usize, coords.len());
+        // `planes(items, bounds, n, axis, out)` writes a lattice's planes.
+        let mut place = |lattices: &mut [SubLattice<R>], coords: &mut [R], nc: &mut usize, b: Aabb<R>, n: [u16; 3], dense_cell: u32, planes: &dyn Fn(usize, &mut [R])| {
+            let available = lattices.len();
+            let slot = lattices.get_mut(nlattices).ok_or_else(|| short("lattices", available))?;
+            let mut sub = SubLattice { bounds: b, n, coord_start: [0; 3], cell_start: ncells as u32, dense_cell };
             for a in 0..3 {
-                let need = nc + n[a] as usize + 1;
+                let need = *nc + n[a] as usize + 1;
                 if need > coords.len() {
-                    let total: usize = (0..nlattices)
-                        .map(|g| lattice_resolution(scene, cfg, g, &lattice_bounds(scene, g)).iter().map(|&v| v as usize + 1).sum::<usize>())
-                        .sum();
-                    return Err(LatticeError { capacity: "coords", needed: total, available: coords.len() });
+                    return Err(short("coords", all_coords));
                 }
-                sub.coord_start[a] = nc as u32;
-                axis_planes(scene, cfg, g, a, &b, n[a], &mut coords[nc..need]);
-                nc = need;
+                sub.coord_start[a] = *nc as u32;
+                planes(a, &mut coords[*nc..need]);
+                *nc = need;
             }
             ncells += sub.cells();
+            nlattices += 1;
             *slot = sub;
+            Ok(())
+        };
+        let base = if cfg.nested { 1 + scene.composites.len() } else { 1 };
+        for g in 0..base {
+            let b = lattice_bounds(scene, g);
+            let n = lattice_resolution(scene, cfg, items_of(g), &b);
+            place(lattices, coords, &mut nc, b, n, u32::MAX, &|a, out| axis_planes(scene, cfg, items_of(g), a, &b, n[a], out))?;
         }
+        // The world's planes stay where they are while the dense cells' follow them; a dense
+        // cell's lattice has equal cells.
+        let (world, more) = coords.split_at_mut(nc);
+        let wp = world_planes(world, &lattices[0]);
+        let mut more_used = 0;
+        let mut failed = Ok(());
+        cluster::for_each_dense(scene, cfg, wp, |d| {
+            if failed.is_ok() {
+                let uniform = |a: usize, out: &mut [R]| {
+                    let (lo, hi) = (d.bounds.min.axis(a), d.bounds.max.axis(a));
+                    out.iter_mut().enumerate().for_each(|(i, c)| *c = uniform_coord(lo, hi, d.n[a], i));
+                };
+                failed = place(lattices, more, &mut more_used, d.bounds, d.n, d.cell as u32, &uniform);
+            }
+        });
+        failed?;
+        // The dense cells' coordinate starts were counted from the end of the world's.
+        for sub in &mut lattices[base..nlattices] {
+            sub.coord_start = sub.coord_start.map(|v| v + nc as u32);
+        }
+        nc += more_used;
         let lattices = &lattices[..nlattices];
         // Pass 0: count the references, which decides the index width.
         let mut nrefs = 0usize;
         for_each_ref(scene, cfg, coords, lattices, |_, _| nrefs += 1);
-        let narrow = cfg.index16 && index::fits16(nrefs, scene.objects.len(), scene.composites.len());
+        let narrow = cfg.index16 && index::fits16(nrefs, scene.objects.len(), nlattices - 1);
         let per_word = if narrow { 2 } else { 1 };
         let cell_words = index::words(ncells + 1, narrow);
         if cell_words > words.len() {
@@ -137,10 +164,32 @@ impl<'a, R: Real> Lattice<'a, R> {
     }
 }
 
-/// Calls `f(item, cell)` for every reference of every lattice, in storage order.
+/// The world lattice's coordinate lists.
+fn world_planes<'c, R: Real>(coords: &'c [R], world: &SubLattice<R>) -> [&'c [R]; 3] {
+    [0, 1, 2].map(|a| {
+        let s = world.coord_start[a] as usize;
+        &coords[s..s + world.n[a] as usize + 1]
+    })
+}
+
+/// Calls `f(item, cell)` for every reference of every lattice, in storage order. A dense
+/// cell of the world holds its composites and its own lattice instead of its free objects.
 fn for_each_ref<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, coords: &[R], lattices: &[SubLattice<R>], mut f: impl FnMut(u32, usize)) {
-    for (g, sub) in lattices.iter().enumerate() {
-        for_each_item(scene, cfg, g, |item, ib| visit_cells(coords, sub, ib, |c| f(item, c)));
+    let base = if cfg.nested { 1 + scene.composites.len() } else { 1 };
+    let dense = &lattices[base..];
+    let find = |c: usize| dense.binary_search_by_key(&(c as u32), |d| d.dense_cell).ok();
+    let world = &lattices[0];
+    for_each_item(scene, cfg, Items::World, |item, ib| {
+        visit_cells(coords, world, ib, |c| match find(c) {
+            Some(k) if item & index::SUB_FLAG == 0 => visit_cells(coords, &dense[k], ib, |c| f(item, c)),
+            _ => f(item, c),
+        })
+    });
+    for (k, d) in dense.iter().enumerate() {
+        f(index::SUB_FLAG | (base - 1 + k) as u32, d.dense_cell as usize);
+    }
+    for (g, sub) in lattices.iter().enumerate().take(base).skip(1) {
+        for_each_item(scene, cfg, items_of(g), |item, ib| visit_cells(coords, sub, ib, |c| f(item, c)));
     }
 }
 

@@ -25,6 +25,7 @@
 #[cfg(feature = "budget")]
 mod budget;
 mod build;
+mod cluster;
 mod index;
 mod plan;
 mod walk;
@@ -40,7 +41,7 @@ use crate::scalar::Real;
 use crate::scene::{Scene, NO_COMPOSITE};
 
 use index::SUB_FLAG;
-/// Deepest nesting of lattices: the world and one level of composites.
+/// Deepest nesting of lattices: the world and one level of composites and dense cells.
 pub const MAX_NESTING: usize = 2;
 
 /// One lattice (the world's or a composite's sub-lattice) inside the shared storage.
@@ -54,6 +55,9 @@ pub struct SubLattice<R> {
     pub coord_start: [u32; 3],
     /// Index of the first cell in the cell storage.
     pub cell_start: u32,
+    /// For a dense cell's lattice, the number of the world cell it serves; [`u32::MAX`] for
+    /// the world and composites.
+    pub dense_cell: u32,
 }
 
 impl<R: Real> SubLattice<R> {
@@ -66,6 +70,7 @@ impl<R: Real> SubLattice<R> {
         n: [0; 3],
         coord_start: [0; 3],
         cell_start: 0,
+        dense_cell: u32::MAX,
     };
     fn cells(&self) -> usize {
         self.n.iter().map(|&v| v as usize).product()
@@ -89,28 +94,39 @@ pub struct Lattice<'a, R> {
     objects: usize,
 }
 
-/// The items one lattice holds: the world holds free objects and composites, a sub-lattice
-/// the objects of its composite.
-fn for_each_item<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, sub: usize, mut f: impl FnMut(u32, &Aabb<R>)) {
-    if sub == 0 {
-        for (i, o) in scene.objects.iter().enumerate() {
-            if o.composite == NO_COMPOSITE || !cfg.nested {
-                f(i as u32, &o.bounds);
+/// Which items a lattice holds.
+#[derive(Clone, Copy, Debug)]
+enum Items {
+    /// The world lattice: free objects (all objects, if flat) and composites.
+    World,
+    /// A composite's sub-lattice: its objects.
+    Composite(usize),
+}
+
+/// Calls `f(item, box)` for the items a lattice holds: an object index, or `SUB_FLAG |`
+/// composite index.
+fn for_each_item<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, mut f: impl FnMut(u32, &Aabb<R>)) {
+    match items {
+        Items::World => {
+            for (i, o) in scene.objects.iter().enumerate() {
+                if o.composite == NO_COMPOSITE || !cfg.nested {
+                    f(i as u32, &o.bounds);
+                }
+            }
+            if cfg.nested {
+                for (g, grp) in scene.composites.iter().enumerate() {
+                    f(SUB_FLAG | g as u32, &grp.bounds);
+                }
             }
         }
-        if cfg.nested {
-            for (g, grp) in scene.composites.iter().enumerate() {
-                f(SUB_FLAG | g as u32, &grp.bounds);
+        Items::Composite(k) => {
+            let grp = &scene.composites[k];
+            for i in grp.first as usize..grp.first as usize + grp.len as usize {
+                f(i as u32, &scene.objects[i].bounds);
             }
-        }
-    } else {
-        let grp = &scene.composites[sub - 1];
-        for i in grp.first as usize..grp.first as usize + grp.len as usize {
-            f(i as u32, &scene.objects[i].bounds);
         }
     }
 }
-
 
 /// Index of the cell holding `x` in a coordinate list of `n` cells given by `c(i)`, clamped to
 /// `0..n`: the largest `i < n` with `c(i) <= x`, by bisection.

@@ -1,6 +1,6 @@
 //! Planning a lattice: its resolution, where its planes go, and how much storage it needs.
 
-use super::{for_each_item, locate, Lattice};
+use super::{cluster, for_each_item, Items, Lattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -43,6 +43,10 @@ pub struct LatticeConfig {
     /// Whether composites get sub-lattices (the paper's hierarchy); if not, their primitives
     /// are listed in the world lattice like any other (a flat lattice).
     pub nested: bool,
+    /// A world cell holding more than this many free objects (of no composite) gets a
+    /// sub-lattice of its own, built like a composite's (`sub` resolution); 0: never. Needs
+    /// `nested`.
+    pub split: u16,
     /// Whether cell starts and references may be 16-bit, two to a word, when they fit (at most
     /// 65 535 references, 32 767 objects and composites): the lattice's index memory halves.
     pub index16: bool,
@@ -61,6 +65,7 @@ impl Default for LatticeConfig {
             max_per_axis: 64,
             spacing: Spacing::Uniform,
             nested: true,
+            split: 16,
             index16: true,
             #[cfg(feature = "budget")]
             budget: None,
@@ -97,11 +102,20 @@ impl LatticeSizes {
         self.lattices * size_of::<super::SubLattice<R>>() + self.coords * size_of::<R>() + self.words() * 4
     }
 }
-/// Cells per axis of lattice `g`.
-pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>) -> [u16; 3] {
-    let mut items = 0;
-    for_each_item(scene, cfg, g, |_, _| items += 1);
-    resolution(b, items, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis)
+/// Cells per axis of a lattice over `b` holding `items`.
+pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, b: &Aabb<R>) -> [u16; 3] {
+    let mut count = 0;
+    for_each_item(scene, cfg, items, |_, _| count += 1);
+    resolution(b, count, if let Items::World = items { cfg.top } else { cfg.sub }, cfg.max_per_axis)
+}
+
+/// The items of lattice `g` below the dense cells' (the world's, or a composite's).
+pub(super) fn items_of(g: usize) -> Items {
+    if g == 0 {
+        Items::World
+    } else {
+        Items::Composite(g - 1)
+    }
 }
 
 /// The region lattice `sub` covers: a composite's box, or for the world lattice the box of
@@ -120,7 +134,7 @@ pub(super) fn lattice_bounds<R: Real>(scene: &Scene<'_, R>, sub: usize) -> Aabb<
     }
 }
 
-fn resolution<R: Real>(b: &Aabb<R>, items: usize, res: Resolution, max_axis: u16) -> [u16; 3] {
+pub(super) fn resolution<R: Real>(b: &Aabb<R>, items: usize, res: Resolution, max_axis: u16) -> [u16; 3] {
     match res {
         Resolution::Uniform(n) => n.map(|v| v.clamp(1, MAX_PER_AXIS)),
         Resolution::Auto { density } => {
@@ -141,14 +155,14 @@ fn resolution<R: Real>(b: &Aabb<R>, items: usize, res: Resolution, max_axis: u16
 
 /// Plane `i` of a uniform coordinate list of `n` cells over `[lo, hi]`, computed from the
 /// index (never accumulated); the last plane is exactly `hi`.
-fn uniform_coord<R: Real>(lo: R, hi: R, n: u16, i: usize) -> R {
+pub(super) fn uniform_coord<R: Real>(lo: R, hi: R, n: u16, i: usize) -> R {
     if i == n as usize {
         hi
     } else {
         lo + (hi - lo) / R::from_i32(n as i32) * R::from_i32(i as i32)
     }
 }/// Writes the `n + 1` planes of axis `a` of lattice `g` (bounds `b`) into `out`.
-pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, b: &Aabb<R>, n: u16, out: &mut [R]) {
+pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, a: usize, b: &Aabb<R>, n: u16, out: &mut [R]) {
     let (lo, hi) = (b.min.axis(a), b.max.axis(a));
     match cfg.spacing {
         Spacing::Uniform => {
@@ -156,7 +170,7 @@ pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g:
                 *c = uniform_coord(lo, hi, n, i);
             }
         }
-        Spacing::Adaptive => adaptive_planes(scene, cfg, g, a, lo, hi, n, out),
+        Spacing::Adaptive => adaptive_planes(scene, cfg, items, a, lo, hi, n, out),
     }
 }
 
@@ -164,13 +178,13 @@ pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g:
 /// 1024 bins (no allocation, no sorting). Out of line so its 4 KB histogram is only on the stack when used.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
+fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
     const BINS: usize = 1024;
     let (l, h) = (lo.to_f64(), hi.to_f64());
     let width = (h - l).max(f64::MIN_POSITIVE);
     let mut hist = [0u32; BINS];
     let mut total = 0u32;
-    for_each_item(scene, cfg, g, |_, ib| {
+    for_each_item(scene, cfg, items, |_, ib| {
         let c = (ib.min.axis(a).to_f64() + ib.max.axis(a).to_f64()) * 0.5;
         let bin = (((c - l) / width) * BINS as f64).clamp(0.0, (BINS - 1) as f64) as usize;
         hist[bin] += 1;
@@ -201,22 +215,16 @@ fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize,
     }
 }
 
-/// Storage entries of the planes of one lattice and of the references to its cells.
+/// References to the cells of one lattice (over `b`, `n` cells per axis, holding `items`).
 #[inline(never)]
-fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3]) -> usize {
+fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, b: &Aabb<R>, n: [u16; 3]) -> usize {
     let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
     for (a, p) in planes.iter_mut().enumerate() {
-        axis_planes(scene, cfg, g, a, b, n[a], p);
+        axis_planes(scene, cfg, items, a, b, n[a], p);
     }
+    let planes = [0, 1, 2].map(|a| &planes[a][..n[a] as usize + 1]);
     let mut refs = 0;
-    for_each_item(scene, cfg, g, |_, ib| {
-        let mut count = 1usize;
-        for a in 0..3 {
-            let c = &planes[a][..n[a] as usize + 1];
-            count *= locate(c, ib.max.axis(a)) - locate(c, ib.min.axis(a)) + 1;
-        }
-        refs += count;
-    });
+    for_each_item(scene, cfg, items, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
     refs
 }
 impl<R: Real> Lattice<'_, R> {
@@ -232,25 +240,52 @@ impl<R: Real> Lattice<'_, R> {
     /// Storage a scene needs with these resolutions (no budget); `each(g, bounds, cells per
     /// axis, references)` sees every lattice on the way.
     pub(super) fn plan_exact(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut each: impl FnMut(usize, &Aabb<R>, [u16; 3], usize)) -> LatticeSizes {
-        let lattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
-        let mut s = LatticeSizes { lattices, cells: 1, ..Default::default() };
+        let mut s = LatticeSizes { cells: 1, ..Default::default() };
         plan_each(scene, cfg, |g, b, n, refs| {
             each(g, b, n, refs);
+            s.lattices += 1;
             s.coords += n.iter().map(|&v| v as usize + 1).sum::<usize>();
             s.cells += n.iter().map(|&v| v as usize).product::<usize>();
             s.refs += refs;
         });
-        s.narrow = cfg.index16 && super::index::fits16(s.refs, scene.objects.len(), scene.composites.len());
+        s.narrow = cfg.index16 && super::index::fits16(s.refs, scene.objects.len(), s.lattices - 1);
         s
     }
 }
 
-/// Calls `f(g, bounds, cells per axis, references)` for every lattice `cfg` builds.
+/// Calls `f(g, bounds, cells per axis, references)` for every lattice `cfg` builds: the world,
+/// the composites', then the dense cells'.
 fn plan_each<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut f: impl FnMut(usize, &Aabb<R>, [u16; 3], usize)) {
     let lattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
-    for g in 0..lattices {
+    let wb = lattice_bounds(scene, 0);
+    let wn = lattice_resolution(scene, cfg, Items::World, &wb);
+    // A dense cell's free objects move to its own lattice, which the cell references instead.
+    let mut moved = 0;
+    plan_dense(scene, cfg, &wb, wn, |_, _, _, free| moved += free - 1);
+    f(0, &wb, wn, plan_refs(scene, cfg, Items::World, &wb, wn) - moved);
+    for g in 1..lattices {
         let b = lattice_bounds(scene, g);
-        let n = lattice_resolution(scene, cfg, g, &b);
-        f(g, &b, n, plan_refs(scene, cfg, g, &b, n));
+        let n = lattice_resolution(scene, cfg, items_of(g), &b);
+        f(g, &b, n, plan_refs(scene, cfg, items_of(g), &b, n));
     }
+    let mut g = lattices;
+    plan_dense(scene, cfg, &wb, wn, |b, n, refs, _| {
+        f(g, b, n, refs);
+        g += 1;
+    });
+}
+
+/// Calls `f(bounds, cells per axis, references, free objects of the world cell)` for
+/// the lattice of every dense world cell (module `cluster`) of the world lattice over `wb`.
+#[inline(never)]
+fn plan_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, wb: &Aabb<R>, wn: [u16; 3], mut f: impl FnMut(&Aabb<R>, [u16; 3], usize, usize)) {
+    if !cluster::possible(scene, cfg) {
+        return;
+    }
+    let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
+    for (a, p) in planes.iter_mut().enumerate() {
+        axis_planes(scene, cfg, Items::World, a, wb, wn[a], p);
+    }
+    let planes = [0, 1, 2].map(|a| &planes[a][..wn[a] as usize + 1]);
+    cluster::for_each_dense(scene, cfg, planes, |d| f(&d.bounds, d.n, d.refs, d.free));
 }
