@@ -100,6 +100,43 @@ pub fn camera_rays(scene: &Scene<'_, f64>, w: i32, h: i32) -> Vec<Ray<f64>> {
 /// A generated scene: `n` random primitives, or the clustered "teapot in a stadium": most of
 /// them in one dense composite far from the sparse rest.
 pub fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
+    generated_as(n, clustered, true, storage)
+}
+
+/// The clustered scene of [`generated`] with the cluster not declared a composite: its
+/// primitives are loose among the others, as in a scene another program wrote out.
+pub fn loose(n: usize, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
+    generated_as(n, true, false, storage)
+}
+
+/// A generated scene of `n` primitives in the given storage.
+type Generator = fn(usize, &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>>;
+
+/// The issue's own check: `n` loose primitives packed into a cube of side 2 on a floor 160
+/// units wide ringed by 40 boxes, seen from the floor's edge.
+pub fn stadium(n: usize, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
+    *storage = vec![Object::default(); n + 41];
+    let mut b = SceneBuilder::new(storage);
+    let mut rng = Rng::new(3000 + n as u64);
+    b.add_material(lattice_rt::scene::Material::DEFAULT)?;
+    b.add_light(lattice_rt::scene::Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 })?;
+    let scaled = |s: Vec3<f64>, at: Vec3<f64>| lattice_rt::Affine::translate(at).after(&lattice_rt::Affine::scale(s));
+    b.add_object(lattice_rt::Shape::Box, scaled(Vec3::new(160.0, 1.0, 160.0), Vec3::new(-80.0, -1.0, -80.0)), 0)?;
+    for i in 0..40 {
+        let a = i as f64 * core::f64::consts::TAU / 40.0;
+        b.add_object(lattice_rt::Shape::Box, scaled(Vec3::new(4.0, 6.0, 4.0), Vec3::new(70.0 * a.cos() - 2.0, 0.0, 70.0 * a.sin() - 2.0)), 0)?;
+    }
+    for _ in 0..n {
+        let c = Vec3::new(rng.range(-1.0, 1.0), rng.range(0.0, 2.0), rng.range(-1.0, 1.0));
+        let (s, t) = random_object(&mut rng, c, 0.04);
+        b.add_object(s, t, 0)?;
+    }
+    b.camera.eye = Vec3::new(0.0, 12.0, -75.0);
+    b.camera.look = Vec3::new(0.0, 1.0, 0.0);
+    Ok(b.finish()?)
+}
+
+fn generated_as(n: usize, clustered: bool, declared: bool, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
     *storage = vec![Object::default(); n];
     let mut b = SceneBuilder::new(storage);
     if !clustered {
@@ -115,14 +152,19 @@ pub fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> R
             let (s, t) = random_object(&mut rng, c, 0.8);
             b.add_object(s, t, 0)?;
         }
-        // The teapot: a composite of the other 90 % packed into a cube of side 2.
-        b.begin_composite(lattice_rt::Affine::translate(Vec3::new(side * 0.8, side * 0.1, side * 0.8)))?;
+        // The teapot: the other 90 % packed into a cube of side 2, a composite when declared.
+        let at = Vec3::new(side * 0.8, side * 0.1, side * 0.8);
+        if declared {
+            b.begin_composite(lattice_rt::Affine::translate(at))?;
+        }
         for _ in sparse..n {
             let c = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
-            let (s, t) = random_object(&mut rng, c, 0.04);
+            let (s, t) = random_object(&mut rng, if declared { c } else { c + at }, 0.04);
             b.add_object(s, t, 0)?;
         }
-        b.end_composite()?;
+        if declared {
+            b.end_composite()?;
+        }
         b.camera.eye = Vec3::new(side * 0.5, side * 0.6, -side * 0.6);
         b.camera.look = Vec3::new(side * 0.8, side * 0.1, side * 0.8);
     }
@@ -303,7 +345,7 @@ fn against_povray(quick: bool, runs: usize) -> Result<String> {
     let cfg = LatticeConfig::default();
     let mut rows = Vec::new();
     let sizes: &[usize] = if quick { &[100, 1000] } else { &[100, 1000, 10_000] };
-    let bar = host_sim::progress::bar(PAPER.len() + 2 * sizes.len(), "against POV-Ray");
+    let bar = host_sim::progress::bar(PAPER.len() + 3 * sizes.len() + 1, "against POV-Ray");
     for (name, ..) in PAPER {
         let path = Path::new("scenes").join(format!("{name}.scene"));
         let text = read(&path)?;
@@ -321,6 +363,20 @@ fn against_povray(quick: bool, runs: usize) -> Result<String> {
             let mut bufs = lattice_storage(&scene, &cfg)?;
             let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
             let name = format!("{} {n}", if clustered { "clustered" } else { "random" });
+            rows.extend(crate::versus::compare(&name, &scene, &lattice, runs, work)?);
+            bar.inc(1);
+            host_sim::progress::log(&bar, format_args!("  {name} against POV-Ray done"));
+        }
+    }
+    let extra: [(&str, Generator, usize); 2] = [("loose clustered", loose, 0), ("stadium", stadium, 3000)];
+    for (kind, make, fixed) in extra {
+        let ns: Vec<usize> = if fixed > 0 { vec![fixed] } else { sizes.to_vec() };
+        for n in ns {
+            let mut storage = Vec::new();
+            let scene = make(n, &mut storage)?;
+            let mut bufs = lattice_storage(&scene, &cfg)?;
+            let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+            let name = format!("{kind} {n}");
             rows.extend(crate::versus::compare(&name, &scene, &lattice, runs, work)?);
             bar.inc(1);
             host_sim::progress::log(&bar, format_args!("  {name} against POV-Ray done"));

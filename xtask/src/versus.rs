@@ -143,8 +143,25 @@ pub fn section(rows: &[Row], runs: usize) -> Result<String> {
             rows.len()
         )?;
     }
+    // Loose clusters against the same scenes with the cluster declared a composite.
+    for r in rows.iter().filter(|r| r.scene.starts_with("loose clustered ")) {
+        let declared = format!("clustered {}", r.n);
+        if let Some(d) = rows.iter().find(|d| d.scene == declared && d.shadows == r.shadows) {
+            writeln!(
+                md,
+                "{} ({} shadows): {:.2} object tests per ray, {:.2}x those with the cluster declared a composite (target: at most {LOOSE_TARGET}x).",
+                r.scene,
+                if r.shadows { "with" } else { "without" },
+                r.tests,
+                r.tests / d.tests.max(1e-9)
+            )?;
+        }
+    }
     Ok(md)
 }
+
+/// How many times the object tests per ray of a loose cluster may be those of the declared one.
+pub const LOOSE_TARGET: f64 = 2.0;
 
 #[cfg(test)]
 mod tests {
