@@ -1,8 +1,8 @@
 //! Building a lattice into caller-provided storage: coordinate lists, then cells and references
 //! in two passes (count, then fill).
 
-use super::plan::{axis_planes, items_of, lattice_bounds, lattice_resolution, uniform_coord};
-use super::{cluster, for_each_item, index, locate, Items, Lattice, LatticeConfig, SubLattice};
+use super::plan::{axis_planes, lattice_bounds, lattice_resolution, uniform_coord};
+use super::{cluster, for_each_item, index, Lattice, LatticeConfig, SubLattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -47,14 +47,6 @@ impl fmt::Display for LatticeError {
 }
 
 impl core::error::Error for LatticeError {}
-/// Cell index range `[lo, hi]` per axis overlapped by a box.
-fn cell_range<R: Real>(coords: &[R], g: &SubLattice<R>, b: &Aabb<R>) -> [(usize, usize); 3] {
-    [0, 1, 2].map(|a| {
-        let s = g.coord_start[a] as usize;
-        let c = &coords[s..s + g.n[a] as usize + 1];
-        (locate(c, b.min.axis(a)), locate(c, b.max.axis(a)))
-    })
-}
 impl<'a, R: Real> Lattice<'a, R> {
     /// Builds the lattice into `storage`.
     pub fn build(scene: &Scene<'_, R>, cfg: &LatticeConfig, storage: LatticeStorage<'a, R>) -> Result<Self, LatticeError> {
@@ -77,7 +69,7 @@ impl<'a, R: Real> Lattice<'a, R> {
         };
         // Coordinate lists and cell ranges: the world, the composites, then the dense cells.
         let (mut nc, mut ncells, mut nlattices, all_coords) = (0usize, 0usize, 0usize, coords.len());
-        // `planes(items, bounds, n, axis, out)` writes a lattice's planes.
+        // `place(.., planes)` stores a lattice; `planes(axis, out)` writes its coordinate lists.
         let mut place = |lattices: &mut [SubLattice<R>], coords: &mut [R], nc: &mut usize, b: Aabb<R>, n: [u16; 3], dense_cell: u32, planes: &dyn Fn(usize, &mut [R])| {
             let available = lattices.len();
             let slot = lattices.get_mut(nlattices).ok_or_else(|| short("lattices", available))?;
@@ -99,13 +91,13 @@ impl<'a, R: Real> Lattice<'a, R> {
         let base = if cfg.nested { 1 + scene.composites.len() } else { 1 };
         for g in 0..base {
             let b = lattice_bounds(scene, g);
-            let n = lattice_resolution(scene, cfg, items_of(g), &b);
-            place(lattices, coords, &mut nc, b, n, u32::MAX, &|a, out| axis_planes(scene, cfg, items_of(g), a, &b, n[a], out))?;
+            let n = lattice_resolution(scene, cfg, g, &b);
+            place(lattices, coords, &mut nc, b, n, u32::MAX, &|a, out| axis_planes(scene, cfg, g, a, &b, n[a], out))?;
         }
         // The world's planes stay where they are while the dense cells' follow them; a dense
         // cell's lattice has equal cells.
         let (world, more) = coords.split_at_mut(nc);
-        let wp = world_planes(world, &lattices[0]);
+        let wp = planes_of(world, &lattices[0]);
         let mut more_used = 0;
         let mut failed = Ok(());
         cluster::for_each_dense(scene, cfg, wp, |d| {
@@ -164,11 +156,11 @@ impl<'a, R: Real> Lattice<'a, R> {
     }
 }
 
-/// The world lattice's coordinate lists.
-fn world_planes<'c, R: Real>(coords: &'c [R], world: &SubLattice<R>) -> [&'c [R]; 3] {
+/// A lattice's coordinate lists.
+fn planes_of<'c, R: Real>(coords: &'c [R], sub: &SubLattice<R>) -> [&'c [R]; 3] {
     [0, 1, 2].map(|a| {
-        let s = world.coord_start[a] as usize;
-        &coords[s..s + world.n[a] as usize + 1]
+        let s = sub.coord_start[a] as usize;
+        &coords[s..s + sub.n[a] as usize + 1]
     })
 }
 
@@ -179,7 +171,7 @@ fn for_each_ref<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, coords: &[R]
     let dense = &lattices[base..];
     let find = |c: usize| dense.binary_search_by_key(&(c as u32), |d| d.dense_cell).ok();
     let world = &lattices[0];
-    for_each_item(scene, cfg, Items::World, |item, ib| {
+    for_each_item(scene, cfg, 0, |item, ib| {
         visit_cells(coords, world, ib, |c| match find(c) {
             Some(k) if item & index::SUB_FLAG == 0 => visit_cells(coords, &dense[k], ib, |c| f(item, c)),
             _ => f(item, c),
@@ -189,13 +181,13 @@ fn for_each_ref<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, coords: &[R]
         f(index::SUB_FLAG | (base - 1 + k) as u32, d.dense_cell as usize);
     }
     for (g, sub) in lattices.iter().enumerate().take(base).skip(1) {
-        for_each_item(scene, cfg, items_of(g), |item, ib| visit_cells(coords, sub, ib, |c| f(item, c)));
+        for_each_item(scene, cfg, g, |item, ib| visit_cells(coords, sub, ib, |c| f(item, c)));
     }
 }
 
 /// Calls `f` with the global cell index of every cell of `sub` a box overlaps.
 fn visit_cells<R: Real>(coords: &[R], sub: &SubLattice<R>, b: &Aabb<R>, mut f: impl FnMut(usize)) {
-    let r = cell_range(coords, sub, b);
+    let r = cluster::span(planes_of(coords, sub), b);
     let (nx, ny) = (sub.n[0] as usize, sub.n[1] as usize);
     for z in r[2].0..=r[2].1 {
         for y in r[1].0..=r[1].1 {

@@ -94,20 +94,11 @@ pub struct Lattice<'a, R> {
     objects: usize,
 }
 
-/// Which items a lattice holds.
-#[derive(Clone, Copy, Debug)]
-enum Items {
-    /// The world lattice: free objects (all objects, if flat) and composites.
-    World,
-    /// A composite's sub-lattice: its objects.
-    Composite(usize),
-}
-
-/// Calls `f(item, box)` for the items a lattice holds: an object index, or `SUB_FLAG |`
-/// composite index.
-fn for_each_item<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, mut f: impl FnMut(u32, &Aabb<R>)) {
-    match items {
-        Items::World => {
+/// Calls `f(item, box)` for the items lattice `g` holds (the world, `0`, or composite `g - 1`'s):
+/// an object index, or `SUB_FLAG |` composite index. A dense cell's lattice is filled by the build.
+fn for_each_item<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, mut f: impl FnMut(u32, &Aabb<R>)) {
+    match g.checked_sub(1) {
+        None => {
             for (i, o) in scene.objects.iter().enumerate() {
                 if o.composite == NO_COMPOSITE || !cfg.nested {
                     f(i as u32, &o.bounds);
@@ -119,7 +110,7 @@ fn for_each_item<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Item
                 }
             }
         }
-        Items::Composite(k) => {
+        Some(k) => {
             let grp = &scene.composites[k];
             for i in grp.first as usize..grp.first as usize + grp.len as usize {
                 f(i as u32, &scene.objects[i].bounds);

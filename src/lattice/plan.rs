@@ -1,6 +1,6 @@
 //! Planning a lattice: its resolution, where its planes go, and how much storage it needs.
 
-use super::{cluster, for_each_item, Items, Lattice};
+use super::{cluster, for_each_item, Lattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -102,20 +102,11 @@ impl LatticeSizes {
         self.lattices * size_of::<super::SubLattice<R>>() + self.coords * size_of::<R>() + self.words() * 4
     }
 }
-/// Cells per axis of a lattice over `b` holding `items`.
-pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, b: &Aabb<R>) -> [u16; 3] {
+/// Cells per axis of lattice `g` over `b`.
+pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>) -> [u16; 3] {
     let mut count = 0;
-    for_each_item(scene, cfg, items, |_, _| count += 1);
-    resolution(b, count, if let Items::World = items { cfg.top } else { cfg.sub }, cfg.max_per_axis)
-}
-
-/// The items of lattice `g` below the dense cells' (the world's, or a composite's).
-pub(super) fn items_of(g: usize) -> Items {
-    if g == 0 {
-        Items::World
-    } else {
-        Items::Composite(g - 1)
-    }
+    for_each_item(scene, cfg, g, |_, _| count += 1);
+    resolution(b, count, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis)
 }
 
 /// The region lattice `sub` covers: a composite's box, or for the world lattice the box of
@@ -162,7 +153,7 @@ pub(super) fn uniform_coord<R: Real>(lo: R, hi: R, n: u16, i: usize) -> R {
         lo + (hi - lo) / R::from_i32(n as i32) * R::from_i32(i as i32)
     }
 }/// Writes the `n + 1` planes of axis `a` of lattice `g` (bounds `b`) into `out`.
-pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, a: usize, b: &Aabb<R>, n: u16, out: &mut [R]) {
+pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, b: &Aabb<R>, n: u16, out: &mut [R]) {
     let (lo, hi) = (b.min.axis(a), b.max.axis(a));
     match cfg.spacing {
         Spacing::Uniform => {
@@ -170,7 +161,7 @@ pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, it
                 *c = uniform_coord(lo, hi, n, i);
             }
         }
-        Spacing::Adaptive => adaptive_planes(scene, cfg, items, a, lo, hi, n, out),
+        Spacing::Adaptive => adaptive_planes(scene, cfg, g, a, lo, hi, n, out),
     }
 }
 
@@ -178,13 +169,13 @@ pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, it
 /// 1024 bins (no allocation, no sorting). Out of line so its 4 KB histogram is only on the stack when used.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
+fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
     const BINS: usize = 1024;
     let (l, h) = (lo.to_f64(), hi.to_f64());
     let width = (h - l).max(f64::MIN_POSITIVE);
     let mut hist = [0u32; BINS];
     let mut total = 0u32;
-    for_each_item(scene, cfg, items, |_, ib| {
+    for_each_item(scene, cfg, g, |_, ib| {
         let c = (ib.min.axis(a).to_f64() + ib.max.axis(a).to_f64()) * 0.5;
         let bin = (((c - l) / width) * BINS as f64).clamp(0.0, (BINS - 1) as f64) as usize;
         hist[bin] += 1;
@@ -215,16 +206,16 @@ fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: It
     }
 }
 
-/// References to the cells of one lattice (over `b`, `n` cells per axis, holding `items`).
+/// References to the cells of lattice `g` (over `b`, `n` cells per axis).
 #[inline(never)]
-fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, items: Items, b: &Aabb<R>, n: [u16; 3]) -> usize {
+fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3]) -> usize {
     let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
     for (a, p) in planes.iter_mut().enumerate() {
-        axis_planes(scene, cfg, items, a, b, n[a], p);
+        axis_planes(scene, cfg, g, a, b, n[a], p);
     }
     let planes = [0, 1, 2].map(|a| &planes[a][..n[a] as usize + 1]);
     let mut refs = 0;
-    for_each_item(scene, cfg, items, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
+    for_each_item(scene, cfg, g, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
     refs
 }
 impl<R: Real> Lattice<'_, R> {
@@ -258,15 +249,15 @@ impl<R: Real> Lattice<'_, R> {
 fn plan_each<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut f: impl FnMut(usize, &Aabb<R>, [u16; 3], usize)) {
     let lattices = if cfg.nested { 1 + scene.composites.len() } else { 1 };
     let wb = lattice_bounds(scene, 0);
-    let wn = lattice_resolution(scene, cfg, Items::World, &wb);
+    let wn = lattice_resolution(scene, cfg, 0, &wb);
     // A dense cell's free objects move to its own lattice, which the cell references instead.
     let mut moved = 0;
     plan_dense(scene, cfg, &wb, wn, |_, _, _, free| moved += free - 1);
-    f(0, &wb, wn, plan_refs(scene, cfg, Items::World, &wb, wn) - moved);
+    f(0, &wb, wn, plan_refs(scene, cfg, 0, &wb, wn) - moved);
     for g in 1..lattices {
         let b = lattice_bounds(scene, g);
-        let n = lattice_resolution(scene, cfg, items_of(g), &b);
-        f(g, &b, n, plan_refs(scene, cfg, items_of(g), &b, n));
+        let n = lattice_resolution(scene, cfg, g, &b);
+        f(g, &b, n, plan_refs(scene, cfg, g, &b, n));
     }
     let mut g = lattices;
     plan_dense(scene, cfg, &wb, wn, |b, n, refs, _| {
@@ -284,7 +275,7 @@ fn plan_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, wb: &Aabb<R>, 
     }
     let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
     for (a, p) in planes.iter_mut().enumerate() {
-        axis_planes(scene, cfg, Items::World, a, wb, wn[a], p);
+        axis_planes(scene, cfg, 0, a, wb, wn[a], p);
     }
     let planes = [0, 1, 2].map(|a| &planes[a][..wn[a] as usize + 1]);
     cluster::for_each_dense(scene, cfg, planes, |d| f(&d.bounds, d.n, d.refs, d.free));
