@@ -178,15 +178,36 @@ impl core::fmt::Display for TooDeep {
 
 impl core::error::Error for TooDeep {}
 
-/// The side of a surface a ray meets: the normal turned to face the ray, the ratio of indices
-/// `eta = n_from / n_to` for a material of index `ior` in air, and whether the ray enters.
-/// A ray from inside (its direction along the outward normal) gets the flipped normal and the
-/// swapped ratio `ior / 1`.
-pub fn facing<R: Real>(d: Vec3<R>, outward: Vec3<R>, ior: R) -> (Vec3<R>, R, bool) {
+/// The side of a surface a ray meets ([`facing`]): the normal turned to face the ray, and
+/// whether the ray enters (travels against the outward normal).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Side<R> {
+    /// The normal on the ray's side.
+    pub normal: Vec3<R>,
+    /// Whether the ray travels against the outward normal (enters a solid from outside).
+    pub entering: bool,
+}
+
+impl<R: Real> Side<R> {
+    /// The ratio of indices `eta = n_from / n_to` at a material of index `ior` in air: `1 / ior`
+    /// entering, `ior / 1` leaving.
+    pub fn eta(&self, ior: R) -> R {
+        if self.entering {
+            R::ONE / ior
+        } else {
+            ior
+        }
+    }
+}
+
+/// The side of a surface with normal `outward` a ray of direction `d` meets: a ray from inside
+/// (its direction along the outward normal) gets the flipped normal. Only the sign of `d . outward`
+/// matters, so `d` need not be unit length.
+pub fn facing<R: Real>(d: Vec3<R>, outward: Vec3<R>) -> Side<R> {
     if d.dot(outward) <= R::ZERO {
-        (outward, R::ONE / ior, true)
+        Side { normal: outward, entering: true }
     } else {
-        (-outward, ior, false)
+        Side { normal: -outward, entering: false }
     }
 }
 
@@ -463,9 +484,14 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let obj = &scene.objects[hit.object as usize];
             let m = scene.materials[obj.material as usize];
             let p = obj.surface_point(hit.point, hit.normal);
-            let d = node.ray.dir.normalize();
-            let (n, eta, _) = facing(d, obj.world_normal(hit.normal), m.ior);
-            let cos_i = -d.dot(n);
+            // Children (a mirror or a refracted ray) need the unit direction; without them only
+            // the side the ray meets is asked, which the direction as traced gives.
+            let reflects = self.simulates(Effects::REFLECTION) && m.ks > R::ZERO;
+            let refracts = self.simulates(Effects::REFRACTION) && m.kt > R::ZERO;
+            let children = node.depth < self.max_depth && (reflects || refracts);
+            let d = if children { node.ray.dir.normalize() } else { node.ray.dir };
+            let side = facing(d, obj.world_normal(hit.normal));
+            let n = side.normal;
             let eps = R::offset(p.max_abs(), obj.size());
             let outside = p + n * eps;
             let mut local = scene.ambient * m.ka;
@@ -475,14 +501,15 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 }
             }
             total += node.weight * local;
-            if node.depth >= self.max_depth {
+            if !children {
                 continue;
             }
             let child = |ray, w: R, kind| Node { ray, weight: node.weight * w, depth: node.depth + 1, kind };
+            let cos_i = -d.dot(n);
             let mirror = d + n * (cos_i + cos_i);
-            let mut reflect_w = if self.simulates(Effects::REFLECTION) { m.ks } else { R::ZERO };
-            if self.simulates(Effects::REFRACTION) && m.kt > R::ZERO {
-                match refract(d, n, eta) {
+            let mut reflect_w = if reflects { m.ks } else { R::ZERO };
+            if refracts {
+                match refract(d, n, side.eta(m.ior)) {
                     // Total internal reflection: the transmitted share is reflected.
                     None => reflect_w += m.kt,
                     Some(dir) if node.weight * m.kt > self.cutoff => {
