@@ -75,7 +75,7 @@ mod writer {
             }
         )*};
     }
-    plain!(u8, u16, u32, i32, usize, bool);
+    plain!(u8, u16, i16, u32, i32, usize, bool);
 
     impl<T: Literal, const N: usize> Literal for [T; N] {
         fn literal(&self, out: &mut String) {
@@ -169,17 +169,15 @@ mod writer {
         fn literal(&self, out: &mut String) {
             let o = self;
             out.push_str("Object::from_tables(");
-            let parts: [&dyn Literal; 13] = [
+            let parts: [&dyn Literal; 11] = [
                 &o.shape,
                 &o.to_object,
                 &o.to_world,
                 &o.unscale,
-                &o.dir_factor,
                 &o.material,
                 &o.composite,
                 &o.bounds,
                 &o.dir_scale,
-                &o.inv_dir_scale,
                 &o.eye_local,
                 &o.eye_window,
                 &o.shadow_window,

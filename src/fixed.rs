@@ -213,6 +213,28 @@ impl Real for Fx {
         let q = q as i32;
         Fx(if self.0 < 0 { -q } else { q })
     }
+    /// A shift of the magnitude, rounded as [`Mul`] rounds the product with `2^k` (half away
+    /// from zero, saturating); powers of two outside fixed point's range multiply by the value
+    /// `from_f64` gives them, as the default does.
+    #[inline]
+    fn mul_pow2(self, k: i16) -> Self {
+        if !(-16..=14).contains(&k) {
+            return self * Fx::from_f64(crate::scalar::pow2(k));
+        }
+        let a = self.0.unsigned_abs();
+        let m = if k >= 0 {
+            if a > (i32::MAX as u32) >> k {
+                i32::MAX as u32
+            } else {
+                a << k
+            }
+        } else {
+            let s = (-k) as u32;
+            (a >> s) + ((a >> (s - 1)) & 1)
+        };
+        let m = m as i32;
+        Fx(if self.0 < 0 { -m } else { m })
+    }
     fn div_pow2(self, k: u32) -> Self {
         // Division rounds half away from zero: a rounded shift of the magnitude.
         let k = k.min(14);
@@ -299,6 +321,23 @@ mod tests {
         assert_eq!(Fx::from_i32(-3), fx(-3.0));
         assert_eq!(Fx::from_f64(f64::NAN), Fx(0));
         assert_eq!(Fx::from_f64(1e12), Fx::MAX);
+    }
+
+    #[test]
+    fn power_of_two_shifts_give_the_products() {
+        // Every exponent in and around fixed point's range, on edge and random operands: the
+        // shift equals the product with `from_f64(2^k)`, rounding and saturation included.
+        let edges = [0, 1, -1, 2, 3, -3, 0x8000, 0x18000, -0x18000, i32::MAX, -i32::MAX, i32::MIN, 1 << 30, -(1 << 30)];
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let random = core::iter::repeat_with(|| {
+            xorshift(&mut x);
+            (x >> 32) as i32 >> (x & 31)
+        });
+        for a in edges.into_iter().chain(random.take(2000)) {
+            for k in -20i16..=20 {
+                assert_eq!(Fx(a).mul_pow2(k), Fx(a) * Fx::from_f64(crate::scalar::pow2(k)), "{a} * 2^{k}");
+            }
+        }
     }
 
     /// One step of the 64-bit xorshift generator the randomised tests draw their operands from.

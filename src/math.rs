@@ -64,6 +64,11 @@ impl<R: Real> Vec3<R> {
         let v = self * m.recip();
         v * v.length().recip()
     }
+    /// Every component times `2^k` ([`Real::mul_pow2`]).
+    #[inline]
+    pub fn mul_pow2(self, k: i16) -> Self {
+        Vec3::new(self.x.mul_pow2(k), self.y.mul_pow2(k), self.z.mul_pow2(k))
+    }
     /// Largest absolute component.
     pub fn max_abs(self) -> R {
         self.x.abs().max(self.y.abs()).max(self.z.abs())

@@ -119,6 +119,12 @@ pub trait Real:
     fn div_pow2(self, k: u32) -> Self {
         self / Self::from_i32(1 << k.min(14))
     }
+    /// `self * 2^k`: the same value as multiplying by `from_f64(2^k)`, which is what the default
+    /// does; fixed point shifts instead of multiplying, `f32` builds the power from its bits.
+    #[inline]
+    fn mul_pow2(self, k: i16) -> Self {
+        self * Self::from_f64(pow2(k))
+    }
     /// The largest integer `k` in `0..=max` with `k <= self` (0 when there is none: below 0,
     /// or NaN). The default bisects with comparisons alone (no float-to-int conversion the
     /// scalar may not have); the built-in scalars convert directly, to the same answer.
@@ -137,6 +143,21 @@ pub trait Real:
 }
 
 /// [`Real::depth_key`] of an `f32`: its top 16 bits (sign, exponent, 7 mantissa bits).
+/// `2^k` in `f64` (0 below its smallest normal power, infinity above its largest): the powers
+/// of two an object's scales are ([`Real::mul_pow2`]).
+pub fn pow2(k: i16) -> f64 {
+    match k {
+        -1022..=1023 => f64::from_bits(((i64::from(k) + 1023) as u64) << 52),
+        ..=-1023 => 0.0,
+        _ => f64::INFINITY,
+    }
+}
+
+/// The exponent `k` of a power of two `p = 2^k` (a normal `f64`): the inverse of [`pow2`].
+pub fn log2_of_pow2(p: f64) -> i16 {
+    ((p.to_bits() >> 52) & 0x7ff) as i16 - 1023
+}
+
 fn f32_key(v: f32) -> u16 {
     if v > 0.0 {
         (v.to_bits() >> 16) as u16
@@ -248,6 +269,14 @@ impl Real for f32 {
     }
     fn depth_key(self) -> u16 {
         f32_key(self)
+    }
+    #[inline]
+    fn mul_pow2(self, k: i16) -> Self {
+        if (-126..=127).contains(&k) {
+            self * f32::from_bits(((k + 127) as u32) << 23)
+        } else {
+            self * pow2(k) as f32
+        }
     }
     fn offset_eps() -> Self {
         3e-6
@@ -428,6 +457,10 @@ macro_rules! f32_with_sqrt {
             }
             fn pad_eps() -> Self {
                 $name(<f32 as Real>::pad_eps())
+            }
+            #[inline]
+            fn mul_pow2(self, k: i16) -> Self {
+                $name(<f32 as Real>::mul_pow2(self.0, k))
             }
             fn is_finite(self) -> bool {
                 self.0.is_finite()

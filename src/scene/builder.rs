@@ -3,7 +3,7 @@
 use super::error::SceneError;
 use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
 use crate::math::{Aabb, Affine, Vec3};
-use crate::scalar::Real;
+use crate::scalar::{log2_of_pow2, pow2, Real};
 use crate::shape::Shape;
 use heapless::Vec;
 
@@ -227,13 +227,11 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             shape,
             to_object: scaled.cast(),
             to_world: place.cast(),
-            unscale: R::from_f64(unscale),
-            dir_factor: R::from_f64(unscale * dir_scale),
+            unscale: log2_of_pow2(unscale),
             material,
             composite,
             bounds: bounds.cast_padded(),
-            dir_scale: R::from_f64(dir_scale),
-            inv_dir_scale: R::from_f64(1.0 / dir_scale),
+            dir_scale: log2_of_pow2(dir_scale),
             // The camera is known at `finish`, which sets both.
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             eye_window: WHOLE_PLANE,
@@ -295,7 +293,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let reach = world.min.max_abs().max(world.max.max_abs()).to_f64();
         let margin = R::pad_eps().to_f64() * (1.0 + reach);
         for o in self.storage[..self.len].iter_mut() {
-            o.eye_local = o.to_object.vector(camera.eye - o.origin()) * o.unscale;
+            o.eye_local = o.to_object.vector(camera.eye - o.origin()).mul_pow2(o.unscale);
             o.eye_window = eye_window(&o.bounds, &camera);
             o.shadow_window = match shadow_basis {
                 Some((a, b)) => shadow_window(&o.bounds, a.cast(), b.cast(), margin),
@@ -309,7 +307,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         // coordinates never exceed those of the world box's corners in its space.
         for (i, o) in objects.iter().enumerate() {
             let inv = o.to_object.cast::<f64>();
-            let unscale = o.unscale.to_f64();
+            let unscale = pow2(o.unscale);
             let reach = world
                 .corners()
                 .into_iter()
@@ -426,7 +424,7 @@ fn checked_inverse(t: &Affine<f64>) -> Result<Affine<f64>, SceneError> {
 /// the object's own ([`Real::offset`]), so nothing else in the scene changes the answer.
 fn thickness<R: Real>(o: &Object<R>) -> (f64, f64) {
     let m = o.to_object.cast::<f64>();
-    let unscale = o.unscale.to_f64();
+    let unscale = pow2(o.unscale);
     let stretch = (0..3)
         .map(|i| libm::sqrt(m.m[i][0] * m.m[i][0] + m.m[i][1] * m.m[i][1] + m.m[i][2] * m.m[i][2]))
         .fold(0.0, f64::max)

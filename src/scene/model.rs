@@ -169,7 +169,7 @@ pub struct Object<R> {
     /// The canonical primitive.
     pub(crate) shape: Shape<R>,
     /// World-to-object transform (the inverse of the placement) multiplied by the power of two
-    /// `1 / unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
+    /// `2^-unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
     /// full precision however large or small the object is (exact in floating point).
     pub(crate) to_object: Affine<R>,
     /// The placement, from canonical object space to the world: hit points are mapped back
@@ -177,21 +177,19 @@ pub struct Object<R> {
     /// taken relative to it before `to_object` (whose translation is then zero), so a scene far
     /// from the world's origin loses no precision to cancellation.
     pub(crate) to_world: Affine<R>,
-    /// The power of two that `to_object`'s results are multiplied by to get object space.
-    pub(crate) unscale: R,
-    /// `unscale * dir_scale`: what `to_object`'s direction results are multiplied by.
-    pub(crate) dir_factor: R,
+    /// The exponent of the power of two `to_object`'s results are multiplied by to get object
+    /// space ([`Real::mul_pow2`]: a shift in fixed point, not a multiply).
+    pub(crate) unscale: i16,
     /// Index into the scene's materials.
     pub(crate) material: u8,
     /// Composite object it belongs to, or [`NO_COMPOSITE`].
     pub(crate) composite: u16,
     /// World-space bounding box, padded for the scalar's rounding.
     pub(crate) bounds: Aabb<R>,
-    /// A power of two that object-space directions are multiplied by, so that they stay near
-    /// unit length however small or large the object is (exact in floating point).
-    pub(crate) dir_scale: R,
-    /// `1 / dir_scale`.
-    pub(crate) inv_dir_scale: R,
+    /// The exponent of a power of two that object-space directions are multiplied by, so that
+    /// they stay near unit length however small or large the object is (exact in floating
+    /// point): `to_object`'s direction results are multiplied by `2^(unscale + dir_scale)`.
+    pub(crate) dir_scale: i16,
     /// The camera's eye in object space, `to_object.vector(eye - origin) * unscale`: the same
     /// for every eye ray, so it is computed once per scene instead of once per eye-ray test.
     pub(crate) eye_local: Vec3<R>,
@@ -240,13 +238,11 @@ impl<R: Real> Default for Object<R> {
             shape: Shape::Sphere,
             to_object: Affine::identity(),
             to_world: Affine::identity(),
-            unscale: R::ONE,
-            dir_factor: R::ONE,
+            unscale: 0,
             material: 0,
             composite: NO_COMPOSITE,
             bounds: Aabb { min: z, max: z },
-            dir_scale: R::ONE,
-            inv_dir_scale: R::ONE,
+            dir_scale: 0,
             eye_local: z,
             eye_window: WHOLE_PLANE,
             shadow_window: shadow_whole_plane(),
@@ -263,18 +259,16 @@ impl<R> Object<R> {
         shape: Shape<R>,
         to_object: Affine<R>,
         to_world: Affine<R>,
-        unscale: R,
-        dir_factor: R,
+        unscale: i16,
         material: u8,
         composite: u16,
         bounds: Aabb<R>,
-        dir_scale: R,
-        inv_dir_scale: R,
+        dir_scale: i16,
         eye_local: Vec3<R>,
         eye_window: EyeWindow,
         shadow_window: ShadowWindow<R>,
     ) -> Self {
-        Object { shape, to_object, to_world, unscale, dir_factor, material, composite, bounds, dir_scale, inv_dir_scale, eye_local, eye_window, shadow_window }
+        Object { shape, to_object, to_world, unscale, material, composite, bounds, dir_scale, eye_local, eye_window, shadow_window }
     }
 }
 
@@ -283,7 +277,7 @@ impl<R: Real> Object<R> {
     /// the object-space normal and point.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        self.intersect_from(self.to_object.vector(ray.origin - self.origin()) * self.unscale, ray, tmin, tmax)
+        self.intersect_from(self.to_object.vector(ray.origin - self.origin()).mul_pow2(self.unscale), ray, tmin, tmax)
     }
 
     /// [`Object::intersect`] for an eye ray (its origin the camera's eye) through window
@@ -302,7 +296,7 @@ impl<R: Real> Object<R> {
     /// The intersection, given the ray's origin already in object space.
     #[inline(always)]
     fn intersect_from(&self, origin: Vec3<R>, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        let r = Ray::new(origin, self.to_object.vector(ray.dir) * self.dir_factor);
+        let r = Ray::new(origin, self.to_object.vector(ray.dir).mul_pow2(self.unscale + self.dir_scale));
         // With the direction scaled by k, the object-space parameter is t / k. Multiplying by
         // a power of two is exact in floating point but rounds in fixed point, so the range is
         // checked on the world parameter: a hit exactly at `tmax` (a tie with the best hit so
@@ -312,11 +306,11 @@ impl<R: Real> Object<R> {
         let far = if tmax == R::MAX {
             R::MAX
         } else {
-            let f = tmax * self.inv_dir_scale;
+            let f = tmax.mul_pow2(-self.dir_scale);
             f + (f.abs() + R::ONE) * R::pad_eps()
         };
-        let hit = self.shape.intersect(&r, tmin * self.inv_dir_scale, far)?;
-        let t = hit.t * self.dir_scale;
+        let hit = self.shape.intersect(&r, tmin.mul_pow2(-self.dir_scale), far)?;
+        let t = hit.t.mul_pow2(self.dir_scale);
         (t > tmin && t <= tmax).then_some(ShapeHit { t, ..hit })
     }
     /// The canonical primitive.
@@ -362,7 +356,7 @@ impl<R: Real> Object<R> {
         let mut t = self.to_object;
         for row in t.m.iter_mut() {
             for v in row.iter_mut() {
-                *v *= self.unscale;
+                *v = v.mul_pow2(self.unscale);
             }
         }
         t
