@@ -84,6 +84,9 @@ pub struct Query<'m> {
     /// The window position of the ray being traced when it is an eye ray (see
     /// [`Query::set_eye_ray`]).
     eye: Option<[i32; 2]>,
+    /// Whether the ray being traced is a shadow ray towards the scene's first light, when that
+    /// light is directional (see [`Query::set_first_light_ray`]).
+    first_light: bool,
     /// The object the last test that hit was made against.
     last_hit: u32,
     /// Per light, the object that last hid it ([`u32::MAX`]: none yet).
@@ -98,7 +101,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -109,6 +112,12 @@ impl<'m> Query<'m> {
     /// eye ray alone; objects whose window the eye ray misses are then not tested.
     pub fn set_eye_ray(&mut self, uv: Option<[i32; 2]>) {
         self.eye = uv;
+    }
+    /// Declares whether the next ray traced is a shadow ray towards the scene's first light,
+    /// when that light is directional (its direction the light's `to_light`): objects then take
+    /// the direction's object-space image from the scene ([`crate::Object::intersect_first_light_ray`]).
+    pub fn set_first_light_ray(&mut self, yes: bool) {
+        self.first_light = yes;
     }
     /// Declares which objects the eye rays to come can hit at all (bit `i`: object `i`; from
     /// [`crate::scene::Scene::eye_candidates`] for the tile being rendered): tracing by
@@ -207,6 +216,7 @@ pub fn offer<R: Real>(
                 return false;
             }
         },
+        None if q.first_light => o.intersect_first_light_ray(ray, tmin, limit),
         None => o.intersect(ray, tmin, limit),
     };
     q.stats.object_tests += 1;

@@ -169,7 +169,7 @@ mod writer {
         fn literal(&self, out: &mut String) {
             let o = self;
             out.push_str("Object::from_tables(");
-            let parts: [&dyn Literal; 11] = [
+            let parts: [&dyn Literal; 12] = [
                 &o.shape,
                 &o.to_object,
                 &o.to_world,
@@ -179,6 +179,7 @@ mod writer {
                 &o.bounds,
                 &o.dir_scale,
                 &o.eye_local,
+                &o.light_local,
                 &o.eye_window,
                 &o.shadow_window,
             ];

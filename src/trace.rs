@@ -555,9 +555,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             // neighbouring points in a shadow share their occluder.
             // Occlusion is a yes-or-no question, so the answer is the accelerator's.
             let last = if self.coherence { q.occluder(l) } else { None };
+            // Towards the first light, when it is directional, every object holds the ray's
+            // direction in its own space already.
+            let first_light = l == 0 && self.scene.shadow_basis.is_some();
             if let Some(o) = last.and_then(|i| self.scene.objects.get(i as usize)) {
                 q.stats.object_tests += 1;
-                if o.intersect(&ray, R::ZERO, reach).is_some() {
+                let hit = if first_light { o.intersect_first_light_ray(&ray, R::ZERO, reach) } else { o.intersect(&ray, R::ZERO, reach) };
+                if hit.is_some() {
                     return R::ZERO;
                 }
             }
@@ -570,7 +574,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                     found.is_some()
                 }
                 _ => {
+                    q.set_first_light_ray(first_light);
                     let hidden = self.accel.occluded(self.scene, &ray, R::ZERO, reach, q);
+                    q.set_first_light_ray(false);
                     // Remembered only while the light stays hidden: a lit point forgets it, so
                     // points in the light pay no extra test.
                     q.remember_occluder(l, hidden);
@@ -585,7 +591,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     }
 
     /// The first object (in index order) whose shadow window holds the shadow ray's position
-    /// `w` across the light and which the ray hits within `reach`.
+    /// `w` across the first light (directional) and which the ray hits within `reach`.
     fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, q: &mut Query<'_>) -> Option<u32> {
         for (i, o) in self.scene.objects.iter().enumerate() {
             let sw = &o.shadow_window;
@@ -594,7 +600,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 continue;
             }
             q.stats.object_tests += 1;
-            if o.intersect(ray, R::ZERO, reach).is_some() {
+            if o.intersect_first_light_ray(ray, R::ZERO, reach).is_some() {
                 return Some(i as u32);
             }
         }

@@ -136,3 +136,35 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
     }
     assert!(checked >= 8 && left_out > 0, "{checked} frames checked, {left_out} objects left out of tiles");
 }
+
+/// A shadow ray towards the first light (directional) takes its direction's object-space image
+/// from the scene: every object answers it as it answers the same ray mapped afresh, in every
+/// scalar, from points all over the world box.
+#[test]
+fn first_light_rays_meet_objects_as_any_ray_does() {
+    fn check<R: Real>() -> usize {
+        let mut hits = 0;
+        for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
+            let mut storage = vec![Object::<R>::default(); 64];
+            let scene = parse::<R>(&scene_text(name), &mut storage).unwrap();
+            let Some(lattice_rt::scene::Light::Directional { to_light, .. }) = scene.lights().first().copied() else { panic!("{name}: no directional light") };
+            let w = scene.world();
+            for i in 0..=20 {
+                for j in 0..=20 {
+                    let f = |lo: R, hi: R, k: i32| lo + (hi - lo) * R::from_i32(k) / R::from_i32(20);
+                    let p = lattice_rt::Vec3::new(f(w.min.x, w.max.x, i), f(w.min.y, w.max.y, j), f(w.min.z, w.max.z, (i * 7 + j * 3) % 21));
+                    let ray = lattice_rt::Ray::new(p, to_light);
+                    for o in scene.objects() {
+                        let want = o.intersect(&ray, R::ZERO, R::MAX);
+                        hits += usize::from(want.is_some());
+                        assert_eq!(o.intersect_first_light_ray(&ray, R::ZERO, R::MAX), want, "{name}, {}, from {p:?}", R::NAME);
+                    }
+                }
+            }
+        }
+        hits
+    }
+    for hits in [check::<f64>(), check::<f32>(), check::<Fx>()] {
+        assert!(hits > 100, "only {hits} of the rays hit anything");
+    }
+}

@@ -234,6 +234,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             dir_scale: log2_of_pow2(dir_scale),
             // The camera is known at `finish`, which sets both.
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
+            light_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             eye_window: WHOLE_PLANE,
             shadow_window: shadow_whole_plane(),
         };
@@ -294,6 +295,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let margin = R::pad_eps().to_f64() * (1.0 + reach);
         for o in self.storage[..self.len].iter_mut() {
             o.eye_local = o.to_object.vector(camera.eye - o.origin()).mul_pow2(o.unscale);
+            o.light_local = match self.lights.first() {
+                Some(Light::Directional { to_light, .. }) => o.direction_local(*to_light),
+                _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),
+            };
             o.eye_window = eye_window(&o.bounds, &camera);
             o.shadow_window = match shadow_basis {
                 Some((a, b)) => shadow_window(&o.bounds, a.cast(), b.cast(), margin),

@@ -193,6 +193,10 @@ pub struct Object<R> {
     /// The camera's eye in object space, `to_object.vector(eye - origin) * unscale`: the same
     /// for every eye ray, so it is computed once per scene instead of once per eye-ray test.
     pub(crate) eye_local: Vec3<R>,
+    /// The direction towards the scene's first light, when it is directional, in object space
+    /// as [`Object::intersect`] maps a ray's direction (zero otherwise): the same for every
+    /// shadow ray towards that light, so it is mapped once per scene instead of once per test.
+    pub(crate) light_local: Vec3<R>,
     /// The part of the image the object can appear in, as an [`EyeWindow`].
     pub(crate) eye_window: EyeWindow,
     /// Where a shadow ray towards the scene's first light can meet it, as a [`ShadowWindow`].
@@ -244,6 +248,7 @@ impl<R: Real> Default for Object<R> {
             bounds: Aabb { min: z, max: z },
             dir_scale: 0,
             eye_local: z,
+            light_local: z,
             eye_window: WHOLE_PLANE,
             shadow_window: shadow_whole_plane(),
         }
@@ -265,10 +270,11 @@ impl<R> Object<R> {
         bounds: Aabb<R>,
         dir_scale: i16,
         eye_local: Vec3<R>,
+        light_local: Vec3<R>,
         eye_window: EyeWindow,
         shadow_window: ShadowWindow<R>,
     ) -> Self {
-        Object { shape, to_object, to_world, unscale, material, composite, bounds, dir_scale, eye_local, eye_window, shadow_window }
+        Object { shape, to_object, to_world, unscale, material, composite, bounds, dir_scale, eye_local, light_local, eye_window, shadow_window }
     }
 }
 
@@ -277,7 +283,7 @@ impl<R: Real> Object<R> {
     /// the object-space normal and point.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        self.intersect_from(self.to_object.vector(ray.origin - self.origin()).mul_pow2(self.unscale), ray, tmin, tmax)
+        self.intersect_local(self.point_local(ray.origin), self.direction_local(ray.dir), tmin, tmax)
     }
 
     /// [`Object::intersect`] for an eye ray (its origin the camera's eye) through window
@@ -290,13 +296,34 @@ impl<R: Real> Object<R> {
         if uv[0] < w[0] || uv[0] > w[1] || uv[1] < w[2] || uv[1] > w[3] {
             return Err(Culled);
         }
-        Ok(self.intersect_from(self.eye_local, ray, tmin, tmax))
+        Ok(self.intersect_local(self.eye_local, self.direction_local(ray.dir), tmin, tmax))
     }
 
-    /// The intersection, given the ray's origin already in object space.
+    /// [`Object::intersect`] for a shadow ray towards the scene's first light when that light
+    /// is directional (the ray's direction is the light's `to_light`): the same answer, with
+    /// the direction's object-space image taken from the scene instead of transformed again.
+    #[inline]
+    pub fn intersect_first_light_ray(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
+        self.intersect_local(self.point_local(ray.origin), self.light_local, tmin, tmax)
+    }
+
+    /// A world point in object space, as the ray tests take it: relative to the object's
+    /// origin, then through `to_object` and its scale.
+    #[inline]
+    fn point_local(&self, p: Vec3<R>) -> Vec3<R> {
+        self.to_object.vector(p - self.origin()).mul_pow2(self.unscale)
+    }
+
+    /// A world direction in object space, scaled to about unit length ([`Object::dir_scale`]).
+    #[inline]
+    pub(crate) fn direction_local(&self, d: Vec3<R>) -> Vec3<R> {
+        self.to_object.vector(d).mul_pow2(self.unscale + self.dir_scale)
+    }
+
+    /// The intersection, given the ray's origin and direction already in object space.
     #[inline(always)]
-    fn intersect_from(&self, origin: Vec3<R>, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        let r = Ray::new(origin, self.to_object.vector(ray.dir).mul_pow2(self.unscale + self.dir_scale));
+    fn intersect_local(&self, origin: Vec3<R>, dir: Vec3<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
+        let r = Ray::new(origin, dir);
         // With the direction scaled by k, the object-space parameter is t / k. Multiplying by
         // a power of two is exact in floating point but rounds in fixed point, so the range is
         // checked on the world parameter: a hit exactly at `tmax` (a tie with the best hit so
