@@ -388,9 +388,30 @@ impl<R: Real> Object<R> {
         }
         t
     }
-    /// Unit world-space normal from an object-space normal (inverse-transpose rule).
+    /// Unit world-space normal from an object-space normal (inverse-transpose rule). A unit
+    /// axis (one component 1 or -1, the others 0: a box's faces, the caps) maps to a row of
+    /// `to_object`, which is taken as it is: the same value without the products by 0 and 1.
     pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
-        self.to_object.transpose_vector(n_obj).normalize()
+        let (o, z) = (R::ONE, R::ZERO);
+        let axis = match (n_obj.x, n_obj.y, n_obj.z) {
+            (x, y, z0) if y == z && z0 == z && x.abs() == o => Some(0),
+            (x, y, z0) if x == z && z0 == z && y.abs() == o => Some(1),
+            (x, y, z0) if x == z && y == z && z0.abs() == o => Some(2),
+            _ => None,
+        };
+        let v = match axis {
+            Some(a) => {
+                let row = &self.to_object.m[a];
+                let v = Vec3::new(row[0], row[1], row[2]);
+                if n_obj.axis(a) < z {
+                    -v
+                } else {
+                    v
+                }
+            }
+            _ => self.to_object.transpose_vector(n_obj),
+        };
+        v.normalize()
     }
 }
 
