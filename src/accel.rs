@@ -87,6 +87,9 @@ pub struct Query<'m> {
     /// Whether the ray being traced is a shadow ray towards the scene's first light, when that
     /// light is directional (see [`Query::set_first_light_ray`]).
     first_light: bool,
+    /// The last world normal [`Query::world_normal`] mapped from a unit axis: the object, the
+    /// axis ([`crate::scene::axis_normal`]) and the normal's components as [`Real::to_raw`] bits.
+    axis_normal: Option<(u32, u8, [u64; 3])>,
     /// The object the last test that hit was made against.
     last_hit: u32,
     /// Per light, the object that last hid it ([`u32::MAX`]: none yet).
@@ -101,7 +104,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, axis_normal: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -155,6 +158,21 @@ impl<'m> Query<'m> {
     /// work does not depend on the bands rendered before it, on whichever core or thread).
     pub fn forget_occluders(&mut self) {
         self.occluders = [u32::MAX; MAX_LIGHTS];
+    }
+    /// [`crate::Object::world_normal`] of object `i` of the scene this query serves: a unit-axis
+    /// normal (a box's face, a cap) that is the last one asked for is given again without
+    /// mapping it anew (neighbouring eye rays mostly hit one face, the floor's above all).
+    pub fn world_normal<R: Real>(&mut self, scene: &Scene<'_, R>, i: u32, n_obj: Vec3<R>) -> Vec3<R> {
+        let o = &scene.objects[i as usize];
+        let Some(axis) = crate::scene::axis_normal(n_obj) else { return o.world_normal(n_obj) };
+        if let Some((j, k, raw)) = self.axis_normal {
+            if (j, k) == (i, axis) {
+                return Vec3::new(R::from_raw(raw[0]), R::from_raw(raw[1]), R::from_raw(raw[2]));
+            }
+        }
+        let n = o.world_normal(n_obj);
+        self.axis_normal = Some((i, axis, [n.x.to_raw(), n.y.to_raw(), n.z.to_raw()]));
+        n
     }
     /// Starts a new ray: every mailbox entry becomes unvisited.
     pub fn next_ray(&mut self) {

@@ -184,6 +184,12 @@ impl Real for Fx {
     fn to_f64(self) -> f64 {
         self.0 as f64 / ONE_RAW as f64
     }
+    fn to_raw(self) -> u64 {
+        u64::from(self.0 as u32)
+    }
+    fn from_raw(bits: u64) -> Self {
+        Fx(bits as u32 as i32)
+    }
     fn depth_key(self) -> u16 {
         // A float of the raw value, integers only: 5 bits of exponent (the leading one's
         // place), 11 of mantissa.

@@ -119,6 +119,11 @@ pub trait Real:
     fn div_pow2(self, k: u32) -> Self {
         self / Self::from_i32(1 << k.min(14))
     }
+    /// The value's bits, for scratch that keeps scalars of any kind ([`Real::from_raw`] gives
+    /// the value back exactly).
+    fn to_raw(self) -> u64;
+    /// The value [`Real::to_raw`] gave these bits for.
+    fn from_raw(bits: u64) -> Self;
     /// `self * 2^k`: the same value as multiplying by `from_f64(2^k)`, which is what the default
     /// does; fixed point shifts instead of multiplying, `f32` builds the power from its bits.
     #[inline]
@@ -183,6 +188,12 @@ impl Real for f64 {
     }
     fn to_f64(self) -> f64 {
         self
+    }
+    fn to_raw(self) -> u64 {
+        self.to_bits()
+    }
+    fn from_raw(bits: u64) -> Self {
+        f64::from_bits(bits)
     }
     fn sqrt(self) -> Self {
         libm::sqrt(self)
@@ -263,6 +274,12 @@ impl Real for f32 {
     }
     fn to_f64(self) -> f64 {
         self as f64
+    }
+    fn to_raw(self) -> u64 {
+        u64::from(self.to_bits())
+    }
+    fn from_raw(bits: u64) -> Self {
+        f32::from_bits(bits as u32)
     }
     fn sqrt(self) -> Self {
         sqrt_f32(self)
@@ -439,6 +456,12 @@ macro_rules! f32_with_sqrt {
             }
             fn from_i32(v: i32) -> Self {
                 $name(v as f32)
+            }
+            fn to_raw(self) -> u64 {
+                <f32 as Real>::to_raw(self.0)
+            }
+            fn from_raw(bits: u64) -> Self {
+                $name(<f32 as Real>::from_raw(bits))
             }
             fn to_f64(self) -> f64 {
                 self.0 as f64

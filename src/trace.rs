@@ -490,7 +490,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let refracts = self.simulates(Effects::REFRACTION) && m.kt > R::ZERO;
             let children = node.depth < self.max_depth && (reflects || refracts);
             let d = if children { node.ray.dir.normalize() } else { node.ray.dir };
-            let side = facing(d, obj.world_normal(hit.normal));
+            let side = facing(d, q.world_normal(scene, hit.object, hit.normal));
             let n = side.normal;
             let eps = R::offset(p.max_abs(), obj.size());
             let outside = p + n * eps;

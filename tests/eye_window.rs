@@ -168,3 +168,32 @@ fn first_light_rays_meet_objects_as_any_ray_does() {
         assert!(hits > 100, "only {hits} of the rays hit anything");
     }
 }
+
+/// The query's world normals (the last unit-axis normal kept) are the objects' own, whatever
+/// order objects and faces are asked in, in every scalar.
+#[test]
+fn kept_axis_normals_are_the_objects_own() {
+    fn check<R: Real>() {
+        let mut storage = vec![Object::<R>::default(); 64];
+        let scene = parse::<R>(&scene_text("whitted"), &mut storage).unwrap();
+        let mut mb = vec![0; Query::mailbox_len(&scene)];
+        let mut q = Query::new(&mut mb);
+        let (o, z, h) = (R::ONE, R::ZERO, R::HALF);
+        let v = lattice_rt::Vec3::new;
+        let normals = [v(o, z, z), v(-o, z, z), v(z, o, z), v(z, -o, z), v(z, z, o), v(z, z, -o), v(h, o, z), v(z, z, h)];
+        let n = scene.objects().len() as u32;
+        let mut x = 7u32;
+        for _ in 0..4000 {
+            x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            let (i, k) = ((x >> 8) % n, ((x >> 20) % 8) as usize);
+            // Runs of the same pair, as neighbouring rays ask.
+            for _ in 0..(x >> 28) % 3 + 1 {
+                let want = scene.objects()[i as usize].world_normal(normals[k]);
+                assert_eq!(q.world_normal(&scene, i, normals[k]), want, "{}: object {i}, normal {k}", R::NAME);
+            }
+        }
+    }
+    check::<f64>();
+    check::<f32>();
+    check::<Fx>();
+}

@@ -392,27 +392,35 @@ impl<R: Real> Object<R> {
     /// axis (one component 1 or -1, the others 0: a box's faces, the caps) maps to a row of
     /// `to_object`, which is taken as it is: the same value without the products by 0 and 1.
     pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
-        let (o, z) = (R::ONE, R::ZERO);
-        let axis = match (n_obj.x, n_obj.y, n_obj.z) {
-            (x, y, z0) if y == z && z0 == z && x.abs() == o => Some(0),
-            (x, y, z0) if x == z && z0 == z && y.abs() == o => Some(1),
-            (x, y, z0) if x == z && y == z && z0.abs() == o => Some(2),
-            _ => None,
-        };
-        let v = match axis {
-            Some(a) => {
-                let row = &self.to_object.m[a];
+        let v = match axis_normal(n_obj) {
+            Some(k) => {
+                let row = &self.to_object.m[usize::from(k / 2)];
                 let v = Vec3::new(row[0], row[1], row[2]);
-                if n_obj.axis(a) < z {
+                if k % 2 == 1 {
                     -v
                 } else {
                     v
                 }
             }
-            _ => self.to_object.transpose_vector(n_obj),
+            None => self.to_object.transpose_vector(n_obj),
         };
         v.normalize()
     }
+}
+
+/// Which unit axis `n` is, if it is one (one component 1 or -1, the others 0): `2 * axis`, plus
+/// 1 for -1. Every face of a box and every cap has such a normal, and its world normal is then
+/// the object's alone (see [`Object::world_normal`]).
+#[inline]
+pub fn axis_normal<R: Real>(n: Vec3<R>) -> Option<u8> {
+    let (o, z) = (R::ONE, R::ZERO);
+    let axis = match (n.x, n.y, n.z) {
+        (x, y, z0) if y == z && z0 == z && x.abs() == o => 0,
+        (x, y, z0) if x == z && z0 == z && y.abs() == o => 1,
+        (x, y, z0) if x == z && y == z && z0.abs() == o => 2,
+        _ => return None,
+    };
+    Some(2 * axis + u8::from(n.axis(usize::from(axis)) < z))
 }
 
 /// A composite object: a contiguous run of objects with a common box (gets a sub-lattice).
