@@ -50,5 +50,30 @@ fn walk_and_tile(c: &mut Criterion) {
     }));
 }
 
-criterion_group!(benches, primitives, walk_and_tile);
+/// The per-test levers of the Pico's ladder in fixed point, each beside what it replaced: a
+/// shadow ray towards the first light with its direction mapped afresh or taken from the scene,
+/// a box face's world normal mapped or kept by the query, a product with a power of two or a
+/// shift.
+fn levers(c: &mut Criterion) {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/chair.scene")).unwrap();
+    let mut st = Vec::new();
+    let scene = scene_parts::<Fx>(&text, &mut st);
+    let Some(&lattice_rt::scene::Light::Directional { to_light, .. }) = scene.lights().first() else { panic!("the chair has a directional light") };
+    let seat = &scene.objects()[1];
+    let ray = Ray::new(Vec3::new(Fx::from_f64(0.1), Fx::from_f64(0.05), Fx::from_f64(-0.2)), to_light);
+    c.bench_function("shadow test, seat, fixed: direction mapped afresh", |b| b.iter(|| black_box(seat).intersect(black_box(&ray), Fx::ZERO, Fx::MAX)));
+    c.bench_function("shadow test, seat, fixed: first light's direction from the scene", |b| {
+        b.iter(|| black_box(seat).intersect_first_light_ray(black_box(&ray), Fx::ZERO, Fx::MAX))
+    });
+    let up = Vec3::new(Fx::ZERO, Fx::ONE, Fx::ZERO);
+    c.bench_function("world normal, floor top, fixed: mapped", |b| b.iter(|| black_box(&scene.objects()[0]).world_normal(black_box(up))));
+    let mut mb = vec![0; Query::mailbox_len(&scene)];
+    let mut q = Query::new(&mut mb);
+    c.bench_function("world normal, floor top, fixed: kept by the query", |b| b.iter(|| q.world_normal(black_box(&scene), 0, black_box(up))));
+    let (x, p) = (Fx::from_f64(3.14159), Fx::from_f64(0.125));
+    c.bench_function("fixed times 2^-3: product", |b| b.iter(|| black_box(x) * black_box(p)));
+    c.bench_function("fixed times 2^-3: shift", |b| b.iter(|| black_box(x).mul_pow2(black_box(-3))));
+}
+
+criterion_group!(benches, primitives, walk_and_tile, levers);
 criterion_main!(benches);
