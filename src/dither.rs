@@ -176,62 +176,70 @@ impl<'c> Carry<'c> {
     }
 
     /// [`Carry::tile`] with one kernel.
+    ///
+    /// The tile's accumulator has a border (a column left of the tile, two right of it and two
+    /// rows below), so every pixel sends its error with the same unchecked additions; the
+    /// border is then handed on: the left column to the tile's first column as its row starts
+    /// (the pixel there is already drawn, so its error goes straight below instead), the right
+    /// columns to the next tile, the rows below to the next band, and what falls outside the
+    /// image is dropped.
     #[inline(always)]
     fn diffuse(&mut self, (kernel, div): Kernel, x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
-        let mut acc = [[0i16; MAX_TILE]; MAX_TILE];
+        // acc[y][x + 1] is the error arriving at tile pixel (x, y), for x in -1..w + 2.
+        let mut acc = [[0i16; MAX_TILE + 3]; MAX_TILE + 2];
         // Gather what earlier tiles sent here.
         let inc = self.incoming;
         for k in 0..2.min(h) {
             let row = self.row(inc, k);
-            for (x, a) in acc[k].iter_mut().enumerate().take(w) {
+            for (x, a) in acc[k][1..].iter_mut().enumerate().take(w) {
                 *a += row[x0 + x];
                 row[x0 + x] = 0;
             }
         }
         for y in 0..h {
-            acc[y][0] += self.right[y][0];
+            acc[y][1] += self.right[y][0];
             if w > 1 {
-                acc[y][1] += self.right[y][1];
+                acc[y][2] += self.right[y][1];
             }
         }
         self.right = [[0; 2]; MAX_TILE];
-        let out_rows = 1 - inc;
-        // How far the kernel reaches left, right and down: a pixel whose reach stays inside the
-        // tile sends all its error to the tile's own accumulator.
-        let reach_left = kernel.iter().map(|k| -k.0).max().unwrap_or(0).max(0) as usize;
-        let reach_x = kernel.iter().map(|k| k.0).max().unwrap_or(0) as usize;
-        let reach_y = kernel.iter().map(|k| k.1).max().unwrap_or(0) as usize;
         for y in 0..h {
+            // The left border's error, at the image's left edge dropped.
+            let left = core::mem::take(&mut acc[y][0]);
+            if x0 > 0 {
+                acc[y][1] += left;
+            }
             for x in 0..w {
-                let v = levels[y * w + x] as i16 * SCALE + acc[y][x];
+                let v = levels[y * w + x] as i16 * SCALE + acc[y][x + 1];
                 let on = v >= (LEVELS as i16 / 2) * SCALE;
                 out[y * w + x] = BinaryColor::from(on);
                 let err = v - if on { LEVELS as i16 * SCALE } else { 0 };
-                if x >= reach_left && x + reach_x < w && y + reach_y < h {
-                    for &(dx, dy, wgt) in kernel {
-                        acc[y + dy as usize][(x as isize + dx as isize) as usize] += err * wgt / div;
-                    }
-                    continue;
-                }
                 for &(dx, dy, wgt) in kernel {
-                    let e = err * wgt / div;
-                    let (tx, ty) = (x as isize + dx as isize, y + dy as usize);
-                    let gx = x0 as isize + tx;
-                    if gx < 0 || gx >= self.width as isize {
-                        continue;
-                    }
-                    if ty < h {
-                        if tx < 0 {
-                            acc[ty][0] += e; // already drawn: straight below instead
-                        } else if (tx as usize) < w {
-                            acc[ty][tx as usize] += e;
-                        } else {
-                            self.right[ty][tx as usize - w] += e;
-                        }
-                    } else {
-                        let col = if tx < 0 { x0 } else { gx as usize };
-                        self.row(out_rows, ty - h)[col] += e;
-                    }
+                    acc[y + dy as usize][(x as isize + 1 + dx as isize) as usize] += err * wgt / div;
+                }
+            }
+        }
+        // The right border to the next tile, unless beyond the image's right edge.
+        for (y, row) in acc.iter().enumerate().take(h) {
+            for k in 0..2 {
+                if x0 + w + k < self.width {
+                    self.right[y][k] += row[w + 1 + k];
+                }
+            }
+        }
+        // The rows below to the next band: the left border's column to the tile's first (or
+        // dropped at the image's left edge), the others where they fall in the image.
+        let out_rows = 1 - inc;
+        let width = self.width;
+        for k in 0..2 {
+            let below = acc[h + k];
+            let row = self.row(out_rows, k);
+            if x0 > 0 {
+                row[x0] += below[0];
+            }
+            for (c, &e) in below[1..w + 3].iter().enumerate() {
+                if x0 + c < width {
+                    row[x0 + c] += e;
                 }
             }
         }
