@@ -75,7 +75,7 @@ mod writer {
             }
         )*};
     }
-    plain!(u8, u16, i16, u32, i32, usize, bool);
+    plain!(u8, u16, u32, i32, usize, bool);
 
     impl<T: Literal, const N: usize> Literal for [T; N] {
         fn literal(&self, out: &mut String) {
@@ -110,6 +110,13 @@ mod writer {
         out.push_str(" }");
     }
 
+    impl<R: Literal> Literal for crate::scalar::Pow2<R> {
+        fn literal(&self, out: &mut String) {
+            out.push_str("Pow2(");
+            self.0.literal(out);
+            out.push(')');
+        }
+    }
     impl<R: Literal> Literal for Vec3<R> {
         fn literal(&self, out: &mut String) {
             record(out, "Vec3", &[("x", &self.x), ("y", &self.y), ("z", &self.z)]);
@@ -169,15 +176,17 @@ mod writer {
         fn literal(&self, out: &mut String) {
             let o = self;
             out.push_str("Object::from_tables(");
-            let parts: [&dyn Literal; 12] = [
+            let parts: [&dyn Literal; 14] = [
                 &o.shape,
                 &o.to_object,
                 &o.to_world,
                 &o.unscale,
+                &o.dir_factor,
                 &o.material,
                 &o.composite,
                 &o.bounds,
                 &o.dir_scale,
+                &o.inv_dir_scale,
                 &o.eye_local,
                 &o.light_local,
                 &o.eye_window,
@@ -280,6 +289,7 @@ pub mod prelude {
     pub use crate::math::{Aabb, Affine, Vec3};
     pub use crate::scene::{Camera, Composite, Light, Material, Object};
     pub use crate::shape::Shape;
+    pub use crate::scalar::Pow2;
     pub use crate::{F32Micro, F32MicroNewton, Fx};
 }
 

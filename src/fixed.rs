@@ -6,7 +6,7 @@
 //! misses); the scene validation (`Real::LIMIT`) keeps every value that must be exact well
 //! inside the range: coordinates, and object-space coordinates, below 8192.
 
-use crate::scalar::Real;
+use crate::scalar::{pow2_f64, Pow2, Real};
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
 /// Fractional bits.
@@ -219,13 +219,18 @@ impl Real for Fx {
         let q = q as i32;
         Fx(if self.0 < 0 { -q } else { q })
     }
+    /// The exponent `k` itself, as the raw bits.
+    fn pow2(k: i16) -> Pow2<Self> {
+        Pow2(Fx(i32::from(k)))
+    }
     /// A shift of the magnitude, rounded as [`Mul`] rounds the product with `2^k` (half away
     /// from zero, saturating); powers of two outside fixed point's range multiply by the value
     /// `from_f64` gives them, as the default does.
     #[inline]
-    fn mul_pow2(self, k: i16) -> Self {
+    fn mul_pow2(self, p: Pow2<Self>) -> Self {
+        let k = p.0 .0;
         if !(-16..=14).contains(&k) {
-            return self * Fx::from_f64(crate::scalar::pow2(k));
+            return self * Fx::from_f64(pow2_f64(k as i16));
         }
         let a = self.0.unsigned_abs();
         let m = if k >= 0 {
@@ -240,6 +245,9 @@ impl Real for Fx {
         };
         let m = m as i32;
         Fx(if self.0 < 0 { -m } else { m })
+    }
+    fn pow2_value(p: Pow2<Self>) -> f64 {
+        pow2_f64(p.0 .0 as i16)
     }
     fn div_pow2(self, k: u32) -> Self {
         // Division rounds half away from zero: a rounded shift of the magnitude.
@@ -341,7 +349,7 @@ mod tests {
         });
         for a in edges.into_iter().chain(random.take(2000)) {
             for k in -20i16..=20 {
-                assert_eq!(Fx(a).mul_pow2(k), Fx(a) * Fx::from_f64(crate::scalar::pow2(k)), "{a} * 2^{k}");
+                assert_eq!(Fx(a).mul_pow2(Fx::pow2(k)), Fx(a) * Fx::from_f64(pow2_f64(k)), "{a} * 2^{k}");
             }
         }
     }

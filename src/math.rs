@@ -64,10 +64,10 @@ impl<R: Real> Vec3<R> {
         let v = self * m.recip();
         v * v.length().recip()
     }
-    /// Every component times `2^k` ([`Real::mul_pow2`]).
+    /// Every component times the power of two `p` ([`Real::mul_pow2`]).
     #[inline]
-    pub fn mul_pow2(self, k: i16) -> Self {
-        Vec3::new(self.x.mul_pow2(k), self.y.mul_pow2(k), self.z.mul_pow2(k))
+    pub fn mul_pow2(self, p: crate::scalar::Pow2<R>) -> Self {
+        Vec3::new(self.x.mul_pow2(p), self.y.mul_pow2(p), self.z.mul_pow2(p))
     }
     /// Largest absolute component.
     pub fn max_abs(self) -> R {

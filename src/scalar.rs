@@ -124,11 +124,19 @@ pub trait Real:
     fn to_raw(self) -> u64;
     /// The value [`Real::to_raw`] gave these bits for.
     fn from_raw(bits: u64) -> Self;
-    /// `self * 2^k`: the same value as multiplying by `from_f64(2^k)`, which is what the default
-    /// does; fixed point shifts instead of multiplying, `f32` builds the power from its bits.
+    /// `2^k` as [`Real::mul_pow2`] applies it: the default keeps the value `from_f64(2^k)`.
+    fn pow2(k: i16) -> Pow2<Self> {
+        Pow2(Self::from_f64(pow2_f64(k)))
+    }
+    /// `self` times the power of two `p`: the same value as multiplying by `from_f64(2^k)`,
+    /// which is what the default does (one multiply); fixed point shifts instead.
     #[inline]
-    fn mul_pow2(self, k: i16) -> Self {
-        self * Self::from_f64(pow2(k))
+    fn mul_pow2(self, p: Pow2<Self>) -> Self {
+        self * p.0
+    }
+    /// The value of the power of two `p`, in `f64`.
+    fn pow2_value(p: Pow2<Self>) -> f64 {
+        p.0.to_f64()
     }
     /// The largest integer `k` in `0..=max` with `k <= self` (0 when there is none: below 0,
     /// or NaN). The default bisects with comparisons alone (no float-to-int conversion the
@@ -148,9 +156,15 @@ pub trait Real:
 }
 
 /// [`Real::depth_key`] of an `f32`: its top 16 bits (sign, exponent, 7 mantissa bits).
+/// A power of two `2^k` as a scalar applies it ([`Real::pow2`] makes it, [`Real::mul_pow2`]
+/// applies it): floating point keeps its value (one multiply), fixed point its exponent `k` in
+/// the raw bits (a shift, not a multiply).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pow2<R>(pub R);
+
 /// `2^k` in `f64` (0 below its smallest normal power, infinity above its largest): the powers
-/// of two an object's scales are ([`Real::mul_pow2`]).
-pub fn pow2(k: i16) -> f64 {
+/// of two an object's scales are ([`Real::pow2`]).
+pub fn pow2_f64(k: i16) -> f64 {
     match k {
         -1022..=1023 => f64::from_bits(((i64::from(k) + 1023) as u64) << 52),
         ..=-1023 => 0.0,
@@ -158,7 +172,7 @@ pub fn pow2(k: i16) -> f64 {
     }
 }
 
-/// The exponent `k` of a power of two `p = 2^k` (a normal `f64`): the inverse of [`pow2`].
+/// The exponent `k` of a power of two `p = 2^k` (a normal `f64`): the inverse of [`pow2_f64`].
 pub fn log2_of_pow2(p: f64) -> i16 {
     ((p.to_bits() >> 52) & 0x7ff) as i16 - 1023
 }
@@ -286,14 +300,6 @@ impl Real for f32 {
     }
     fn depth_key(self) -> u16 {
         f32_key(self)
-    }
-    #[inline]
-    fn mul_pow2(self, k: i16) -> Self {
-        if (-126..=127).contains(&k) {
-            self * f32::from_bits(((k + 127) as u32) << 23)
-        } else {
-            self * pow2(k) as f32
-        }
     }
     fn offset_eps() -> Self {
         3e-6
@@ -481,10 +487,7 @@ macro_rules! f32_with_sqrt {
             fn pad_eps() -> Self {
                 $name(<f32 as Real>::pad_eps())
             }
-            #[inline]
-            fn mul_pow2(self, k: i16) -> Self {
-                $name(<f32 as Real>::mul_pow2(self.0, k))
-            }
+
             fn is_finite(self) -> bool {
                 self.0.is_finite()
             }

@@ -3,7 +3,7 @@
 use super::error::SceneError;
 use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
 use crate::math::{Aabb, Affine, Vec3};
-use crate::scalar::{log2_of_pow2, pow2, Real};
+use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
 use heapless::Vec;
 
@@ -227,11 +227,13 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             shape,
             to_object: scaled.cast(),
             to_world: place.cast(),
-            unscale: log2_of_pow2(unscale),
+            unscale: R::pow2(log2_of_pow2(unscale)),
+            dir_factor: R::pow2(log2_of_pow2(unscale * dir_scale)),
             material,
             composite,
             bounds: bounds.cast_padded(),
-            dir_scale: log2_of_pow2(dir_scale),
+            dir_scale: R::pow2(log2_of_pow2(dir_scale)),
+            inv_dir_scale: R::pow2(log2_of_pow2(1.0 / dir_scale)),
             // The camera is known at `finish`, which sets both.
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             light_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
@@ -312,7 +314,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         // coordinates never exceed those of the world box's corners in its space.
         for (i, o) in objects.iter().enumerate() {
             let inv = o.to_object.cast::<f64>();
-            let unscale = pow2(o.unscale);
+            let unscale = R::pow2_value(o.unscale);
             let reach = world
                 .corners()
                 .into_iter()
@@ -429,7 +431,7 @@ fn checked_inverse(t: &Affine<f64>) -> Result<Affine<f64>, SceneError> {
 /// the object's own ([`Real::offset`]), so nothing else in the scene changes the answer.
 fn thickness<R: Real>(o: &Object<R>) -> (f64, f64) {
     let m = o.to_object.cast::<f64>();
-    let unscale = pow2(o.unscale);
+    let unscale = R::pow2_value(o.unscale);
     let stretch = (0..3)
         .map(|i| libm::sqrt(m.m[i][0] * m.m[i][0] + m.m[i][1] * m.m[i][1] + m.m[i][2] * m.m[i][2]))
         .fold(0.0, f64::max)

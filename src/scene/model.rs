@@ -1,7 +1,7 @@
 //! The validated scene: objects, composites, materials, lights and the camera.
 
 use crate::math::{Aabb, Affine, Ray, Vec3};
-use crate::scalar::Real;
+use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
 use heapless::Vec;
 
@@ -177,19 +177,22 @@ pub struct Object<R> {
     /// taken relative to it before `to_object` (whose translation is then zero), so a scene far
     /// from the world's origin loses no precision to cancellation.
     pub(crate) to_world: Affine<R>,
-    /// The exponent of the power of two `to_object`'s results are multiplied by to get object
-    /// space ([`Real::mul_pow2`]: a shift in fixed point, not a multiply).
-    pub(crate) unscale: i16,
+    /// The power of two `to_object`'s results are multiplied by to get object space
+    /// ([`Real::mul_pow2`]: a shift in fixed point, not a multiply).
+    pub(crate) unscale: Pow2<R>,
+    /// `unscale * dir_scale`: what `to_object`'s direction results are multiplied by.
+    pub(crate) dir_factor: Pow2<R>,
     /// Index into the scene's materials.
     pub(crate) material: u8,
     /// Composite object it belongs to, or [`NO_COMPOSITE`].
     pub(crate) composite: u16,
     /// World-space bounding box, padded for the scalar's rounding.
     pub(crate) bounds: Aabb<R>,
-    /// The exponent of a power of two that object-space directions are multiplied by, so that
-    /// they stay near unit length however small or large the object is (exact in floating
-    /// point): `to_object`'s direction results are multiplied by `2^(unscale + dir_scale)`.
-    pub(crate) dir_scale: i16,
+    /// A power of two that object-space directions are multiplied by, so that they stay near
+    /// unit length however small or large the object is (exact in floating point).
+    pub(crate) dir_scale: Pow2<R>,
+    /// `1 / dir_scale`.
+    pub(crate) inv_dir_scale: Pow2<R>,
     /// The camera's eye in object space, `to_object.vector(eye - origin) * unscale`: the same
     /// for every eye ray, so it is computed once per scene instead of once per eye-ray test.
     pub(crate) eye_local: Vec3<R>,
@@ -242,11 +245,13 @@ impl<R: Real> Default for Object<R> {
             shape: Shape::Sphere,
             to_object: Affine::identity(),
             to_world: Affine::identity(),
-            unscale: 0,
+            unscale: R::pow2(0),
+            dir_factor: R::pow2(0),
             material: 0,
             composite: NO_COMPOSITE,
             bounds: Aabb { min: z, max: z },
-            dir_scale: 0,
+            dir_scale: R::pow2(0),
+            inv_dir_scale: R::pow2(0),
             eye_local: z,
             light_local: z,
             eye_window: WHOLE_PLANE,
@@ -264,17 +269,19 @@ impl<R> Object<R> {
         shape: Shape<R>,
         to_object: Affine<R>,
         to_world: Affine<R>,
-        unscale: i16,
+        unscale: Pow2<R>,
+        dir_factor: Pow2<R>,
         material: u8,
         composite: u16,
         bounds: Aabb<R>,
-        dir_scale: i16,
+        dir_scale: Pow2<R>,
+        inv_dir_scale: Pow2<R>,
         eye_local: Vec3<R>,
         light_local: Vec3<R>,
         eye_window: EyeWindow,
         shadow_window: ShadowWindow<R>,
     ) -> Self {
-        Object { shape, to_object, to_world, unscale, material, composite, bounds, dir_scale, eye_local, light_local, eye_window, shadow_window }
+        Object { shape, to_object, to_world, unscale, dir_factor, material, composite, bounds, dir_scale, inv_dir_scale, eye_local, light_local, eye_window, shadow_window }
     }
 }
 
@@ -317,7 +324,7 @@ impl<R: Real> Object<R> {
     /// A world direction in object space, scaled to about unit length ([`Object::dir_scale`]).
     #[inline]
     pub(crate) fn direction_local(&self, d: Vec3<R>) -> Vec3<R> {
-        self.to_object.vector(d).mul_pow2(self.unscale + self.dir_scale)
+        self.to_object.vector(d).mul_pow2(self.dir_factor)
     }
 
     /// The intersection, given the ray's origin and direction already in object space.
@@ -333,10 +340,10 @@ impl<R: Real> Object<R> {
         let far = if tmax == R::MAX {
             R::MAX
         } else {
-            let f = tmax.mul_pow2(-self.dir_scale);
+            let f = tmax.mul_pow2(self.inv_dir_scale);
             f + (f.abs() + R::ONE) * R::pad_eps()
         };
-        let hit = self.shape.intersect(&r, tmin.mul_pow2(-self.dir_scale), far)?;
+        let hit = self.shape.intersect(&r, tmin.mul_pow2(self.inv_dir_scale), far)?;
         let t = hit.t.mul_pow2(self.dir_scale);
         (t > tmin && t <= tmax).then_some(ShapeHit { t, ..hit })
     }
