@@ -230,7 +230,14 @@ impl Real for Fx {
     fn mul_pow2(self, p: Pow2<Self>) -> Self {
         let k = p.0 .0;
         if !(-16..=14).contains(&k) {
-            return self * Fx::from_f64(pow2_f64(k as i16));
+            // What `from_f64(2^k)` is there, in integers (no float code in the renderer): the
+            // largest value above, 2^-16 for 2^-17 (a half rounded away from zero), else 0.
+            let v = match k {
+                15.. => Fx::MAX,
+                -17 => Fx(1),
+                _ => Fx(0),
+            };
+            return self * v;
         }
         let a = self.0.unsigned_abs();
         let m = if k >= 0 {
