@@ -102,11 +102,54 @@ impl LatticeSizes {
         self.lattices * size_of::<super::SubLattice<R>>() + self.coords * size_of::<R>() + self.words() * 4
     }
 }
-/// Cells per axis of lattice `g` over `b`.
+/// Cells per axis of lattice `g` over `b`. An automatic resolution with equal cells is then
+/// moved by one cell on an axis whose planes fall on the items' faces ([`off_the_faces`]).
 pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>) -> [u16; 3] {
     let mut count = 0;
     for_each_item(scene, cfg, g, |_, _| count += 1);
-    resolution(b, count, if g == 0 { cfg.top } else { cfg.sub }, cfg.max_per_axis)
+    let res = if g == 0 { cfg.top } else { cfg.sub };
+    let n = resolution(b, count, res, cfg.max_per_axis);
+    if matches!(res, Resolution::Auto { .. }) && cfg.spacing == Spacing::Uniform {
+        off_the_faces(scene, cfg, g, b, n, count)
+    } else {
+        n
+    }
+}
+
+/// A regular scene (a floor of equal tiles) whose pitch is the cell width puts every plane on
+/// the items' faces, and each item, padded for rounding, then reaches a sliver into the cells
+/// on both sides: three cells an axis instead of two. Per axis, of `n - 1`, `n` and `n + 1`
+/// cells the count whose cells an item overlaps least beyond what a random placement gives
+/// (`1 + extent / cell width`) is taken, when `n`'s excess is more than a quarter of a cell per
+/// item: a scene without such a coincidence keeps `n`.
+fn off_the_faces<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3], items: usize) -> [u16; 3] {
+    let max = cfg.max_per_axis.clamp(1, MAX_PER_AXIS);
+    let cand = |a: usize, k: usize| (n[a] as i32 - 1 + k as i32).clamp(1, max as i32) as u16;
+    let mut excess = [[0.0f64; 3]; 3];
+    for_each_item(scene, cfg, g, |_, ib| {
+        for (a, row) in excess.iter_mut().enumerate() {
+            let (lo, hi) = (b.min.axis(a).to_f64(), b.max.axis(a).to_f64());
+            if hi <= lo {
+                continue;
+            }
+            let (x0, x1) = (ib.min.axis(a).to_f64().max(lo), ib.max.axis(a).to_f64().min(hi));
+            for (k, e) in row.iter_mut().enumerate() {
+                let m = cand(a, k) as f64;
+                let w = (hi - lo) / m;
+                let cell = |x: f64| libm::floor((x - lo) / w).clamp(0.0, m - 1.0);
+                *e += cell(x1) - cell(x0) + 1.0 - (1.0 + (x1 - x0).max(0.0) / w).min(m);
+            }
+        }
+    });
+    [0, 1, 2].map(|a| {
+        let e = excess[a];
+        let best = (0..3).min_by(|&i, &j| e[i].total_cmp(&e[j])).unwrap_or(1);
+        if e[1] > 0.25 * items as f64 && e[best] < e[1] {
+            cand(a, best)
+        } else {
+            n[a]
+        }
+    })
 }
 
 /// The region lattice `sub` covers: a composite's box, or for the world lattice the box of
