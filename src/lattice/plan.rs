@@ -136,7 +136,8 @@ fn off_the_faces<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b
             for (k, e) in row.iter_mut().enumerate() {
                 let m = cand(a, k) as f64;
                 let w = (hi - lo) / m;
-                let cell = |x: f64| libm::floor((x - lo) / w).clamp(0.0, m - 1.0);
+                // max/min, not clamp: clamp's assertion would link float formatting in.
+                let cell = |x: f64| libm::floor((x - lo) / w).max(0.0).min(m - 1.0);
                 *e += cell(x1) - cell(x0) + 1.0 - (1.0 + (x1 - x0).max(0.0) / w).min(m);
             }
         }
