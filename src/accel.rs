@@ -170,7 +170,7 @@ impl<'m> Query<'m> {
                 return Vec3::new(R::from_raw(raw[0]), R::from_raw(raw[1]), R::from_raw(raw[2]));
             }
         }
-        let n = o.world_normal(n_obj);
+        let n = o.axis_world_normal(axis);
         self.axis_normal = Some((i, axis, [n.x.to_raw(), n.y.to_raw(), n.z.to_raw()]));
         n
     }

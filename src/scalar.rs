@@ -155,7 +155,6 @@ pub trait Real:
     }
 }
 
-/// [`Real::depth_key`] of an `f32`: its top 16 bits (sign, exponent, 7 mantissa bits).
 /// A power of two `2^k` as a scalar applies it ([`Real::pow2`] makes it, [`Real::mul_pow2`]
 /// applies it): floating point keeps its value (one multiply), fixed point its exponent `k` in
 /// the raw bits (a shift, not a multiply).
@@ -177,6 +176,7 @@ pub fn log2_of_pow2(p: f64) -> i16 {
     ((p.to_bits() >> 52) & 0x7ff) as i16 - 1023
 }
 
+/// [`Real::depth_key`] of an `f32`: its top 16 bits (sign, exponent, 7 mantissa bits).
 fn f32_key(v: f32) -> u16 {
     if v > 0.0 {
         (v.to_bits() >> 16) as u16

@@ -126,9 +126,10 @@ fn off_the_faces<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b
     let max = cfg.max_per_axis.clamp(1, MAX_PER_AXIS);
     let cand = |a: usize, k: usize| (n[a] as i32 - 1 + k as i32).clamp(1, max as i32) as u16;
     let mut excess = [[0.0f64; 3]; 3];
+    let range = [0, 1, 2].map(|a| (b.min.axis(a).to_f64(), b.max.axis(a).to_f64()));
     for_each_item(scene, cfg, g, |_, ib| {
         for (a, row) in excess.iter_mut().enumerate() {
-            let (lo, hi) = (b.min.axis(a).to_f64(), b.max.axis(a).to_f64());
+            let (lo, hi) = range[a];
             if hi <= lo {
                 continue;
             }

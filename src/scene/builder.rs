@@ -296,7 +296,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let reach = world.min.max_abs().max(world.max.max_abs()).to_f64();
         let margin = R::pad_eps().to_f64() * (1.0 + reach);
         for o in self.storage[..self.len].iter_mut() {
-            o.eye_local = o.to_object.vector(camera.eye - o.origin()).mul_pow2(o.unscale);
+            o.eye_local = o.point_local(camera.eye);
             o.light_local = match self.lights.first() {
                 Some(Light::Directional { to_light, .. }) => o.direction_local(*to_light),
                 _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),

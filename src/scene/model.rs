@@ -317,7 +317,7 @@ impl<R: Real> Object<R> {
     /// A world point in object space, as the ray tests take it: relative to the object's
     /// origin, then through `to_object` and its scale.
     #[inline]
-    fn point_local(&self, p: Vec3<R>) -> Vec3<R> {
+    pub(crate) fn point_local(&self, p: Vec3<R>) -> Vec3<R> {
         self.to_object.vector(p - self.origin()).mul_pow2(self.unscale)
     }
 
@@ -399,19 +399,16 @@ impl<R: Real> Object<R> {
     /// axis (one component 1 or -1, the others 0: a box's faces, the caps) maps to a row of
     /// `to_object`, which is taken as it is: the same value without the products by 0 and 1.
     pub fn world_normal(&self, n_obj: Vec3<R>) -> Vec3<R> {
-        let v = match axis_normal(n_obj) {
-            Some(k) => {
-                let row = &self.to_object.m[usize::from(k / 2)];
-                let v = Vec3::new(row[0], row[1], row[2]);
-                if k % 2 == 1 {
-                    -v
-                } else {
-                    v
-                }
-            }
-            None => self.to_object.transpose_vector(n_obj),
-        };
-        v.normalize()
+        match axis_normal(n_obj) {
+            Some(k) => self.axis_world_normal(k),
+            None => self.to_object.transpose_vector(n_obj).normalize(),
+        }
+    }
+    /// [`Object::world_normal`] of the unit axis `k` ([`axis_normal`]'s numbering).
+    pub(crate) fn axis_world_normal(&self, k: u8) -> Vec3<R> {
+        let row = &self.to_object.m[usize::from(k / 2)];
+        let v = Vec3::new(row[0], row[1], row[2]);
+        if k % 2 == 1 { -v } else { v }.normalize()
     }
 }
 
