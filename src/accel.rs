@@ -97,6 +97,9 @@ pub struct Query<'m> {
     /// The objects (bit `i`: object `i`) whose eye window meets the current tile; the others
     /// cannot be hit by its eye rays (see [`Query::set_eye_candidates`]).
     eye_candidates: u64,
+    /// The objects whose eye window meets the current tile, when a render listed them (see
+    /// [`Query::set_eye_list`]); `None`: not listed.
+    eye_list: Option<&'m [u32]>,
 }
 
 impl<'m> Query<'m> {
@@ -104,7 +107,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, axis_normal: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, axis_normal: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -128,6 +131,16 @@ impl<'m> Query<'m> {
     /// have culled them ray by ray. `u64::MAX` (the default) holds every object.
     pub fn set_eye_candidates(&mut self, objects: u64) {
         self.eye_candidates = objects;
+    }
+    /// Declares which objects the eye rays to come can hit at all, in index order (those whose
+    /// window meets the tile being rendered), or that they are not listed (`None`): eye rays
+    /// through an accelerator then test the listed objects instead of asking it.
+    pub fn set_eye_list(&mut self, objects: Option<&'m [u32]>) {
+        self.eye_list = objects;
+    }
+    /// The objects eye rays can hit, if listed (see [`Query::set_eye_list`]).
+    pub fn eye_list(&self) -> Option<&'m [u32]> {
+        self.eye_list
     }
     /// The objects eye rays can hit (see [`Query::set_eye_candidates`]).
     pub fn eye_candidates(&self) -> u64 {

@@ -46,6 +46,7 @@ pub mod dither;
 pub use dither::{Dither, Tone};
 pub mod outline;
 pub mod render;
+mod cover;
 pub use render::{dither_band, render, render_pass, render_share, trace_pass, trace_share, Frame, Hooks, KeptTile, NoHooks, Sampling, Scratch, Share, Traced};
 pub mod bitframe;
 pub use bitframe::BitFrame;

@@ -129,6 +129,11 @@ impl Frame {
         Ditherer::rows_len(self.dither, w) + Sampler::rows_len(self.sampling, self.dither.block(), w)
     }
 
+    /// Entries of [`Scratch::with_cover`] a render of this frame uses (a few per tile).
+    pub fn cover_len(&self) -> usize {
+        crate::cover::Tiling { t: self.tile.max(1) as usize, size: (self.width as usize, self.height as usize), margin: 0 }.len()
+    }
+
     /// Entries of `i16` scratch storage [`trace_share`] needs: [`Frame::scratch_len`] without
     /// the dither's carries (the levels are dithered later, by [`dither_band`]).
     pub fn trace_scratch_len(&self) -> usize {
@@ -527,6 +532,12 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
     // The outline is drawn on finished frames: a progressive frame's last pass, not its previews.
     let outline = frame.outline && pass.as_ref().is_none_or(|p| p.n == 1);
+    // Past 64 objects the tiles' candidate masks hold every object: list the objects whose
+    // windows meet each tile instead, when the scratch has room.
+    let tiling = crate::cover::Tiling { t, size: (w, h), margin: block };
+    let many = tracer.scene().objects().len() > 64;
+    let counted = many && tiling.count(tracer.scene(), (frame.rows.0 as usize, frame.rows.1 as usize), scratch.cover);
+    let cover: &[u32] = scratch.cover;
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
     let mut q = Query::new(&mut scratch.mailbox[..need]);
     let (tiles_x, tiles_y) = (w.div_ceil(t), h.div_ceil(t));
@@ -557,7 +568,11 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
             let at = Block { x0, y0, tw, th, t };
-            q.set_eye_candidates(tile_candidates(tracer.scene(), at, block, (w4, h4)));
+            if many {
+                q.set_eye_list(if counted { tiling.list(cover, (tx, ty)) } else { None });
+            } else {
+                q.set_eye_candidates(tile_candidates(tracer.scene(), at, block, (w4, h4)));
+            }
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 let ray = eye(&mut q, sx, sy);
                 let (v, id, depth) = tracer.eye_sample(ray, &mut q);
@@ -623,12 +638,9 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
 /// The objects the eye rays of the tile `at` can hit: those whose window meets the tile's
 /// (widened by a `block` on each side, beyond any ray the sampler shoots in the tile), on an
 /// image of `size` quarter pixels.
-fn tile_candidates<R: Real>(scene: &Scene<'_, R>, at: Block, block: usize, (w4, h4): (i32, i32)) -> u64 {
-    let Block { x0, y0, tw, th, .. } = at;
-    let m = 4 * block as i32;
-    let (sx, sy) = ([4 * x0 as i32 - m, 4 * (x0 + tw) as i32 + m], [4 * y0 as i32 - m, 4 * (y0 + th) as i32 + m]);
-    let (lo, hi) = (Camera::<R>::window_uv(sx[0], sy[1], w4, h4), Camera::<R>::window_uv(sx[1], sy[0], w4, h4));
-    scene.eye_candidates([lo[0], hi[0]], [lo[1], hi[1]])
+fn tile_candidates<R: Real>(scene: &Scene<'_, R>, at: Block, block: usize, size: (i32, i32)) -> u64 {
+    let (u, v) = crate::cover::tile_window::<R>((at.x0, at.tw), (at.y0, at.th), block, size);
+    scene.eye_candidates(u, v)
 }
 
 /// A tile of pass `n` of a progressive frame: a preview of `n`x`n` blocks (each side a constant
@@ -762,11 +774,20 @@ fn preview_tile<R: Real, const N: usize>(
 pub struct Scratch<'a> {
     pub(crate) mailbox: &'a mut [u32],
     pub(crate) rows: &'a mut [i16],
+    pub(crate) cover: &'a mut [u32],
 }
 
 impl<'a> Scratch<'a> {
     /// Scratch in caller-owned slices.
     pub fn new(mailbox: &'a mut [u32], rows: &'a mut [i16]) -> Self {
-        Scratch { mailbox, rows }
+        Scratch { mailbox, rows, cover: &mut [] }
+    }
+
+    /// With room to list which objects' eye windows meet each tile ([`Frame::cover_len`]
+    /// entries): in a scene of more than 64 objects, the eye rays of a tile that few windows
+    /// meet then test those objects without walking the lattice (the same frame, sooner).
+    /// Without it (or with too few entries) every eye ray walks.
+    pub fn with_cover(self, cover: &'a mut [u32]) -> Self {
+        Scratch { cover, ..self }
     }
 }

@@ -264,6 +264,7 @@ impl<'a, R: Real> FrameStorage<'a, R> {
 pub struct HeapScratch {
     mailbox: alloc::vec::Vec<u32>,
     rows: alloc::vec::Vec<i16>,
+    cover: alloc::vec::Vec<u32>,
 }
 
 #[cfg(feature = "alloc")]
@@ -273,11 +274,13 @@ impl HeapScratch {
         HeapScratch {
             mailbox: alloc::vec![0; Query::mailbox_len(scene)],
             rows: alloc::vec![0; frame.scratch_len()],
+            // Only scenes of more than 64 objects list windows per tile.
+            cover: alloc::vec![0; if scene.objects().len() > 64 { frame.cover_len() } else { 0 }],
         }
     }
 
     /// The scratch to render in.
     pub fn scratch(&mut self) -> Scratch<'_> {
-        Scratch::new(&mut self.mailbox, &mut self.rows)
+        Scratch::new(&mut self.mailbox, &mut self.rows).with_cover(&mut self.cover)
     }
 }

@@ -445,7 +445,17 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 q.set_eye_ray(Some(uv));
                 match self.eye_rays {
                     EyeRays::Windows => nearest_by_windows(self.scene, ray, q),
-                    _ => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, q),
+                    _ => match q.eye_list() {
+                        // The tile listed its objects: no walk (see `Scratch::with_cover`).
+                        Some(list) => {
+                            let mut best = None;
+                            for &i in list {
+                                crate::accel::offer(self.scene, i as usize, ray, R::ZERO, R::MAX, &mut best, q);
+                            }
+                            best
+                        }
+                        None => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, q),
+                    },
                 }
             }
             _ => {

@@ -197,3 +197,68 @@ fn kept_axis_normals_are_the_objects_own() {
     check::<f32>();
     check::<Fx>();
 }
+
+/// Renders `frame` of `scene` with the tracer's defaults over its lattice, with the scratch's
+/// tile lists (`Scratch::with_cover`) or without; returns the PBM bytes and the gray levels.
+fn render_cover<R: Real>(scene: &Scene<'_, R>, frame: &lattice_rt::Frame, cover: bool) -> (Vec<u8>, Vec<u8>, lattice_rt::Stats) {
+    struct Gray(Vec<u8>, usize);
+    impl lattice_rt::Hooks for Gray {
+        fn gray_tile(&mut self, x0: u16, y0: u16, w: u16, h: u16, levels: &[u8]) {
+            for y in 0..h as usize {
+                let at = (y0 as usize + y) * self.1 + x0 as usize;
+                self.0[at..at + w as usize].copy_from_slice(&levels[y * w as usize..(y + 1) * w as usize]);
+            }
+        }
+    }
+    let mut st = lattice_storage(scene, &LatticeConfig::default());
+    let lat = build_lattice(scene, &LatticeConfig::default(), &mut st);
+    let tracer = Tracer::new(scene, &lat);
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let mut bits = vec![0u8; lattice_rt::BitFrame::bytes(w as u32, h as u32)];
+    let mut target = lattice_rt::BitFrame::new(w as u32, h as u32, &mut bits).unwrap();
+    let (mut mailbox, mut rows) = (vec![0; Query::mailbox_len(scene)], vec![0; frame.scratch_len()]);
+    let mut room = vec![0; if cover { frame.cover_len() } else { 0 }];
+    let mut scratch = lattice_rt::Scratch::new(&mut mailbox, &mut rows).with_cover(&mut room);
+    let mut gray = Gray(vec![0; w * h], w);
+    let stats = lattice_rt::render(&tracer, frame, &mut target, &mut scratch, &mut gray).expect("render");
+    (bits, gray.0, stats)
+}
+
+/// Past 64 objects a render lists per tile the objects whose eye windows meet it, and the eye
+/// rays of a tile with few test those instead of walking the lattice: every frame equals the
+/// one rendered without the lists, in every scalar, for clustered and spread generated scenes
+/// seen from outside and from within, with adaptive sampling, silhouette lines and error
+/// diffusion (whose samples and apron rays reach past the tile).
+#[test]
+fn tile_lists_change_no_pixel() {
+    fn check<R: Real>() -> (usize, usize) {
+        let (mut checked, mut fewer_walks) = (0, 0);
+        for (seed, composite_size, spread) in [(1u64, 0, 0.0), (2, 0, 40.0), (3, 25, 0.0), (4, 0, 6.0)] {
+            for (eye, look) in [((0.0, 8.0, -60.0), (0.0, 0.0, 0.0)), ((0.3, 0.2, 0.1), (5.0, 1.0, 2.0)), ((40.0, 3.0, 5.0), (0.0, 0.0, 0.0))] {
+                let mut storage = vec![Object::<R>::default(); 150];
+                let mut b = SceneBuilder::new(&mut storage);
+                random_scene(&mut b, &RandomScene { objects: 150, composite_size, spread, seed }).unwrap();
+                b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
+                b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
+                b.camera.fov = (60.0, 40.0);
+                let Ok(scene) = b.finish() else { continue };
+                let frames = [
+                    lattice_rt::Frame::new(64, 40),
+                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4 }, outline: true, dither: lattice_rt::Dither::FloydSteinberg, ..lattice_rt::Frame::new(53, 35) },
+                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Edges { contrast: 8 }, rows: (1, 3), ..lattice_rt::Frame::new(48, 40) },
+                ];
+                for frame in &frames {
+                    let (with, without) = (render_cover(&scene, frame, true), render_cover(&scene, frame, false));
+                    let at = format!("{}, seed {seed}, eye {eye:?}, {}x{}", R::NAME, frame.width, frame.height);
+                    assert_eq!((&with.0, &with.1), (&without.0, &without.1), "{at}");
+                    fewer_walks += usize::from(with.2.cells_visited < without.2.cells_visited);
+                    checked += 1;
+                }
+            }
+        }
+        (checked, fewer_walks)
+    }
+    for (checked, fewer_walks) in [check::<f64>(), check::<f32>(), check::<Fx>()] {
+        assert!(checked >= 24 && fewer_walks >= 12, "{checked} frames checked, {fewer_walks} walked less");
+    }
+}

@@ -108,12 +108,42 @@ pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeCon
     let mut count = 0;
     for_each_item(scene, cfg, g, |_, _| count += 1);
     let res = if g == 0 { cfg.top } else { cfg.sub };
-    let n = resolution(b, count, res, cfg.max_per_axis);
+    let mut n = resolution(b, count, res, cfg.max_per_axis);
+    if g == 0 && matches!(res, Resolution::Auto { .. }) && cluster::possible(scene, cfg) {
+        n = past_the_clusters(scene, cfg, b, n, count, res);
+    }
     if matches!(res, Resolution::Auto { .. }) && cfg.spacing == Spacing::Uniform {
         off_the_faces(scene, cfg, g, b, n, count)
     } else {
         n
     }
+}
+
+/// The world resolution again for the items the world lattice keeps. Free objects crowded into
+/// dense cells (module `cluster`) go to those cells' own lattices, so the world's cells need
+/// not be fine enough for them: a loose cluster of thousands in a big sparse scene would
+/// otherwise cut the whole scene into cells for thousands, and every ray would step through
+/// that many empty cells. The world lattice keeps its references outside dense cells (as a
+/// share of its `items`) and one reference per dense cell; with no dense cell, `n` stands.
+#[inline(never)]
+fn past_the_clusters<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: &Aabb<R>, n: [u16; 3], items: usize, res: Resolution) -> [u16; 3] {
+    let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
+    for (a, p) in planes.iter_mut().enumerate() {
+        axis_planes(scene, cfg, 0, a, b, n[a], p);
+    }
+    let planes = [0, 1, 2].map(|a| &planes[a][..n[a] as usize + 1]);
+    let (mut crowded, mut cells) = (0, 0);
+    cluster::for_each_dense(scene, cfg, planes, |d| {
+        crowded += d.free;
+        cells += 1;
+    });
+    if cells == 0 {
+        return n;
+    }
+    let mut refs = 0;
+    for_each_item(scene, cfg, 0, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
+    let kept = items as f64 * (refs.saturating_sub(crowded)) as f64 / refs.max(1) as f64;
+    resolution(b, libm::round(kept) as usize + cells, res, cfg.max_per_axis)
 }
 
 /// A regular scene (a floor of equal tiles) whose pitch is the cell width puts every plane on

@@ -109,9 +109,6 @@ pub fn loose(n: usize, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>>
     generated_as(n, true, false, storage)
 }
 
-/// A generated scene of `n` primitives in the given storage.
-type Generator = fn(usize, &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>>;
-
 /// The issue's own check: `n` loose primitives packed into a cube of side 2 on a floor 160
 /// units wide ringed by 40 boxes, seen from the floor's edge.
 pub fn stadium(n: usize, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
@@ -334,53 +331,78 @@ fn resolution_sweep(md: &mut String, quick: bool, runs: usize) -> Result<()> {
     Ok(())
 }
 
-/// The POV-Ray section: the paper scenes and generated scenes of 100, 1 000 and 10 000
-/// primitives (1 000 at most with `quick`), random and clustered, with and without shadows.
+/// A scene of the POV-Ray comparison made in the storage it is given.
+type Maker = Box<dyn for<'a> Fn(&'a mut Vec<Object<f64>>) -> Result<Scene<'a, f64>>>;
+
+/// The scenes of the POV-Ray comparison, by name: the paper scenes and generated scenes of 100,
+/// 1 000 and 10 000 primitives (1 000 at most with `quick`), random, clustered and loosely
+/// clustered, and the stadium.
+pub fn versus_cases(quick: bool) -> Vec<(String, Maker)> {
+    let mut cases: Vec<(String, Maker)> = Vec::new();
+    for (name, ..) in PAPER {
+        cases.push((
+            name.to_string(),
+            Box::new(move |storage: &mut Vec<Object<f64>>| {
+                let path = Path::new("scenes").join(format!("{name}.scene"));
+                let text = read(&path)?;
+                *storage = object_storage::<f64>(&text)?;
+                parse_scene::<f64>(&path, &text, storage)
+            }),
+        ));
+    }
+    let sizes: &[usize] = if quick { &[100, 1000] } else { &[100, 1000, 10_000] };
+    for clustered in [false, true] {
+        for &n in sizes {
+            let name = format!("{} {n}", if clustered { "clustered" } else { "random" });
+            cases.push((name, Box::new(move |storage: &mut Vec<Object<f64>>| generated(n, clustered, storage))));
+        }
+    }
+    for &n in sizes {
+        cases.push((format!("loose clustered {n}"), Box::new(move |storage: &mut Vec<Object<f64>>| loose(n, storage))));
+    }
+    cases.push(("stadium 3000".into(), Box::new(|storage: &mut Vec<Object<f64>>| stadium(3000, storage))));
+    cases
+}
+
+/// The POV-Ray section over [`versus_cases`].
 fn against_povray(quick: bool, runs: usize) -> Result<String> {
     if !crate::versus::available() {
         eprintln!("povray is not installed: the POV-Ray comparison is left out (apt-get install povray)");
         return Ok("## Against POV-Ray 3.7\n\nLeft out: `povray` was not installed when this was written.\n".into());
     }
+    let rows = versus_rows(&versus_cases(quick), runs, true)?;
+    crate::versus::section(&rows, runs)
+}
+
+/// The command: the chosen cases' rows printed as a table.
+pub fn versus_cmd(scenes: &[String], runs: usize, povray: bool) -> Result<()> {
+    if povray && !crate::versus::available() {
+        anyhow::bail!("povray is not installed (apt-get install povray), or pass --no-povray");
+    }
+    let cases: Vec<_> = versus_cases(false).into_iter().filter(|(name, _)| scenes.is_empty() || scenes.iter().any(|s| name.starts_with(s.as_str()))).collect();
+    if cases.is_empty() {
+        let names: Vec<String> = versus_cases(false).into_iter().map(|(n, _)| n).collect();
+        anyhow::bail!("no scene of the comparison is named {}; they are: {}", scenes.join(", "), names.join(", "));
+    }
+    let rows = versus_rows(&cases, runs.max(1), povray)?;
+    print!("{}", crate::versus::section(&rows, runs.max(1))?);
+    Ok(())
+}
+
+/// Times each case in host-sim and, with `povray`, in POV-Ray (see [`crate::versus::compare`]).
+pub fn versus_rows(cases: &[(String, Maker)], runs: usize, povray: bool) -> Result<Vec<crate::versus::Row>> {
     let work = Path::new("target/povray-bench");
     let cfg = LatticeConfig::default();
     let mut rows = Vec::new();
-    let sizes: &[usize] = if quick { &[100, 1000] } else { &[100, 1000, 10_000] };
-    let bar = host_sim::progress::bar(PAPER.len() + 3 * sizes.len() + 1, "against POV-Ray");
-    for (name, ..) in PAPER {
-        let path = Path::new("scenes").join(format!("{name}.scene"));
-        let text = read(&path)?;
-        let mut storage = object_storage::<f64>(&text)?;
-        let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
+    let bar = host_sim::progress::bar(cases.len(), "against POV-Ray");
+    for (name, make) in cases {
+        let mut storage = Vec::new();
+        let scene = make(&mut storage)?;
         let mut bufs = lattice_storage(&scene, &cfg)?;
         let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
-        rows.extend(crate::versus::compare(name, &scene, &lattice, runs, work)?);
+        rows.extend(crate::versus::compare(name, &scene, &lattice, runs, povray.then_some(work))?);
         bar.inc(1);
+        host_sim::progress::log(&bar, format_args!("  {name} done"));
     }
-    for clustered in [false, true] {
-        for &n in sizes {
-            let mut storage = Vec::new();
-            let scene = generated(n, clustered, &mut storage)?;
-            let mut bufs = lattice_storage(&scene, &cfg)?;
-            let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
-            let name = format!("{} {n}", if clustered { "clustered" } else { "random" });
-            rows.extend(crate::versus::compare(&name, &scene, &lattice, runs, work)?);
-            bar.inc(1);
-            host_sim::progress::log(&bar, format_args!("  {name} against POV-Ray done"));
-        }
-    }
-    let extra: [(&str, Generator, usize); 2] = [("loose clustered", loose, 0), ("stadium", stadium, 3000)];
-    for (kind, make, fixed) in extra {
-        let ns: Vec<usize> = if fixed > 0 { vec![fixed] } else { sizes.to_vec() };
-        for n in ns {
-            let mut storage = Vec::new();
-            let scene = make(n, &mut storage)?;
-            let mut bufs = lattice_storage(&scene, &cfg)?;
-            let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
-            let name = format!("{kind} {n}");
-            rows.extend(crate::versus::compare(&name, &scene, &lattice, runs, work)?);
-            bar.inc(1);
-            host_sim::progress::log(&bar, format_args!("  {name} against POV-Ray done"));
-        }
-    }
-    crate::versus::section(&rows, runs)
+    Ok(rows)
 }

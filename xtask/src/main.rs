@@ -98,6 +98,18 @@ enum Command {
         #[arg(long, default_value = "docs/performance.svg")]
         plot: PathBuf,
     },
+    /// host-sim against POV-Ray on chosen scenes of `bench`'s comparison, printed as a table
+    /// (nothing written): for measuring one scene while working on it.
+    Versus {
+        /// Scenes by name or name prefix (`chair`, `loose clustered 1000`, `random`); all when none.
+        scenes: Vec<String>,
+        /// Timed runs per scene (the median is used).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// host-sim only (POV-Ray's column left empty): for profiling.
+        #[arg(long)]
+        no_povray: bool,
+    },
     /// The memory-time frontier: lattices built within byte budgets from 64 B to 1 MiB on the
     /// paper's scenes and generated ones; writes docs/memory.md and its plots.
     Memory {
@@ -197,6 +209,7 @@ fn real_main() -> Result<()> {
         Command::Playground { out, serve, check, screenshot, no_build } => playground::playground_cmd(&root, &playground::PlaygroundArgs { out, serve, check, screenshot, no_build }),
         Command::Firmware { out, no_build } => firmware::firmware_cmd(&root, &out, no_build),
         Command::Bench { quick, runs, out, plot } => bench::bench_cmd(quick, runs, &out, &plot),
+        Command::Versus { scenes, runs, no_povray } => bench::versus_cmd(&scenes, runs, !no_povray),
         Command::Memory { quick, runs, out, plot, tests_plot } => memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot }),
         Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv } => tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv),
         Command::Effects { scenes, runs, out, firmware_csv } => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),

@@ -16,6 +16,10 @@ use std::time::Duration;
 pub const SIZE: (u16, u16) = (480, 300);
 /// The speed-up over POV-Ray the issue asks for on every scene.
 pub const TARGET: f64 = 2.0;
+/// The speed-up over POV-Ray the issue asks for on the paper's scenes.
+pub const PAPER_TARGET: f64 = 3.0;
+/// The paper's scenes, by the names the comparison gives them.
+const PAPER_SCENES: [&str; 4] = ["chair", "desk", "polyhedron", "spheres"];
 
 /// Whether `povray` can be run here.
 pub fn available() -> bool {
@@ -80,10 +84,13 @@ fn povray(pov: &str, work: &Path, name: &str) -> Result<Duration> {
     trace_time(&stderr).with_context(|| format!("povray printed no Trace Time for {}", src.display()))
 }
 
-/// Times `scene` in host-sim (its default tracer over `accel`, one core) and in POV-Ray,
-/// interleaved `runs` times, with and without shadows.
-pub fn compare(name: &str, scene: &Scene<'_, f64>, accel: &(dyn Accelerator<f64> + Sync), runs: usize, work: &Path) -> Result<Vec<Row>> {
-    std::fs::create_dir_all(work).with_context(|| format!("cannot create {}", work.display()))?;
+/// Times `scene` in host-sim (its default tracer over `accel`, one core) and, given a work
+/// folder, in POV-Ray, interleaved `runs` times, with and without shadows (POV-Ray's time is
+/// zero without one).
+pub fn compare(name: &str, scene: &Scene<'_, f64>, accel: &(dyn Accelerator<f64> + Sync), runs: usize, work: Option<&Path>) -> Result<Vec<Row>> {
+    if let Some(work) = work {
+        std::fs::create_dir_all(work).with_context(|| format!("cannot create {}", work.display()))?;
+    }
     let full = export(scene, PovMode::Full)?;
     let frame = Frame::new(SIZE.0, SIZE.1);
     let mut rows = Vec::new();
@@ -98,9 +105,11 @@ pub fn compare(name: &str, scene: &Scene<'_, f64>, accel: &(dyn Accelerator<f64>
             let r = render_band(&tracer, &frame, false)?;
             ours.push(r.elapsed);
             tests = r.stats.object_tests as f64 / r.stats.total_rays().max(1) as f64;
-            pov.push(povray(&pov_text, work, name)?);
+            if let Some(work) = work {
+                pov.push(povray(&pov_text, work, name)?);
+            }
         }
-        rows.push(Row { scene: name.to_string(), n: scene.objects().len(), shadows, ours: median(ours), pov: median(pov), tests });
+        rows.push(Row { scene: name.to_string(), n: scene.objects().len(), shadows, ours: median(ours), pov: if pov.is_empty() { Duration::ZERO } else { median(pov) }, tests });
     }
     Ok(rows)
 }
@@ -115,32 +124,35 @@ pub fn section(rows: &[Row], runs: usize) -> Result<String> {
     writeln!(md, "defaults, dithering and 1-bit output included). Medians of {runs} runs, the two interleaved.")?;
     writeln!(md, "Without shadows: POV-Ray's lights `shadowless`, host-sim's shadow effect off. Generated scenes")?;
     writeln!(md, "as in *Scaling* below (random; clustered: the teapot in a stadium). Target: host-sim at least")?;
-    writeln!(md, "{TARGET}x faster on every scene.\n")?;
+    writeln!(md, "{TARGET}x faster on every scene, {PAPER_TARGET}x on the paper's.\n")?;
     writeln!(md, "| scene | N | shadows | host-sim ms | POV-Ray trace ms | host-sim faster by | object tests/ray |\n|---|---:|---|---:|---:|---:|---:|")?;
     for r in rows {
+        let (pov, by) = if r.pov.is_zero() { ("-".into(), "-".into()) } else { (format!("{:.1}", r.pov.as_secs_f64() * 1e3), format!("{:.2}x", r.speedup())) };
         writeln!(
             md,
-            "| {} | {} | {} | {:.1} | {:.1} | {:.2}x | {:.2} |",
+            "| {} | {} | {} | {:.1} | {pov} | {by} | {:.2} |",
             r.scene,
             r.n,
             if r.shadows { "yes" } else { "no" },
             r.ours.as_secs_f64() * 1e3,
-            r.pov.as_secs_f64() * 1e3,
-            r.speedup(),
             r.tests
         )?;
     }
-    if let (Some(lo), Some(hi)) = (rows.iter().min_by(|a, b| a.speedup().total_cmp(&b.speedup())), rows.iter().max_by(|a, b| a.speedup().total_cmp(&b.speedup()))) {
-        let met = rows.iter().filter(|r| r.speedup() >= TARGET).count();
+    let timed: Vec<&Row> = rows.iter().filter(|r| !r.pov.is_zero()).collect();
+    if let (Some(lo), Some(hi)) = (timed.iter().min_by(|a, b| a.speedup().total_cmp(&b.speedup())), timed.iter().max_by(|a, b| a.speedup().total_cmp(&b.speedup()))) {
+        let met = timed.iter().filter(|r| r.speedup() >= TARGET).count();
+        let paper: Vec<&&Row> = timed.iter().filter(|r| PAPER_SCENES.contains(&r.scene.as_str())).collect();
+        let paper_met = paper.iter().filter(|r| r.speedup() >= PAPER_TARGET).count();
         writeln!(
             md,
-            "\nhost-sim is {:.2}x ({}, {} shadows) to {:.2}x ({}) faster than POV-Ray; the {TARGET}x target holds on {met} of {} scenes.\n",
+            "\nhost-sim is {:.2}x ({}, {} shadows) to {:.2}x ({}) faster than POV-Ray; the {TARGET}x target holds on {met} of {} scenes, the {PAPER_TARGET}x target on {paper_met} of the {} paper scene rows.\n",
             lo.speedup(),
             lo.scene,
             if lo.shadows { "with" } else { "without" },
             hi.speedup(),
             hi.scene,
-            rows.len()
+            timed.len(),
+            paper.len()
         )?;
     }
     // Loose clusters against the same scenes with the cluster declared a composite.
