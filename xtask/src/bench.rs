@@ -308,8 +308,16 @@ fn scaling(md: &mut String, quick: bool, runs: usize) -> Result<Series> {
     if let (Some(u), Some(a), Some(nst)) = (at("clustered: lattice, uniform", *sizes.last().unwrap() as f64), at("clustered: lattice, adaptive", *sizes.last().unwrap() as f64), at("clustered: lattice, nested", *sizes.last().unwrap() as f64)) {
         writeln!(md, "Clustered, N = {}: uniform {u:.2} us/ray, adaptive coordinate lists {a:.2}, nested sub-lattice {nst:.2}.", sizes.last().unwrap())?;
     }
+    let big = *sizes.last().unwrap() as f64;
+    if let (Some(a), Some(b)) = (at("clustered: lattice, nested", 1_000.0), at("clustered: lattice, nested", big)) {
+        let met = if b / a <= SCALING_TARGET { "met" } else { "not met" };
+        writeln!(md, "Scaling target (the default nested lattice, clustered): us per ray at N = {big} is {:.2}x that at N = 1 000 (target: at most {SCALING_TARGET}x, {met}).", b / a)?;
+    }
     Ok(series)
 }
+
+/// How many times the time per ray at 100 000 clustered primitives may be that at 1 000.
+const SCALING_TARGET: f64 = 1.2;
 
 /// The automatic lattice resolution against a sweep of uniform ones.
 fn resolution_sweep(md: &mut String, quick: bool, runs: usize) -> Result<()> {
