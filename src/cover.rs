@@ -116,6 +116,12 @@ impl Tiling {
     }
 }
 
+/// Whether a render of a scene of `objects` objects lists them per tile: past the 64 a tile's
+/// candidate mask holds ([`crate::scene::Scene::eye_candidates`]).
+pub(crate) const fn lists(objects: usize) -> bool {
+    objects > u64::BITS as usize
+}
+
 /// Most objects a tile lists: a tile with more has its eye rays walk the lattice. An eye ray
 /// tests each listed object's window (a few comparisons) and the objects it meets, which costs
 /// less than a walk through the cells in front of them.

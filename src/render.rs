@@ -535,7 +535,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     // Past 64 objects the tiles' candidate masks hold every object: list the objects whose
     // windows meet each tile instead, when the scratch has room.
     let tiling = crate::cover::Tiling { t, size: (w, h), margin: block };
-    let many = tracer.scene().objects().len() > 64;
+    let many = crate::cover::lists(tracer.scene().objects().len());
     let counted = many && tiling.count(tracer.scene(), (frame.rows.0 as usize, frame.rows.1 as usize), scratch.cover);
     let cover: &[u32] = scratch.cover;
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
