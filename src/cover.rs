@@ -54,13 +54,25 @@ impl Tiling {
     }
 
     /// The window range of tile column `tx` (`u`) and of tile row `ty` (`v`).
+    #[cfg(test)]
     fn ranges<R: Real>(&self, tx: usize, ty: usize) -> ([i32; 2], [i32; 2]) {
-        let (w, h) = self.size;
-        let (x0, y0) = (tx * self.t, ty * self.t);
-        let quarter = (4 * w as i32, 4 * h as i32);
-        let (u, _) = tile_window::<R>((x0, self.t.min(w - x0)), (0, 1), self.margin, quarter);
-        let (_, v) = tile_window::<R>((0, 1), (y0, self.t.min(h - y0)), self.margin, quarter);
-        (u, v)
+        (self.column::<R>(tx), self.row::<R>(ty))
+    }
+
+    /// The `u` range of tile column `tx`'s window (widened by the margin).
+    fn column<R: Real>(&self, tx: usize) -> [i32; 2] {
+        let (w, m) = (self.size.0, 4 * self.margin as i32);
+        let x0 = tx * self.t;
+        let w4 = 4 * w as i32;
+        [Camera::<R>::window_u(4 * x0 as i32 - m, w4), Camera::<R>::window_u(4 * (x0 + self.t.min(w - x0)) as i32 + m, w4)]
+    }
+
+    /// The `v` range of tile row `ty`'s window (widened by the margin; `v` points up).
+    fn row<R: Real>(&self, ty: usize) -> [i32; 2] {
+        let (h, m) = (self.size.1, 4 * self.margin as i32);
+        let y0 = ty * self.t;
+        let h4 = 4 * h as i32;
+        [Camera::<R>::window_v(4 * (y0 + self.t.min(h - y0)) as i32 + m, h4), Camera::<R>::window_v(4 * y0 as i32 - m, h4)]
     }
 
     /// Counts into `cover`'s first entries (one per tile, row by row; saturating) how many of
@@ -92,8 +104,8 @@ impl Tiling {
     fn met<R: Real>(&self, window: EyeWindow) -> (Range<usize>, Range<usize>) {
         let (nx, ny) = self.tiles();
         let [u0, u1, v0, v1] = window;
-        let u = |tx: usize| self.ranges::<R>(tx, 0).0;
-        let v = |ty: usize| self.ranges::<R>(0, ty).1;
+        let u = |tx: usize| self.column::<R>(tx);
+        let v = |ty: usize| self.row::<R>(ty);
         // Columns grow in u; rows fall in v (the window's v points up).
         let (a, b) = (first_not(nx, |tx| u(tx)[1] < u0), first_not(nx, |tx| u(tx)[0] <= u1));
         let (c, d) = (first_not(ny, |ty| v(ty)[0] > v1), first_not(ny, |ty| v(ty)[1] >= v0));
@@ -145,6 +157,12 @@ mod tests {
         for (size, t, margin) in [((64, 40), 8, 1), ((53, 35), 8, 2), ((480, 300), 8, 1), ((20, 12), 4, 0)] {
             let tiling = Tiling { t, size, margin };
             let (nx, ny) = tiling.tiles();
+            // Each tile's ranges are the rectangle a tile's candidate mask is taken over.
+            for (tx, ty) in (0..nx).flat_map(|tx| (0..ny).map(move |ty| (tx, ty))) {
+                let (x0, y0) = (tx * t, ty * t);
+                let whole = tile_window::<f64>((x0, t.min(size.0 - x0)), (y0, t.min(size.1 - y0)), margin, (4 * size.0 as i32, 4 * size.1 as i32));
+                assert_eq!(tiling.ranges::<f64>(tx, ty), whole, "{size:?} tile ({tx}, {ty})");
+            }
             for k in 0..400 {
                 let r = if k % 4 == 0 { 1 << 18 } else { 1 << 16 };
                 let (a, b, c, d) = (next(r), next(r), next(r), next(r));

@@ -132,14 +132,17 @@ impl<R: Real> Camera<R> {
     /// The window position `(u, v)` of [`Camera::ray`]`(sx2, sy2, w2, h2)` in units of 2^-16,
     /// in integers (to within one unit), for [`Object::intersect_eye_ray`].
     pub fn window_uv(sx2: i32, sy2: i32, w2: i32, h2: i32) -> [i32; 2] {
-        let (x, y) = (2 * sx2 - w2, h2 - 2 * sy2);
-        if x.unsigned_abs() < 1 << 15 && y.unsigned_abs() < 1 << 15 {
-            // One 32-bit division each (a microcontroller's divider does that in a few cycles).
-            [(x << 16) / w2.max(1), (y << 16) / h2.max(1)]
-        } else {
-            let q = |n: i32, d: i32| ((i64::from(n) << 16) / i64::from(d.max(1))).clamp(i32::MIN.into(), i32::MAX.into()) as i32;
-            [q(x, w2), q(y, h2)]
-        }
+        [Self::window_u(sx2, w2), Self::window_v(sy2, h2)]
+    }
+
+    /// The `u` of [`Camera::window_uv`] (it depends on the horizontal position alone).
+    pub fn window_u(sx2: i32, w2: i32) -> i32 {
+        window_coord(2 * sx2 - w2, w2)
+    }
+
+    /// The `v` of [`Camera::window_uv`] (it depends on the vertical position alone).
+    pub fn window_v(sy2: i32, h2: i32) -> i32 {
+        window_coord(h2 - 2 * sy2, h2)
     }
 
     /// The eye ray through the point `(sx, sy)` of a `w x h` window, in pixel units from the
@@ -149,6 +152,16 @@ impl<R: Real> Camera<R> {
         let u = ratio::<R>(2 * sx2 - w2, w2);
         let v = ratio::<R>(h2 - 2 * sy2, h2);
         Ray::new(self.eye, self.forward + self.right * u + self.up * v)
+    }
+}
+
+/// `(n << 16) / d` (`d` at least 1), clamped to `i32`: one 32-bit division while `n` is small
+/// (a microcontroller's divider does that in a few cycles).
+fn window_coord(n: i32, d: i32) -> i32 {
+    if n.unsigned_abs() < 1 << 15 {
+        (n << 16) / d.max(1)
+    } else {
+        ((i64::from(n) << 16) / i64::from(d.max(1))).clamp(i32::MIN.into(), i32::MAX.into()) as i32
     }
 }
 
