@@ -92,6 +92,9 @@ pub struct Query<'m> {
     axis_normal: Option<(u32, u8, [u64; 3])>,
     /// The object the last test that hit was made against.
     last_hit: u32,
+    /// Objects the ray being traced is known to miss, so not tested ([`u32::MAX`]: none): the
+    /// one it leaves ([`Query::set_leaving`]) and one already tried ([`Query::set_tried`]).
+    skip: [u32; 2],
     /// Per light, the object that last hid it ([`u32::MAX`]: none yet).
     occluders: [u32; MAX_LIGHTS],
     /// The objects (bit `i`: object `i`) whose eye window meets the current tile; the others
@@ -107,7 +110,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, axis_normal: None, last_hit: u32::MAX, occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, axis_normal: None, last_hit: u32::MAX, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -124,6 +127,24 @@ impl<'m> Query<'m> {
     /// the direction's object-space image from the scene ([`crate::Object::intersect_first_light_ray`]).
     pub fn set_first_light_ray(&mut self, yes: bool) {
         self.first_light = yes;
+    }
+    /// Declares the object the next rays leave (`None`: none): they start outside it, on the
+    /// side of the tangent plane its outward normal points to, and travel away from that plane.
+    /// Every primitive is convex, so lies wholly behind that plane: such a ray cannot hit it,
+    /// and it is not tested.
+    pub fn set_leaving(&mut self, object: Option<u32>) {
+        self.skip[0] = object.unwrap_or(u32::MAX);
+    }
+    /// Declares an object the next rays were already tested against and missed (`None`: none),
+    /// so that it is not tested again.
+    pub fn set_tried(&mut self, object: Option<u32>) {
+        self.skip[1] = object.unwrap_or(u32::MAX);
+    }
+    /// Whether object `i` is known to be missed by the ray being traced (see
+    /// [`Query::set_leaving`] and [`Query::set_tried`]).
+    #[inline]
+    pub fn skips(&self, i: u32) -> bool {
+        self.skip[0] == i || self.skip[1] == i
     }
     /// Declares which objects the eye rays to come can hit at all (bit `i`: object `i`; from
     /// [`crate::scene::Scene::eye_candidates`] for the tile being rendered): tracing by
@@ -237,6 +258,10 @@ pub fn offer<R: Real>(
     best: &mut Option<Hit<R>>,
     q: &mut Query<'_>,
 ) -> bool {
+    if q.skips(i as u32) {
+        q.stats.culled += 1;
+        return false;
+    }
     let limit = reach(best, tmax);
     let o = &scene.objects[i];
     let hit = match q.eye {

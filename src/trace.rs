@@ -308,6 +308,9 @@ struct Node<R> {
     weight: R,
     depth: u8,
     kind: RayKind,
+    /// The object the ray leaves from outside (a mirror ray off its surface), which it cannot
+    /// hit ([`Query::set_leaving`]), or [`NO_OBJECT`].
+    leaving: u32,
 }
 
 impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
@@ -476,13 +479,15 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         // Depth-first, each node pushes at most two children and `max_depth <= MAX_DEPTH`, so at
         // most `MAX_DEPTH + 2` nodes wait: no push below can fail.
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
-        let _ = stack.push(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary });
+        let _ = stack.push(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary, leaving: NO_OBJECT });
         let mut total = R::ZERO;
         // The eye ray's window position (if the caller gave one) serves the eye ray alone.
         let eye_uv = q.eye_ray();
         while let Some(node) = stack.pop() {
             q.stats.rays[node.kind as usize] += 1;
+            q.set_leaving((node.leaving != NO_OBJECT).then_some(node.leaving));
             let found = self.nearest(&node.ray, if node.depth == 0 { eye_uv } else { None }, q);
+            q.set_leaving(None);
             let Some(hit) = found else {
                 total += node.weight * scene.background;
                 continue;
@@ -502,19 +507,26 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let d = if children { node.ray.dir.normalize() } else { node.ray.dir };
             let side = facing(d, q.world_normal(scene, hit.object, hit.normal));
             let n = side.normal;
+            // Rays off the outer side of the surface, towards where its normal points (shadow
+            // rays to lights in front, the mirror ray), leave the object: every primitive is
+            // convex, so they cannot meet it again.
+            let leaving = if side.entering { hit.object } else { NO_OBJECT };
             let eps = R::offset(p.max_abs(), obj.size());
             let outside = p + n * eps;
             let mut local = scene.ambient * m.ka;
             if m.kd > R::ZERO {
+                // Lit from outside, the point's shadow rays leave its own (convex) object.
+                q.set_leaving((leaving != NO_OBJECT).then_some(leaving));
                 for (l, light) in scene.lights.iter().enumerate() {
                     local += self.direct(l, light, outside, n, m.kd, node.weight, q);
                 }
+                q.set_leaving(None);
             }
             total += node.weight * local;
             if !children {
                 continue;
             }
-            let child = |ray, w: R, kind| Node { ray, weight: node.weight * w, depth: node.depth + 1, kind };
+            let child = |ray, w: R, kind, leaving| Node { ray, weight: node.weight * w, depth: node.depth + 1, kind, leaving };
             let cos_i = -d.dot(n);
             let mirror = d + n * (cos_i + cos_i);
             let mut reflect_w = if reflects { m.ks } else { R::ZERO };
@@ -523,13 +535,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                     // Total internal reflection: the transmitted share is reflected.
                     None => reflect_w += m.kt,
                     Some(dir) if node.weight * m.kt > self.cutoff => {
-                        let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction));
+                        let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction, NO_OBJECT));
                     }
                     Some(_) => {}
                 }
             }
             if reflect_w > R::ZERO && node.weight * reflect_w > self.cutoff {
-                let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection));
+                let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection, leaving));
             }
         }
         (total.max(R::ZERO).min(R::ONE), first, depth)
@@ -568,13 +580,17 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             // Towards the first light, when it is directional, every object holds the ray's
             // direction in its own space already.
             let first_light = l == 0 && self.scene.shadow_basis.is_some();
-            if let Some(o) = last.and_then(|i| self.scene.objects.get(i as usize)) {
+            let tried = last.filter(|&i| !q.skips(i) && (i as usize) < self.scene.objects.len());
+            if let Some(i) = tried {
+                let o = &self.scene.objects[i as usize];
                 q.stats.object_tests += 1;
                 let hit = if first_light { o.intersect_first_light_ray(&ray, R::ZERO, reach) } else { o.intersect(&ray, R::ZERO, reach) };
                 if hit.is_some() {
                     return R::ZERO;
                 }
             }
+            // Missed: the search below need not test it again.
+            q.set_tried(tried);
             let hidden = match self.scene.shadow_basis {
                 // Towards the first light, when it is directional, a small scene's shadow rays
                 // test the objects whose shadow window holds the ray, with no walk.
@@ -593,6 +609,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                     hidden
                 }
             };
+            q.set_tried(None);
             if hidden {
                 return R::ZERO;
             }
@@ -605,7 +622,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, q: &mut Query<'_>) -> Option<u32> {
         for (i, o) in self.scene.objects.iter().enumerate() {
             let sw = &o.shadow_window;
-            if w[0] < sw[0] || w[0] > sw[1] || w[1] < sw[2] || w[1] > sw[3] {
+            if w[0] < sw[0] || w[0] > sw[1] || w[1] < sw[2] || w[1] > sw[3] || q.skips(i as u32) {
                 q.stats.culled += 1;
                 continue;
             }

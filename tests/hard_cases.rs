@@ -70,6 +70,46 @@ fn no_self_shadow_acne<R: Real>() {
     assert_eq!(gray_all(&scene, &frame, true), gray_all(&scene, &frame, false), "{}: acne", R::NAME);
 }
 
+/// Rays that leave a primitive's surface from outside, towards where its outward normal points
+/// (shadow rays to lights in front, mirror rays), miss that primitive: the tracer relies on it
+/// to leave the primitive untested ([`lattice_rt::Query::set_leaving`]; every primitive is
+/// convex). This checks it against the tests themselves, rounding and offset included.
+fn leaving_rays_miss_their_object<R: Real>() {
+    let text = "camera eye 0 3 -8 look 0 0.5 0\nlight directional dir 1 -1 1\n\
+        sphere center -2 1 0 radius 1\n\
+        box min 1 0 -1 max 3 1.5 1 rotate y 30\n\
+        cylinder base -0.5 0 2 radius 0.6 height 2 rotate x 20\n\
+        cone base 1 0 3 radius 0.8 height 1.5 top 0.3 rotate z 15 scale 1 1.5 1\n\
+        cone base -3 0 3 radius 0.5 height 1 rotate y 40\n";
+    let mut st = Vec::new();
+    let scene = scene_in::<R>(text, &mut st);
+    let cam = scene.camera();
+    let dirs = [(1.0, 1.0, -1.0), (-0.6, 1.0, 0.5), (0.0, 1.0, 0.0), (0.3, 0.2, -1.0), (1.0, 0.05, 0.0), (-1.0, 0.3, 0.7)];
+    let mut checked = 0;
+    for (i, o) in scene.objects().iter().enumerate() {
+        for y in 0..48 {
+            for x in 0..64 {
+                let eye = cam.ray(2 * x + 1, 2 * y + 1, 128, 96);
+                let Some(hit) = o.intersect(&eye, R::ZERO, R::MAX) else { continue };
+                let n = o.world_normal(hit.normal);
+                if facing(eye.dir, n).entering {
+                    let p = o.surface_point(hit.point, hit.normal);
+                    let from = p + n * R::offset(p.max_abs(), o.size());
+                    let mirror = eye.dir.normalize() + n * (-(eye.dir.normalize().dot(n)) * R::from_f64(2.0));
+                    for d in dirs.iter().map(|&(a, b, c)| Vec3::new(R::from_f64(a), R::from_f64(b), R::from_f64(c)).normalize()).chain([mirror]) {
+                        if d.dot(n) > R::ZERO {
+                            checked += 1;
+                            let again = o.intersect(&Ray::new(from, d), R::ZERO, R::MAX);
+                            assert!(again.is_none(), "{}: object {i}, pixel ({x}, {y}), direction {d:?}: hit again at {:?}", R::NAME, again.map(|h| h.t));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 5000, "{}: only {checked} rays checked", R::NAME);
+}
+
 // 2. The whole scene far from the origin: the same picture within a stated tolerance.
 fn far_from_the_origin<R: Real>() {
     let base = scene_text("spheres");
@@ -453,6 +493,7 @@ fn scale_scene(text: &str, k: f64) -> String {
 
 every_scalar! {
     shadow_rays_leave_surfaces_without_acne => no_self_shadow_acne;
+    rays_leaving_a_surface_from_outside_miss_its_object => leaving_rays_miss_their_object;
     a_scene_far_from_the_origin_renders_the_same => far_from_the_origin;
     a_small_far_sphere_keeps_its_silhouette => small_far_sphere;
     tangent_rays_never_give_nan_and_decide_consistently => tangent_rays;
