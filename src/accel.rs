@@ -84,9 +84,10 @@ pub struct Query<'m> {
     /// The window position of the ray being traced when it is an eye ray (see
     /// [`Query::set_eye_ray`]).
     eye: Option<[i32; 2]>,
-    /// Whether the ray being traced is a shadow ray towards the scene's first light, when that
-    /// light is directional (see [`Query::set_first_light_ray`]).
-    first_light: bool,
+    /// When the ray being traced is a shadow ray towards the scene's first light, and that
+    /// light is directional, its position across the light ([`Real::to_raw`] bits of the
+    /// coordinates [`crate::Object::shadow_window`]s are in; see [`Query::set_first_light_ray`]).
+    first_light: Option<[u64; 2]>,
     /// The last world normal [`Query::world_normal`] mapped from a unit axis: the object, the
     /// axis ([`crate::scene::axis_normal`]) and the normal's components as [`Real::to_raw`] bits.
     axis_normal: Option<(u32, u8, [u64; 3])>,
@@ -110,7 +111,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: false, axis_normal: None, last_hit: u32::MAX, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: None, axis_normal: None, last_hit: u32::MAX, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -125,8 +126,10 @@ impl<'m> Query<'m> {
     /// Declares whether the next ray traced is a shadow ray towards the scene's first light,
     /// when that light is directional (its direction the light's `to_light`): objects then take
     /// the direction's object-space image from the scene ([`crate::Object::intersect_first_light_ray`]).
-    pub fn set_first_light_ray(&mut self, yes: bool) {
-        self.first_light = yes;
+    /// `at` is the ray's position across the light (the origin's products with the two axes of
+    /// the scene's shadow basis): objects whose shadow window does not hold it are not tested.
+    pub fn set_first_light_ray<R: Real>(&mut self, at: Option<[R; 2]>) {
+        self.first_light = at.map(|w| [w[0].to_raw(), w[1].to_raw()]);
     }
     /// Declares the object the next rays leave (`None`: none): they start outside it, on the
     /// side of the tangent plane its outward normal points to, and travel away from that plane.
@@ -272,8 +275,16 @@ pub fn offer<R: Real>(
                 return false;
             }
         },
-        None if q.first_light => o.intersect_first_light_ray(ray, tmin, limit),
-        None => o.intersect(ray, tmin, limit),
+        None => match q.first_light {
+            Some(w) => {
+                if !o.shadow_window_holds([R::from_raw(w[0]), R::from_raw(w[1])]) {
+                    q.stats.culled += 1;
+                    return false;
+                }
+                o.intersect_first_light_ray(ray, tmin, limit)
+            }
+            None => o.intersect(ray, tmin, limit),
+        },
     };
     q.stats.object_tests += 1;
     match hit {

@@ -579,30 +579,44 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let last = if self.coherence { q.occluder(l) } else { None };
             // Towards the first light, when it is directional, every object holds the ray's
             // direction in its own space already.
-            let first_light = l == 0 && self.scene.shadow_basis.is_some();
+            // The ray's position across it, which objects' shadow windows are in.
+            let across = match self.scene.shadow_basis {
+                Some((a, b)) if l == 0 => Some([from.dot(a), from.dot(b)]),
+                _ => None,
+            };
             let tried = last.filter(|&i| !q.skips(i) && (i as usize) < self.scene.objects.len());
             if let Some(i) = tried {
                 let o = &self.scene.objects[i as usize];
-                q.stats.object_tests += 1;
-                let hit = if first_light { o.intersect_first_light_ray(&ray, R::ZERO, reach) } else { o.intersect(&ray, R::ZERO, reach) };
+                let hit = match across {
+                    // Outside its window the remembered occluder cannot hide the light.
+                    Some(w) if !o.shadow_window_holds(w) => None,
+                    Some(_) => {
+                        q.stats.object_tests += 1;
+                        o.intersect_first_light_ray(&ray, R::ZERO, reach)
+                    }
+                    None => {
+                        q.stats.object_tests += 1;
+                        o.intersect(&ray, R::ZERO, reach)
+                    }
+                };
                 if hit.is_some() {
                     return R::ZERO;
                 }
             }
             // Missed: the search below need not test it again.
             q.set_tried(tried);
-            let hidden = match self.scene.shadow_basis {
+            let hidden = match across {
                 // Towards the first light, when it is directional, a small scene's shadow rays
                 // test the objects whose shadow window holds the ray, with no walk.
-                Some((a, b)) if l == 0 && self.eye_rays == EyeRays::Windows => {
-                    let found = self.shadow_by_windows(&ray, [from.dot(a), from.dot(b)], reach, q);
+                Some(w) if self.eye_rays == EyeRays::Windows => {
+                    let found = self.shadow_by_windows(&ray, w, reach, q);
                     q.set_occluder(l, found);
                     found.is_some()
                 }
                 _ => {
-                    q.set_first_light_ray(first_light);
+                    q.set_first_light_ray(across);
                     let hidden = self.accel.occluded(self.scene, &ray, R::ZERO, reach, q);
-                    q.set_first_light_ray(false);
+                    q.set_first_light_ray::<R>(None);
                     // Remembered only while the light stays hidden: a lit point forgets it, so
                     // points in the light pay no extra test.
                     q.remember_occluder(l, hidden);
@@ -621,8 +635,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// `w` across the first light (directional) and which the ray hits within `reach`.
     fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, q: &mut Query<'_>) -> Option<u32> {
         for (i, o) in self.scene.objects.iter().enumerate() {
-            let sw = &o.shadow_window;
-            if w[0] < sw[0] || w[0] > sw[1] || w[1] < sw[2] || w[1] > sw[3] || q.skips(i as u32) {
+            if !o.shadow_window_holds(w) || q.skips(i as u32) {
                 q.stats.culled += 1;
                 continue;
             }

@@ -327,6 +327,14 @@ impl<R: Real> Object<R> {
         self.intersect_local(self.point_local(ray.origin), self.light_local, tmin, tmax)
     }
 
+    /// Whether a shadow ray towards the scene's first light (directional) at position `w` across
+    /// the light can meet the object: `w` lies in its [`ShadowWindow`].
+    #[inline]
+    pub fn shadow_window_holds(&self, w: [R; 2]) -> bool {
+        let sw = &self.shadow_window;
+        w[0] >= sw[0] && w[0] <= sw[1] && w[1] >= sw[2] && w[1] <= sw[3]
+    }
+
     /// A world point in object space, as the ray tests take it: relative to the object's
     /// origin, then through `to_object` and its scale.
     #[inline]
