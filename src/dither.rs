@@ -110,11 +110,35 @@ impl Tone {
     }
 }
 
-/// (dx, dy, weight) of an error-diffusion kernel and its divisor.
-type Kernel = (&'static [(i8, i8, i16)], i16);
+/// A tile's error accumulator with its border: `acc[y][x + 1]` is the error arriving at tile
+/// pixel `(x, y)`, for `x` in `-1..w + 2` and `y` in `0..h + 2`.
+type Acc = [[i16; MAX_TILE + 3]; MAX_TILE + 2];
 
-const FLOYD_STEINBERG: Kernel = (&[(1, 0, 7), (-1, 1, 3), (0, 1, 5), (1, 1, 1)], 16);
-const ATKINSON: Kernel = (&[(1, 0, 1), (2, 0, 1), (-1, 1, 1), (0, 1, 1), (1, 1, 1), (0, 2, 1)], 8);
+// An error-diffusion kernel sends error `err` of the pixel at accumulator row `y`, column `c`
+// (the pixel's `x + 1`) to its neighbours, each share `err * weight / divisor` (rounded towards
+// zero). Written out, not a table walked per pixel: the weights are constants, the divisor a
+// shift, and no index is checked at run time.
+
+/// Floyd-Steinberg: 7/16 right, 3/16 below left, 5/16 below, 1/16 below right.
+#[inline(always)]
+fn floyd_steinberg(acc: &mut Acc, y: usize, c: usize, err: i16) {
+    acc[y][c + 1] += err * 7 / 16;
+    acc[y + 1][c - 1] += err * 3 / 16;
+    acc[y + 1][c] += err * 5 / 16;
+    acc[y + 1][c + 1] += err / 16;
+}
+
+/// Atkinson: 1/8 to each of two right, three below and one two rows below (6/8 of the error).
+#[inline(always)]
+fn atkinson(acc: &mut Acc, y: usize, c: usize, err: i16) {
+    let e = err / 8;
+    acc[y][c + 1] += e;
+    acc[y][c + 2] += e;
+    acc[y + 1][c - 1] += e;
+    acc[y + 1][c] += e;
+    acc[y + 1][c + 1] += e;
+    acc[y + 2][c] += e;
+}
 
 /// Largest tile side the renderer supports: 16, or 8 with the `tile8` feature, which makes
 /// every per-tile buffer a quarter the size (firmware whose frames have 8x8 tiles).
@@ -169,9 +193,9 @@ impl<'c> Carry<'c> {
         // Each kernel inlined as a constant: its weights unrolled and its divisor a shift, not
         // a division call per neighbour (a Cortex-M0+ has no divide instruction).
         if mode == Dither::Atkinson {
-            self.diffuse(ATKINSON, x0, w, h, levels, out);
+            self.diffuse(atkinson, x0, w, h, levels, out);
         } else {
-            self.diffuse(FLOYD_STEINBERG, x0, w, h, levels, out);
+            self.diffuse(floyd_steinberg, x0, w, h, levels, out);
         }
     }
 
@@ -184,9 +208,11 @@ impl<'c> Carry<'c> {
     /// columns to the next tile, the rows below to the next band, and what falls outside the
     /// image is dropped.
     #[inline(always)]
-    fn diffuse(&mut self, (kernel, div): Kernel, x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
-        // acc[y][x + 1] is the error arriving at tile pixel (x, y), for x in -1..w + 2.
-        let mut acc = [[0i16; MAX_TILE + 3]; MAX_TILE + 2];
+    fn diffuse(&mut self, kernel: impl Fn(&mut Acc, usize, usize, i16), x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
+        // No tile is larger (the render's tiles are at most MAX_TILE on a side); saying so lets
+        // the kernel's indices go unchecked.
+        let (w, h) = (w.min(MAX_TILE), h.min(MAX_TILE));
+        let mut acc: Acc = [[0; MAX_TILE + 3]; MAX_TILE + 2];
         // Gather what earlier tiles sent here.
         let inc = self.incoming;
         for k in 0..2.min(h) {
@@ -214,9 +240,7 @@ impl<'c> Carry<'c> {
                 let on = v >= (LEVELS as i16 / 2) * SCALE;
                 out[y * w + x] = BinaryColor::from(on);
                 let err = v - if on { LEVELS as i16 * SCALE } else { 0 };
-                for &(dx, dy, wgt) in kernel {
-                    acc[y + dy as usize][(x as isize + 1 + dx as isize) as usize] += err * wgt / div;
-                }
+                kernel(&mut acc, y, x + 1, err);
             }
         }
         // The right border to the next tile, unless beyond the image's right edge.
