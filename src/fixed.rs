@@ -47,11 +47,20 @@ impl Mul for Fx {
     fn mul(self, o: Fx) -> Fx {
         let neg = (self.0 ^ o.0) < 0;
         let (a, b) = (self.0.unsigned_abs(), o.0.unsigned_abs());
-        let (ah, al, bh, bl) = (a >> 16, a & 0xFFFF, b >> 16, b & 0xFFFF);
-        // (a * b + 2^15) >> 16 = ah*bh << 16 + ah*bl + al*bh + (al*bl + 2^15) >> 16; each product
-        // fits 32 bits (ah, bh <= 2^15), and al*bl + 2^15 < 2^32.
-        let m = (u64::from(ah * bh) << 16) + u64::from(ah * bl) + u64::from(al * bh) + u64::from((al * bl + 0x8000) >> 16);
-        let m = if m > i32::MAX as u64 { i32::MAX } else { m as i32 };
+        let m = if (a | b) >> 16 == 0 {
+            // Both below 1 (unit vectors and normals, the objects' scaled matrices): the one
+            // product of the low halves is the whole, (a * b + 2^15) >> 16 < 2^16.
+            ((a * b + 0x8000) >> 16) as i32
+        } else if a >> 16 == 0 || b >> 16 == 0 {
+            let (big, small) = if a >> 16 == 0 { (b, a) } else { (a, b) };
+            ((big >> 16) * small + (((big & 0xFFFF) * small + 0x8000) >> 16)).min(i32::MAX as u32) as i32
+        } else {
+            let (ah, al, bh, bl) = (a >> 16, a & 0xFFFF, b >> 16, b & 0xFFFF);
+            // (a * b + 2^15) >> 16 = ah*bh << 16 + ah*bl + al*bh + (al*bl + 2^15) >> 16; each
+            // product fits 32 bits (ah, bh <= 2^15), and al*bl + 2^15 < 2^32.
+            let m = (u64::from(ah * bh) << 16) + u64::from(ah * bl) + u64::from(al * bh) + u64::from((al * bl + 0x8000) >> 16);
+            if m > i32::MAX as u64 { i32::MAX } else { m as i32 }
+        };
         Fx(if neg { -m } else { m })
     }
 }
@@ -381,6 +390,11 @@ mod tests {
             xorshift(&mut x);
             let (a, b) = ((x as i32) >> (x % 17) as i32, ((x >> 32) as i32) >> ((x >> 40) % 19) as i32);
             check(a.max(-i32::MAX), b.max(-i32::MAX));
+            // One factor or both below 1, as the short paths take them.
+            let small = ((x >> 48) as i32) - 0x8000;
+            check(small, a.max(-i32::MAX));
+            check(b.max(-i32::MAX), small);
+            check(small, small >> (x % 5));
         }
         // Around the products that just fit and just saturate, and the halves' extremes.
         let edges: [i32; 13] = [0, 1, 0x7FFF, 0x8000, 0xFFFF, 0x1_0000, 0x1_FFFF, 0x00B5_04F3, 0x00B5_0500, 0x7FFF_0000, 0x7FFF_FFFF, 0x00FF_FFFF, 0x0100_0000];
