@@ -175,28 +175,12 @@ impl<R: Real> Aabb<R> {
     }
     /// Clips the ray's parameter range `[t0, t1]` to the box (slab method). A zero direction
     /// component (+0.0 or -0.0 alike) keeps the whole range if the origin lies within that slab.
-    pub fn clip(&self, ray: &Ray<R>, mut t0: R, mut t1: R) -> Option<(R, R)> {
-        for a in 0..3 {
-            let (o, d) = (ray.origin.axis(a), ray.dir.axis(a));
-            let (lo, hi) = (self.min.axis(a), self.max.axis(a));
-            if d == R::ZERO {
-                if o < lo || o > hi {
-                    return None;
-                }
-                continue;
-            }
-            let inv = d.recip();
-            let (mut ta, mut tb) = ((lo - o) * inv, (hi - o) * inv);
-            if ta > tb {
-                core::mem::swap(&mut ta, &mut tb);
-            }
-            t0 = t0.max(ta);
-            t1 = t1.min(tb);
-            if t0 > t1 {
-                return None;
-            }
-        }
-        Some((t0, t1))
+    pub fn clip(&self, ray: &Ray<R>, t0: R, t1: R) -> Option<(R, R)> {
+        // The three slabs written out: no axis chosen by index at run time.
+        let (o, d) = (ray.origin, ray.dir);
+        let (t0, t1) = slab(o.x, d.x, self.min.x, self.max.x, t0, t1)?;
+        let (t0, t1) = slab(o.y, d.y, self.min.y, self.max.y, t0, t1)?;
+        slab(o.z, d.z, self.min.z, self.max.z, t0, t1)
     }
     /// Converts to another scalar, rounding outwards by the target's padding so the box stays
     /// conservative.
@@ -210,6 +194,26 @@ impl<R: Real> Aabb<R> {
         let pad = S::pad_eps().to_f64() * (1.0 + ext);
         let grow = |v: Vec3<R>, s: f64| Vec3::new(v.x.to_f64() + s * pad, v.y.to_f64() + s * pad, v.z.to_f64() + s * pad);
         Aabb { min: grow(self.min, -1.0), max: grow(self.max, 1.0) }
+    }
+}
+
+/// [`Aabb::clip`] on one axis: the range `[t0, t1]` of a ray with origin `o` and direction `d`
+/// on that axis, cut to the slab `lo..=hi`.
+#[inline(always)]
+fn slab<R: Real>(o: R, d: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
+    if d == R::ZERO {
+        return if o < lo || o > hi { None } else { Some((t0, t1)) };
+    }
+    let inv = d.recip();
+    let (mut ta, mut tb) = ((lo - o) * inv, (hi - o) * inv);
+    if ta > tb {
+        core::mem::swap(&mut ta, &mut tb);
+    }
+    let (t0, t1) = (t0.max(ta), t1.min(tb));
+    if t0 > t1 {
+        None
+    } else {
+        Some((t0, t1))
     }
 }
 
