@@ -127,6 +127,11 @@ mod writer {
             record(out, "Aabb", &[("min", &self.min), ("max", &self.max)]);
         }
     }
+    impl<R: Literal> Literal for crate::math::Linear<R> {
+        fn literal(&self, out: &mut String) {
+            record(out, "Linear", &[("m", &self.m)]);
+        }
+    }
     impl<R: Literal> Literal for crate::math::Affine<R> {
         fn literal(&self, out: &mut String) {
             record(out, "Affine", &[("m", &self.m)]);
@@ -286,7 +291,7 @@ pub mod prelude {
     pub use crate::lattice::{Lattice, SubLattice};
     pub use crate::scene::Scene;
     pub use heapless::Vec;
-    pub use crate::math::{Aabb, Affine, Vec3};
+    pub use crate::math::{Aabb, Affine, Linear, Vec3};
     pub use crate::scene::{Camera, Composite, Light, Material, Object};
     pub use crate::shape::Shape;
     pub use crate::scalar::Pow2;

@@ -19,7 +19,7 @@ pub use scalar::{F32Micro, F32MicroNewton, Real};
 pub mod fixed;
 pub use fixed::Fx;
 pub mod math;
-pub use math::{Aabb, Affine, Ray, Vec3};
+pub use math::{Aabb, Affine, Linear, Ray, Vec3};
 pub mod shape;
 pub use shape::{Shape, ShapeHit};
 pub mod scene;

@@ -217,6 +217,47 @@ fn slab<R: Real>(o: R, d: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
     }
 }
 
+/// A linear map as a 3x3 matrix: an [`Affine`] transform without its translation (what maps
+/// directions, and points taken relative to an origin).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Linear<R> {
+    /// Rows of `A`.
+    pub m: [[R; 3]; 3],
+}
+
+impl<R: Real> Linear<R> {
+    /// Applies the map to a direction.
+    #[inline]
+    pub fn vector(&self, v: Vec3<R>) -> Vec3<R> {
+        let m = &self.m;
+        Vec3::new(
+            m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
+            m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+            m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z,
+        )
+    }
+    /// Applies the transpose: with `self` the world-to-object map this maps an object-space
+    /// normal to world space (the inverse transpose rule).
+    #[inline]
+    pub fn transpose_vector(&self, v: Vec3<R>) -> Vec3<R> {
+        let m = &self.m;
+        Vec3::new(
+            m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z,
+            m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
+            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z,
+        )
+    }
+    /// Converts to another scalar.
+    pub fn cast<S: Real>(&self) -> Linear<S> {
+        Linear { m: self.m.map(|row| row.map(|v| S::from_f64(v.to_f64()))) }
+    }
+    /// The affine transform with this linear part and no translation.
+    pub fn affine(&self) -> Affine<R> {
+        let (m, z) = (&self.m, R::ZERO);
+        Affine { m: [[m[0][0], m[0][1], m[0][2], z], [m[1][0], m[1][1], m[1][2], z], [m[2][0], m[2][1], m[2][2], z]] }
+    }
+}
+
 /// An affine transform as a 3x4 matrix `[A | b]`: `p' = A p + b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Affine<R> {
@@ -243,23 +284,13 @@ impl<R: Real> Affine<R> {
     /// Applies the linear part to a direction.
     #[inline]
     pub fn vector(&self, v: Vec3<R>) -> Vec3<R> {
-        let m = &self.m;
-        Vec3::new(
-            m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
-            m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
-            m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z,
-        )
+        self.linear().vector(v)
     }
-    /// Applies the transpose of the linear part: with `self` the world-to-object transform this
-    /// maps an object-space normal to world space (the inverse transpose rule).
+    /// The linear part `A`, without the translation.
     #[inline]
-    pub fn transpose_vector(&self, v: Vec3<R>) -> Vec3<R> {
+    pub fn linear(&self) -> Linear<R> {
         let m = &self.m;
-        Vec3::new(
-            m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z,
-            m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
-            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z,
-        )
+        Linear { m: [[m[0][0], m[0][1], m[0][2]], [m[1][0], m[1][1], m[1][2]], [m[2][0], m[2][1], m[2][2]]] }
     }
     /// Maps a ray (the parameter `t` is preserved because the direction is not renormalised).
     #[inline]

@@ -225,7 +225,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         scaled.m.iter_mut().for_each(|row| row[3] = 0.0);
         self.storage[self.len] = Object {
             shape,
-            to_object: scaled.cast(),
+            to_object: scaled.linear().cast(),
             to_world: place.cast(),
             unscale: R::pow2(log2_of_pow2(unscale)),
             dir_factor: R::pow2(log2_of_pow2(unscale * dir_scale)),

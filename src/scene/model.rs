@@ -1,6 +1,6 @@
 //! The validated scene: objects, composites, materials, lights and the camera.
 
-use crate::math::{Aabb, Affine, Ray, Vec3};
+use crate::math::{Aabb, Affine, Linear, Ray, Vec3};
 use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
 use heapless::Vec;
@@ -184,7 +184,7 @@ pub struct Object<R> {
     /// World-to-object transform (the inverse of the placement) multiplied by the power of two
     /// `2^-unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
     /// full precision however large or small the object is (exact in floating point).
-    pub(crate) to_object: Affine<R>,
+    pub(crate) to_object: Linear<R>,
     /// The placement, from canonical object space to the world: hit points are mapped back
     /// through it ([`Object::surface_point`]). Its translation is the object's origin: rays are
     /// taken relative to it before `to_object` (whose translation is then zero), so a scene far
@@ -256,7 +256,7 @@ impl<R: Real> Default for Object<R> {
         let z = Vec3::new(R::ZERO, R::ZERO, R::ZERO);
         Object {
             shape: Shape::Sphere,
-            to_object: Affine::identity(),
+            to_object: Affine::identity().linear(),
             to_world: Affine::identity(),
             unscale: R::pow2(0),
             dir_factor: R::pow2(0),
@@ -280,7 +280,7 @@ impl<R> Object<R> {
     #[allow(clippy::too_many_arguments)]
     pub const fn from_tables(
         shape: Shape<R>,
-        to_object: Affine<R>,
+        to_object: Linear<R>,
         to_world: Affine<R>,
         unscale: Pow2<R>,
         dir_factor: Pow2<R>,
@@ -408,7 +408,7 @@ impl<R: Real> Object<R> {
     /// The map from a world offset relative to [`Object::origin`] to object space (the
     /// inverse of the placement), without the scaling the stored copy carries for precision.
     pub fn world_to_object(&self) -> Affine<R> {
-        let mut t = self.to_object;
+        let mut t = self.to_object.affine();
         for row in t.m.iter_mut() {
             for v in row.iter_mut() {
                 *v = v.mul_pow2(self.unscale);
