@@ -550,9 +550,11 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
     // The eye ray through `(sx, sy)` (quarter pixels), its window position given to the query.
-    let eye = |q: &mut Query<'_>, sx: usize, sy: usize| {
-        q.set_eye_ray(Some(Camera::<R>::window_uv(sx as i32, sy as i32, w4, h4)));
-        cam.ray(sx as i32, sy as i32, w4, h4)
+    let mut window = Window::<R>::new(w4, h4);
+    let mut eye = |q: &mut Query<'_>, sx: usize, sy: usize| {
+        let (uv, u, v) = window.at(sx as i32, sy as i32);
+        q.set_eye_ray(Some(uv));
+        cam.ray_through(u, v)
     };
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut hits = Hits::new();
@@ -633,6 +635,38 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
         }
     }
     Ok(q.stats)
+}
+
+/// Where a frame's eye rays pass the window: per quarter-pixel column its window coordinate
+/// ([`Camera::window_u`]) and ray factor ([`Camera::ray_u`]), and the same of the last row
+/// asked for, each kept from the last ray that needed it. Both depend on one position alone,
+/// so a tile's rays (row by row) compute them, each a division, once per column and row
+/// instead of once per ray; the values are the same.
+struct Window<R> {
+    size: (i32, i32),
+    cols: [(i32, i32, R); MAX_TILE],
+    row: (i32, i32, R),
+}
+
+impl<R: Real> Window<R> {
+    fn new(w4: i32, h4: i32) -> Self {
+        Window { size: (w4, h4), cols: [(-1, 0, R::ZERO); MAX_TILE], row: (-1, 0, R::ZERO) }
+    }
+
+    /// Window position (2^-16 units) and ray factors `u`, `v` of the eye ray through `(sx, sy)`.
+    #[inline]
+    fn at(&mut self, sx: i32, sy: i32) -> ([i32; 2], R, R) {
+        let (w4, h4) = self.size;
+        let c = &mut self.cols[(sx as usize >> 2) % MAX_TILE];
+        if c.0 != sx {
+            *c = (sx, Camera::<R>::window_u(sx, w4), Camera::<R>::ray_u(sx, w4));
+        }
+        let r = &mut self.row;
+        if r.0 != sy {
+            *r = (sy, Camera::<R>::window_v(sy, h4), Camera::<R>::ray_v(sy, h4));
+        }
+        ([c.1, r.1], c.2, r.2)
+    }
 }
 
 /// The objects the eye rays of the tile `at` can hit: those whose window meets the tile's

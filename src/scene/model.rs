@@ -148,9 +148,25 @@ impl<R: Real> Camera<R> {
     /// The eye ray through the point `(sx, sy)` of a `w x h` window, in pixel units from the
     /// top-left corner (pixel centres are at `i + 0.5`).
     pub fn ray(&self, sx2: i32, sy2: i32, w2: i32, h2: i32) -> Ray<R> {
-        // Arguments are doubled coordinates so that pixel centres stay integers.
-        let u = ratio::<R>(2 * sx2 - w2, w2);
-        let v = ratio::<R>(h2 - 2 * sy2, h2);
+        self.ray_through(Self::ray_u(sx2, w2), Self::ray_v(sy2, h2))
+    }
+
+    /// The factor of `right` in the direction of [`Camera::ray`] (it depends on the horizontal
+    /// position alone). Arguments are doubled coordinates so that pixel centres stay integers.
+    #[inline]
+    pub fn ray_u(sx2: i32, w2: i32) -> R {
+        ratio::<R>(2 * sx2 - w2, w2)
+    }
+
+    /// The factor of `up` in the direction of [`Camera::ray`] (the vertical position's alone).
+    #[inline]
+    pub fn ray_v(sy2: i32, h2: i32) -> R {
+        ratio::<R>(h2 - 2 * sy2, h2)
+    }
+
+    /// The eye ray with direction `forward + right * u + up * v`.
+    #[inline]
+    pub fn ray_through(&self, u: R, v: R) -> Ray<R> {
         Ray::new(self.eye, self.forward + self.right * u + self.up * v)
     }
 }
