@@ -63,7 +63,13 @@ pub const BAYER8: [[u8; 8]; 8] = [
 /// The NxN matrix is the top-left corner of the 8x8 one divided down, which is the Bayer
 /// matrix of that size; the level is first rounded to the N*N + 1 levels it can show.
 pub fn ordered(level: u8, x: u32, y: u32, n: u8) -> BinaryColor {
-    let n = n.clamp(1, 8) as u32;
+    ordered_by(level, x, y, n.clamp(1, 8) as u32)
+}
+
+/// [`ordered`] with `n` already in 1..=8: inlined where `n` is a constant, its divisions are
+/// shifts.
+#[inline(always)]
+fn ordered_by(level: u8, x: u32, y: u32, n: u32) -> BinaryColor {
     let cells = n * n;
     let q = (level.min(LEVELS) as u32 * cells + 32) / 64; // 0..=cells
     let shift = 64 / cells;
@@ -318,12 +324,20 @@ impl<'c> Ditherer<'c> {
                 }
             }
             None => {
-                let n = if self.mode == Dither::Bayer { 8 } else { self.mode.block() };
-                for y in 0..h {
-                    for x in 0..w {
-                        let (l, gx, gy) = (levels[y * w + x], (x0 + x) as u32, (y0 + y) as u32);
-                        out[y * w + x] = ordered(l, gx, gy, n);
+                // Each pattern size its own copy of the loop, with `n` a constant.
+                let mut each = |n: u32| {
+                    for y in 0..h {
+                        for x in 0..w {
+                            let (l, gx, gy) = (levels[y * w + x], (x0 + x) as u32, (y0 + y) as u32);
+                            out[y * w + x] = ordered_by(l, gx, gy, n);
+                        }
                     }
+                };
+                match if self.mode == Dither::Bayer { 8 } else { self.mode.block().clamp(1, 8) } {
+                    8 => each(8),
+                    4 => each(4),
+                    2 => each(2),
+                    n => each(u32::from(n)),
                 }
             }
         }
