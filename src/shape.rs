@@ -232,9 +232,10 @@ fn unit_box<R: Real>(r: &Ray<R>, tmin: R, t0: R, t1: R) -> Option<ShapeHit<R>> {
             }
         }
     }
-    let mut n = [R::ZERO; 3];
-    n[axis] = sign;
-    Some(ShapeHit { t, normal: Vec3::new(n[0], n[1], n[2]), point: p })
+    // Component by component, not through an array indexed by `axis`: a store at a computed
+    // index read back whole straight after stalls the load on x86 (store forwarding).
+    let on = |a: usize| if axis == a { sign } else { R::ZERO };
+    Some(ShapeHit { t, normal: Vec3::new(on(0), on(1), on(2)), point: p })
 }
 
 #[cfg(test)]
