@@ -12,11 +12,10 @@
 #![no_main]
 
 use core::cell::Cell;
-use core::fmt;
 use cortex_m::interrupt::{free, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_semihosting::{debug, hio};
 use firmware::app::{render_embedded_at, Board, OneCore, Scalar, SceneMemory, ShareMemory, Shot, EMBEDDED, FRAME};
 use firmware::stack;
 use lattice_rt::{BitFrame, NoHooks};
@@ -41,10 +40,67 @@ fn ticks() -> u64 {
     }
 }
 
-struct Hex<'a>(&'a [u8]);
-impl fmt::Display for Hex<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.0.iter().try_for_each(|b| write!(f, "{b:02x}"))
+/// A line the harness prints on the host's standard output over semihosting, built without
+/// `core::fmt` (its formatting machinery is kilobytes of the flash the baked builds measure).
+struct Line {
+    bytes: [u8; 48],
+    len: usize,
+}
+
+impl Line {
+    fn new() -> Self {
+        Line { bytes: [0; 48], len: 0 }
+    }
+    /// Appends bytes, sending the line so far when it is full.
+    fn put(&mut self, bytes: &[u8]) -> &mut Self {
+        for &b in bytes {
+            if self.len == self.bytes.len() {
+                send(&self.bytes);
+                self.len = 0;
+            }
+            self.bytes[self.len] = b;
+            self.len += 1;
+        }
+        self
+    }
+    /// Appends text.
+    fn text(&mut self, t: &str) -> &mut Self {
+        self.put(t.as_bytes())
+    }
+    /// Appends a number in decimal.
+    fn dec(&mut self, mut v: u64) -> &mut Self {
+        let mut digits = [0u8; 20];
+        let mut i = digits.len();
+        loop {
+            i -= 1;
+            digits[i] = b'0' + (v % 10) as u8;
+            v /= 10;
+            if v == 0 {
+                break;
+            }
+        }
+        self.put(&digits[i..])
+    }
+    /// Appends bytes as lowercase hex, two digits each.
+    fn hex(&mut self, bytes: &[u8]) -> &mut Self {
+        const DIGITS: &[u8; 16] = b"0123456789abcdef";
+        for &b in bytes {
+            self.put(&[DIGITS[usize::from(b >> 4)], DIGITS[usize::from(b & 15)]]);
+        }
+        self
+    }
+    /// Ends the line and sends it.
+    fn end(&mut self) {
+        self.put(b"\n");
+        send(&self.bytes[..self.len]);
+        self.len = 0;
+    }
+}
+
+/// Writes bytes to the host's standard output.
+fn send(bytes: &[u8]) {
+    if let Ok(mut out) = hio::hstdout() {
+        let _ = out.write_all(bytes);
     }
 }
 
@@ -69,12 +125,12 @@ fn main() -> ! {
     cp.SYST.enable_interrupt();
     cp.SYST.enable_counter();
     let board = env!("FIRMWARE_CORE");
-    hprintln!("BOARD {} scalar {} size {}x{}", board, <Scalar as lattice_rt::Real>::NAME, FRAME.width, FRAME.height);
+    Line::new().text("BOARD ").text(board).text(" scalar ").text(<Scalar as lattice_rt::Real>::NAME).text(" size ").dec(FRAME.width.into()).text("x").dec(FRAME.height.into()).end();
     // SysTick's clock differs between the machines (25 MHz on the an385/an386, 20 MHz on the
     // an505): a loop of exactly CALIBRATE_INSTRUCTIONS instructions tells the host the rate.
     let t0 = ticks();
     spin(CALIBRATE_INSTRUCTIONS / 2);
-    hprintln!("CALIBRATE instructions {} ticks {}", CALIBRATE_INSTRUCTIONS, ticks() - t0);
+    Line::new().text("CALIBRATE instructions ").dec(CALIBRATE_INSTRUCTIONS.into()).text(" ticks ").dec(ticks() - t0).end();
     let mut st = SceneMemory::new();
     let mut second = ShareMemory::new();
     let mut bits = [0u8; BitFrame::bytes(FRAME.width as u32, FRAME.height as u32)];
@@ -88,22 +144,37 @@ fn main() -> ! {
             Ok(r) => {
                 let t = ticks() - t0;
                 let s = r.stats;
-                hprintln!(
-                    "SCENE {} ticks {} tiles {} rays {} primary {} shadow {} reflection {} refraction {} tests {} cells {} objects {} lattice_bytes {} stack_so_far {}",
-                    name, t, r.share_us[0] + r.share_us[1], s.total_rays(), s.rays[0], s.rays[1], s.rays[2], s.rays[3], s.object_tests,
-                    s.cells_visited, r.objects, r.lattice_bytes, stack::high_water()
-                );
+                let fields = [
+                    ("ticks", t),
+                    ("tiles", r.share_us[0] + r.share_us[1]),
+                    ("rays", s.total_rays()),
+                    ("primary", s.rays[0]),
+                    ("shadow", s.rays[1]),
+                    ("reflection", s.rays[2]),
+                    ("refraction", s.rays[3]),
+                    ("tests", s.object_tests),
+                    ("cells", s.cells_visited),
+                    ("objects", r.objects as u64),
+                    ("lattice_bytes", r.lattice_bytes as u64),
+                    ("stack_so_far", stack::high_water() as u64),
+                ];
+                let mut line = Line::new();
+                line.text("SCENE ").text(name);
+                for (key, value) in fields {
+                    line.text(" ").text(key).text(" ").dec(value);
+                }
+                line.end();
                 for row in frame.raster().chunks(FRAME.width as usize / 8) {
-                    hprintln!("ROW {}", Hex(row));
+                    Line::new().text("ROW ").hex(row).end();
                 }
             }
             Err(e) => {
-                hprintln!("ERROR {}: {}", name, e);
+                report_error(name, &e);
                 failed = true;
             }
         }
     }
-    hprintln!("RAM stack_high_water {} static {}", stack::high_water(), stack::static_bytes());
+    Line::new().text("RAM stack_high_water ").dec(stack::high_water() as u64).text(" static ").dec(stack::static_bytes() as u64).end();
     debug::exit(if failed { debug::EXIT_FAILURE } else { debug::EXIT_SUCCESS });
     loop {
         cortex_m::asm::wfi();
@@ -112,7 +183,7 @@ fn main() -> ! {
 
 #[exception]
 unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    hprintln!("HARDFAULT at pc {:#010x}", ef.pc());
+    Line::new().text("HARDFAULT at pc 0x").hex(&ef.pc().to_be_bytes()).end();
     debug::exit(debug::EXIT_FAILURE);
     loop {
         cortex_m::asm::wfi();
@@ -121,9 +192,33 @@ unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("PANIC {}", info);
+    // Where, not the message: formatting it would link `core::fmt` into every build.
+    match info.location() {
+        Some(at) => Line::new().text("PANIC at ").text(at.file()).text(":").dec(at.line().into()).end(),
+        None => Line::new().text("PANIC").end(),
+    }
     debug::exit(debug::EXIT_FAILURE);
     loop {
         cortex_m::asm::wfi();
+    }
+}
+
+/// The `ERROR` line of a scene that could not be shown: with the message where scenes are
+/// parsed (the parser's messages are linked there anyway), the error's kind where they are baked.
+fn report_error<E: core::fmt::Debug>(name: &str, e: &firmware::app::AppError<'_, E>) {
+    #[cfg(not(baked_scenes))]
+    {
+        cortex_m_semihosting::hprintln!("ERROR {}: {}", name, e);
+    }
+    #[cfg(baked_scenes)]
+    {
+        use firmware::app::AppError;
+        let kind = match e {
+            AppError::Effects(_) => "the scene needs an effect this build leaves out",
+            AppError::BakedCamera => "a baked scene is shown from its own camera only",
+            AppError::Render(_) => "the render failed",
+            AppError::Text(_) => "",
+        };
+        Line::new().text("ERROR ").text(name).text(": ").text(kind).end();
     }
 }
