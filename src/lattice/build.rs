@@ -100,7 +100,7 @@ impl<'a, R: Real> Lattice<'a, R> {
         let wp = planes_of(world, &lattices[0]);
         let mut more_used = 0;
         let mut failed = Ok(());
-        cluster::for_each_dense(scene, cfg, wp, |d| {
+        cluster::for_each_dense(scene, cfg, &wp, |d| {
             if failed.is_ok() {
                 let uniform = |a: usize, out: &mut [R]| {
                     let (lo, hi) = (d.bounds.min.axis(a), d.bounds.max.axis(a));
@@ -187,7 +187,7 @@ fn for_each_ref<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, coords: &[R]
 
 /// Calls `f` with the global cell index of every cell of `sub` a box overlaps.
 fn visit_cells<R: Real>(coords: &[R], sub: &SubLattice<R>, b: &Aabb<R>, mut f: impl FnMut(usize)) {
-    let r = cluster::span(planes_of(coords, sub), b);
+    let r = cluster::span(&planes_of(coords, sub), b);
     let (nx, ny) = (sub.n[0] as usize, sub.n[1] as usize);
     for z in r[2].0..=r[2].1 {
         for y in r[1].0..=r[1].1 {

@@ -9,7 +9,7 @@
 //! a pass or two over the free objects per 4096 world cells and no storage.
 
 use super::plan::{resolution, uniform_coord};
-use super::{locate, locate_by, LatticeConfig, NO_COMPOSITE};
+use super::{locate_by, LatticeConfig, NO_COMPOSITE};
 use crate::math::{Aabb, Vec3};
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -32,19 +32,51 @@ pub(super) struct Dense<R> {
     pub refs: usize,
 }
 
-/// Cell index range `[lo, hi]` per axis a box overlaps on coordinate lists `planes`.
-pub(super) fn span<R: Real>(planes: [&[R]; 3], b: &Aabb<R>) -> [(usize, usize); 3] {
-    [0, 1, 2].map(|a| (locate(planes[a], b.min.axis(a)), locate(planes[a], b.max.axis(a))))
+/// A lattice's coordinate lists, stored or computed.
+pub(super) trait Planes<R> {
+    /// Cells on axis `a`.
+    fn cells(&self, a: usize) -> usize;
+    /// Plane `i` (0 to `cells(a)`) of axis `a`.
+    fn plane(&self, a: usize, i: usize) -> R;
 }
 
-/// Cell index range `[lo, hi]` per axis a box overlaps in a dense cell's lattice (equal cells,
-/// the planes [`uniform_coord`] gives, as stored).
-pub(super) fn span_uniform<R: Real>(lattice: &Aabb<R>, n: [u16; 3], b: &Aabb<R>) -> [(usize, usize); 3] {
-    [0, 1, 2].map(|a| {
-        let (lo, hi) = (lattice.min.axis(a), lattice.max.axis(a));
-        let at = |x: R| locate_by(n[a] as usize, x, |i| uniform_coord(lo, hi, n[a], i));
-        (at(b.min.axis(a)), at(b.max.axis(a)))
-    })
+/// Stored coordinate lists, one per axis.
+impl<R: Real> Planes<R> for [&[R]; 3] {
+    fn cells(&self, a: usize) -> usize {
+        self[a].len() - 1
+    }
+    fn plane(&self, a: usize, i: usize) -> R {
+        self[a][i]
+    }
+}
+
+/// Equal cells over a box: the planes [`uniform_coord`] gives, as stored, computed when asked
+/// (no list on the stack, which for [`super::MAX_PER_AXIS`] planes an axis is 12 KB in fixed
+/// point).
+pub(super) struct Uniform<'b, R> {
+    /// The box.
+    pub bounds: &'b Aabb<R>,
+    /// Cells per axis.
+    pub n: [u16; 3],
+}
+
+impl<R: Real> Planes<R> for Uniform<'_, R> {
+    fn cells(&self, a: usize) -> usize {
+        self.n[a] as usize
+    }
+    fn plane(&self, a: usize, i: usize) -> R {
+        uniform_coord(self.bounds.min.axis(a), self.bounds.max.axis(a), self.n[a], i)
+    }
+}
+
+/// Cell index range `[lo, hi]` per axis a box overlaps on the coordinate lists `planes`.
+pub(super) fn span<R: Real>(planes: &(impl Planes<R> + ?Sized), b: &Aabb<R>) -> [(usize, usize); 3] {
+    [0, 1, 2].map(|a| (locate_on(planes, a, b.min.axis(a)), locate_on(planes, a, b.max.axis(a))))
+}
+
+/// The cell of axis `a` that coordinate `x` falls in.
+fn locate_on<R: Real>(planes: &(impl Planes<R> + ?Sized), a: usize, x: R) -> usize {
+    locate_by(planes.cells(a), x, |i| planes.plane(a, i))
 }
 
 /// Cells a box overlaps in a range from [`span`].
@@ -65,7 +97,7 @@ pub(super) fn possible<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> bo
 
 /// Calls `f` for every dense cell of the world lattice whose coordinate lists are `planes`, in
 /// cell order.
-pub(super) fn for_each_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: [&[R]; 3], f: impl FnMut(&Dense<R>)) {
+pub(super) fn for_each_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Planes<R> + ?Sized), f: impl FnMut(&Dense<R>)) {
     if possible(scene, cfg) {
         scan(scene, cfg, planes, f);
     }
@@ -74,16 +106,16 @@ pub(super) fn for_each_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig,
 /// [`for_each_dense`]'s work, out of line so that its counters are on the stack only when a
 /// scene can have a dense cell.
 #[inline(never)]
-fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: [&[R]; 3], mut f: impl FnMut(&Dense<R>)) {
+fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Planes<R> + ?Sized), mut f: impl FnMut(&Dense<R>)) {
     let split = cfg.split as usize;
-    let n = planes.map(|p| p.len() - 1);
+    let n = [0, 1, 2].map(|a| planes.cells(a));
     let (slab, total) = (n[0] * n[1], n[0] * n[1] * n[2]);
     let xyz = |c: usize| [c % n[0], (c / n[0]) % n[1], c / slab];
     let dense = |c: usize, free: usize| {
         let [x, y, z] = xyz(c);
         let bounds = Aabb {
-            min: Vec3::new(planes[0][x], planes[1][y], planes[2][z]),
-            max: Vec3::new(planes[0][x + 1], planes[1][y + 1], planes[2][z + 1]),
+            min: Vec3::new(planes.plane(0, x), planes.plane(1, y), planes.plane(2, z)),
+            max: Vec3::new(planes.plane(0, x + 1), planes.plane(1, y + 1), planes.plane(2, z + 1)),
         };
         Dense { cell: c, free, bounds, n: resolution(&bounds, free, cfg.sub, cfg.max_per_axis), refs: 0 }
     };
@@ -95,7 +127,7 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: [&[R]; 3], m
         // overlaps.
         let each = |visit: &mut dyn FnMut(usize, &Aabb<R>)| {
             for (_, b) in free_objects(scene) {
-                let (lz, hz) = (locate(planes[2], b.min.z), locate(planes[2], b.max.z));
+                let (lz, hz) = (locate_on(planes, 2, b.min.z), locate_on(planes, 2, b.max.z));
                 if hz < z0 || lz > z1 {
                     continue;
                 }
@@ -121,7 +153,7 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: [&[R]; 3], m
         each(&mut |i, b| {
             if counts[i] as usize > split {
                 let d = dense(base + i, counts[i] as usize);
-                refs[i] += cells_in(&span_uniform(&d.bounds, d.n, b)) as u32;
+                refs[i] += cells_in(&span(&Uniform { bounds: &d.bounds, n: d.n }, b)) as u32;
             }
         });
         for i in 0..end - base {

@@ -127,21 +127,21 @@ pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeCon
 /// share of its `items`) and one reference per dense cell; with no dense cell, `n` stands.
 #[inline(never)]
 fn past_the_clusters<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: &Aabb<R>, n: [u16; 3], items: usize, res: Resolution) -> [u16; 3] {
-    let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
-    for (a, p) in planes.iter_mut().enumerate() {
-        axis_planes(scene, cfg, 0, a, b, n[a], p);
-    }
-    let planes = [0, 1, 2].map(|a| &planes[a][..n[a] as usize + 1]);
-    let (mut crowded, mut cells) = (0, 0);
-    cluster::for_each_dense(scene, cfg, planes, |d| {
-        crowded += d.free;
-        cells += 1;
+    let (crowded, cells, refs) = with_planes(scene, cfg, 0, b, n, |planes| {
+        let (mut crowded, mut cells) = (0, 0);
+        cluster::for_each_dense(scene, cfg, planes, |d| {
+            crowded += d.free;
+            cells += 1;
+        });
+        let mut refs = 0;
+        if cells > 0 {
+            for_each_item(scene, cfg, 0, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
+        }
+        (crowded, cells, refs)
     });
     if cells == 0 {
         return n;
     }
-    let mut refs = 0;
-    for_each_item(scene, cfg, 0, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
     let kept = items as f64 * (refs.saturating_sub(crowded)) as f64 / refs.max(1) as f64;
     resolution(b, libm::round(kept) as usize + cells, res, cfg.max_per_axis)
 }
@@ -284,14 +284,32 @@ fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize,
 /// References to the cells of lattice `g` (over `b`, `n` cells per axis).
 #[inline(never)]
 fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3]) -> usize {
+    with_planes(scene, cfg, g, b, n, |planes| {
+        let mut refs = 0;
+        for_each_item(scene, cfg, g, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
+        refs
+    })
+}
+
+/// `work` over the coordinate lists of lattice `g` over `b` with `n` cells per axis, as
+/// [`axis_planes`] writes them: equal cells computed when asked, adaptive ones written into
+/// lists on the stack (12 KB in fixed point for [`MAX_PER_AXIS`] planes an axis, out of line
+/// so that only they pay it).
+fn with_planes<R: Real, T>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3], work: impl FnOnce(&dyn cluster::Planes<R>) -> T) -> T {
+    match cfg.spacing {
+        Spacing::Uniform => work(&cluster::Uniform { bounds: b, n }),
+        Spacing::Adaptive => listed_planes(scene, cfg, g, b, n, work),
+    }
+}
+
+/// [`with_planes`] for adaptive spacing.
+#[inline(never)]
+fn listed_planes<R: Real, T>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3], work: impl FnOnce(&dyn cluster::Planes<R>) -> T) -> T {
     let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
     for (a, p) in planes.iter_mut().enumerate() {
         axis_planes(scene, cfg, g, a, b, n[a], p);
     }
-    let planes = [0, 1, 2].map(|a| &planes[a][..n[a] as usize + 1]);
-    let mut refs = 0;
-    for_each_item(scene, cfg, g, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
-    refs
+    work(&[0, 1, 2].map(|a| &planes[a][..n[a] as usize + 1]))
 }
 impl<R: Real> Lattice<'_, R> {
     /// Storage a scene needs with this configuration (within its budget, if it has one: see
@@ -348,10 +366,5 @@ fn plan_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, wb: &Aabb<R>, 
     if !cluster::possible(scene, cfg) {
         return;
     }
-    let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
-    for (a, p) in planes.iter_mut().enumerate() {
-        axis_planes(scene, cfg, 0, a, wb, wn[a], p);
-    }
-    let planes = [0, 1, 2].map(|a| &planes[a][..wn[a] as usize + 1]);
-    cluster::for_each_dense(scene, cfg, planes, |d| f(&d.bounds, d.n, d.refs, d.free));
+    with_planes(scene, cfg, 0, wb, wn, |planes| cluster::for_each_dense(scene, cfg, planes, |d| f(&d.bounds, d.n, d.refs, d.free)));
 }
