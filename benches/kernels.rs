@@ -17,14 +17,14 @@ fn primitives(c: &mut Criterion) {
     c.bench_function("intersect sphere fixed", |b| b.iter(|| black_box(Shape::<Fx>::Sphere).intersect(black_box(&rf), Fx::ZERO, Fx::MAX)));
 }
 
-fn scene_parts<'a, R: Real>(text: &str, st: &'a mut Vec<Object<R>>) -> lattice_rt::Scene<'a, R> {
+fn scene_parts<'a, R: Real>(text: &str, (st, parts): &'a mut (Vec<Object<R>>, lattice_rt::Parts<R>)) -> lattice_rt::Scene<'a, R> {
     *st = vec![Object::default(); 64];
-    parse::<R>(text, st).unwrap()
+    parse::<R>(text, st, parts).unwrap()
 }
 
 fn walk_and_tile(c: &mut Criterion) {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/desk.scene")).unwrap();
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_parts::<f64>(&text, &mut st);
     let cfg = LatticeConfig::default();
     let mut storage = HeapStorage::new(Sizes { objects: 0, ..Sizes::of(&scene, Some(&cfg), &Frame::new(8, 8)) });
@@ -56,7 +56,7 @@ fn walk_and_tile(c: &mut Criterion) {
 /// shift.
 fn levers(c: &mut Criterion) {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/chair.scene")).unwrap();
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_parts::<Fx>(&text, &mut st);
     let Some(&lattice_rt::scene::Light::Directional { to_light, .. }) = scene.lights().first() else { panic!("the chair has a directional light") };
     let seat = &scene.objects()[1];

@@ -131,7 +131,8 @@ fn table_name(scene: &str) -> String {
 /// (the scene as parsed and its lattice as built in that scalar, as the firmware would).
 fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&str, &mut String)>) -> (Sizes, u8) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
-    let scene = lattice_rt::parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut parts = lattice_rt::Parts::default();
+    let scene = lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let effects = lattice_rt::Effects::of(&scene).bits();
     let cfg = LatticeConfig::default();
     // The frame this build renders, from its features (as `app::RENDERED` has it).

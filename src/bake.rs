@@ -232,9 +232,9 @@ mod writer {
             out.push_str(",\n        ");
             v.literal(out);
         };
-        arg(&mut out, &Fixed(&scene.composites));
-        arg(&mut out, &Fixed(&scene.materials));
-        arg(&mut out, &Fixed(&scene.lights));
+        arg(&mut out, &Slice(scene.composites));
+        arg(&mut out, &Slice(scene.materials));
+        arg(&mut out, &Slice(scene.lights));
         arg(&mut out, &scene.ambient);
         arg(&mut out, &scene.background);
         arg(&mut out, &scene.camera);
@@ -251,16 +251,6 @@ mod writer {
         arg(&mut out, &scene.objects.len());
         out.push_str(",\n    ),\n};\n");
         out
-    }
-
-    /// A fixed-capacity list: `Vec::from_array([a, b, ...])`.
-    struct Fixed<'a, T>(&'a [T]);
-    impl<T: Literal> Literal for Fixed<'_, T> {
-        fn literal(&self, out: &mut String) {
-            out.push_str("Vec::from_array(");
-            list(self.0, out);
-            out.push(')');
-        }
     }
 
     /// `&[a, b, ...]`.
@@ -290,7 +280,6 @@ pub mod prelude {
     pub use super::Baked;
     pub use crate::lattice::{Lattice, SubLattice};
     pub use crate::scene::Scene;
-    pub use heapless::Vec;
     pub use crate::math::{Aabb, Affine, Linear, Vec3};
     pub use crate::scene::{Camera, Composite, Light, Material, Object};
     pub use crate::shape::Shape;
@@ -312,7 +301,8 @@ mod tests {
     #[test]
     fn tables_answer_as_the_lattice_they_were_taken_from_and_the_source_names_every_object() {
         let mut st = vec![Object::<Fx>::default(); 40];
-        let mut b = SceneBuilder::new(&mut st);
+        let mut parts = crate::Parts::default();
+        let mut b = SceneBuilder::new(&mut st, &mut parts);
         random_scene(&mut b, &RandomScene { objects: 40, composite_size: 8, spread: 0.0, seed: 9 }).unwrap();
         let scene = b.finish().unwrap();
         let cfg = LatticeConfig::default();
@@ -323,9 +313,9 @@ mod tests {
         let copy = Lattice::from_tables(l, co, words, entries, narrow, scene.objects.len());
         let tables = Scene::from_tables(
             scene.objects,
-            scene.composites.clone(),
-            scene.materials.clone(),
-            scene.lights.clone(),
+            scene.composites,
+            scene.materials,
+            scene.lights,
             scene.ambient,
             scene.background,
             scene.camera,

@@ -24,7 +24,7 @@ pub mod shape;
 pub use shape::{Shape, ShapeHit};
 pub mod scene;
 pub use scene::text::{parse, ParseError};
-pub use scene::{Scene, SceneBuilder, SceneError};
+pub use scene::{Parts, Scene, SceneBuilder, SceneError};
 #[cfg(any(test, feature = "generate"))]
 pub mod generate;
 pub mod accel;

@@ -61,8 +61,8 @@ impl<'a, R: Real> StorageView<'a, R> {
         cfg: &LatticeConfig,
         camera: impl FnOnce(&mut CameraDesc),
     ) -> Result<Loaded<'a, R>, LoadError<'t>> {
-        let (objects, rest) = self.split();
-        let scene = parse_with::<R>(text, objects, camera).map_err(LoadError::Parse)?;
+        let ((objects, parts), rest) = self.split();
+        let scene = parse_with::<R>(text, objects, parts, camera).map_err(LoadError::Parse)?;
         let (lattice, scratch) = rest.lattice(&scene, cfg).map_err(LoadError::Lattice)?;
         Ok(Loaded {
             scene,

@@ -13,7 +13,8 @@ use crate::accel::Query;
 use crate::lattice::{SubLattice, Lattice, LatticeConfig, LatticeError, LatticeStorage};
 use crate::render::{Frame, Scratch};
 use crate::scalar::Real;
-use crate::scene::{Object, Scene};
+use crate::scene::{Object, Parts, Scene};
+use core::borrow::BorrowMut;
 
 /// How much of each kind of storage a scene and a frame need.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -76,8 +77,10 @@ impl Sizes {
 /// arrays ([`Storage`]) or, with the `alloc` feature, vectors (`HeapStorage`). One type, so
 /// lending the [`StorageView`] is written once.
 #[derive(Debug)]
-pub struct Buffers<O, L, C, W, S> {
+pub struct Buffers<O, P, L, C, W, S> {
     objects: O,
+    /// The scene's composites, materials and lights ([`Parts`]).
+    parts: P,
     lattices: L,
     coords: C,
     words: W,
@@ -93,23 +96,25 @@ pub type Storage<
     const COORDS: usize,
     const WORDS: usize,
     const ROWS: usize,
-> = Buffers<[Object<R>; OBJECTS], [SubLattice<R>; LATTICES], [R; COORDS], [u32; WORDS], [i16; ROWS]>;
+> = Buffers<[Object<R>; OBJECTS], Parts<R>, [SubLattice<R>; LATTICES], [R; COORDS], [u32; WORDS], [i16; ROWS]>;
 
 /// All memory a frame needs, on the heap, sized at run time (the host's [`Storage`]).
 #[cfg(feature = "alloc")]
 pub type HeapStorage<R> = Buffers<
     alloc::vec::Vec<Object<R>>,
+    Parts<R>,
     alloc::vec::Vec<SubLattice<R>>,
     alloc::vec::Vec<R>,
     alloc::vec::Vec<u32>,
     alloc::vec::Vec<i16>,
 >;
 
-impl<O, L, C, W, S> Buffers<O, L, C, W, S> {
+impl<O, P, L, C, W, S> Buffers<O, P, L, C, W, S> {
     /// The storage with its capacities erased.
     pub fn view<R: Real>(&mut self) -> StorageView<'_, R>
     where
         O: AsMut<[Object<R>]>,
+        P: BorrowMut<Parts<R>>,
         L: AsMut<[SubLattice<R>]>,
         C: AsMut<[R]>,
         W: AsMut<[u32]>,
@@ -117,6 +122,7 @@ impl<O, L, C, W, S> Buffers<O, L, C, W, S> {
     {
         StorageView::new(
             self.objects.as_mut(),
+            self.parts.borrow_mut(),
             self.lattices.as_mut(),
             self.coords.as_mut(),
             self.words.as_mut(),
@@ -134,6 +140,7 @@ impl<O, L, C, W, S> Buffers<O, L, C, W, S> {
         S: AsRef<[i16]>,
     {
         size_of_val(self.objects.as_ref())
+            + size_of::<Parts<R>>()
             + size_of_val(self.lattices.as_ref())
             + size_of_val(self.coords.as_ref())
             + size_of_val(self.words.as_ref())
@@ -148,6 +155,7 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
     pub fn new() -> Self {
         Buffers {
             objects: [Object::default(); O],
+            parts: Parts::new(),
             lattices: [SubLattice::EMPTY; G],
             coords: [R::ZERO; C],
             words: [0; W],
@@ -182,6 +190,7 @@ impl<R: Real> HeapStorage<R> {
         use alloc::vec;
         Buffers {
             objects: vec![Object::default(); sizes.objects],
+            parts: Parts::new(),
             lattices: vec![SubLattice::EMPTY; sizes.lattices],
             coords: vec![R::ZERO; sizes.coords],
             words: vec![0; sizes.words],
@@ -195,6 +204,7 @@ impl<R: Real> HeapStorage<R> {
 #[derive(Debug)]
 pub struct StorageView<'a, R> {
     objects: &'a mut [Object<R>],
+    parts: &'a mut Parts<R>,
     rest: FrameStorage<'a, R>,
 }
 
@@ -212,6 +222,7 @@ impl<'a, R: Real> StorageView<'a, R> {
     /// A view of caller-owned slices.
     pub fn new(
         objects: &'a mut [Object<R>],
+        parts: &'a mut Parts<R>,
         lattices: &'a mut [SubLattice<R>],
         coords: &'a mut [R],
         words: &'a mut [u32],
@@ -219,6 +230,7 @@ impl<'a, R: Real> StorageView<'a, R> {
     ) -> Self {
         StorageView {
             objects,
+            parts,
             rest: FrameStorage {
                 lattices,
                 coords,
@@ -228,9 +240,10 @@ impl<'a, R: Real> StorageView<'a, R> {
         }
     }
 
-    /// The object storage (for a [`crate::SceneBuilder`]) and the rest.
-    pub fn split(self) -> (&'a mut [Object<R>], FrameStorage<'a, R>) {
-        (self.objects, self.rest)
+    /// The scene's storage (objects and parts, for a [`crate::SceneBuilder`]) and the rest.
+    #[allow(clippy::type_complexity)]
+    pub fn split(self) -> ((&'a mut [Object<R>], &'a mut Parts<R>), FrameStorage<'a, R>) {
+        ((self.objects, self.parts), self.rest)
     }
 }
 

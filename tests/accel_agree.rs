@@ -59,7 +59,8 @@ fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &m
 
 fn check<R: Real>(p: &RandomScene, cfg: &LatticeConfig, nrays: usize) -> Result<(), TestCaseError> {
     let mut storage = vec![Object::<R>::default(); p.objects];
-    let mut b = SceneBuilder::new(&mut storage);
+    let mut parts = lattice_rt::Parts::default();
+    let mut b = SceneBuilder::new(&mut storage, &mut parts);
     random_scene(&mut b, p).unwrap();
     check_scene(&b.finish().unwrap(), cfg, p.seed, nrays)
 }
@@ -159,7 +160,8 @@ proptest! {
 fn check_crowded<R: Real>(seed: u64, n: usize, group: usize, cfg: &LatticeConfig) -> Result<(), TestCaseError> {
     use lattice_rt::generate::random_object;
     let mut storage = vec![Object::<R>::default(); n + group];
-    let mut b = SceneBuilder::new(&mut storage);
+    let mut parts = lattice_rt::Parts::default();
+    let mut b = SceneBuilder::new(&mut storage, &mut parts);
     let mut rng = Rng::new(seed);
     b.add_material(lattice_rt::scene::Material::DEFAULT).unwrap();
     b.add_light(lattice_rt::scene::Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 }).unwrap();
@@ -197,7 +199,8 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
     use lattice_rt::generate::random_object;
     use lattice_rt::{Affine, Shape};
     let mut storage = vec![Object::<R>::default(); lead + members];
-    let mut b = SceneBuilder::new(&mut storage);
+    let mut parts = lattice_rt::Parts::default();
+    let mut b = SceneBuilder::new(&mut storage, &mut parts);
     let mut rng = Rng::new(seed);
     // The lead objects: a thin sheet of small spheres far behind the group.
     let side = (lead as f64).sqrt().ceil() as usize;

@@ -11,7 +11,8 @@ use lattice_rt::{parse, Frame, Fx, LatticeConfig, Real, Tracer};
 /// The error message for `text` in `R` (panics if the scene is accepted).
 fn err<R: Real>(text: &str) -> String {
     let mut storage = vec![Object::<R>::default(); 16];
-    match parse::<R>(text, &mut storage) {
+    let mut parts = lattice_rt::Parts::default();
+    match parse::<R>(text, &mut storage, &mut parts) {
         Ok(_) => panic!("{} accepted:\n{text}", R::NAME),
         Err(e) => e.to_string(),
     }
@@ -20,13 +21,15 @@ fn err<R: Real>(text: &str) -> String {
 /// Whether `text` is accepted in `R`.
 fn accepted<R: Real>(text: &str) -> bool {
     let mut storage = vec![Object::<R>::default(); 16];
-    parse::<R>(text, &mut storage).is_ok()
+    let mut parts = lattice_rt::Parts::default();
+    parse::<R>(text, &mut storage, &mut parts).is_ok()
 }
 
 /// Gray levels of `text` in `R` (lattice, the scene's own effects and depth).
 fn gray<R: Real>(text: &str, frame: &Frame) -> Vec<u8> {
     let mut storage = vec![Object::<R>::default(); 16];
-    let scene = parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}", R::NAME));
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", R::NAME));
     let cfg = LatticeConfig::default();
     let mut bufs = lattice_storage(&scene, &cfg);
     let lat = build_lattice(&scene, &cfg, &mut bufs);
@@ -164,7 +167,8 @@ fn a_byte_order_mark_and_every_line_ending_parse_alike() {
         plain.replace('\n', "\r"),
     ] {
         let mut storage = vec![Object::<f64>::default(); 4];
-        let scene = parse::<f64>(&text, &mut storage).unwrap_or_else(|e| panic!("{text:?}: {e}"));
+        let mut parts = lattice_rt::Parts::default();
+        let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{text:?}: {e}"));
         assert_eq!(scene.objects().len(), 2);
     }
     // Line numbers count CR-only lines too.
@@ -176,8 +180,10 @@ fn zero_is_zero_whatever_its_exponent() {
     for zero in ["0e999", "-0e999", "0.000e-999", "0e0"] {
         let text = format!("sphere center {zero} 0 0");
         let mut storage = vec![Object::<f64>::default(); 1];
-        let scene = parse::<f64>(&text, &mut storage).unwrap_or_else(|e| panic!("{zero}: {e}"));
-        let expected = parse::<f64>("sphere center 0 0 0", &mut vec![Object::<f64>::default(); 1]).unwrap().objects()[0].origin();
+        let mut parts = lattice_rt::Parts::default();
+        let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{zero}: {e}"));
+        let mut parts = lattice_rt::Parts::default();
+        let expected = parse::<f64>("sphere center 0 0 0", &mut vec![Object::<f64>::default(); 1], &mut parts).unwrap().objects()[0].origin();
         assert_eq!(scene.objects()[0].origin(), expected, "{zero}");
     }
     // Tiny non-zero numbers underflow to zero as f64 itself rounds them.

@@ -9,7 +9,8 @@ use lattice_rt::{parse, Effects, Frame, LatticeConfig, Tracer};
 
 fn effects_of(text: &str) -> Effects {
     let mut storage = vec![Object::<f64>::default(); 64];
-    Effects::of(&parse::<f64>(text, &mut storage).unwrap())
+    let mut parts = lattice_rt::Parts::default();
+    Effects::of(&parse::<f64>(text, &mut storage, &mut parts).unwrap())
 }
 
 const LIGHT: &str = "light directional dir 0 -1 0\n";
@@ -60,7 +61,8 @@ fn the_paper_scenes_call_for_what_they_show() {
 fn a_tracer_without_refraction_refuses_glass() {
     let text = scene_text("whitted");
     let mut storage = vec![Object::<f64>::default(); 64];
-    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     const MATTE: u8 = Effects::SHADOWS.union(Effects::COMPOSITES).bits();
@@ -74,7 +76,8 @@ fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
     for s in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
         let text = scene_text(s);
         let mut storage = vec![Object::<f64>::default(); 64];
-        let scene = parse::<f64>(&text, &mut storage).unwrap();
+        let mut parts = lattice_rt::Parts::default();
+        let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
         let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
         let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
         let frame = Frame::new(160, 100);
@@ -92,7 +95,8 @@ fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
 fn a_one_level_cutoff_prunes_the_whitted_tree_and_barely_changes_the_frame() {
     let text = scene_text("whitted");
     let mut storage = vec![Object::<f64>::default(); 64];
-    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let frame = Frame::new(128, 64);

@@ -58,7 +58,8 @@ fn scenes_in<R: Real>() {
     for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
         let text = scene_text(name);
         let mut storage = vec![Object::<R>::default(); 64];
-        let scene = parse::<R>(&text, &mut storage).unwrap();
+        let mut parts = lattice_rt::Parts::default();
+        let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
         let culled = same_with_and_without(&scene, 48, 24, name);
         assert!(culled > 0, "{name}, {}: the windows skipped no test", R::NAME);
     }
@@ -73,8 +74,8 @@ fn the_paper_scenes_render_the_same_with_windows_in_every_scalar() {
 
 /// A random scene of 40 objects (4 per composite) seen from `eye` towards `look`, or `None`
 /// if the camera is refused.
-fn generated(storage: &mut [Object<f64>], seed: u64, eye: (f64, f64, f64), look: (f64, f64, f64)) -> Option<Scene<'_, f64>> {
-    let mut b = SceneBuilder::new(storage);
+fn generated<'a>(storage: &'a mut [Object<f64>], parts: &'a mut lattice_rt::Parts<f64>, seed: u64, eye: (f64, f64, f64), look: (f64, f64, f64)) -> Option<Scene<'a, f64>> {
+    let mut b = SceneBuilder::new(storage, parts);
     random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
     b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
     b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
@@ -87,8 +88,8 @@ fn generated_scenes_and_cameras_inside_or_beside_objects_render_the_same() {
     let (mut built, mut culled) = (0, 0);
     for seed in 0..6u64 {
         for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0)), ((3.0, 0.0, 0.0), (-3.0, 0.5, 0.0))] {
-            let mut storage = vec![Object::<f64>::default(); 40];
-            let Some(scene) = generated(&mut storage, seed, eye, look) else { continue };
+            let (mut storage, mut parts) = (vec![Object::<f64>::default(); 40], lattice_rt::Parts::default());
+            let Some(scene) = generated(&mut storage, &mut parts, seed, eye, look) else { continue };
             built += 1;
             culled += same_with_and_without(&scene, 32, 20, &format!("seed {seed}, eye {eye:?}"));
         }
@@ -105,8 +106,8 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
     let (mut checked, mut left_out) = (0, 0);
     for seed in 0..4u64 {
         for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0))] {
-            let mut storage = vec![Object::<f64>::default(); 40];
-            let Some(scene) = generated(&mut storage, seed, eye, look) else { continue };
+            let (mut storage, mut parts) = (vec![Object::<f64>::default(); 40], lattice_rt::Parts::default());
+            let Some(scene) = generated(&mut storage, &mut parts, seed, eye, look) else { continue };
             // 8x8 tiles of a 48x32 frame, every quarter-pixel ray position in each.
             let (w4, h4) = (4 * 48, 4 * 32);
             for (tx, ty) in (0..6).flat_map(|tx| (0..4).map(move |ty| (tx, ty))) {
@@ -146,7 +147,8 @@ fn first_light_rays_meet_objects_as_any_ray_does() {
         let mut hits = 0;
         for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
             let mut storage = vec![Object::<R>::default(); 64];
-            let scene = parse::<R>(&scene_text(name), &mut storage).unwrap();
+            let mut parts = lattice_rt::Parts::default();
+            let scene = parse::<R>(&scene_text(name), &mut storage, &mut parts).unwrap();
             let Some(lattice_rt::scene::Light::Directional { to_light, .. }) = scene.lights().first().copied() else { panic!("{name}: no directional light") };
             let w = scene.world();
             for i in 0..=20 {
@@ -175,7 +177,8 @@ fn first_light_rays_meet_objects_as_any_ray_does() {
 fn kept_axis_normals_are_the_objects_own() {
     fn check<R: Real>() {
         let mut storage = vec![Object::<R>::default(); 64];
-        let scene = parse::<R>(&scene_text("whitted"), &mut storage).unwrap();
+        let mut parts = lattice_rt::Parts::default();
+        let scene = parse::<R>(&scene_text("whitted"), &mut storage, &mut parts).unwrap();
         let mut mb = vec![0; Query::mailbox_len(&scene)];
         let mut q = Query::new(&mut mb);
         let (o, z, h) = (R::ONE, R::ZERO, R::HALF);
@@ -236,7 +239,8 @@ fn tile_lists_change_no_pixel() {
         for (seed, composite_size, spread) in [(1u64, 0, 0.0), (2, 0, 40.0), (3, 25, 0.0), (4, 0, 6.0)] {
             for (eye, look) in [((0.0, 8.0, -60.0), (0.0, 0.0, 0.0)), ((0.3, 0.2, 0.1), (5.0, 1.0, 2.0)), ((40.0, 3.0, 5.0), (0.0, 0.0, 0.0))] {
                 let mut storage = vec![Object::<R>::default(); 150];
-                let mut b = SceneBuilder::new(&mut storage);
+                let mut parts = lattice_rt::Parts::default();
+                let mut b = SceneBuilder::new(&mut storage, &mut parts);
                 random_scene(&mut b, &RandomScene { objects: 150, composite_size, spread, seed }).unwrap();
                 b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
                 b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);

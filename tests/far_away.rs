@@ -17,7 +17,8 @@ use lattice_rt::{parse, Accelerator, BoundingBox, BruteForce, Frame, Fx, Lattice
 /// Gray levels of `text` in `R` with `accel` (the scene's own effects and depth).
 fn gray<R: Real>(text: &str, accel: Accel, frame: &Frame) -> Vec<u8> {
     let mut storage = vec![Object::<R>::default(); text.lines().count()];
-    let scene = parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{}: {e}\n{text}", R::NAME));
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}\n{text}", R::NAME));
     let cfg = LatticeConfig::default();
     let mut st = lattice_storage(&scene, &cfg);
     let lat = build_lattice(&scene, &cfg, &mut st);
@@ -204,7 +205,8 @@ fn far_camera_draws_the_scene<R: Real>() {
     // Ten times farther than the scalar resolves: refused at render time.
     let text = format!("{}{}", camera(0.3, 0.5, hi * 100.0), matte(&near_scene(&mut Rng::new(1))));
     let mut storage = vec![Object::<R>::default(); text.lines().count()];
-    let scene = parse::<R>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
     let (_, stats_or_err) = {
         let mut bits = vec![0u8; lattice_rt::BitFrame::bytes(128, 64)];
         let mut target = lattice_rt::BitFrame::new(128, 64, &mut bits).unwrap();
@@ -276,7 +278,8 @@ fn a_large_index_of_refraction_renders_as_in_f64_or_is_refused() {
         assert!(off <= 0.01, "ior {ior}: f32 {:.2} % of pixels more than one level off f64", off * 100.0);
     }
     let mut storage = vec![Object::<f32>::default(); 8];
-    let err = parse::<f32>(&glass(40000.0), &mut storage).expect_err("ior 40,000 in f32").to_string();
+    let mut parts = lattice_rt::Parts::default();
+    let err = parse::<f32>(&glass(40000.0), &mut storage, &mut parts).expect_err("ior 40,000 in f32").to_string();
     assert!(err.contains("index of refraction out of range for f32: magnitude must stay below 8192"), "{err}");
 }
 

@@ -25,9 +25,9 @@ macro_rules! every_scalar {
     )*};
 }
 
-fn scene_in<'a, R: Real>(text: &str, storage: &'a mut Vec<Object<R>>) -> Scene<'a, R> {
+fn scene_in<'a, R: Real>(text: &str, (storage, parts): &'a mut (Vec<Object<R>>, lattice_rt::Parts<R>)) -> Scene<'a, R> {
     *storage = vec![Object::default(); text.lines().count().max(1)];
-    parse::<R>(text, storage).unwrap_or_else(|e| panic!("{} : {e}", R::NAME))
+    parse::<R>(text, storage, parts).unwrap_or_else(|e| panic!("{} : {e}", R::NAME))
 }
 
 /// Calls `f` with each accelerator over the scene (a lattice with `cfg`).
@@ -64,7 +64,7 @@ fn gray_all<R: Real>(scene: &Scene<'_, R>, frame: &Frame, shadows: bool) -> Vec<
 // side: the frame with shadow rays must equal the frame without them, pixel for pixel.
 fn no_self_shadow_acne<R: Real>() {
     let text = "camera eye 0 3 -8 look 0 0.5 0\nlight directional dir 1 -1 1\nsphere center -1.5 1 0 radius 1\nbox min 1 0 -1 max 3 1.5 1\n";
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
     let frame = Frame::new(96, 64);
     assert_eq!(gray_all(&scene, &frame, true), gray_all(&scene, &frame, false), "{}: acne", R::NAME);
@@ -81,7 +81,7 @@ fn leaving_rays_miss_their_object<R: Real>() {
         cylinder base -0.5 0 2 radius 0.6 height 2 rotate x 20\n\
         cone base 1 0 3 radius 0.8 height 1.5 top 0.3 rotate z 15 scale 1 1.5 1\n\
         cone base -3 0 3 radius 0.5 height 1 rotate y 40\n";
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
     let cam = scene.camera();
     let dirs = [(1.0, 1.0, -1.0), (-0.6, 1.0, 0.5), (0.0, 1.0, 0.0), (0.3, 0.2, -1.0), (1.0, 0.05, 0.0), (-1.0, 0.3, 0.7)];
@@ -119,7 +119,7 @@ fn far_from_the_origin<R: Real>() {
         _ => 1.0e5,
     };
     let moved = translate_scene(&base, shift);
-    let (mut s1, mut s2) = (Vec::new(), Vec::new());
+    let (mut s1, mut s2) = Default::default();
     let (a, b) = (scene_in::<R>(&base, &mut s1), scene_in::<R>(&moved, &mut s2));
     let frame = Frame::new(128, 64);
     let (ga, gb) = (gray_all(&a, &frame, true), gray_all(&b, &frame, true));
@@ -156,7 +156,8 @@ fn translate_scene(text: &str, d: f64) -> String {
 fn small_far_sphere<R: Real>() {
     let text = "camera eye 0 0 -200 look 0 0 0 fov 1 1\nsphere radius 0.5\n";
     let mut st = vec![Object::<R>::default(); 2];
-    let scene = match parse::<R>(text, &mut st) {
+    let mut parts = lattice_rt::Parts::default();
+    let scene = match parse::<R>(text, &mut st, &mut parts) {
         Ok(s) => s,
         Err(e) => {
             assert!(R::NAME == "fixed", "{e}");
@@ -164,7 +165,8 @@ fn small_far_sphere<R: Real>() {
         }
     };
     let mut st64 = vec![Object::<f64>::default(); 2];
-    let s64 = parse::<f64>(text, &mut st64).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let s64 = parse::<f64>(text, &mut st64, &mut parts).unwrap();
     let n = 64;
     let pixel = 2.0 * (0.5f64.to_radians()).tan() * 200.0 / n as f64; // world size of a pixel at the sphere
     let mut mb = vec![0; 4];
@@ -247,7 +249,7 @@ fn glass_and_total_internal_reflection<R: Real>() {
 // 6. Rays parallel to lattice planes, +0.0 and -0.0, from a point on a cell plane.
 fn signed_zero_parallel_rays<R: Real>() {
     let text = "camera eye 0 0 -10\nlight directional dir 0 -1 0\nbox min -2 -2 -2 max -1 -1 -1\nsphere center 1 1 1 radius 0.7\nbox min -1 0 1 max 2 1 2\n";
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([6, 6, 6]), ..LatticeConfig::default() };
     with_accels(&scene, &cfg, |name, a| {
@@ -271,7 +273,7 @@ fn signed_zero_parallel_rays<R: Real>() {
 // lattice answers exactly as brute force.
 fn corners_faces_and_sub_lattices<R: Real>() {
     let text = "camera eye -4 -4 -4 look 0 0 0\nbox min 0 0 0 max 1 1 1\nsphere center 2 2 2 radius 0.5\ngroup g\n  box min 3 0 0 max 4 1 1\n  sphere center 3.5 2 0.5 radius 0.5\nend\n";
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([4, 4, 4]), sub: Resolution::Uniform([2, 2, 2]), ..LatticeConfig::default() };
     let w = scene.world();
@@ -300,7 +302,7 @@ fn corners_faces_and_sub_lattices<R: Real>() {
 // 9. A long ray across thousands of cells: the same cell sequence as an exact walk.
 fn long_walk_does_not_drift<R: Real>() {
     let text = "camera eye 0 0 -5 look 1 1 0\nbox min 0 0 0 max 1000 1000 1\n";
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([1000, 1000, 1]), ..LatticeConfig::default() };
     let mut bufs = lattice_storage(&scene, &cfg);
@@ -337,7 +339,7 @@ fn long_walk_does_not_drift<R: Real>() {
 // only in that later cell: the nearer one wins, and each object is tested once per ray.
 fn large_object_and_mailbox<R: Real>() {
     let text = "camera eye 0 0.5 -1\nbox min -50 -1 10 max 50 2 60\nsphere center 0 0.5 9.5 radius 0.3\n";
-    let mut st = Vec::new();
+    let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
     let cfg = LatticeConfig { top: Resolution::Uniform([100, 3, 60]), ..LatticeConfig::default() };
     with_accels(&scene, &cfg, |name, a| {
@@ -387,7 +389,8 @@ fn boxes_under_extreme_transforms<R: Real>() {
     for (name, tr) in [("scale 1000", "scale 1000"), ("scale 0.001", "scale 0.001"), ("shear", "shear x y 3 rotate z 20"), ("mixed", "scale 1000 1 0.01")] {
         let text = format!("camera eye 0.3 0.2 -20\nbox min -0.5 -0.5 -0.5 max 0.5 0.5 0.5 {tr}\n");
         let mut st = vec![Object::<R>::default(); 2];
-        let scene = match parse::<R>(&text, &mut st) {
+        let mut parts = lattice_rt::Parts::default();
+        let scene = match parse::<R>(&text, &mut st, &mut parts) {
             Ok(s) => s,
             Err(e) => {
                 assert!(R::NAME == "fixed" && e.to_string().contains("fixed"), "{} {name}: {e}", R::NAME);
@@ -395,7 +398,8 @@ fn boxes_under_extreme_transforms<R: Real>() {
             }
         };
         let mut st64 = vec![Object::<f64>::default(); 2];
-        let s64 = parse::<f64>(&text, &mut st64).unwrap();
+        let mut parts = lattice_rt::Parts::default();
+        let s64 = parse::<f64>(&text, &mut st64, &mut parts).unwrap();
         let mut mb = vec![0; 2];
         let mut q = Query::new(&mut mb);
         for k in 0..50 {
@@ -430,7 +434,8 @@ fn fixed_point_far_spheres_are_right_and_tiny_ones_refused() {
     // Distance 4000: 4000^2 overflows i32 Q16.16 many times over; the hit must still be right.
     let text = "camera eye 0 0 -4000 look 0 0 0 fov 2 2\nsphere radius 40\n";
     let (mut a, mut b) = (vec![Object::<Fx>::default(); 2], vec![Object::<f64>::default(); 2]);
-    let (fx, f) = (parse::<Fx>(text, &mut a).unwrap(), parse::<f64>(text, &mut b).unwrap());
+    let (mut pa, mut pb) = (lattice_rt::Parts::default(), lattice_rt::Parts::default());
+    let (fx, f) = (parse::<Fx>(text, &mut a, &mut pa).unwrap(), parse::<f64>(text, &mut b, &mut pb).unwrap());
     let mut mb = vec![0; 2];
     let mut q = Query::new(&mut mb);
     let h = BruteForce.nearest(&fx, &Ray::new(fx.camera().eye, fx.camera().forward), Fx::ZERO, Fx::MAX, &mut q).unwrap();
@@ -440,7 +445,8 @@ fn fixed_point_far_spheres_are_right_and_tiny_ones_refused() {
     // A radius near the LSB in a scene of size 10 is refused, with the object's line.
     let tiny = "camera eye 0 0 -10\nsphere radius 1\nsphere center 2 0 0 radius 0.0001\n";
     let mut c = vec![Object::<Fx>::default(); 3];
-    let e = parse::<Fx>(tiny, &mut c).unwrap_err();
+    let mut parts = lattice_rt::Parts::default();
+    let e = parse::<Fx>(tiny, &mut c, &mut parts).unwrap_err();
     assert_eq!((e.line, e.token), (3, "sphere"), "{e}");
 }
 
@@ -450,7 +456,7 @@ fn mirror_and_scale<R: Real>() {
     let base = scene_text("chair");
     let mirrored = format!("{}\n", base.replace("group chair rotate y 20", "group chair rotate y 20 scale -1 1 1").replace("box min -4 -0.1 -4 max 4 0 4", "box min -4 -0.1 -4 max 4 0 4 scale -1 1 1").replace("camera eye 3 2.6", "camera eye -3 2.6").replace("dir -0.5 -1 0.6", "dir 0.5 -1 0.6"));
     let frame = Frame::new(96, 48);
-    let (mut s1, mut s2) = (Vec::new(), Vec::new());
+    let (mut s1, mut s2) = Default::default();
     let (a, b) = (scene_in::<R>(&base, &mut s1), scene_in::<R>(&mirrored, &mut s2));
     let (ga, gb) = (gray_all(&a, &frame, true), gray_all(&b, &frame, true));
     let w = frame.width as usize;
@@ -460,7 +466,7 @@ fn mirror_and_scale<R: Real>() {
         return; // rounding in fixed point does not scale exactly
     }
     let scaled = scale_scene(&base, 2.0);
-    let mut s3 = Vec::new();
+    let mut s3 = Default::default();
     let c = scene_in::<R>(&scaled, &mut s3);
     assert!(gray_all(&a, &frame, true) == gray_all(&c, &frame, true), "{}: scaling by 2 changed the image", R::NAME);
 }

@@ -5,7 +5,8 @@ use lattice_rt::{parse, Real};
 
 fn err<R: Real>(text: &str) -> String {
     let mut storage = vec![Object::<R>::default(); 8];
-    match parse::<R>(text, &mut storage) {
+    let mut parts = lattice_rt::Parts::default();
+    match parse::<R>(text, &mut storage, &mut parts) {
         Ok(_) => panic!("accepted:\n{text}"),
         Err(e) => e.to_string(),
     }
@@ -142,7 +143,8 @@ fn out_of_range_for_the_scalar() {
 fn comments_blank_lines_and_groups_parse() {
     let text = "# a chair\n\nmaterial wood kd 0.7 # brown\ngroup chair rotate y 20\n  box min 0 0 0 max 1 1 1 material wood\nend\n";
     let mut storage = vec![Object::<f64>::default(); 4];
-    let scene = parse::<f64>(text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<f64>(text, &mut storage, &mut parts).unwrap();
     assert_eq!(scene.objects().len(), 1);
     assert_eq!(scene.composites().len(), 1);
 }
@@ -164,5 +166,6 @@ fn fixed_point_refuses_an_object_too_small_for_the_scene_and_names_its_line() {
     );
     // The same scene is fine in floating point.
     let mut storage = vec![Object::<f32>::default(); 4];
-    assert!(parse::<f32>(text, &mut storage).is_ok());
+    let mut parts = lattice_rt::Parts::default();
+    assert!(parse::<f32>(text, &mut storage, &mut parts).is_ok());
 }

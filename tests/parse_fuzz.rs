@@ -16,7 +16,8 @@ const WORDS: [&str; 30] = [
 
 fn check<R: Real>(text: &str) -> Result<(), TestCaseError> {
     let mut storage = vec![Object::<R>::default(); 48];
-    match parse::<R>(text, &mut storage) {
+    let mut parts = lattice_rt::Parts::default();
+    match parse::<R>(text, &mut storage, &mut parts) {
         Err(e) => {
             let lines = text.lines().count().max(1) as u32;
             prop_assert!(e.line >= 1 && e.line <= lines + 1 && e.col >= 1, "{}: bad position in {e}", R::NAME);

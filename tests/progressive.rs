@@ -14,7 +14,8 @@ use lattice_rt::{parse, render_pass, render_share, BitFrame, Dither, Frame, Fx, 
 fn passes<R: Real>(name: &str, frame: Frame, of: u8) -> (Vec<Vec<u8>>, u64, Vec<u8>, u64) {
     let text = scene_text(name);
     let mut storage = vec![Object::<R>::default(); 64];
-    let scene = parse::<R>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let tracer = Tracer::new(&scene, &lat);
@@ -81,7 +82,8 @@ fn passes_plain<R: Real>(name: &str, frame: Frame) -> (Vec<u8>, u64, Vec<u8>, u6
 fn frames_that_cannot_be_progressive_are_refused() {
     let text = scene_text("chair");
     let mut storage = vec![Object::<Fx>::default(); 64];
-    let scene = parse::<Fx>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<Fx>(&text, &mut storage, &mut parts).unwrap();
     let tracer = Tracer::new(&scene, &lattice_rt::BruteForce);
     let mut bits = vec![0u8; BitFrame::bytes(64, 32)];
     let mut target = BitFrame::new(64, 32, &mut bits).unwrap();

@@ -21,7 +21,8 @@ impl Hooks for Gray {
 fn gray(sampling: Sampling) -> (Vec<u8>, u64) {
     let text = scene_text("spheres");
     let mut storage = vec![Object::<f64>::default(); 16];
-    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let frame = Frame { sampling, ..Frame::new(128, 64) };

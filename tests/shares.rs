@@ -12,7 +12,8 @@ use lattice_rt::{dither_band, parse, render_pass, trace_pass, KeptTile, render, 
 fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
     let text = scene_text(name);
     let mut storage = vec![Object::<R>::default(); 64];
-    let scene = parse::<R>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let mut tracer = Tracer::new(&scene, &lat);
@@ -72,7 +73,8 @@ fn a_share_holds_a_checkerboard_of_tiles() {
 fn frames_that_carry_error_between_tiles_or_bad_shares_are_refused() {
     let text = scene_text("chair");
     let mut storage = vec![Object::<f64>::default(); 64];
-    let scene = parse::<f64>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
     let tracer = Tracer::new(&scene, &lattice_rt::BruteForce);
     let mut bits = vec![0u8; BitFrame::bytes(64, 32)];
     let mut target = BitFrame::new(64, 32, &mut bits).unwrap();
@@ -127,7 +129,8 @@ fn shares_count_their_tiles_as_the_checkerboard_holds_them() {
 fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
     let text = scene_text(name);
     let mut storage = vec![Object::<R>::default(); 64];
-    let scene = parse::<R>(&text, &mut storage).unwrap();
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let tracer = Tracer::new(&scene, &lat);
@@ -197,7 +200,8 @@ fn traced_passes_dithered_in_order_give_every_pass() {
     for name in ["chair", "whitted"] {
         let text = scene_text(name);
         let mut storage = vec![Object::<Fx>::default(); 64];
-        let scene = parse::<Fx>(&text, &mut storage).unwrap();
+        let mut parts = lattice_rt::Parts::default();
+        let scene = parse::<Fx>(&text, &mut storage, &mut parts).unwrap();
         let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
         let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
         let tracer = Tracer::new(&scene, &lat);

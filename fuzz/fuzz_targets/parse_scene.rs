@@ -10,7 +10,8 @@ use libfuzzer_sys::fuzz_target;
 
 fn check<R: Real>(text: &str) {
     let mut storage = vec![Object::<R>::default(); 64];
-    match parse::<R>(text, &mut storage) {
+    let mut parts = lattice_rt::Parts::default();
+    match parse::<R>(text, &mut storage, &mut parts) {
         Err(e) => {
             let lines = text.lines().count().max(1) as u32;
             assert!(e.line >= 1 && e.line <= lines + 1 && e.col >= 1, "{e}");

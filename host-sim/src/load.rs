@@ -5,7 +5,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::lattice::LatticeSizes;
 use lattice_rt::scene::text::{object_count, text_from_bytes};
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, Frame, HeapStorage, Lattice, LatticeConfig, Real, Scene, Sizes};
+use lattice_rt::{parse, Frame, HeapStorage, Lattice, LatticeConfig, Parts, Real, Scene, SceneBuilder, Sizes};
 use std::io::Read;
 use std::path::Path;
 
@@ -33,9 +33,25 @@ pub fn read(path: &Path) -> Result<String> {
     })
 }
 
+/// A scene's storage on the host: its objects and its composites, materials and lights.
+#[derive(Debug, Default)]
+pub struct SceneStore<R> {
+    /// The objects.
+    pub objects: Vec<Object<R>>,
+    /// The composites, materials and lights.
+    pub parts: Parts<R>,
+}
+
+impl<R: Real> SceneStore<R> {
+    /// A builder of a scene into this storage.
+    pub fn builder(&mut self) -> SceneBuilder<'_, R> {
+        SceneBuilder::new(&mut self.objects, &mut self.parts)
+    }
+}
+
 /// Object storage for the objects `text` declares (counted before anything is allocated), or
 /// an error when it would take more than [`MAX_OBJECT_BYTES`].
-pub fn object_storage<R: Real>(text: &str) -> Result<Vec<Object<R>>> {
+pub fn object_storage<R: Real>(text: &str) -> Result<SceneStore<R>> {
     let n = object_count(text);
     let each = core::mem::size_of::<Object<R>>();
     if n.saturating_mul(each) > MAX_OBJECT_BYTES {
@@ -46,12 +62,12 @@ pub fn object_storage<R: Real>(text: &str) -> Result<Vec<Object<R>>> {
             R::NAME
         );
     }
-    Ok(vec![Object::default(); n.max(1)])
+    Ok(SceneStore { objects: vec![Object::default(); n.max(1)], parts: Parts::new() })
 }
 
 /// Parses `text` into `storage`, turning errors into messages that name the file.
-pub fn parse_scene<'a, R: Real>(path: &Path, text: &str, storage: &'a mut [Object<R>]) -> Result<Scene<'a, R>> {
-    parse::<R>(text, storage).map_err(|e| anyhow!("{}: {e}", path.display()))
+pub fn parse_scene<'a, R: Real>(path: &Path, text: &str, storage: &'a mut SceneStore<R>) -> Result<Scene<'a, R>> {
+    parse::<R>(text, &mut storage.objects, &mut storage.parts).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 /// The most memory a lattice may take on the host (so that no flag makes host-sim allocate

@@ -23,7 +23,7 @@ pub fn orbit_renders<R: Real>(path: &Path, text: &str, frames: u32, frame: &Fram
     let mut out = Vec::new();
     for i in 0..frames {
         let turn = i as f64 / frames as f64;
-        let scene = parse_with::<R>(text, &mut storage, |c| *c = c.orbit(turn))
+        let scene = parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| *c = c.orbit(turn))
             .map_err(|e| anyhow!("{}: frame {i} of the orbit: {e}", path.display()))?;
         let cfg = LatticeConfig::default();
         let mut bufs = lattice_storage(&scene, &cfg)?;

@@ -277,7 +277,8 @@ mod tests {
         }
         // A generated random scene too.
         let mut storage = vec![Object::<f64>::default(); 30];
-        let mut b = SceneBuilder::new(&mut storage);
+        let mut parts = lattice_rt::Parts::default();
+        let mut b = SceneBuilder::new(&mut storage, &mut parts);
         random_scene(&mut b, &RandomScene { objects: 30, composite_size: 0, spread: 0.0, seed: 42 }).unwrap();
         let scene = b.finish().unwrap();
         let (agree, mean, far) = compare("random30", &scene);

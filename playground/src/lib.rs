@@ -143,8 +143,8 @@ fn render_in<R: Real>(text: &str, turn: f64, frame: &Frame) -> Result<Output, Mi
     if n > MAX_OBJECTS {
         return Err(unplaced(format!("the scene declares {n} objects; the playground takes at most {MAX_OBJECTS}")));
     }
-    let mut objects = vec![Object::<R>::default(); n.max(1)];
-    let scene = parse_with::<R>(text, &mut objects, |c| *c = c.orbit(turn))
+    let (mut objects, mut parts) = (vec![Object::<R>::default(); n.max(1)], lattice_rt::Parts::new());
+    let scene = parse_with::<R>(text, &mut objects, &mut parts, |c| *c = c.orbit(turn))
         .map_err(|e| Mistake { line: e.line, col: e.col, message: e.to_string() })?;
     let cfg = LatticeConfig::default();
     let sizes = Sizes { objects: 0, rows: 0, ..Sizes::of(&scene, Some(&cfg), &Frame::new(1, 1)) };

@@ -175,7 +175,8 @@ mod tests {
     #[test]
     fn a_budget_is_never_exceeded_and_the_choice_is_what_is_built() {
         let mut st = vec![Object::<f64>::default(); 200];
-        let mut b = SceneBuilder::new(&mut st);
+        let mut parts = crate::Parts::default();
+        let mut b = SceneBuilder::new(&mut st, &mut parts);
         random_scene(&mut b, &RandomScene { objects: 200, composite_size: 20, spread: 0.0, seed: 5 }).unwrap();
         let scene = b.finish().unwrap();
         let full = Lattice::choose(&scene, &LatticeConfig::default());

@@ -236,7 +236,8 @@ mod tests {
 
     fn with_lattice(n: usize, group: usize, cfg: LatticeConfig, f: impl FnOnce(&Scene<'_, f64>, &Lattice<'_, f64>)) {
         let mut st = scene_storage(n);
-        let mut b = SceneBuilder::new(&mut st);
+        let mut parts = crate::Parts::default();
+        let mut b = SceneBuilder::new(&mut st, &mut parts);
         random_scene(&mut b, &RandomScene { objects: n, composite_size: group, spread: 0.0, seed: 7 }).unwrap();
         let scene = b.finish().unwrap();
         let s = Lattice::plan(&scene, &cfg);
@@ -257,7 +258,8 @@ mod tests {
     #[test]
     fn too_little_storage_names_the_capacity_and_the_size_needed() {
         let mut st = scene_storage(20);
-        let mut b = SceneBuilder::new(&mut st);
+        let mut parts = crate::Parts::default();
+        let mut b = SceneBuilder::new(&mut st, &mut parts);
         random_scene(&mut b, &RandomScene { objects: 20, composite_size: 5, spread: 0.0, seed: 3 }).unwrap();
         let scene = b.finish().unwrap();
         // 16-bit indices count two to a word, 32-bit ones one.

@@ -1,20 +1,18 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE};
+use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Parts, Scene, NO_COMPOSITE};
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
-use heapless::Vec;
 
 /// Builds and validates a [`Scene`] into caller-provided object storage.
 #[derive(Debug)]
 pub struct SceneBuilder<'a, R> {
     storage: &'a mut [Object<R>],
     len: usize,
-    composites: Vec<Composite<R>, MAX_COMPOSITES>,
-    materials: Vec<Material<R>, MAX_MATERIALS>,
-    lights: Vec<Light<R>, MAX_LIGHTS>,
+    /// The composites, materials and lights, as the scene will hold them.
+    parts: &'a mut Parts<R>,
     open_composite: Option<(usize, Affine<f64>, Aabb<f64>)>,
     /// Ambient intensity `Ia`.
     pub ambient: f64,
@@ -77,14 +75,14 @@ fn check_range<R: Real>(v: Vec3<f64>) -> Result<(), SceneError> {
 }
 
 impl<'a, R: Real> SceneBuilder<'a, R> {
-    /// A builder storing objects in `storage` (its length is the object capacity).
-    pub fn new(storage: &'a mut [Object<R>]) -> Self {
+    /// A builder storing objects in `storage` (its length is the object capacity) and the
+    /// composites, materials and lights in `parts` (emptied first).
+    pub fn new(storage: &'a mut [Object<R>], parts: &'a mut Parts<R>) -> Self {
+        *parts = Parts::new();
         SceneBuilder {
             storage,
             len: 0,
-            composites: Vec::new(),
-            materials: Vec::new(),
-            lights: Vec::new(),
+            parts,
             open_composite: None,
             ambient: 0.2,
             background: 0.0,
@@ -115,8 +113,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         check_value::<R>(IOR, m.ior)?;
         let f = R::from_f64;
         let conv = Material { ka: f(m.ka), kd: f(m.kd), ks: f(m.ks), kt: f(m.kt), ior: f(m.ior) };
-        self.materials.push(conv).map_err(|_| SceneError::TooManyMaterials)?;
-        Ok((self.materials.len() - 1) as u8)
+        self.parts.materials.push(conv).map_err(|_| SceneError::TooManyMaterials)?;
+        Ok((self.parts.materials.len() - 1) as u8)
     }
 
     /// Adds a light. A directional light's `dir` is the direction the light travels.
@@ -139,7 +137,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
                 Light::Point { pos: pos.cast(), intensity: R::from_f64(intensity) }
             }
         };
-        self.lights.push(conv).map_err(|_| SceneError::TooManyLights)
+        self.parts.lights.push(conv).map_err(|_| SceneError::TooManyLights)
     }
 
     /// Opens a composite object placed by `t`; objects until [`SceneBuilder::end_composite`] belong to it.
@@ -147,7 +145,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if self.open_composite.is_some() {
             return Err(SceneError::NestedComposite);
         }
-        if self.composites.is_full() {
+        if self.parts.composites.is_full() {
             return Err(SceneError::TooManyComposites);
         }
         checked_inverse(&t)?;
@@ -163,7 +161,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         }
         // Object indices are below 2^31 (checked in `add_object`), so both fit in u32.
         let g = Composite { first: first as u32, len: (self.len - first) as u32, bounds: bounds.cast_padded() };
-        self.composites.push(g).map_err(|_| SceneError::TooManyComposites)
+        self.parts.composites.push(g).map_err(|_| SceneError::TooManyComposites)
     }
 
     /// Adds a primitive placed by `to_world` (inside an open composite, the composite's
@@ -192,14 +190,14 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let padded = bounds.padded_for::<R>();
         check_range::<R>(padded.min)?;
         check_range::<R>(padded.max)?;
-        let material = material.min(self.materials.len().saturating_sub(1) as u8);
-        if self.materials.is_empty() {
+        let material = material.min(self.parts.materials.len().saturating_sub(1) as u8);
+        if self.parts.materials.is_empty() {
             self.add_material(Material::DEFAULT)?;
         }
         let composite = match &mut self.open_composite {
             Some((_, _, gb)) => {
                 *gb = gb.union(&bounds);
-                self.composites.len() as u16
+                self.parts.composites.len() as u16
             }
             None => NO_COMPOSITE,
         };
@@ -252,7 +250,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if self.len == 0 {
             return Err(SceneError::NoObjects);
         }
-        if self.materials.is_empty() {
+        if self.parts.materials.is_empty() {
             self.add_material(Material::DEFAULT)?;
         }
         let c = self.camera;
@@ -290,14 +288,14 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         for o in &self.storage[..self.len] {
             world = world.union(&o.bounds);
         }
-        let shadow_basis = shadow_basis(&self.lights);
+        let shadow_basis = shadow_basis(&self.parts.lights);
         // A point's light-window position is two dot products in R: widen every window by what
         // their rounding can reach anywhere in the world (the scalar's padding at its corners).
         let reach = world.min.max_abs().max(world.max.max_abs()).to_f64();
         let margin = R::pad_eps().to_f64() * (1.0 + reach);
         for o in self.storage[..self.len].iter_mut() {
             o.eye_local = o.point_local(camera.eye);
-            o.light_local = match self.lights.first() {
+            o.light_local = match self.parts.lights.first() {
                 Some(Light::Directional { to_light, .. }) => o.direction_local(*to_light),
                 _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             };
@@ -307,7 +305,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
                 None => shadow_whole_plane(),
             };
         }
-        let objects: &'a [Object<R>] = &self.storage[..self.len];
+        let bound = brightness_bound(&self.parts.materials, &self.parts.lights, self.ambient, self.background);
+        let (len, ambient, background, max_depth) = (self.len, self.ambient, self.background, self.max_depth);
+        let objects: &'a [Object<R>] = &self.storage[..len];
+        let parts: &'a Parts<R> = self.parts;
         check_range::<R>(world.min.cast())?;
         check_range::<R>(world.max.cast())?;
         // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
@@ -330,19 +331,18 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
                 return Err(SceneError::ObjectTooThin { object: i, size, smallest, scalar: R::NAME });
             }
         }
-        let bound = brightness_bound(&self.materials, &self.lights, self.ambient, self.background);
         if !(bound < R::LIMIT) {
             return Err(SceneError::TooBright { bound, limit: R::LIMIT, scalar: R::NAME });
         }
         Ok(Scene {
             objects,
-            composites: self.composites,
-            materials: self.materials,
-            lights: self.lights,
-            ambient: R::from_f64(self.ambient),
-            background: R::from_f64(self.background),
+            composites: &parts.composites,
+            materials: &parts.materials,
+            lights: &parts.lights,
+            ambient: R::from_f64(ambient),
+            background: R::from_f64(background),
             camera,
-            max_depth: self.max_depth,
+            max_depth,
             world,
             shadow_basis,
         })

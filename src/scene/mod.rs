@@ -18,6 +18,6 @@ pub mod text;
 pub use builder::{check_value, SceneBuilder, IOR};
 pub use error::SceneError;
 pub use model::{
-    axis_normal, Camera, CameraDesc, Composite, Culled, EyeWindow, ShadowWindow, Light, Material, Object, Scene, EYE_MARGIN, VIEW_MARGIN, MAX_COMPOSITES, MAX_LIGHTS,
+    axis_normal, Camera, CameraDesc, Composite, Culled, EyeWindow, ShadowWindow, Light, Material, Object, Parts, Scene, EYE_MARGIN, VIEW_MARGIN, MAX_COMPOSITES, MAX_LIGHTS,
     MAX_MATERIALS, NO_COMPOSITE, WHOLE_PLANE,
 };

@@ -475,17 +475,40 @@ pub struct Composite<R> {
     pub bounds: Aabb<R>,
 }
 
+/// Where a parsed scene's composites, materials and lights are kept, beside the object storage
+/// (lists of fixed capacity; a [`Scene`] holds exact slices of them, as a baked scene holds
+/// slices of its tables, so that neither carries the unused capacity).
+#[derive(Clone, Debug)]
+pub struct Parts<R> {
+    pub(crate) composites: Vec<Composite<R>, MAX_COMPOSITES>,
+    pub(crate) materials: Vec<Material<R>, MAX_MATERIALS>,
+    pub(crate) lights: Vec<Light<R>, MAX_LIGHTS>,
+}
+
+impl<R> Parts<R> {
+    /// Empty lists.
+    pub const fn new() -> Self {
+        Parts { composites: Vec::new(), materials: Vec::new(), lights: Vec::new() }
+    }
+}
+
+impl<R> Default for Parts<R> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// A validated scene, ready to trace.
 #[derive(Debug)]
 pub struct Scene<'a, R> {
     /// All primitives; the objects of a composite are contiguous.
     pub(crate) objects: &'a [Object<R>],
     /// Composite objects.
-    pub(crate) composites: Vec<Composite<R>, MAX_COMPOSITES>,
+    pub(crate) composites: &'a [Composite<R>],
     /// Materials.
-    pub(crate) materials: Vec<Material<R>, MAX_MATERIALS>,
+    pub(crate) materials: &'a [Material<R>],
     /// Lights.
-    pub(crate) lights: Vec<Light<R>, MAX_LIGHTS>,
+    pub(crate) lights: &'a [Light<R>],
     /// Ambient intensity `Ia`.
     pub(crate) ambient: R,
     /// Gray of rays that hit nothing (0 black .. 1 white).
@@ -507,9 +530,9 @@ impl<'a, R> Scene<'a, R> {
     #[allow(clippy::too_many_arguments)]
     pub const fn from_tables(
         objects: &'a [Object<R>],
-        composites: Vec<Composite<R>, MAX_COMPOSITES>,
-        materials: Vec<Material<R>, MAX_MATERIALS>,
-        lights: Vec<Light<R>, MAX_LIGHTS>,
+        composites: &'a [Composite<R>],
+        materials: &'a [Material<R>],
+        lights: &'a [Light<R>],
         ambient: R,
         background: R,
         camera: Camera<R>,
@@ -544,16 +567,16 @@ impl<'a, R: Real> Scene<'a, R> {
         self.objects
     }
     /// Composite objects.
-    pub fn composites(&self) -> &[Composite<R>] {
-        &self.composites
+    pub fn composites(&self) -> &'a [Composite<R>] {
+        self.composites
     }
     /// Materials.
-    pub fn materials(&self) -> &[Material<R>] {
-        &self.materials
+    pub fn materials(&self) -> &'a [Material<R>] {
+        self.materials
     }
     /// Lights.
-    pub fn lights(&self) -> &[Light<R>] {
-        &self.lights
+    pub fn lights(&self) -> &'a [Light<R>] {
+        self.lights
     }
     /// Ambient intensity `Ia`.
     pub fn ambient(&self) -> R {

@@ -7,7 +7,7 @@
 
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
-use super::{check_value, CameraDesc, Light, Material, Object, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
+use super::{check_value, CameraDesc, Light, Material, Object, Parts, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
 use crate::shape::Shape;
 use crate::trace::MAX_DEPTH;
 use core::fmt;
@@ -698,13 +698,14 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
     }
 }
 
-/// Parses scene text into a validated scene whose objects live in `storage`.
+/// Parses scene text into a validated scene whose objects live in `storage` and whose
+/// composites, materials and lights live in `parts`.
 ///
 /// Kept out of line so that on a microcontroller the parser's frame is released before the
 /// render that follows it needs the stack.
 #[inline(never)]
-pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Result<Scene<'a, R>, ParseError<'t>> {
-    parse_with(text, storage, |_| {})
+pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>], parts: &'a mut Parts<R>) -> Result<Scene<'a, R>, ParseError<'t>> {
+    parse_with(text, storage, parts, |_| {})
 }
 
 /// [`parse`], with the camera the text describes changed by `camera` before the scene is
@@ -712,11 +713,12 @@ pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>]) -> Re
 pub fn parse_with<'a, 't, R: Real>(
     text: &'t str,
     storage: &'a mut [Object<R>],
+    parts: &'a mut Parts<R>,
     camera: impl FnOnce(&mut CameraDesc),
 ) -> Result<Scene<'a, R>, ParseError<'t>> {
     let mut p = Parser {
         text,
-        b: SceneBuilder::<R>::new(storage),
+        b: SceneBuilder::<R>::new(storage, parts),
         names: Vec::new(),
         camera_at: (0, 0, ""),
         group_at: (0, 0, ""),

@@ -47,7 +47,8 @@ pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, 
 /// Parses `text` and renders it with one accelerator and the scene's own settings.
 pub fn render_text<R: Real>(text: &str, accel: Accel, frame: &Frame) -> (Vec<u8>, Stats) {
     let mut storage = vec![Object::<R>::default(); text.lines().count()];
-    let scene = parse::<R>(text, &mut storage).unwrap_or_else(|e| panic!("{e}"));
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{e}"));
     let mut st = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut st);
     let a: &dyn Accelerator<R> = match accel {

@@ -2,7 +2,7 @@
 //! the lattice's resolution choice against a sweep. Writes `docs/performance.md` and a plot.
 
 use host_sim::shared::median;
-use host_sim::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
+use host_sim::load::{object_storage, parse_scene, read, build_lattice, lattice_storage, SceneStore};
 use host_sim::run::render_band;
 use host_sim::output::write_atomic;
 use host_sim::shared::plot_link;
@@ -10,7 +10,7 @@ use anyhow::Result;
 use lattice_rt::generate::{random_object, random_scene, RandomScene, Rng};
 use lattice_rt::lattice::{Resolution, Spacing};
 use lattice_rt::scene::Object;
-use lattice_rt::{Accelerator, BoundingBox, BruteForce, Effects, EyeRays, Frame, LatticeConfig, Query, Ray, Scene, SceneBuilder, Tracer, Vec3};
+use lattice_rt::{Accelerator, BoundingBox, BruteForce, Effects, EyeRays, Frame, LatticeConfig, Query, Ray, Scene, Tracer, Vec3};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -99,21 +99,21 @@ pub fn camera_rays(scene: &Scene<'_, f64>, w: i32, h: i32) -> Vec<Ray<f64>> {
 
 /// A generated scene: `n` random primitives, or the clustered "teapot in a stadium": most of
 /// them in one dense composite far from the sparse rest.
-pub fn generated(n: usize, clustered: bool, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
+pub fn generated(n: usize, clustered: bool, storage: &mut SceneStore<f64>) -> Result<Scene<'_, f64>> {
     generated_as(n, clustered, true, storage)
 }
 
 /// The clustered scene of [`generated`] with the cluster not declared a composite: its
 /// primitives are loose among the others, as in a scene another program wrote out.
-pub fn loose(n: usize, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
+pub fn loose(n: usize, storage: &mut SceneStore<f64>) -> Result<Scene<'_, f64>> {
     generated_as(n, true, false, storage)
 }
 
 /// The issue's own check: `n` loose primitives packed into a cube of side 2 on a floor 160
 /// units wide ringed by 40 boxes, seen from the floor's edge.
-pub fn stadium(n: usize, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
-    *storage = vec![Object::default(); n + 41];
-    let mut b = SceneBuilder::new(storage);
+pub fn stadium(n: usize, storage: &mut SceneStore<f64>) -> Result<Scene<'_, f64>> {
+    storage.objects = vec![Object::default(); n + 41];
+    let mut b = storage.builder();
     let mut rng = Rng::new(3000 + n as u64);
     b.add_material(lattice_rt::scene::Material::DEFAULT)?;
     b.add_light(lattice_rt::scene::Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 })?;
@@ -133,9 +133,9 @@ pub fn stadium(n: usize, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64
     Ok(b.finish()?)
 }
 
-fn generated_as(n: usize, clustered: bool, declared: bool, storage: &mut Vec<Object<f64>>) -> Result<Scene<'_, f64>> {
-    *storage = vec![Object::default(); n];
-    let mut b = SceneBuilder::new(storage);
+fn generated_as(n: usize, clustered: bool, declared: bool, storage: &mut SceneStore<f64>) -> Result<Scene<'_, f64>> {
+    storage.objects = vec![Object::default(); n];
+    let mut b = storage.builder();
     if !clustered {
         random_scene(&mut b, &RandomScene { objects: n, composite_size: 0, spread: 0.0, seed: n as u64 })?;
     } else {
@@ -252,7 +252,7 @@ fn scaling(md: &mut String, quick: bool, runs: usize) -> Result<Series> {
     let bar = host_sim::progress::bar(2 * sizes.len(), "generated scenes");
     for clustered in [false, true] {
         for &n in &sizes {
-            let mut storage = Vec::new();
+            let mut storage = SceneStore::default();
             let scene = generated(n, clustered, &mut storage)?;
             let all_rays = camera_rays(&scene, 64, 40);
             let kind = if clustered { "clustered" } else { "random" };
@@ -324,7 +324,7 @@ fn scaling(md: &mut String, quick: bool, runs: usize) -> Result<Series> {
 fn stadium_scaling(md: &mut String, sizes: [usize; 2], runs: usize) -> Result<()> {
     let mut per = Vec::new();
     for n in sizes {
-        let mut storage = Vec::new();
+        let mut storage = SceneStore::default();
         let scene = stadium(n, &mut storage)?;
         let cfg = LatticeConfig::default();
         let mut bufs = lattice_storage(&scene, &cfg)?;
@@ -351,7 +351,7 @@ fn resolution_sweep(md: &mut String, quick: bool, runs: usize) -> Result<()> {
     let n = if quick { 1000 } else { 10_000 };
     writeln!(md, "\n## Lattice resolution: automatic against a sweep\n\nRandom scene, N = {n}; uniform lists. The automatic choice aims at about 2 cells per object\n(cells per axis proportional to extent x cube root of the count, as in Cleary and Wyvill's\nanalysis and pbrt's `GridAccel`).\n")?;
     writeln!(md, "| resolution | cells | us/ray | object tests/ray | cells/ray | bytes |\n|---|---|---|---|---|---|")?;
-    let mut storage = Vec::new();
+    let mut storage = SceneStore::default();
     let scene = generated(n, false, &mut storage)?;
     let rays = camera_rays(&scene, 64, 40);
     let mut sweep: Vec<(String, LatticeConfig)> = [4u16, 8, 16, 24, 32, 48, 64].iter().map(|&k| (format!("{k}^3"), LatticeConfig { top: Resolution::Uniform([k; 3]), nested: false, ..LatticeConfig::default() })).collect();
@@ -367,7 +367,7 @@ fn resolution_sweep(md: &mut String, quick: bool, runs: usize) -> Result<()> {
 }
 
 /// A scene of the POV-Ray comparison made in the storage it is given.
-type Maker = Box<dyn for<'a> Fn(&'a mut Vec<Object<f64>>) -> Result<Scene<'a, f64>>>;
+type Maker = Box<dyn for<'a> Fn(&'a mut SceneStore<f64>) -> Result<Scene<'a, f64>>>;
 
 /// The scenes of the POV-Ray comparison, by name: the paper scenes and generated scenes of 100,
 /// 1 000 and 10 000 primitives (1 000 at most with `quick`), random, clustered and loosely
@@ -377,7 +377,7 @@ pub fn versus_cases(quick: bool) -> Vec<(String, Maker)> {
     for (name, ..) in PAPER {
         cases.push((
             name.to_string(),
-            Box::new(move |storage: &mut Vec<Object<f64>>| {
+            Box::new(move |storage: &mut SceneStore<f64>| {
                 let path = Path::new("scenes").join(format!("{name}.scene"));
                 let text = read(&path)?;
                 *storage = object_storage::<f64>(&text)?;
@@ -389,13 +389,13 @@ pub fn versus_cases(quick: bool) -> Vec<(String, Maker)> {
     for clustered in [false, true] {
         for &n in sizes {
             let name = format!("{} {n}", if clustered { "clustered" } else { "random" });
-            cases.push((name, Box::new(move |storage: &mut Vec<Object<f64>>| generated(n, clustered, storage))));
+            cases.push((name, Box::new(move |storage: &mut SceneStore<f64>| generated(n, clustered, storage))));
         }
     }
     for &n in sizes {
-        cases.push((format!("loose clustered {n}"), Box::new(move |storage: &mut Vec<Object<f64>>| loose(n, storage))));
+        cases.push((format!("loose clustered {n}"), Box::new(move |storage: &mut SceneStore<f64>| loose(n, storage))));
     }
-    cases.push(("stadium 3000".into(), Box::new(|storage: &mut Vec<Object<f64>>| stadium(3000, storage))));
+    cases.push(("stadium 3000".into(), Box::new(|storage: &mut SceneStore<f64>| stadium(3000, storage))));
     cases
 }
 
@@ -431,7 +431,7 @@ pub fn versus_rows(cases: &[(String, Maker)], runs: usize, povray: bool) -> Resu
     let mut rows = Vec::new();
     let bar = host_sim::progress::bar(cases.len(), "against POV-Ray");
     for (name, make) in cases {
-        let mut storage = Vec::new();
+        let mut storage = SceneStore::default();
         let scene = make(&mut storage)?;
         let mut bufs = lattice_storage(&scene, &cfg)?;
         let lattice = build_lattice(&mut bufs, &scene, &cfg)?;

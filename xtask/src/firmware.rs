@@ -378,17 +378,20 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
         for (part, bytes) in parts.into_iter().filter(|p| p.1 > 0) {
             writeln!(md, "| {part} | {bytes} |")?;
         }
-        // The tables' two big parts: the objects, and each scene's own fixed-capacity lists.
-        let mut objects = 0;
+        // The tables' parts: the objects, each scene's header, and its composites, materials
+        // and lights (exactly as many as it has).
+        let (mut objects, mut lists) = (0, 0);
         for s in &r.scenes {
             let text = host_sim::load::read(&root.join("scenes").join(format!("{}.scene", s.name)))?;
             let mut storage = host_sim::load::object_storage::<lattice_rt::Fx>(&text)?;
-            objects += lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage).map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?.objects().len();
+            let scene = lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage.objects, &mut storage.parts).map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?;
+            objects += scene.objects().len();
+            lists += size_of_val(scene.composites()) + size_of_val(scene.materials()) + size_of_val(scene.lights());
         }
         let (object, baked) = (size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>(), size_of::<lattice_rt::Baked<lattice_rt::Fx>>());
         writeln!(
             md,
-            "\nOf the tables, the {objects} objects take {objects} x {object} = {} B and the {} scenes' `Baked` statics\n{} x {baked} = {} B (a scene's composites, materials and lights sit in lists of fixed capacity,\nkept whole so that the scene is used in place, not copied to RAM); the rest are the lattices\n(cells, references, coordinate lists) and constants.",
+            "\nOf the tables, the {objects} objects take {objects} x {object} = {} B, the {} scenes' `Baked` statics\n{} x {baked} = {} B (each scene's camera, world box and lattice header, and slices of its\ncomposites, materials and lights) and those lists {lists} B; the rest are the lattices (cells,\nreferences, coordinate lists) and constants.",
             objects * object,
             r.scenes.len(),
             r.scenes.len(),

@@ -4,12 +4,11 @@
 //! end that keeps no lattice. Writes `docs/memory.md` and two plots.
 
 use crate::bench::{camera_rays, generated};
-use host_sim::load::{build_lattice, lattice_storage, object_storage, parse_scene, read};
+use host_sim::load::{build_lattice, lattice_storage, object_storage, parse_scene, read, SceneStore};
 use host_sim::output::write_atomic;
 use host_sim::shared::{median, plot_link, PAPER_SCENES};
 use anyhow::{ensure, Result};
 use lattice_rt::lattice::Choice;
-use lattice_rt::scene::Object;
 use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, Query, Ray, Scene};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -86,7 +85,7 @@ fn measure(scene: &Scene<'_, f64>, methods: &[Method<'_>], rays: &[Ray<f64>], ru
 /// A scene of the study and how its name reads in the report.
 struct Subject {
     name: String,
-    objects: Vec<Object<f64>>,
+    objects: SceneStore<f64>,
     source: Source,
 }
 
@@ -106,7 +105,7 @@ fn subjects(quick: bool) -> Result<Vec<Subject>> {
     for clustered in [false, true] {
         for &n in sizes {
             let kind = if clustered { "clustered" } else { "uniform" };
-            v.push(Subject { name: format!("{kind} {n}"), objects: Vec::new(), source: Source::Generated(n, clustered) });
+            v.push(Subject { name: format!("{kind} {n}"), objects: SceneStore::default(), source: Source::Generated(n, clustered) });
         }
     }
     Ok(v)
