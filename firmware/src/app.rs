@@ -147,6 +147,9 @@ pub struct Report {
     /// Time each tile share took, all passes together (in the units of the clock given to
     /// [`render_scene_at`]).
     pub share_us: [u64; 2],
+    /// The clock (as [`Board::now`] read it) when the tile shares started: what the frame did
+    /// before is its set-up.
+    pub tiles_at: u64,
 }
 
 /// The passes a frame is shown in: with the `progressive` feature 8, 4, 2 and 1 (`render_pass`:
@@ -425,10 +428,11 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
     let mut times = [0u64; 2];
+    let tiles_at = now();
     if TRACE_THEN_DITHER {
         let memory = DitherMemory { mailbox, rows, kept, rays, above, band, carries };
         let (s, [there, mine]) = trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown), target)?;
-        return Ok(Report { stats: s, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [mine, there] });
+        return Ok(Report { stats: s, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [mine, there], tiles_at });
     }
     for &pass in PASSES {
         // One core: both shares straight to the display, one after the other.
@@ -441,7 +445,7 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
         (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
         shown(pass);
     }
-    Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]] })
+    Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]], tiles_at })
 }
 
 /// Where [`trace_then_dither`] works: core 1's query scratch, what every tile keeps, the

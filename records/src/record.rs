@@ -18,6 +18,9 @@ pub struct FrameDone {
     pub scene: u8,
     /// Microseconds from the LED going on to the frame on the panel.
     pub us: u64,
+    /// Microseconds from the LED going on to the first tile: the scene's set-up (with run-time
+    /// parsing, the parse and the lattice build) and the tracer's.
+    pub setup_us: u64,
     /// Microseconds each core spent on its tile share (core 0, core 1).
     pub share_us: [u64; 2],
     /// Rays traced by kind: eye, shadow, reflection, refraction.

@@ -30,13 +30,17 @@ pub fn report(record: Record) {
     BOARD_RECORDS.send(&record);
 }
 
+/// A frame's microseconds: the whole frame, and up to the first tile (its set-up).
+type Micros = (u64, u64);
+
 /// What a frame of scene `scene` reports (orbit mode reports whole orbits instead).
 #[cfg(any(feature = "ladder", not(feature = "orbit")))]
-fn frame_done(scene: usize, r: &Report, us: u64) -> FrameDone {
+fn frame_done(scene: usize, r: &Report, (us, setup_us): Micros) -> FrameDone {
     let s = &r.stats;
     FrameDone {
         scene: scene as u8,
         us,
+        setup_us,
         share_us: r.share_us,
         rays: s.rays,
         object_tests: s.object_tests,
@@ -67,11 +71,12 @@ pub struct Panel<'m, T, L> {
 }
 
 impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin> Panel<'_, T, L> {
-    /// One frame, with the LED lit while it renders; its report and microseconds. The passes of
+    /// One frame, with the LED lit while it renders; its report and its microseconds, whole and
+    /// up to the first tile (the set-up). The passes of
     /// a progressive frame (the `progressive` feature) follow each other without waiting for the
     /// bus: each reaches the panel as its bytes do, while the cores trace the next, and the LED
     /// goes out when the last is on the panel.
-    pub fn show(&mut self, scene: Embedded, shot: &Shot) -> Result<(Report, u64), AppError<'static, T::Error>> {
+    pub fn show(&mut self, scene: Embedded, shot: &Shot) -> Result<(Report, Micros), AppError<'static, T::Error>> {
         let timer = self.timer;
         let t0 = timer.get_counter();
         let _ = self.led.set_high();
@@ -82,7 +87,10 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         let sent = crate::display::flush();
         let _ = self.led.set_low();
         let result = result.and_then(|r| sent.map(|()| r).map_err(|_| AppError::Render(RenderError::Draw(DisplayError::BusWriteError))));
-        result.map(|r| (r, (timer.get_counter() - t0).to_micros()))
+        result.map(|r| {
+            let setup_us = r.tiles_at.saturating_sub(t0.ticks());
+            (r, ((timer.get_counter() - t0).to_micros(), setup_us))
+        })
     }
 
     /// Sleeps between scenes.
@@ -97,8 +105,8 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
     loop {
         for (i, (name, scene)) in EMBEDDED.iter().copied().enumerate() {
             match panel.show(scene, &Shot::default()) {
-                Ok((r, us)) => {
-                    report(Record::Frame(frame_done(i, &r, us)));
+                Ok((r, (us, setup_us))) => {
+                    report(Record::Frame(frame_done(i, &r, (us, setup_us))));
                     let (s, shares) = (r.stats, r.share_us);
                     defmt::info!(
                         "{}: {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
@@ -150,8 +158,8 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
         let (name, text) = EMBEDDED[0];
         for (rung, (what, tuning)) in LADDER.iter().enumerate() {
             match panel.show(text, &Shot { turn: 0.0, tuning: *tuning }) {
-                Ok((r, us)) => {
-                    report(Record::Rung { rung: rung as u8, frame: frame_done(0, &r, us) });
+                Ok((r, (us, setup_us))) => {
+                    report(Record::Rung { rung: rung as u8, frame: frame_done(0, &r, (us, setup_us)) });
                     defmt::info!(
                         "ladder {}: {}: {} us, shares {} us and {} us, object tests {}, cells {} ({})",
                         rung, name, us, r.share_us[0], r.share_us[1], r.stats.object_tests, r.stats.cells_visited, what
