@@ -483,7 +483,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let mut total = R::ZERO;
         // The eye ray's window position (if the caller gave one) serves the eye ray alone.
         let eye_uv = q.eye_ray();
-        while let Some(node) = stack.pop() {
+        while let Some(top) = stack.len().checked_sub(1) {
+            // The node is read where it lies, field by field, not moved out whole: a move copies
+            // it in wide loads that straddle the narrower stores it was written with, and such a
+            // load waits for those stores to retire (no store-to-load forwarding on x86).
+            let at = &stack[top];
+            let node = Node { ray: at.ray, weight: at.weight, depth: at.depth, kind: at.kind, leaving: at.leaving };
+            stack.truncate(top);
             q.stats.rays[node.kind as usize] += 1;
             q.set_leaving((node.leaving != NO_OBJECT).then_some(node.leaving));
             let found = self.nearest(&node.ray, if node.depth == 0 { eye_uv } else { None }, q);
