@@ -80,6 +80,23 @@ fn product(a: u32, b: u32) -> i32 {
         m as i32
     }
 }
+/// `(a << 16) / b` for `b > 0` as a quotient and remainder, by restoring long division in base
+/// 2 in 32 bits (the remainder stays below `b < 2^32`, and below 2^31 doubling it fits), not a
+/// 64-bit division: its sixteen fraction bits after the integer quotient `a / b`, which must be
+/// below 2^16 for the quotient to fit.
+pub(crate) fn shifted_quotient(a: u32, b: u32) -> (u32, u32) {
+    let (mut q, mut r) = (a / b, a % b);
+    for _ in 0..FRAC {
+        r <<= 1;
+        q <<= 1;
+        if r >= b {
+            r -= b;
+            q |= 1;
+        }
+    }
+    (q, r)
+}
+
 impl Div for Fx {
     type Output = Fx;
     /// `(a << 16) / b` rounded half away from zero; saturates, and `x / 0` is the largest value
@@ -120,15 +137,7 @@ impl Div for Fx {
             // A divisor of 2^23 or more: the quotient is below 2^24 and its 16 fraction bits
             // come by restoring long division in base 2, in 32 bits (the remainder stays
             // below the divisor, at most 2^31, so doubling it fits), not a 64-bit division.
-            let (mut q, mut r) = (a / b, a % b);
-            for _ in 0..FRAC {
-                r <<= 1;
-                q <<= 1;
-                if r >= b {
-                    r -= b;
-                    q |= 1;
-                }
-            }
+            let (q, r) = shifted_quotient(a, b);
             if r >= b - r {
                 q + 1
             } else {

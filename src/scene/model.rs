@@ -171,13 +171,30 @@ impl<R: Real> Camera<R> {
     }
 }
 
-/// `(n << 16) / d` (`d` at least 1), clamped to `i32`: one 32-bit division while `n` is small
-/// (a microcontroller's divider does that in a few cycles).
+/// `(n << 16) / d` (`d` at least 1) truncated towards zero, clamped to `i32`: one 32-bit
+/// division while `n` is small (a microcontroller's divider does that in a few cycles), else
+/// long division in 32 bits (no 64-bit division routine linked).
 fn window_coord(n: i32, d: i32) -> i32 {
+    let d = d.max(1);
     if n.unsigned_abs() < 1 << 15 {
-        (n << 16) / d.max(1)
+        (n << 16) / d
     } else {
-        ((i64::from(n) << 16) / i64::from(d.max(1))).clamp(i32::MIN.into(), i32::MAX.into()) as i32
+        window_coord_far(n, d)
+    }
+}
+
+/// [`window_coord`] of a numerator of 2^15 or more (a window thousands of pixels wide), kept
+/// out of the way of the common case.
+#[cold]
+#[inline(never)]
+fn window_coord_far(n: i32, d: i32) -> i32 {
+    let (a, b) = (n.unsigned_abs(), d as u32);
+    // A whole quotient of 2^15 or more is past the clamp.
+    let q = if a / b >= 1 << 15 { u32::MAX } else { crate::fixed::shifted_quotient(a, b).0 };
+    if n < 0 {
+        if q >= 1 << 31 { i32::MIN } else { -(q as i32) }
+    } else {
+        q.min(i32::MAX as u32) as i32
     }
 }
 
@@ -600,3 +617,29 @@ impl<'a, R: Real> Scene<'a, R> {
     }
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::window_coord;
+
+    /// The window coordinate is the 64-bit quotient, truncated and clamped, for numerators
+    /// small and large (long division past 2^15) and divisors from 1 up.
+    #[test]
+    fn window_coord_is_the_wide_quotient_clamped() {
+        let wide = |n: i32, d: i32| ((i64::from(n) << 16) / i64::from(d.max(1))).clamp(i32::MIN.into(), i32::MAX.into()) as i32;
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let n = (x as i32) >> (x % 31);
+            let d = ((x >> 32) as i32 >> ((x >> 40) % 31)).max(-5);
+            assert_eq!(window_coord(n, d), wide(n, d), "({n} << 16) / {d}");
+        }
+        for n in [i32::MIN, i32::MIN + 1, -(1 << 15), (1 << 15) - 1, 1 << 15, i32::MAX, 0, -1] {
+            for d in [-1, 0, 1, 2, 3, 1 << 15, (1 << 16) + 1, i32::MAX] {
+                assert_eq!(window_coord(n, d), wide(n, d), "({n} << 16) / {d}");
+            }
+        }
+    }
+}

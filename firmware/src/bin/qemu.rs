@@ -67,19 +67,32 @@ impl Line {
     fn text(&mut self, t: &str) -> &mut Self {
         self.put(t.as_bytes())
     }
-    /// Appends a number in decimal.
+    /// Appends a number in decimal, by subtracting powers of ten (no 64-bit division, whose
+    /// library routine would be a kilobyte of the image for this alone).
     fn dec(&mut self, mut v: u64) -> &mut Self {
-        let mut digits = [0u8; 20];
-        let mut i = digits.len();
-        loop {
-            i -= 1;
-            digits[i] = b'0' + (v % 10) as u8;
-            v /= 10;
-            if v == 0 {
-                break;
+        // 10^19 down to 1.
+        const POWERS: [u64; 20] = {
+            let mut p = [1u64; 20];
+            let mut i = 19;
+            while i > 0 {
+                p[i - 1] = p[i] * 10;
+                i -= 1;
+            }
+            p
+        };
+        let mut started = false;
+        for power in POWERS {
+            let mut digit = b'0';
+            while v >= power {
+                v -= power;
+                digit += 1;
+            }
+            started |= digit != b'0' || power == 1;
+            if started {
+                self.put(&[digit]);
             }
         }
-        self.put(&digits[i..])
+        self
     }
     /// Appends bytes as lowercase hex, two digits each.
     fn hex(&mut self, bytes: &[u8]) -> &mut Self {
