@@ -20,19 +20,26 @@ use std::{env, fs, path::PathBuf};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
-    let (pico, pico2, microbit) = (has("pico"), has("pico2"), has("microbit"));
+    let (pico, pico2, microbit, tiny) = (has("pico"), has("pico2"), has("microbit"), has("tiny"));
     let target = env::var("TARGET").unwrap_or_default();
     let m33 = target.starts_with("thumbv8m");
-    let src = match (pico, pico2, m33, microbit) {
-        (true, _, _, _) => "../memory.x",
-        (_, true, _, _) => "pico2/memory.x",
-        (_, _, true, _) => "qemu-an505/memory.x",
-        (_, _, _, true) => "microbit/memory.x",
+    let src = match (pico, pico2, m33, microbit, tiny) {
+        (true, ..) => "../memory.x",
+        (_, true, ..) => "pico2/memory.x",
+        (_, _, true, ..) => "qemu-an505/memory.x",
+        (_, _, _, true, _) => "microbit/memory.x",
+        (.., true) => "tiny/memory.x",
         _ => "qemu/memory.x",
     };
-    fs::copy(src, out.join("memory.x")).expect("memory.x");
+    let mut map = fs::read_to_string(src).expect("memory.x");
+    println!("cargo:rerun-if-env-changed=FIRMWARE_FLASH_KIB");
+    if let (true, Ok(kib)) = (tiny, env::var("FIRMWARE_FLASH_KIB")) {
+        let kib: u32 = kib.trim().parse().unwrap_or_else(|_| panic!("FIRMWARE_FLASH_KIB is not a number of KiB: {kib:?}"));
+        map = map.replace("LENGTH = 16K", &format!("LENGTH = {kib}K"));
+    }
+    fs::write(out.join("memory.x"), map).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
-    for map in ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x", "microbit/memory.x"] {
+    for map in ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x", "microbit/memory.x", "tiny/memory.x"] {
         println!("cargo:rerun-if-changed={map}");
     }
     // The core's name in the firmware's reports.

@@ -27,6 +27,8 @@ struct Variant {
     scenes: Option<&'static str>,
     scalar: &'static str,
     what: String,
+    /// The flash size the `tiny` memory map is linked at (`FIRMWARE_FLASH_KIB`), if not its own.
+    flash_kib: Option<u32>,
 }
 
 /// The firmware scalars: (name in reports, cargo feature).
@@ -52,6 +54,7 @@ fn variants() -> Vec<Variant> {
                 scenes: None,
                 scalar,
                 what: format!("{core}, {scalar}, all five scenes"),
+                flash_kib: None,
             });
         }
     }
@@ -66,6 +69,7 @@ fn variants() -> Vec<Variant> {
             scenes: Some("chair"),
             scalar,
             what: format!("Cortex-M0+, {scalar}, only the chair embedded"),
+            flash_kib: None,
         });
     }
     // The smallest board: a BBC micro:bit (nRF51822, Cortex-M0, 16 KiB of RAM), the chair alone.
@@ -79,6 +83,7 @@ fn variants() -> Vec<Variant> {
         scenes: Some("chair"),
         scalar: "fixed",
         what: "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, run on QEMU's microbit machine), fixed, only the chair embedded".into(),
+        flash_kib: None,
     });
     // What adaptive sub-sampling saves: the same build tracing one eye ray per pixel.
     v.push(Variant {
@@ -91,6 +96,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Cortex-M0+, fixed, all five scenes, one eye ray per pixel (exact-sampling) instead of adaptive sub-sampling".into(),
+        flash_kib: None,
     });
     // What a progressive frame costs: the same build showing each frame in four passes.
     v.push(Variant {
@@ -103,6 +109,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Cortex-M0+, fixed, all five scenes, each frame in four progressive passes (8x8, 4x4, 2x2 blocks, then the frame; the last pass is the frame checked)".into(),
+        flash_kib: None,
     });
     // What the effect set saves: every effect forced in, and the matte paper scenes with their
     // derived set against every effect (the same scenes, so the difference is the effect code).
@@ -128,6 +135,7 @@ fn variants() -> Vec<Variant> {
             scenes,
             scalar: "fixed",
             what: what.into(),
+            flash_kib: None,
         });
     }
     // The baked images the flash targets are about, built for size (the `small` profile:
@@ -147,8 +155,24 @@ fn variants() -> Vec<Variant> {
             scenes,
             scalar: "fixed",
             what: what.into(),
+            flash_kib: None,
         });
     }
+    // The smallest parts: the chair alone in 4 KiB of RAM, linker-enforced (tiny/memory.x), its
+    // flash linked at 32 KiB while it does not fit the 16 KiB the memory map gives
+    // ([`tiny_section`] asks the linker for the gap).
+    v.push(Variant {
+        name: TINY.into(),
+        target: "thumbv6m-none-eabi",
+        profile: "small",
+        features: "tiny,scalar-fixed,baked".into(),
+        bin: "qemu",
+        machine: Some("mps2-an385"),
+        scenes: Some("chair"),
+        scalar: "fixed",
+        what: "the smallest Cortex-M0 parts' memory (tiny/memory.x: 4 KiB of RAM, linker-enforced, flip-link; flash linked at 32 KiB), fixed, only the chair, baked, built for size".into(),
+        flash_kib: Some(32),
+    });
     v.push(Variant {
         name: "pico".into(),
         target: "thumbv6m-none-eabi",
@@ -159,6 +183,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes baked (run on an emulated board by `cargo xtask board`: docs/board.md)".into(),
+        flash_kib: None,
     });
     v.push(Variant {
         name: "pico2".into(),
@@ -170,6 +195,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "f32",
         what: "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes baked (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32)".into(),
+        flash_kib: None,
     });
     v
 }
@@ -182,7 +208,8 @@ fn build(root: &Path, v: &Variant) -> Result<()> {
     let args = ["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target];
     let built = Path::new(v.target).join(v.profile).join(v.bin);
     let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);
-    host_sim::uf2::build_image(root, &v.name, &args, scenes, &built).with_context(|| format!("building firmware variant {} failed", v.name))?;
+    let vars: Vec<(&str, String)> = v.flash_kib.map(|k| ("FIRMWARE_FLASH_KIB", k.to_string())).into_iter().collect();
+    host_sim::uf2::build_image_with(root, &v.name, &args, scenes, &built, &vars).with_context(|| format!("building firmware variant {} failed", v.name))?;
     Ok(())
 }
 
@@ -379,6 +406,72 @@ fn baked_static_bytes(elf: &Path) -> Result<u64> {
         .sum())
 }
 
+/// The `tiny` build's variant: the chair in the smallest parts' memory map.
+const TINY: &str = "tiny-m0-fixed-chair";
+
+/// What the linker says of the `tiny` build at the 16 KiB of flash its memory map gives: `Ok(None)`
+/// if the image fits, else by how many bytes the flash region overflows (the largest overflow it
+/// reports, that of the last section placed).
+fn tiny_overflow(root: &Path, v: &Variant) -> Result<Option<u64>> {
+    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .args(["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target])
+        .env_remove("RUSTFLAGS")
+        .env_remove("FIRMWARE_FLASH_KIB")
+        .env("FIRMWARE_SCENES", v.scenes.unwrap_or("chair"))
+        .stdin(Stdio::null())
+        .output()
+        .context("cannot run cargo")?;
+    if out.status.success() {
+        return Ok(None);
+    }
+    let text = String::from_utf8_lossy(&out.stderr);
+    let over = text
+        .lines()
+        .filter_map(|l| l.split("overflowed by ").nth(1)?.split_whitespace().next()?.parse::<u64>().ok())
+        .max();
+    match over {
+        Some(bytes) => Ok(Some(bytes)),
+        None => bail!("the tiny build failed at 16 KiB for another reason than its size:\n{text}"),
+    }
+}
+
+/// The `tiny` build against its targets: the chair in 16 KiB of flash and 4 KiB of RAM.
+fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identical: &std::collections::BTreeMap<(String, String), bool>, tally: &mut Tally) -> Result<()> {
+    let Some((v, r)) = runs.iter().find(|(v, _)| v.name == TINY) else { return Ok(()) };
+    let flash = elf_sizes(&elf_path(root, v))?.0;
+    let ram = r.statics + r.stack;
+    let same = r.scenes.iter().all(|s| identical.get(&(TINY.to_string(), s.name.clone())) == Some(&true));
+    let over = tiny_overflow(root, v)?;
+    // The run itself proves the 4 KiB: its memory map holds no more, and flip-link faults on an
+    // overflow (a fault fails the run).
+    if ram <= 4 << 10 && !r.scenes.is_empty() {
+        tally.passed += 1;
+    } else {
+        tally.failed += 1;
+        eprintln!("FAIL {TINY}: {ram} B of RAM in a 4096 B memory map, or no frame");
+    }
+    writeln!(md, "\n## The tiny build\n")?;
+    writeln!(md, "`{TINY}` (the `tiny` feature, `small` profile): the chair alone in the memory of the smallest")?;
+    writeln!(md, "Cortex-M0 parts, `firmware/tiny/memory.x`: 16 KiB of flash and 4 KiB of RAM, enforced by the linker,")?;
+    writeln!(md, "with flip-link placing the stack below the statics so that an overflow faults. The harness logs")?;
+    writeln!(md, "through a few bytes of its own (`Line` in `firmware/src/bin/qemu.rs`, not `core::fmt`; core's")?;
+    writeln!(md, "index checks still link its integer formatter for their panic messages).\n")?;
+    writeln!(md, "| target | measured | limit | met |\n|---|---:|---:|---|")?;
+    writeln!(md, "| RAM (static + stack high-water, in the 4 KiB map) | {ram} B | 4096 B | {} |", if ram <= 4 << 10 { "yes" } else { "**no**" })?;
+    let fits = over.is_none();
+    writeln!(md, "| flash | {flash} B | 16384 B | {} |", if fits { "yes" } else { "**no**" })?;
+    match over {
+        None => writeln!(md, "\nLinked at 16 KiB the image fits; the frame above ran at that size's layout too.")?,
+        Some(bytes) => writeln!(
+            md,
+            "\nLinked at 16 KiB the linker refuses the image: its flash region overflows by {bytes} B (`rust-lld`:\n*section will not fit in region 'FLASH'*). So it is linked at 32 KiB (`FIRMWARE_FLASH_KIB=32`) to run:\nthe chair's frame {} host-sim's, bit for bit.",
+            if same { "equals" } else { "**differs from**" }
+        )?,
+    }
+    Ok(())
+}
+
 /// The baked builds against the memory targets (issue: flash at most 48 KiB with all five scenes
 /// and every effect, 32 KiB for the matte paper scenes with their effects, which must be at least
 /// 25 % smaller than the all-effects build; RAM at most 4 KiB for the chair, 6 KiB for all five).
@@ -480,6 +573,7 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     table.ratios(&mut md)?;
     table.pico2(&mut md)?;
     baked_section(&mut md, root, &runs, &identical)?;
+    tiny_section(&mut md, root, &runs, &identical, &mut tally)?;
     table.smallest(&mut md)?;
     float_audit_section(root, &variants, &mut md, &mut tally)?;
     std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
