@@ -204,8 +204,13 @@ fn elf_path(root: &Path, v: &Variant) -> PathBuf {
     host_sim::uf2::kept_image(root, &v.name)
 }
 
+/// The cargo arguments that build variant `v`.
+fn cargo_args(v: &Variant) -> [&str; 11] {
+    ["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target]
+}
+
 fn build(root: &Path, v: &Variant) -> Result<()> {
-    let args = ["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target];
+    let args = cargo_args(v);
     let built = Path::new(v.target).join(v.profile).join(v.bin);
     let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);
     let vars: Vec<(&str, String)> = v.flash_kib.map(|k| ("FIRMWARE_FLASH_KIB", k.to_string())).into_iter().collect();
@@ -415,7 +420,7 @@ const TINY: &str = "tiny-m0-fixed-chair";
 fn tiny_overflow(root: &Path, v: &Variant) -> Result<Option<u64>> {
     let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .current_dir(root)
-        .args(["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target])
+        .args(cargo_args(v))
         .env_remove("RUSTFLAGS")
         .env_remove("FIRMWARE_FLASH_KIB")
         .env("FIRMWARE_SCENES", v.scenes.unwrap_or("chair"))
