@@ -154,22 +154,28 @@ proptest! {
     }
 }
 
-/// `n` free objects crowded into a cube of side 3 and, with `group`, a composite of `group`
-/// objects among them: checked as [`check`] does, after making sure a world cell of `cfg`'s 12
+/// `n` free objects crowded into a cube of side 3 on a floor and, with `group`, a composite of
+/// `group` objects among them: checked as [`check`] does, after making sure a world cell of `cfg`'s 12
 /// that must be dense got a lattice of its own.
 fn check_crowded<R: Real>(seed: u64, n: usize, group: usize, cfg: &LatticeConfig) -> Result<(), TestCaseError> {
     use lattice_rt::generate::random_object;
-    let mut storage = vec![Object::<R>::default(); n + group];
+    let mut storage = vec![Object::<R>::default(); n + group + 1];
     let mut parts = lattice_rt::Parts::default();
     let mut b = SceneBuilder::new(&mut storage, &mut parts);
     let mut rng = Rng::new(seed);
     b.add_material(lattice_rt::scene::Material::DEFAULT).unwrap();
     b.add_light(lattice_rt::scene::Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 }).unwrap();
+    // Objects at most about 0.56 across (a cylinder of radius and height 0.25, turned): small
+    // beside a world cell of equal cells (2 x 1.3 x 2), so each moves to its cell's lattice
+    // when the cell is dense.
     let place = |b: &mut SceneBuilder<'_, R>, rng: &mut Rng| {
         let c = Vec3::new(rng.range(0.0, 3.0), rng.range(0.0, 3.0), rng.range(0.0, 3.0));
-        let (s, t) = random_object(rng, c, 0.5);
+        let (s, t) = random_object(rng, c, 0.25);
         b.add_object(s, t, 0).unwrap();
     };
+    // A floor under them all, too large to move: it stays in every dense cell's world list.
+    b.add_object(lattice_rt::Shape::Box, lattice_rt::Affine::translate(Vec3::new(-0.5, -0.5, -0.5)).after(&lattice_rt::Affine::scale(Vec3::new(4.0, 0.6, 4.0))), 0)
+        .unwrap();
     for _ in 0..n {
         place(&mut b, &mut rng);
     }

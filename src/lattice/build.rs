@@ -165,15 +165,19 @@ fn planes_of<'c, R: Real>(coords: &'c [R], sub: &SubLattice<R>) -> [&'c [R]; 3] 
 }
 
 /// Calls `f(item, cell)` for every reference of every lattice, in storage order. A dense
-/// cell of the world holds its composites and its own lattice instead of its free objects.
+/// cell of the world holds its composites, its free objects too large to move
+/// ([`cluster::moves`]) and its own lattice instead of the others.
 fn for_each_ref<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, coords: &[R], lattices: &[SubLattice<R>], mut f: impl FnMut(u32, usize)) {
     let base = if cfg.nested { 1 + scene.composites.len() } else { 1 };
     let dense = &lattices[base..];
     let find = |c: usize| dense.binary_search_by_key(&(c as u32), |d| d.dense_cell).ok();
     let world = &lattices[0];
+    let wp = planes_of(coords, world);
     for_each_item(scene, cfg, 0, |item, ib| {
         visit_cells(coords, world, ib, |c| match find(c) {
-            Some(k) if item & index::SUB_FLAG == 0 => visit_cells(coords, &dense[k], ib, |c| f(item, c)),
+            Some(k) if item & index::SUB_FLAG == 0 && cluster::moves(&cluster::cell_box(&wp, c), ib) => {
+                visit_cells(coords, &dense[k], ib, |c| f(item, c))
+            }
             _ => f(item, c),
         })
     });

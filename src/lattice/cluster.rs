@@ -14,16 +14,20 @@ use crate::math::{Aabb, Vec3};
 use crate::scalar::Real;
 use crate::scene::Scene;
 
-/// World cells counted at a time while looking for dense cells (the counters live on the stack).
-const CHUNK: usize = 4096;
+/// World cells counted at a time while looking for dense cells (their four counters live on the
+/// stack).
+const CHUNK: usize = 2048;
 
 /// A dense world cell and its lattice.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Dense<R> {
     /// Number of the world cell.
     pub cell: usize,
-    /// Free objects the world lattice assigns to it.
+    /// Free objects the world lattice assigns to it that move to its lattice ([`moves`]).
     pub free: usize,
+    /// Of those, the ones whose box centre lies in the cell (each object is counted in one cell
+    /// at most).
+    pub centred: usize,
     /// The cell's box: the region of its lattice.
     pub bounds: Aabb<R>,
     /// Cells per axis of its lattice.
@@ -103,6 +107,87 @@ pub(super) fn for_each_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig,
     }
 }
 
+/// Whether a free object with box `b` in a dense world cell `cell` moves to the cell's lattice:
+/// it is small beside the cell, at most half as long on every axis. A larger one (the floor
+/// under a cluster) stays in the world cell's list; in the cell's lattice it would be listed in
+/// most of its cells, and it would stretch the lattice's box over the whole cell.
+pub(super) fn moves<R: Real>(cell: &Aabb<R>, b: &Aabb<R>) -> bool {
+    (0..3).all(|a| {
+        let len = b.max.axis(a) - b.min.axis(a);
+        len + len <= cell.max.axis(a) - cell.min.axis(a)
+    })
+}
+
+/// The box of world cell `c` on the coordinate lists `planes`.
+pub(super) fn cell_box<R: Real>(planes: &(impl Planes<R> + ?Sized), c: usize) -> Aabb<R> {
+    let n = [0, 1, 2].map(|a| planes.cells(a));
+    let [x, y, z] = [c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1])];
+    Aabb {
+        min: Vec3::new(planes.plane(0, x), planes.plane(1, y), planes.plane(2, z)),
+        max: Vec3::new(planes.plane(0, x + 1), planes.plane(1, y + 1), planes.plane(2, z + 1)),
+    }
+}
+
+/// Steps per axis in which a dense cell's lattice box is kept, inside the world cell.
+const STEPS: u32 = 32;
+/// An empty [`Occupied`] box.
+const NOTHING: u32 = u32::MAX;
+
+/// The part of a world cell its moving objects occupy, in [`STEPS`] of the cell per axis,
+/// packed in a word (per axis the first step and the last, five bits each): the dense cell's
+/// lattice covers only that, so a cluster in a corner of a big cell gets its cells where it is.
+struct Occupied;
+
+impl Occupied {
+    /// The steps `b` reaches on each axis of `cell`, packed.
+    fn of<R: Real>(cell: &Aabb<R>, b: &Aabb<R>) -> u32 {
+        let mut w = 0;
+        for a in 0..3 {
+            let (lo, hi) = (cell.min.axis(a).to_f64(), cell.max.axis(a).to_f64());
+            let step = |x: R| if hi > lo { (x.to_f64() - lo) / (hi - lo) * STEPS as f64 } else { 0.0 };
+            // max/min, not clamp: clamp's assertion would link float formatting in.
+            let first = libm::floor(step(b.min.axis(a))).max(0.0).min((STEPS - 1) as f64) as u32;
+            let last = (libm::ceil(step(b.max.axis(a))).max(0.0) as u32).max(first + 1).min(STEPS) - 1;
+            w |= (first | last << 5) << (10 * a);
+        }
+        w
+    }
+
+    /// The smallest packed box holding both.
+    fn union(p: u32, q: u32) -> u32 {
+        if p == NOTHING {
+            return q;
+        }
+        let field = |w: u32, a: usize, k: usize| (w >> (10 * a + 5 * k)) & 31;
+        (0..3).fold(0, |w, a| w | (field(p, a, 0).min(field(q, a, 0)) | field(p, a, 1).max(field(q, a, 1)) << 5) << (10 * a))
+    }
+
+    /// The packed box `p` in world coordinates inside `cell`, its inner planes moved outwards
+    /// by the scalar's padding (as [`Aabb::cast_padded`] rounds), so no object's edge is left out.
+    fn region<R: Real>(cell: &Aabb<R>, p: u32) -> Aabb<R> {
+        let at = |a: usize, k: u32, out: R| {
+            let (lo, hi) = (cell.min.axis(a), cell.max.axis(a));
+            match k {
+                0 => lo,
+                STEPS => hi,
+                _ => {
+                    let v = R::from_f64(lo.to_f64() + (hi.to_f64() - lo.to_f64()) * k as f64 / STEPS as f64);
+                    (v + out * (v.abs() + R::ONE) * R::pad_eps()).max(lo).min(hi)
+                }
+            }
+        };
+        let (first, last) = ([0, 1, 2].map(|a| (p >> (10 * a)) & 31), [0, 1, 2].map(|a| ((p >> (10 * a + 5)) & 31) + 1));
+        let (down, up) = (-R::ONE, R::ONE);
+        Aabb {
+            min: Vec3::new(at(0, first[0], down), at(1, first[1], down), at(2, first[2], down)),
+            max: Vec3::new(at(0, last[0], up), at(1, last[1], up), at(2, last[2], up)),
+        }
+    }
+}
+
+/// What [`scan`] calls per object and cell: the cell's number in its chunk, its box, the object's box.
+type Visit<'v, R> = dyn FnMut(usize, &Aabb<R>, &Aabb<R>) + 'v;
+
 /// [`for_each_dense`]'s work, out of line so that its counters are on the stack only when a
 /// scene can have a dense cell.
 #[inline(never)]
@@ -110,22 +195,18 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Plane
     let split = cfg.split as usize;
     let n = [0, 1, 2].map(|a| planes.cells(a));
     let (slab, total) = (n[0] * n[1], n[0] * n[1] * n[2]);
-    let xyz = |c: usize| [c % n[0], (c / n[0]) % n[1], c / slab];
-    let dense = |c: usize, free: usize| {
-        let [x, y, z] = xyz(c);
-        let bounds = Aabb {
-            min: Vec3::new(planes.plane(0, x), planes.plane(1, y), planes.plane(2, z)),
-            max: Vec3::new(planes.plane(0, x + 1), planes.plane(1, y + 1), planes.plane(2, z + 1)),
-        };
-        Dense { cell: c, free, bounds, n: resolution(&bounds, free, cfg.sub, cfg.max_per_axis), refs: 0 }
+    // A dense cell's lattice: over the part of the cell its moving objects occupy.
+    let dense = |c: usize, free: usize, occupied: u32| {
+        let bounds = Occupied::region(&cell_box(planes, c), occupied);
+        Dense { cell: c, free, centred: 0, bounds, n: resolution(&bounds, free, cfg.sub, cfg.max_per_axis), refs: 0 }
     };
-    let (mut counts, mut refs) = ([0u32; CHUNK], [0u32; CHUNK]);
+    let (mut counts, mut centred, mut occupied, mut refs) = ([0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK]);
     for base in (0..total).step_by(CHUNK) {
         let end = (base + CHUNK).min(total);
         let (z0, z1) = (base / slab, (end - 1) / slab);
-        // Calls `visit(cell - base, object box)` for every cell of the chunk each free object
-        // overlaps.
-        let each = |visit: &mut dyn FnMut(usize, &Aabb<R>)| {
+        // Calls `visit(cell - base, cell box, object box)` for every cell of the chunk each free
+        // object overlaps and would move to, were the cell dense.
+        let each = |visit: &mut Visit<'_, R>| {
             for (_, b) in free_objects(scene) {
                 let (lz, hz) = (locate_on(planes, 2, b.min.z), locate_on(planes, 2, b.max.z));
                 if hz < z0 || lz > z1 {
@@ -137,7 +218,10 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Plane
                         for x in r[0].0..=r[0].1 {
                             let c = x + n[0] * (y + n[1] * z);
                             if (base..end).contains(&c) {
-                                visit(c - base, b);
+                                let cell = cell_box(planes, c);
+                                if moves(&cell, b) {
+                                    visit(c - base, &cell, b);
+                                }
                             }
                         }
                     }
@@ -145,21 +229,75 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Plane
             }
         };
         counts.iter_mut().for_each(|k| *k = 0);
-        each(&mut |i, _| counts[i] += 1);
+        each(&mut |i, _, _| counts[i] += 1);
         if !counts.iter().any(|&k| k as usize > split) {
             continue;
         }
-        refs.iter_mut().for_each(|k| *k = 0);
-        each(&mut |i, b| {
+        centred.iter_mut().chain(refs.iter_mut()).for_each(|k| *k = 0);
+        occupied.iter_mut().for_each(|k| *k = NOTHING);
+        each(&mut |i, cell, b| {
             if counts[i] as usize > split {
-                let d = dense(base + i, counts[i] as usize);
+                occupied[i] = Occupied::union(occupied[i], Occupied::of(cell, b));
+                let centre = (b.min + b.max) * R::HALF;
+                centred[i] += u32::from((0..3).all(|a| centre.axis(a) >= cell.min.axis(a) && centre.axis(a) < cell.max.axis(a)));
+            }
+        });
+        each(&mut |i, _, b| {
+            if counts[i] as usize > split {
+                let d = dense(base + i, counts[i] as usize, occupied[i]);
                 refs[i] += cells_in(&span(&Uniform { bounds: &d.bounds, n: d.n }, b)) as u32;
             }
         });
         for i in 0..end - base {
             if counts[i] as usize > split {
-                f(&Dense { refs: refs[i] as usize, ..dense(base + i, counts[i] as usize) });
+                f(&Dense { centred: centred[i] as usize, refs: refs[i] as usize, ..dense(base + i, counts[i] as usize, occupied[i]) });
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::Rng;
+
+    /// The region of the packed union of boxes holds each box's part in the cell, in every
+    /// scalar, and stays inside the cell.
+    fn occupied_holds_its_boxes<R: Real>() {
+        let mut rng = Rng::new(5);
+        for _ in 0..300 {
+            let lo = Vec3::new(rng.range(-50.0, 50.0), rng.range(-50.0, 50.0), rng.range(-50.0, 50.0));
+            let cell = Aabb { min: lo, max: lo + Vec3::new(rng.range(0.0, 9.0), rng.range(0.0, 9.0), rng.range(0.0, 9.0)) };
+            let cell = Aabb { min: cell.min.cast::<R>(), max: cell.max.cast::<R>() };
+            let boxes: std::vec::Vec<Aabb<R>> = (0..1 + rng.below(4))
+                .map(|_| {
+                    let mut p = |a: usize| {
+                        let (l, h) = (cell.min.axis(a).to_f64(), cell.max.axis(a).to_f64());
+                        let (x, y) = (rng.range(l - 1.0, h + 1.0), rng.range(l - 1.0, h + 1.0));
+                        (R::from_f64(x.min(y)), R::from_f64(x.max(y)))
+                    };
+                    let (x, y, z) = (p(0), p(1), p(2));
+                    Aabb { min: Vec3::new(x.0, y.0, z.0), max: Vec3::new(x.1, y.1, z.1) }
+                })
+                .collect();
+            let packed = boxes.iter().fold(NOTHING, |w, b| Occupied::union(w, Occupied::of(&cell, b)));
+            let r = Occupied::region(&cell, packed);
+            for a in 0..3 {
+                assert!(r.min.axis(a) >= cell.min.axis(a) && r.max.axis(a) <= cell.max.axis(a), "{} outside the cell", R::NAME);
+                for b in &boxes {
+                    let (l, h) = (b.min.axis(a).max(cell.min.axis(a)), b.max.axis(a).min(cell.max.axis(a)));
+                    if l <= h {
+                        assert!(r.min.axis(a) <= l && r.max.axis(a) >= h, "{}: axis {a}: {:?} does not hold {:?}", R::NAME, r, b);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn occupied_region_holds_every_box_in_every_scalar() {
+        occupied_holds_its_boxes::<f64>();
+        occupied_holds_its_boxes::<f32>();
+        occupied_holds_its_boxes::<crate::Fx>();
     }
 }

@@ -123,27 +123,22 @@ pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeCon
 /// dense cells (module `cluster`) go to those cells' own lattices, so the world's cells need
 /// not be fine enough for them: a loose cluster of thousands in a big sparse scene would
 /// otherwise cut the whole scene into cells for thousands, and every ray would step through
-/// that many empty cells. The world lattice keeps its references outside dense cells (as a
-/// share of its `items`) and one reference per dense cell; with no dense cell, `n` stands.
+/// that many empty cells. The world lattice keeps the items not centred in a dense cell, and one
+/// reference per dense cell; with no dense cell, `n` stands.
 #[inline(never)]
 fn past_the_clusters<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: &Aabb<R>, n: [u16; 3], items: usize, res: Resolution) -> [u16; 3] {
-    let (crowded, cells, refs) = with_planes(scene, cfg, 0, b, n, |planes| {
-        let (mut crowded, mut cells) = (0, 0);
+    let (centred, cells) = with_planes(scene, cfg, 0, b, n, |planes| {
+        let (mut centred, mut cells) = (0, 0);
         cluster::for_each_dense(scene, cfg, planes, |d| {
-            crowded += d.free;
+            centred += d.centred;
             cells += 1;
         });
-        let mut refs = 0;
-        if cells > 0 {
-            for_each_item(scene, cfg, 0, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
-        }
-        (crowded, cells, refs)
+        (centred, cells)
     });
     if cells == 0 {
         return n;
     }
-    let kept = items as f64 * (refs.saturating_sub(crowded)) as f64 / refs.max(1) as f64;
-    resolution(b, libm::round(kept) as usize + cells, res, cfg.max_per_axis)
+    resolution(b, items.saturating_sub(centred) + cells, res, cfg.max_per_axis)
 }
 
 /// A regular scene (a floor of equal tiles) whose pitch is the cell width puts every plane on
