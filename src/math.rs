@@ -205,10 +205,14 @@ fn slab<R: Real>(o: R, d: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
         return if o < lo || o > hi { None } else { Some((t0, t1)) };
     }
     let inv = d.recip();
-    let (mut ta, mut tb) = ((lo - o) * inv, (hi - o) * inv);
-    if ta > tb {
-        core::mem::swap(&mut ta, &mut tb);
-    }
+    cut((lo - o) * inv, (hi - o) * inv, t0, t1)
+}
+
+/// The range `[t0, t1]` cut to a slab the ray crosses at `ta` and `tb` (either order), or
+/// `None` if nothing is left.
+#[inline(always)]
+pub(crate) fn cut<R: Real>(ta: R, tb: R, t0: R, t1: R) -> Option<(R, R)> {
+    let (ta, tb) = if ta > tb { (tb, ta) } else { (ta, tb) };
     let (t0, t1) = (t0.max(ta), t1.min(tb));
     if t0 > t1 {
         None
