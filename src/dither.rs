@@ -120,30 +120,58 @@ impl Tone {
 /// pixel `(x, y)`, for `x` in `-1..w + 2` and `y` in `0..h + 2`.
 type Acc = [[i16; MAX_TILE + 3]; MAX_TILE + 2];
 
-// An error-diffusion kernel sends error `err` of the pixel at accumulator row `y`, column `c`
-// (the pixel's `x + 1`) to its neighbours, each share `err * weight / divisor` (rounded towards
-// zero). Written out, not a table walked per pixel: the weights are constants, the divisor a
-// shift, and no index is checked at run time.
+// An error-diffusion kernel dithers one row `y` of a tile: each pixel's level plus the error
+// arriving at it (`acc[y][x + 1]`) is set or not, and its error `err` goes to its neighbours,
+// each share `err * weight / divisor` (rounded towards zero). Written out, not a table walked
+// per pixel: the weights are constants, the divisor a shift, and no index is checked at run
+// time.
 
-/// Floyd-Steinberg: 7/16 right, 3/16 below left, 5/16 below, 1/16 below right.
+/// A pixel of level `level` (0..=64) with error `arriving`: whether it is set, and its error.
 #[inline(always)]
-fn floyd_steinberg(acc: &mut Acc, y: usize, c: usize, err: i16) {
-    acc[y][c + 1] += err * 7 / 16;
-    acc[y + 1][c - 1] += err * 3 / 16;
-    acc[y + 1][c] += err * 5 / 16;
-    acc[y + 1][c + 1] += err / 16;
+fn quantize(level: u8, arriving: i16) -> (bool, i16) {
+    let v = level as i16 * SCALE + arriving;
+    let on = v >= (LEVELS as i16 / 2) * SCALE;
+    (on, v - if on { LEVELS as i16 * SCALE } else { 0 })
+}
+
+/// Floyd-Steinberg: 7/16 right, 3/16 below left, 5/16 below, 1/16 below right. The error going
+/// right and the two entries of the row below still taking shares are carried in locals along
+/// the row: per pixel one entry of each row is read and one of the row below written.
+#[inline(always)]
+fn floyd_steinberg(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColor]) {
+    let w = levels.len().min(out.len()).min(MAX_TILE);
+    let (above, below) = acc.split_at_mut(y + 1);
+    let (row, below) = (&mut above[y], &mut below[0]);
+    // `right`: the error arriving at the pixel; `b0`, `b1`: the row below's entries under the
+    // pixel's left neighbour and under the pixel, with the shares they have so far.
+    let (mut right, mut b0, mut b1) = (row[1], below[0], below[1]);
+    for x in 0..w {
+        let (on, err) = quantize(levels[x], right);
+        out[x] = BinaryColor::from(on);
+        right = row[x + 2] + err * 7 / 16;
+        below[x] = b0 + err * 3 / 16;
+        b0 = b1 + err * 5 / 16;
+        b1 = below[x + 2] + err / 16;
+    }
+    row[w + 1] = right;
+    below[w] = b0;
+    below[w + 1] = b1;
 }
 
 /// Atkinson: 1/8 to each of two right, three below and one two rows below (6/8 of the error).
 #[inline(always)]
-fn atkinson(acc: &mut Acc, y: usize, c: usize, err: i16) {
-    let e = err / 8;
-    acc[y][c + 1] += e;
-    acc[y][c + 2] += e;
-    acc[y + 1][c - 1] += e;
-    acc[y + 1][c] += e;
-    acc[y + 1][c + 1] += e;
-    acc[y + 2][c] += e;
+fn atkinson(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColor]) {
+    for (x, (&l, px)) in levels.iter().zip(out.iter_mut()).enumerate().take(MAX_TILE) {
+        let (on, err) = quantize(l, acc[y][x + 1]);
+        *px = BinaryColor::from(on);
+        let (e, c) = (err / 8, x + 1);
+        acc[y][c + 1] += e;
+        acc[y][c + 2] += e;
+        acc[y + 1][c - 1] += e;
+        acc[y + 1][c] += e;
+        acc[y + 1][c + 1] += e;
+        acc[y + 2][c] += e;
+    }
 }
 
 /// Largest tile side the renderer supports: 16, or 8 with the `tile8` feature, which makes
@@ -216,7 +244,7 @@ impl<'c> Carry<'c> {
     /// columns to the next tile, the rows below to the next band, and what falls outside the
     /// image is dropped.
     #[inline(always)]
-    fn diffuse(&mut self, kernel: impl Fn(&mut Acc, usize, usize, i16), x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
+    fn diffuse(&mut self, kernel: impl Fn(&mut Acc, usize, &[u8], &mut [BinaryColor]), x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
         // No tile is larger (the render's tiles are at most MAX_TILE on a side); saying so lets
         // the kernel's indices go unchecked.
         let (w, h) = (w.min(MAX_TILE), h.min(MAX_TILE));
@@ -243,13 +271,7 @@ impl<'c> Carry<'c> {
             if x0 > 0 {
                 acc[y][1] += left;
             }
-            for x in 0..w {
-                let v = levels[y * w + x] as i16 * SCALE + acc[y][x + 1];
-                let on = v >= (LEVELS as i16 / 2) * SCALE;
-                out[y * w + x] = BinaryColor::from(on);
-                let err = v - if on { LEVELS as i16 * SCALE } else { 0 };
-                kernel(&mut acc, y, x + 1, err);
-            }
+            kernel(&mut acc, y, &levels[y * w..(y + 1) * w], &mut out[y * w..(y + 1) * w]);
         }
         // The right border to the next tile, unless beyond the image's right edge.
         for (y, row) in acc.iter().enumerate().take(h) {
