@@ -282,27 +282,42 @@ fn adaptive<R: Real>(
             depths[y * tw + x] = depth;
         }
     }
+    // Pixel `i`'s entry: `i` itself, masked to the tiles' storage (a power of two), which every
+    // index here already lies in; so no index is checked at run time.
+    let at = |i: usize| i & (MAX_TILE * MAX_TILE - 1);
     for y in 0..th {
+        let row_traced = traced(y, th);
         for x in 0..tw {
-            if traced(x, tw) && traced(y, th) {
+            let column_traced = traced(x, tw);
+            if row_traced && column_traced {
                 continue;
             }
-            let (xs, ys) = around(x, y, tw, th);
-            let at = |i: usize| (xs[i % 2], ys[i / 2]);
-            let first = ids[ys[0] * tw + xs[0]];
+            let i = y * tw + x;
+            // The traced pixels around (`around`): two on the pixel's row or column, each
+            // counted twice in the mean of four, or the four corners; the first of them gives
+            // the object.
+            let (ns, n) = if row_traced {
+                ([i - 1, i + 1, 0, 0], 2)
+            } else if column_traced {
+                ([i - tw, i + tw, 0, 0], 2)
+            } else {
+                ([i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], 4)
+            };
+            let first = ids[at(ns[0])];
             let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
-            for i in 0..4 {
-                let (nx, ny) = at(i);
-                let l = levels[ny * tw + nx];
+            for &k in &ns[..n] {
+                let l = levels[at(k)];
                 lo = lo.min(l);
                 hi = hi.max(l);
                 sum += l as u32;
-                same &= ids[ny * tw + nx] == first;
-                near = near.min(depths[ny * tw + nx]);
+                same &= ids[at(k)] == first;
+                near = near.min(depths[at(k)]);
             }
-            let i = y * tw + x;
+            let i = at(i);
             if same && hi - lo <= contrast {
-                (levels[i], ids[i], depths[i]) = (((sum + 2) / 4) as u8, first, near);
+                // Two pixels counted twice: (2 sum + 2) / 4 = (sum + 1) / 2, rounded up.
+                let mean = if n == 2 { sum.div_ceil(2) } else { (sum + 2) / 4 };
+                (levels[i], ids[i], depths[i]) = (mean as u8, first, near);
             } else {
                 let (cx, cy) = centre(x, y);
                 let (v, id, depth) = shoot(cx, cy);
