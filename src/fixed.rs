@@ -313,6 +313,11 @@ impl Real for Fx {
     fn pad_eps() -> Self {
         Fx(1 << 6)
     }
+    /// `pad_eps` is 2^-10: the product with it is that shift, rounded as [`Mul`] rounds.
+    #[inline]
+    fn padding(self) -> Self {
+        self.mul_pow2(Self::pow2(-10))
+    }
     fn point_eps() -> Self {
         Fx(0)
     }
@@ -400,6 +405,19 @@ mod tests {
         *x ^= *x << 13;
         *x ^= *x >> 7;
         *x ^= *x << 17;
+    }
+
+    #[test]
+    fn padding_is_the_product_with_pad_eps() {
+        let mut x = 0x9e37_79b9u64;
+        let check = |a: i32| assert_eq!(Fx(a).padding(), Fx(a) * Fx::pad_eps(), "{a}");
+        for a in [0, 1, -1, 511, 512, 513, -512, 1023, 1024, 0xFFFF, 0x1_0000, i32::MAX, -i32::MAX] {
+            check(a);
+        }
+        for _ in 0..100_000 {
+            xorshift(&mut x);
+            check(((x as i32) >> (x % 23) as i32).max(-i32::MAX));
+        }
     }
 
     #[test]

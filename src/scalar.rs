@@ -93,6 +93,12 @@ pub trait Real:
     /// Relative padding of bounding boxes registered in lattice cells, so that rounding in
     /// an object test can never put a hit outside the cells the object is listed in.
     fn pad_eps() -> Self;
+    /// `self * pad_eps()`, the padding a size of `self` gets: the same value as the product,
+    /// which is what the default does; fixed point's padding is a power of two, so it shifts.
+    #[inline]
+    fn padding(self) -> Self {
+        self * Self::pad_eps()
+    }
     /// Whether the value is finite (always true for fixed point).
     fn is_finite(self) -> bool;
     /// A 16-bit key that orders distances: `a <= b` gives `a.depth_key() <= b.depth_key()`

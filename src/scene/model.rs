@@ -395,7 +395,7 @@ impl<R: Real> Object<R> {
             R::MAX
         } else {
             let f = tmax.mul_pow2(self.inv_dir_scale);
-            f + (f.abs() + R::ONE) * R::pad_eps()
+            f + (f.abs() + R::ONE).padding()
         };
         let hit = self.shape.intersect(&r, tmin.mul_pow2(self.inv_dir_scale), far)?;
         let t = hit.t.mul_pow2(self.dir_scale);
