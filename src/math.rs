@@ -221,6 +221,19 @@ pub(crate) fn cut<R: Real>(ta: R, tb: R, t0: R, t1: R) -> Option<(R, R)> {
     }
 }
 
+/// `a * b` for a matrix entry `a`; where products are dear ([`Real::SKIPS_ZERO_ENTRIES`]), zero
+/// without multiplying when `a` is zero: an object placed along the axes, or turned about one,
+/// has four to six zero entries. The same value either way (a fixed-point sum adds the zero as
+/// nothing).
+#[inline(always)]
+fn entry_times<R: Real>(a: R, b: R) -> R {
+    if R::SKIPS_ZERO_ENTRIES && a == R::ZERO {
+        R::ZERO
+    } else {
+        a * b
+    }
+}
+
 /// A linear map as a 3x3 matrix: an [`Affine`] transform without its translation (what maps
 /// directions, and points taken relative to an origin).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -233,22 +246,22 @@ impl<R: Real> Linear<R> {
     /// Applies the map to a direction.
     #[inline]
     pub fn vector(&self, v: Vec3<R>) -> Vec3<R> {
-        let m = &self.m;
+        let (m, t) = (&self.m, entry_times);
         Vec3::new(
-            m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
-            m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
-            m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z,
+            t(m[0][0], v.x) + t(m[0][1], v.y) + t(m[0][2], v.z),
+            t(m[1][0], v.x) + t(m[1][1], v.y) + t(m[1][2], v.z),
+            t(m[2][0], v.x) + t(m[2][1], v.y) + t(m[2][2], v.z),
         )
     }
     /// Applies the transpose: with `self` the world-to-object map this maps an object-space
     /// normal to world space (the inverse transpose rule).
     #[inline]
     pub fn transpose_vector(&self, v: Vec3<R>) -> Vec3<R> {
-        let m = &self.m;
+        let (m, t) = (&self.m, entry_times);
         Vec3::new(
-            m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z,
-            m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
-            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z,
+            t(m[0][0], v.x) + t(m[1][0], v.y) + t(m[2][0], v.z),
+            t(m[0][1], v.x) + t(m[1][1], v.y) + t(m[2][1], v.z),
+            t(m[0][2], v.x) + t(m[1][2], v.y) + t(m[2][2], v.z),
         )
     }
     /// Converts to another scalar.
@@ -278,11 +291,11 @@ impl<R: Real> Affine<R> {
     /// Applies to a point.
     #[inline]
     pub fn point(&self, p: Vec3<R>) -> Vec3<R> {
-        let m = &self.m;
+        let (m, t) = (&self.m, entry_times);
         Vec3::new(
-            m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
-            m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
-            m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3],
+            t(m[0][0], p.x) + t(m[0][1], p.y) + t(m[0][2], p.z) + m[0][3],
+            t(m[1][0], p.x) + t(m[1][1], p.y) + t(m[1][2], p.z) + m[1][3],
+            t(m[2][0], p.x) + t(m[2][1], p.y) + t(m[2][2], p.z) + m[2][3],
         )
     }
     /// Applies the linear part to a direction.

@@ -120,6 +120,11 @@ pub trait Real:
     /// the padding every box has. Fixed point divides: the reciprocal of a small component is
     /// coarse there.
     const WALK_BY_RECIPROCAL: bool = false;
+    /// Whether a matrix product skips the products of zero entries (`math`'s transforms): where
+    /// a product costs a dozen instructions or a call (fixed point on a Cortex-M0+), not where
+    /// it is one instruction and a branch would cost more (floats on an FPU). Either way the
+    /// value is the same: fixed point's zero products and sums are exact.
+    const SKIPS_ZERO_ENTRIES: bool = false;
     /// `self / 2^k` for `k` in `0..=14`: the same value as dividing by `from_i32(1 << k)`, which
     /// is what the default does; fixed point shifts instead of dividing.
     fn div_pow2(self, k: u32) -> Self {
