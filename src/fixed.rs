@@ -325,8 +325,10 @@ impl Real for Fx {
     /// Fixed point has the same absolute precision everywhere, so the offset depends on the
     /// size of the object only, not on where the point lies: a few units of the last place,
     /// and as many of the object's own (unit-sized) coordinates scaled to its size.
+    /// `offset_eps` is 2^-13: the product with it is that shift, rounded as [`Mul`] rounds.
+    #[inline]
     fn offset(_p_max: Self, size: Self) -> Self {
-        Self::offset_eps() * (Self::ONE + size)
+        (Self::ONE + size).mul_pow2(Self::pow2(-13))
     }
     fn is_finite(self) -> bool {
         true
@@ -418,6 +420,9 @@ mod tests {
         for _ in 0..100_000 {
             xorshift(&mut x);
             check(((x as i32) >> (x % 23) as i32).max(-i32::MAX));
+            // The offset's product with offset_eps (2^-13) is a shift too.
+            let size = Fx(((x >> 32) as i32 >> (x % 19) as i32).max(-i32::MAX));
+            assert_eq!(Fx::offset(Fx::ONE, size), Fx::offset_eps() * (Fx::ONE + size), "{size:?}");
         }
     }
 
