@@ -62,9 +62,11 @@ impl Default for Hits {
     }
 }
 
-/// Gray level (0..=64) of a brightness in `[0, 1]`, rounded to nearest.
+/// Gray level (0..=64) of a brightness in `[0, 1]`, rounded to nearest. `v * 64` is taken as
+/// `v * 2^6` ([`Real::mul_pow2`]): the same value, a shift in fixed point.
 pub fn level<R: Real>(v: R) -> u8 {
-    (v * R::from_i32(LEVELS as i32) + R::HALF).floor_clamped(LEVELS)
+    const { assert!(LEVELS == 1 << 6) };
+    (v.mul_pow2(R::pow2(6)) + R::HALF).floor_clamped(LEVELS)
 }
 
 /// Samples tiles in the render's order (tile rows top to bottom, tiles left to right).
@@ -345,6 +347,25 @@ fn grid2x2<R: Real>(shoot: &mut impl FnMut(usize, usize) -> Shot<R>, cx: usize, 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`level`]'s power of two gives what the product with 64 gives, in every scalar.
+    #[test]
+    fn level_is_the_product_with_64_rounded() {
+        fn check<R: Real>(v: R) {
+            assert_eq!(level(v), (v * R::from_i32(LEVELS as i32) + R::HALF).floor_clamped(LEVELS), "{} {}", R::NAME, v.to_f64());
+        }
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let raw = ((x as i32) >> (x % 15) as i32).max(-i32::MAX);
+            check(crate::Fx(raw));
+            let v = raw as f64 / 65536.0 / 1024.0;
+            check(v);
+            check(v as f32);
+        }
+    }
 
     /// With adaptive sampling a tile side asks for the exact hit of its traced pixels and of a
     /// pixel between traced ones that hit different objects, and fills the rest as the sampler
