@@ -204,7 +204,7 @@ impl Real for Fx {
     const HALF: Self = Fx(ONE_RAW / 2);
     const MAX: Self = Fx(i32::MAX);
     const NAME: &'static str = "fixed";
-    const SKIPS_ZERO_ENTRIES: bool = true;
+    const DEAR_PRODUCTS: bool = true;
     const LIMIT: f64 = 8192.0;
     const RESOLUTION: f64 = 1.0 / 65536.0;
     fn from_f64(v: f64) -> Self {

@@ -221,13 +221,13 @@ pub(crate) fn cut<R: Real>(ta: R, tb: R, t0: R, t1: R) -> Option<(R, R)> {
     }
 }
 
-/// `a * b` for a matrix entry `a`; where products are dear ([`Real::SKIPS_ZERO_ENTRIES`]), zero
+/// `a * b` for a matrix entry `a`; where products are dear ([`Real::DEAR_PRODUCTS`]), zero
 /// without multiplying when `a` is zero: an object placed along the axes, or turned about one,
 /// has four to six zero entries. The same value either way (a fixed-point sum adds the zero as
 /// nothing).
 #[inline(always)]
 fn entry_times<R: Real>(a: R, b: R) -> R {
-    if R::SKIPS_ZERO_ENTRIES && a == R::ZERO {
+    if R::DEAR_PRODUCTS && a == R::ZERO {
         R::ZERO
     } else {
         a * b

@@ -120,11 +120,23 @@ pub trait Real:
     /// the padding every box has. Fixed point divides: the reciprocal of a small component is
     /// coarse there.
     const WALK_BY_RECIPROCAL: bool = false;
-    /// Whether a matrix product skips the products of zero entries (`math`'s transforms): where
-    /// a product costs a dozen instructions or a call (fixed point on a Cortex-M0+), not where
-    /// it is one instruction and a branch would cost more (floats on an FPU). Either way the
-    /// value is the same: fixed point's zero products and sums are exact.
-    const SKIPS_ZERO_ENTRIES: bool = false;
+    /// Whether a product is dear enough that the tracer skips the ones whose answer it knows: by
+    /// a zero matrix entry (`math`'s transforms), by a weight of exactly one (an eye ray's):
+    /// where a product costs a dozen instructions or a call (fixed point on a Cortex-M0+), not
+    /// where it is one instruction and a branch would cost more (floats on an FPU). Either way
+    /// the value is the same: fixed point's products by zero and one, and its sums with zero,
+    /// are exact.
+    const DEAR_PRODUCTS: bool = false;
+    /// `self * x`, with `self` a weight that is often exactly one: where products are dear
+    /// ([`Real::DEAR_PRODUCTS`]) `x` itself then. The same value.
+    #[inline]
+    fn weigh(self, x: Self) -> Self {
+        if Self::DEAR_PRODUCTS && self == Self::ONE {
+            x
+        } else {
+            self * x
+        }
+    }
     /// `self / 2^k` for `k` in `0..=14`: the same value as dividing by `from_i32(1 << k)`, which
     /// is what the default does; fixed point shifts instead of dividing.
     fn div_pow2(self, k: u32) -> Self {

@@ -495,7 +495,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let found = self.nearest(&node.ray, if node.depth == 0 { eye_uv } else { None }, q);
             q.set_leaving(None);
             let Some(hit) = found else {
-                total += node.weight * scene.background;
+                total += node.weight.weigh(scene.background);
                 continue;
             };
             if node.depth == 0 {
@@ -528,7 +528,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 }
                 q.set_leaving(None);
             }
-            total += node.weight * local;
+            total += node.weight.weigh(local);
             if !children {
                 continue;
             }
@@ -575,7 +575,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             return R::ZERO;
         }
         let term = ip * kd * cos;
-        if self.simulates(Effects::SHADOWS) && weight * term >= self.cutoff {
+        if self.simulates(Effects::SHADOWS) && weight.weigh(term) >= self.cutoff {
             q.stats.rays[RayKind::Shadow as usize] += 1;
             let ray = Ray::new(from, to_light);
             // Shadow-ray coherence: the object that last hid this light from a point is tried
