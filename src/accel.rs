@@ -337,6 +337,17 @@ impl<R: Real> Accelerator<R> for BruteForce {
     }
 }
 
+/// How much wider than a box an accelerator takes it for `ray` (a lattice's and an object's
+/// alike). An object test rounds its hit's `t`, in fixed point to 2^-16 of the object's own
+/// scale, so a ray that grazes a box can hit an object inside it at a point a few units of `t`
+/// (each `|dir|` long) outside the box, which brute force would find and an accelerator that
+/// took the box as it is would miss. Taking it a little wider is safe: an accelerator only
+/// chooses which objects are tested.
+#[inline]
+pub(crate) fn slack<R: Real>(ray: &Ray<R>) -> R {
+    ray.dir.max_abs() * R::pad_eps()
+}
+
 /// The paper's baseline: every object's box gets an inside test for every ray, and only the
 /// objects whose box the ray passes are intersected.
 ///
@@ -344,7 +355,8 @@ impl<R: Real> Accelerator<R> for BruteForce {
 /// the origin, the box corners are mapped by the same matrix, and the ray passes the box only
 /// if the mapped x values straddle 0 and the mapped y values straddle 0 (and the box is not
 /// wholly behind the origin). The paper maps two corners; we map all eight, which makes the
-/// test conservative for any orientation, so it never rejects a box the ray really enters.
+/// test conservative for any orientation, so it never rejects a box the ray really enters; each
+/// box is taken [`slack`] wider, as a lattice takes its boxes.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BoundingBox;
 
@@ -400,10 +412,11 @@ impl BoundingBox {
         q: &mut Query<'_>,
     ) -> Option<Hit<R>> {
         let frame = RayFrame::new(ray);
+        let slack = slack(ray);
         let mut best = None;
         for (i, o) in scene.objects.iter().enumerate() {
             q.stats.inside_tests += 1;
-            if frame.passes(&o.bounds) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
+            if frame.passes(&o.bounds.padded(slack)) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                 return best;
             }
         }

@@ -2,7 +2,7 @@
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
 use super::{index, locate, Lattice, MAX_NESTING};
-use crate::accel::{offer, reach, Hit, Query};
+use crate::accel::{offer, reach, slack, Hit, Query};
 use crate::math::Ray;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -72,15 +72,6 @@ impl<R: Real> Lattice<'_, R> {
     }
 }
 
-/// How much wider than its box a lattice is entered by `ray`. An object test rounds its hit's
-/// `t`, in fixed point to 2^-16 of the object's own scale, so a ray that grazes a box can hit an
-/// object inside it at a point a few units of `t` (each `|dir|` long) outside the box, which
-/// brute force would find and the walk would miss. Entering a little early or late is safe: the
-/// walk only chooses which objects are tested.
-#[inline]
-fn slack<R: Real>(ray: &Ray<R>) -> R {
-    ray.dir.max_abs() * R::pad_eps()
-}
 
 /// What a walk keeps of a ray for its crossings: which axes it steps along (a zero
 /// component, +0.0 or -0.0, never steps), and per axis the factor a crossing uses.
