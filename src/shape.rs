@@ -85,12 +85,7 @@ impl<R: Real> Shape<R> {
     /// parallel to the side) is left for `clip`'s own two products, which saturate apart.
     #[inline]
     fn clip(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<(R, R)> {
-        let (o, d) = (r.origin, r.dir);
-        let (round, flat) = match self {
-            Shape::Sphere => (true, true),
-            Shape::Cylinder | Shape::Cone { .. } => (true, false),
-            Shape::Box => (false, false),
-        };
+        let ((o, d), (round, flat)) = ((r.origin, r.dir), self.sides_below());
         let (t0, t1) = unit_slab(o.x, d.x, round, tmin, tmax)?;
         let (t0, t1) = unit_slab(o.y, d.y, flat, t0, t1)?;
         unit_slab(o.z, d.z, round, t0, t1)
@@ -115,11 +110,19 @@ impl<R: Real> Shape<R> {
 
     /// Corners of an object-space box that holds the shape.
     pub fn bounds(&self) -> (Vec3<R>, Vec3<R>) {
-        let (o, z) = (R::ONE, R::ZERO);
+        let (round, flat) = self.sides_below();
+        let side = |below: bool| if below { -R::ONE } else { R::ZERO };
+        (Vec3::new(side(round), side(flat), side(round)), Vec3::new(R::ONE, R::ONE, R::ONE))
+    }
+
+    /// Which sides of the shape's box ([`Shape::bounds`]) lie at -1 rather than 0: those of the
+    /// x and z axes, and that of the y axis. Every upper side lies at 1.
+    #[inline]
+    fn sides_below(&self) -> (bool, bool) {
         match self {
-            Shape::Sphere => (Vec3::new(-o, -o, -o), Vec3::new(o, o, o)),
-            Shape::Cylinder | Shape::Cone { .. } => (Vec3::new(-o, z, -o), Vec3::new(o, o, o)),
-            Shape::Box => (Vec3::new(z, z, z), Vec3::new(o, o, o)),
+            Shape::Sphere => (true, true),
+            Shape::Cylinder | Shape::Cone { .. } => (true, false),
+            Shape::Box => (false, false),
         }
     }
 }
