@@ -47,6 +47,6 @@ pub use dither::{Dither, Tone};
 pub mod outline;
 pub mod render;
 mod cover;
-pub use render::{dither_band, render, render_pass, render_share, trace_pass, trace_share, Frame, Hooks, KeptTile, NoHooks, Sampling, Scratch, Share, Traced};
+pub use render::{dither_band, dither_tiles, render, render_pass, render_share, trace_pass, trace_share, Frame, Hooks, KeptTile, NoHooks, Sampling, Scratch, Share, Traced};
 pub mod bitframe;
 pub use bitframe::BitFrame;

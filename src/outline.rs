@@ -35,48 +35,51 @@ fn differ(a: (u16, u16), b: (u16, u16)) -> bool {
 /// (level 0): where its left column's and top row's hits (`left`, `top`) differ from the
 /// apron's. With the lines inside the tile ([`tile`] with no apron) these are [`tile`]'s lines.
 pub fn apron(tw: usize, th: usize, left: &[(u16, u16)], top: &[(u16, u16)], apron: Apron<'_>, levels: &mut [u8]) {
-    for (y, &here) in left.iter().enumerate().take(th) {
-        if apron.left.and_then(|l| l.get(y)).is_some_and(|&n| differ(n, here)) {
-            levels[y * tw] = 0;
+    borders(tw, th, |y| left.get(y).copied(), |x| top.get(x).copied(), apron, levels);
+}
+
+/// [`apron`] with the tile's left column's and top row's hits as `left(y)` and `top(x)`.
+fn borders(tw: usize, th: usize, left: impl Fn(usize) -> Option<(u16, u16)>, top: impl Fn(usize) -> Option<(u16, u16)>, apron: Apron<'_>, levels: &mut [u8]) {
+    if let Some(column) = apron.left {
+        for (y, &n) in column.iter().enumerate().take(th) {
+            if left(y).is_some_and(|here| differ(n, here)) {
+                levels[y * tw] = 0;
+            }
         }
     }
-    for (x, &here) in top.iter().enumerate().take(tw) {
-        if apron.up.and_then(|u| u.get(x)).is_some_and(|&n| differ(n, here)) {
-            levels[x] = 0;
+    if let Some(row) = apron.up {
+        for (x, &n) in row.iter().enumerate().take(tw) {
+            if top(x).is_some_and(|here| differ(n, here)) {
+                levels[x] = 0;
+            }
         }
     }
 }
 
 /// Draws the silhouettes of a `tw x th` tile into its `levels` (level 0 where a line runs),
-/// from what its pixels hit and what its apron hit.
+/// from what its pixels hit and what its apron hit. Each pair of neighbours inside the tile
+/// (along its rows, then down its columns) draws the farther pixel's line; a pixel beside the
+/// apron gets the line of its pair across the border. A line only ever sets a level to 0 and is
+/// decided by the hits alone, so the order the pairs are visited in does not change the result.
 pub fn tile(tw: usize, th: usize, hits: &Hits, apron: Apron<'_>, levels: &mut [u8]) {
-    let mut line = [false; crate::dither::MAX_TILE * crate::dither::MAX_TILE];
-    for y in 0..th {
-        for x in 0..tw {
-            let i = y * tw + x;
-            let here = (hits.object[i], hits.depth[i]);
-            // Neighbours right and below are in this tile: the farther one of a pair gets the
-            // line.
-            for (nx, ny) in [(x + 1, y), (x, y + 1)] {
-                if nx < tw && ny < th {
-                    let j = ny * tw + nx;
-                    let there = (hits.object[j], hits.depth[j]);
-                    if differ(here, there) {
-                        line[if here.1 > there.1 { i } else { j }] = true;
-                    }
-                }
-            }
-            // Neighbours in the apron: this pixel gets the line.
-            let left = if x == 0 { apron.left.and_then(|l| l.get(y)) } else { None };
-            let up = if y == 0 { apron.up.and_then(|u| u.get(x)) } else { None };
-            if left.is_some_and(|&n| differ(n, here)) || up.is_some_and(|&n| differ(n, here)) {
-                line[i] = true;
-            }
+    let n = (tw * th).min(levels.len()).min(hits.object.len());
+    let (objects, depths, levels) = (&hits.object[..n], &hits.depth[..n], &mut levels[..n]);
+    let mut pair = |i: usize, j: usize| {
+        let (a, b) = ((objects[i], depths[i]), (objects[j], depths[j]));
+        if differ(a, b) {
+            levels[if a.1 > b.1 { i } else { j }] = 0;
+        }
+    };
+    for row in (0..n).step_by(tw.max(1)) {
+        for i in row + 1..(row + tw).min(n) {
+            pair(i - 1, i);
         }
     }
-    for (l, _) in levels.iter_mut().zip(&line).filter(|(_, &on)| on) {
-        *l = 0;
+    for i in tw..n {
+        pair(i - tw, i);
     }
+    let hit = |i: usize| Some((*objects.get(i)?, *depths.get(i)?));
+    borders(tw, th, |y| hit(y * tw), hit, apron, levels);
 }
 
 #[cfg(test)]

@@ -384,7 +384,7 @@ pub fn trace_pass<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 /// drawn in one `fill_contiguous` call (a display then gets it in one transfer, not one per
 /// tile), from `band`, at least the frame's width times the tile side of pixels. `ditherer`
 /// carries error between bands: make it once per frame ([`Ditherer::new`] over
-/// [`Ditherer::rows_len`] entries).
+/// [`Ditherer::rows_len`] entries). [`dither_tiles`] dithers a band in parts.
 pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
     frame: &Frame,
     ty: usize,
@@ -393,6 +393,30 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
     ditherer: &mut Ditherer<'_>,
     target: &mut D,
 ) -> Result<(), RenderError<D::Error>> {
+    let mut left = [(0, 0); MAX_TILE];
+    dither_tiles(frame, (ty, 0), tile, (above, band, &mut left), ditherer, target).map(|_| ())
+}
+
+/// What [`dither_tiles`] keeps between the parts of a band and between bands: the row above
+/// the band's hits, the band's pixels and the right column's hits of the last tile dithered.
+pub type BandRows<'a> = (&'a mut [(u16, u16)], &'a mut [BinaryColor], &'a mut [(u16, u16); MAX_TILE]);
+
+/// [`dither_band`] in parts, as the tiles of a band come in: dithers tile row `ty` of `frame`
+/// from tile `from` on, as far as `tile` has them (`tile(tx)`: tile `tx` of the row, `None`
+/// where the part ends), and draws those tiles in one `fill_contiguous` call. Returns the
+/// first tile it did not dither (the row's tile count once the band is done): the next call's
+/// `from`. A band dithered part after part, from tile 0 on and each part where the last
+/// ended, is bit for bit the band [`dither_band`] draws. `left` holds, between the parts, the
+/// right column's hits of the last tile dithered (the silhouette lines' apron); `above` and
+/// `band` are as for [`dither_band`].
+pub fn dither_tiles<'l, D: DrawTarget<Color = BinaryColor>>(
+    frame: &Frame,
+    (ty, from): (usize, usize),
+    tile: impl Fn(usize) -> Option<&'l KeptTile>,
+    (above, band, left): BandRows<'_>,
+    ditherer: &mut Ditherer<'_>,
+    target: &mut D,
+) -> Result<usize, RenderError<D::Error>> {
     let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
     if frame.outline && above.len() < w {
         return Err(RenderError::ScratchTooSmall { needed: w });
@@ -401,40 +425,46 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
     let Some(band) = band.get_mut(..w * rows) else {
         return Err(RenderError::ScratchTooSmall { needed: w * rows });
     };
-    let mut end = 0;
+    let (tiles, start) = (w.div_ceil(t), from * t);
     let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
-    let mut left: Option<&KeptTile> = None;
-    ditherer.next_band();
-    for tx in 0..w.div_ceil(t) {
+    if from == 0 {
+        ditherer.next_band();
+    }
+    let mut tx = from;
+    while tx < tiles {
         let (x0, y0) = (tx * t, ty * t);
         let (tw, th) = (t.min(w - x0), t.min(h - y0));
         let Some(kept) = tile(tx) else { break };
         levels[..tw * th].copy_from_slice(&kept.levels[..tw * th]);
         if frame.outline {
             let up = above.get(x0..x0 + tw).filter(|_| ty > 0);
-            let apron = Apron { left: left.map(|l| &l.right[..th]), up };
+            let apron = Apron { left: Some(&left[..th]).filter(|_| tx > 0), up };
             crate::outline::apron(tw, th, &kept.left[..th], &kept.top[..tw], apron, &mut levels[..tw * th]);
             if let Some(row) = above.get_mut(x0..x0 + tw) {
                 row.copy_from_slice(&kept.bottom[..tw]);
             }
+            left[..th].copy_from_slice(&kept.right[..th]);
         }
         ditherer.tile(x0, y0, tw, th, &levels[..tw * th], &mut bits);
         for (y, row) in bits[..tw * th].chunks(tw).enumerate() {
             band[y * w + x0..y * w + x0 + tw].copy_from_slice(row);
         }
-        left = Some(kept);
-        end = x0 + tw;
+        tx += 1;
     }
-    // The band as far as it was kept (whole unless `tile` ran out), row by row: a whole band
-    // as one slice (the common case, and the cheapest iterator to draw from).
-    let area = Rectangle::new(Point::new(0, (ty * t) as i32), Size::new(end as u32, rows as u32));
-    let drawn = if end == w {
+    let end = (tx * t).min(w);
+    if end <= start {
+        return Ok(tx);
+    }
+    // The part, row by row: a whole band as one slice (the common case, and the cheapest
+    // iterator to draw from).
+    let area = Rectangle::new(Point::new(start as i32, (ty * t) as i32), Size::new((end - start) as u32, rows as u32));
+    let drawn = if end - start == w {
         target.fill_contiguous(&area, band.iter().copied())
     } else {
-        target.fill_contiguous(&area, band.chunks(w).flat_map(|row| row[..end].iter().copied()))
+        target.fill_contiguous(&area, band.chunks(w).flat_map(|row| row[start..end].iter().copied()))
     };
-    drawn.map_err(RenderError::Draw)
+    drawn.map(|()| tx).map_err(RenderError::Draw)
 }
 
 /// Where the tile loop puts a finished tile: dithered and drawn, or kept as gray levels.

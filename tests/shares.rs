@@ -125,8 +125,10 @@ fn shares_count_their_tiles_as_the_checkerboard_holds_them() {
 
 /// Trace, then dither: shares trace a frame's bands into kept levels (`trace_share`), and the
 /// bands dithered in order (`dither_band`) are the frame `render` draws, bit for bit, with
-/// error diffusion too (which cannot be shared out any other way).
-fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
+/// error diffusion too (which cannot be shared out any other way). With `part` tiles, each band
+/// is dithered in parts of that many tiles (`dither_tiles`, as the two-core board dithers the
+/// tiles traced so far); with none, whole (`dither_band`).
+fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8, part: Option<usize>) -> Vec<u8> {
     let text = scene_text(name);
     let mut storage = vec![Object::<R>::default(); 64];
     let mut parts = lattice_rt::Parts::default();
@@ -155,7 +157,18 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8) -> Vec<u8> {
             .collect();
         // Share s holds the tiles tx = s - ty (mod of) of this row: tile tx is its (tx / of)-th.
         let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
-        dither_band(&frame, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap();
+        match part {
+            None => dither_band(&frame, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap(),
+            Some(part) => {
+                let (tiles, mut from, mut left) = ((w as usize).div_ceil(frame.tile as usize), 0, [(0, 0); lattice_rt::dither::MAX_TILE]);
+                while from < tiles {
+                    let upto = |tx: usize| if tx < from + part { tile(tx) } else { None };
+                    let next = lattice_rt::dither_tiles(&frame, (ty as usize, from), upto, (&mut above, &mut band_bits, &mut left), &mut ditherer, &mut target).unwrap();
+                    assert_eq!(next, (from + part).min(tiles), "a part ends where its tiles end");
+                    from = next;
+                }
+            }
+        }
     }
     bits
 }
@@ -165,19 +178,22 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
     for name in ["chair", "desk", "whitted"] {
         let samplings = [Sampling::Adaptive { contrast: 4 }, Sampling::Center, Sampling::Grid2x2];
         for (dither, sampling) in [Dither::FloydSteinberg, Dither::Atkinson, Dither::BlueNoise].into_iter().zip(samplings) {
-            for (width, height, outline) in [(128, 64, true), (100, 60, true), (100, 60, false)] {
-                let frame = Frame { dither, outline, sampling, ..Frame::new(width, height) };
+            for (width, height, outline, tile) in [(128, 64, true, 8), (100, 60, true, 8), (100, 60, false, 8), (128, 64, true, 16), (100, 60, true, 16)] {
+                let frame = Frame { dither, outline, sampling, tile, ..Frame::new(width, height) };
                 let (whole, _) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
-                // 1 to 3 shares, and one tile at a time (`Share::single`: as many shares as tiles across).
-                for of in [1, 2, 3, (width as usize).div_ceil(8) as u8] {
-                    assert_eq!(whole, traced_then_dithered::<Fx>(name, frame, of), "{name}, {dither:?}, {sampling:?}, {width}x{height}, lines {outline}, {of} shares");
+                // 1 to 3 shares, and one tile at a time (`Share::single`: as many shares as tiles
+                // across), each band dithered whole; one tile at a time, dithered in parts of
+                // one and of three tiles.
+                let across = (width as usize).div_ceil(tile as usize) as u8;
+                for (of, part) in [(1, None), (2, None), (3, None), (across, None), (across, Some(1)), (across, Some(3))] {
+                    assert_eq!(whole, traced_then_dithered::<Fx>(name, frame, of, part), "{name}, {dither:?}, {sampling:?}, {width}x{height}, {tile}x{tile} tiles, lines {outline}, {of} shares, parts of {part:?} tiles");
                 }
                 assert_eq!(Share::single(5, 3, 16), Share { index: 8, of: 16 });
             }
         }
     }
     let frame = Frame { dither: Dither::FloydSteinberg, outline: true, ..Frame::new(128, 64) };
-    assert_eq!(render_into::<f32>("spheres", &[(frame, Share::ALL)], true).0, traced_then_dithered::<f32>("spheres", frame, 2), "f32");
+    assert_eq!(render_into::<f32>("spheres", &[(frame, Share::ALL)], true).0, traced_then_dithered::<f32>("spheres", frame, 2, None), "f32");
     // Lines need the row above: too short a row is refused, not drawn without them.
     let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, 128)];
     let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, 128, &mut carries).unwrap();

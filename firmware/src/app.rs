@@ -12,7 +12,7 @@ use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::dither::{Carry, Ditherer};
-use lattice_rt::{dither_band, KeptTile, render_pass, render_share, trace_pass, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
+use lattice_rt::{dither_tiles, KeptTile, render_pass, render_share, trace_pass, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 
 pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
@@ -249,7 +249,7 @@ const TRACE_THEN_DITHER: bool = SECOND_CORE;
 /// Rays each tile keeps between the passes of a progressive frame on a two-core board (the
 /// cores take tiles one at a time, so each has its own: one per pixel of its 2x2 grid); none
 /// otherwise.
-const TILE_RAYS: usize = if cfg!(feature = "progressive") && SECOND_CORE { (FRAME.tile as usize / 2) * (FRAME.tile as usize / 2) } else { 0 };
+const TILE_RAYS: usize = if cfg!(feature = "progressive") && SECOND_CORE { (RENDERED.tile as usize / 2) * (RENDERED.tile as usize / 2) } else { 0 };
 /// Entries of [`ShareMemory`]'s arrays when [`TRACE_THEN_DITHER`] (else none).
 const fn dithered(n: usize) -> usize {
     if TRACE_THEN_DITHER {
@@ -259,9 +259,9 @@ const fn dithered(n: usize) -> usize {
     }
 }
 /// Tiles across the frame.
-const TILES_X: usize = (WIDTH as usize).div_ceil(FRAME.tile as usize);
+const TILES_X: usize = (WIDTH as usize).div_ceil(RENDERED.tile as usize);
 /// Tiles of the frame.
-const TILES: usize = TILES_X * (HEIGHT as usize).div_ceil(FRAME.tile as usize);
+const TILES: usize = TILES_X * (HEIGHT as usize).div_ceil(RENDERED.tile as usize);
 
 /// The memory of the second tile share: on a board with two cores its own query scratch; and
 /// the rays both shares keep between progressive passes ([`TRACED`] each) on one core. Where
@@ -275,7 +275,7 @@ pub struct ShareMemory {
     kept: [KeptTile; dithered(TILES)],
     rays: [[Traced; TILE_RAYS]; TILES],
     above: [(u16, u16); dithered(WIDTH as usize)],
-    band: [BinaryColor; dithered(WIDTH as usize * FRAME.tile as usize)],
+    band: [BinaryColor; dithered(WIDTH as usize * RENDERED.tile as usize)],
     carries: [i16; dithered(Carry::len(WIDTH as usize))],
 }
 
@@ -290,7 +290,7 @@ impl ShareMemory {
             kept: [KeptTile::EMPTY; dithered(TILES)],
             rays: [[NONE; TILE_RAYS]; TILES],
             above: [(0, 0); dithered(WIDTH as usize)],
-            band: [BinaryColor::Off; dithered(WIDTH as usize * FRAME.tile as usize)],
+            band: [BinaryColor::Off; dithered(WIDTH as usize * RENDERED.tile as usize)],
             carries: [0; dithered(Carry::len(WIDTH as usize))],
         }
     }
@@ -599,31 +599,32 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                     // Only a finished frame (a progressive one's last pass) has silhouette lines.
                     let shows = Frame { outline: frame.outline && pass <= 1, ..*frame };
                     let mut ditherer = Ditherer::new(frame.dither, w, &mut *carries).ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
-                    let mut band = 0;
+                    let (mut band, mut from) = (0, 0);
+                    // The right column's hits of the last tile dithered (`dither_tiles`).
+                    let mut left = [(0, 0); lattice_rt::dither::MAX_TILE];
                     while band < bands {
-                        // Every band whose tiles are all traced, in order, dithered and sent,
-                        // and its tiles freed for the next pass.
+                        // The band's tiles traced since its last part, in order, dithered and
+                        // sent as one part, and freed for the next pass: so once the last tile
+                        // is traced, what is left on the bus is its part, not the whole band.
                         let ready = critical_section::with(|cs| {
                             let mut b = board.borrow(cs).borrow_mut();
-                            let row = &mut b.done[band * tiles_x..(band + 1) * tiles_x];
-                            if row.iter().all(Option::is_some) {
-                                let mut out: [Option<Slot<'_>>; TILES_X] = [const { None }; TILES_X];
-                                out.iter_mut().zip(row.iter_mut()).for_each(|(o, r)| *o = r.take());
-                                Some(out)
-                            } else {
-                                None
-                            }
+                            let row = &mut b.done[band * tiles_x + from..(band + 1) * tiles_x];
+                            let mut out: [Option<Slot<'_>>; TILES_X] = [const { None }; TILES_X];
+                            out.iter_mut().zip(row.iter_mut()).take_while(|(_, r)| r.is_some()).for_each(|(o, r)| *o = r.take());
+                            Some(out).filter(|o| o[0].is_some())
                         });
-                        if let Some(mut row) = ready {
-                            let tile = |tx: usize| row.get(tx).and_then(|l| l.as_ref()).map(|l| &*l.kept);
-                            dither_band(&shows, band, tile, (&mut *above, &mut *band_bits), &mut ditherer, target).map_err(AppError::Render)?;
+                        if let Some(mut part) = ready {
+                            let tile = |tx: usize| part.get(tx.wrapping_sub(from)).and_then(|l| l.as_ref()).map(|l| &*l.kept);
+                            let next = dither_tiles(&shows, (band, from), tile, (&mut *above, &mut *band_bits, &mut left), &mut ditherer, target).map_err(AppError::Render)?;
                             critical_section::with(|cs| {
                                 let mut b = board.borrow(cs).borrow_mut();
-                                for (tx, slot) in row.iter_mut().enumerate() {
-                                    b.free[band * tiles_x + tx] = slot.take();
+                                for (tx, slot) in part.iter_mut().enumerate() {
+                                    if let Some(slot) = slot.take() {
+                                        b.free[band * tiles_x + from + tx] = Some(slot);
+                                    }
                                 }
                             });
-                            band += 1;
+                            (band, from) = if next >= tiles_x { (band + 1, 0) } else { (band, next) };
                             continue;
                         }
                         match take(scratch, &mut trace) {

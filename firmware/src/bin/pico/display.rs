@@ -1,4 +1,4 @@
-//! The SSD1306 as the render loop's draw target: 8-row tiles or whole bands sent as page bytes (no
+//! The SSD1306 as the render loop's draw target: whole bands of tiles sent as page bytes (no
 //! framebuffer), over I2C ([`i2c`]: a queue the bus drains while the cores trace, and a display
 //! that does not answer reported) or, with the `spi` feature, 4-wire SPI ([`spi`]). Each gives
 //! the render loop the same two things: [`Pump`], its hooks, and [`flush`], the wait until the
@@ -18,12 +18,16 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-use firmware::app::{HEIGHT, WIDTH};
+use firmware::app::{HEIGHT, RENDERED, WIDTH};
+
+/// The most rows drawn at once: a band of tiles.
+const BAND_ROWS: usize = RENDERED.tile as usize;
 use ssd1306::mode::BasicMode;
 use ssd1306::prelude::*;
 
-/// Draws whole 8-row tiles by sending SSD1306 page bytes; nothing else is supported (there is
-/// no framebuffer to merge single pixels into), and anything else is refused with an error.
+/// Draws areas that start on a page and are at most a band high ([`BAND_ROWS`]) by sending
+/// SSD1306 page bytes; nothing else is supported (there is no framebuffer to merge single pixels
+/// into), and anything else is refused with an error.
 pub struct PageTiles<DI> {
     /// The display, in its basic mode (commands and raw page data).
     pub display: ssd1306::Ssd1306<DI, DisplaySize128x64, BasicMode>,
@@ -46,14 +50,17 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
     fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Self::Error> {
         let (x0, y0) = (area.top_left.x, area.top_left.y);
         let (w, h) = (area.size.width as usize, area.size.height as usize);
-        if y0 < 0 || x0 < 0 || y0 % 8 != 0 || h > 8 || x0 as usize + w > WIDTH as usize {
+        if y0 < 0 || x0 < 0 || y0 % 8 != 0 || h > BAND_ROWS || x0 as usize + w > WIDTH as usize {
             return Err(display_interface::DisplayError::OutOfBoundsError);
         }
-        // One byte per column, bit k = row k of the page (LSB on top).
-        let mut cols = [0u8; WIDTH as usize];
+        // One byte per column of each page, the pages one after the other (the SSD1306's
+        // horizontal addressing fills a draw area that way); bit k = row k of its page (LSB on
+        // top).
+        let mut pages = [0u8; WIDTH as usize * BAND_ROWS.div_ceil(8)];
         let mut colors = colors.into_iter();
-        for bit in (0..h).map(|y| 1u8 << y) {
-            for col in cols[..w].iter_mut() {
+        for y in 0..h {
+            let (page, bit) = (&mut pages[y / 8 * w..(y / 8 + 1) * w], 1u8 << (y % 8));
+            for col in page.iter_mut() {
                 if colors.next().is_some_and(|c| c.is_on()) {
                     *col |= bit;
                 }
@@ -62,6 +69,6 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
         // `set_draw_area` takes pixel coordinates (it divides rows by 8 into pages itself).
         let (x1, y1) = ((x0 as usize + w) as u8, (y0 as usize + h) as u8);
         self.display.set_draw_area((x0 as u8, y0 as u8), (x1, y1))?;
-        self.display.draw(&cols[..w])
+        self.display.draw(&pages[..h.div_ceil(8) * w])
     }
 }

@@ -24,13 +24,17 @@ pub struct QueuedI2c<P> {
 }
 
 /// Words the queue holds: IC_DATA_CMD values (the byte, and the STOP bit on a transaction's
-/// last). A frame is 1,152 bytes (8 page rows of 128 column bytes and their addressing); the
-/// queue holds two bands' worth, so a band is queued whole while the last is still on the bus.
-/// A progressive frame's first passes are traced in a fraction of the time their bytes take on
-/// the bus: its queue holds all four passes' bytes (9.4 KB), so the cores never wait for the
-/// bus and trace the later passes while it sends the earlier ones (with two passes' worth, core
-/// 0 waited for room during the third pass: the chair took 1.06x the still frame).
-const QUEUED: usize = if cfg!(feature = "progressive") { 4 * 1152 + 96 } else { 320 };
+/// last). A band is its pages' column bytes (128 per page, [`BAND_PAGES`] pages) and 16 bytes of
+/// addressing; the queue holds two bands' worth, so a band is queued whole while the last is
+/// still on the bus. A progressive frame's first passes are traced in a fraction of the time
+/// their bytes take on the bus: its queue holds all four passes' bytes (a frame is 1,152 bytes
+/// in 8-row bands, fewer in higher ones), so the cores never wait for the bus and trace the later
+/// passes while it sends the earlier ones (with two passes' worth, core 0 waited for room during
+/// the third pass: the chair took 1.06x the still frame).
+const QUEUED: usize = if cfg!(feature = "progressive") { 4 * 1152 + 96 } else { 2 * (BAND_PAGES * firmware::app::WIDTH as usize + 16) };
+
+/// SSD1306 pages (8 rows each) in a band of tiles.
+const BAND_PAGES: usize = (firmware::app::RENDERED.tile as usize).div_ceil(8);
 
 /// The bytes on their way to the bus: a ring of IC_DATA_CMD words, and the abort the controller
 /// reported while the queue was being moved into its FIFO.
