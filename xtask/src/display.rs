@@ -16,7 +16,7 @@ use embedded_graphics::pixelcolor::Gray8;
 use embedded_graphics::prelude::*;
 use embedded_graphics::text::{Baseline, Text};
 use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
-use lattice_rt::{Dither, Frame, Fx, Sampling, Tone};
+use lattice_rt::{Dither, Frame, Fx, Tone};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -51,9 +51,10 @@ impl Look {
     fn frame(self, w: u16, h: u16) -> Frame {
         Frame {
             dither: DITHERS[self.dither].1,
-            sampling: Sampling::Adaptive { contrast: 4 },
+            sampling: board_frame::SAMPLING,
             outline: self.outline,
             tone: Tone { gamma_tenths: self.gamma },
+            tile: board_frame::PANEL_TILE,
             ..Frame::new(w, h)
         }
     }
@@ -347,8 +348,10 @@ fn report(out: &Path, names: &[String], looks: &[Look], scores: &[Score], order:
     writeln!(md, "# What the display shows\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask display` ({n} scenes: {}). Every frame is rendered as the\nboards render it: {w}x{h}, Q16.16 fixed point, adaptive sampling. Each 1-bit frame (lit pixel = 64,\ndark = 0) and the reference gray image (f64, 4x4 rays per pixel) are both low-passed by a\nGaussian of sigma 1 and 2 display pixels, a model of viewing the panel from a distance where\nsingle dots merge; the table gives the mean absolute difference of the two (levels of 64) and\ntheir SSIM (Wang et al. 2004; 1 is identical), averaged over the scenes. Ranked by SSIM averaged\nover both sigmas.\n",
-        names.join(", ")
+        "Written by `cargo xtask display` ({n} scenes: {}). Every frame is rendered as the\nboards render it: {w}x{h}, Q16.16 fixed point, adaptive sampling in\nthe Pico panel's {}x{} tiles. Each 1-bit frame (lit pixel = 64,\ndark = 0) and the reference gray image (f64, 4x4 rays per pixel) are both low-passed by a\nGaussian of sigma 1 and 2 display pixels, a model of viewing the panel from a distance where\nsingle dots merge; the table gives the mean absolute difference of the two (levels of 64) and\ntheir SSIM (Wang et al. 2004; 1 is identical), averaged over the scenes. Ranked by SSIM averaged\nover both sigmas.\n",
+        names.join(", "),
+        board_frame::PANEL_TILE,
+        board_frame::PANEL_TILE
     )?;
     writeln!(md, "**Best: {}** (mean SSIM {:.3}).\n", best.label(), scores[order[0]].ssim(n))?;
     writeln!(md, "| rank | look | SSIM (sigma 1) | SSIM (sigma 2) | mean abs error (sigma 1) | mean abs error (sigma 2) |\n|---|---|---|---|---|---|")?;

@@ -1,8 +1,9 @@
 //! Raspberry Pi Pico (RP2040, `--features pico`, fixed point) or Pico 2 (RP2350, Cortex-M33
 //! with an FPU, `--features pico2`, f32) + SSD1306 128x64 OLED on I2C (or SPI, `spi`): renders the embedded
-//! scenes in turn, tile by tile straight to the display (each 8x8 tile is one SSD1306 page high,
-//! so it is sent as eight column bytes; no framebuffer), core 1 tracing every second tile, and
-//! logs per-frame time and statistics over defmt-rtt.
+//! scenes in turn, tile by tile straight to the display (16x16 tiles, two SSD1306 pages high,
+//! sent as page bytes; no framebuffer), both cores tracing the tiles as they come free and core 0
+//! dithering and sending each band's traced tiles in order, and logs per-frame time and
+//! statistics over defmt-rtt.
 //!
 //! The on-board LED is lit while a frame is being rendered and goes out when the frame is on
 //! the display; between scenes the core sleeps (`wfi`) until a timer alarm. With no display
