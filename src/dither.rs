@@ -319,8 +319,12 @@ impl<'c> Ditherer<'c> {
     }
 
     /// A ditherer over storage of at least [`Ditherer::rows_len`] entries, or `None` if it is
-    /// shorter.
+    /// shorter, or if `mode` diffuses error and the core was built without its `diffusion`
+    /// feature.
     pub fn new(mode: Dither, width: usize, rows: &'c mut [i16]) -> Option<Self> {
+        if mode.diffuses() && !cfg!(feature = "diffusion") {
+            return None;
+        }
         let carry = if mode.diffuses() { Some(Carry::new(rows, width)?) } else { None };
         Some(Ditherer { mode, carry })
     }
@@ -334,7 +338,8 @@ impl<'c> Ditherer<'c> {
 
     /// Dithers the `w x h` tile of `levels` (row-major) at `(x0, y0)` into `out`.
     pub fn tile(&mut self, x0: usize, y0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
-        match self.carry.as_mut() {
+        // Without the `diffusion` feature no ditherer has carries, and their code is not linked.
+        match self.carry.as_mut().filter(|_| cfg!(feature = "diffusion")) {
             Some(c) => c.tile(self.mode, x0, w, h, levels, out),
             None if self.mode == Dither::BlueNoise => {
                 // Row by row against the mask's row (the same pixels as `blue_noise`).

@@ -196,6 +196,9 @@ pub enum RenderError<E> {
     /// The frame asks for edge sampling and the core was built without its `edge-sampling`
     /// feature.
     EdgesNotCompiled,
+    /// The frame asks for error diffusion (Floyd-Steinberg, Atkinson) and the core was built
+    /// without its `diffusion` feature.
+    DiffusionNotCompiled,
     /// The scratch storage is smaller than [`Frame::scratch_len`].
     ScratchTooSmall {
         /// Entries needed.
@@ -227,6 +230,7 @@ impl RenderError<core::convert::Infallible> {
             RenderError::Cancelled => RenderError::Cancelled,
             RenderError::BadTile => RenderError::BadTile,
             RenderError::EdgesNotCompiled => RenderError::EdgesNotCompiled,
+            RenderError::DiffusionNotCompiled => RenderError::DiffusionNotCompiled,
             RenderError::ScratchTooSmall { needed } => RenderError::ScratchTooSmall { needed },
             RenderError::BadShare => RenderError::BadShare,
             RenderError::ViewTooNarrow { most, scalar } => RenderError::ViewTooNarrow { most, scalar },
@@ -244,6 +248,7 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
                 write!(f, "tile side must be 1..={MAX_TILE} and a multiple of the pattern block")
             }
             RenderError::EdgesNotCompiled => write!(f, "this build leaves out edge sampling (the core's `edge-sampling` feature)"),
+            RenderError::DiffusionNotCompiled => write!(f, "this build leaves out error diffusion (the core's `diffusion` feature)"),
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
@@ -719,7 +724,7 @@ fn pass_tile<R: Real>(n: u8, sampler: &mut Sampler<'_>, at: Block, kept: &mut [T
 }
 
 /// Whether `frame` can be rendered in `share`: its tile a multiple of its dither's block and at
-/// most [`MAX_TILE`], its sampling compiled in, and the share one of its independent bands
+/// most [`MAX_TILE`], its sampling and dither compiled in, and the share one of its independent bands
 /// (when it is `dithered` here; kept levels only need independent tracing).
 fn check<E>(frame: &Frame, share: Share, dithered: bool) -> Result<(), RenderError<E>> {
     let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
@@ -728,6 +733,9 @@ fn check<E>(frame: &Frame, share: Share, dithered: bool) -> Result<(), RenderErr
     }
     if frame.edges() && !cfg!(feature = "edge-sampling") {
         return Err(RenderError::EdgesNotCompiled);
+    }
+    if frame.dither.diffuses() && !cfg!(feature = "diffusion") {
+        return Err(RenderError::DiffusionNotCompiled);
     }
     let independent = if dithered { frame.bands_independent() } else { !frame.edges() };
     if !share.valid() || (share.of > 1 && !independent) {
