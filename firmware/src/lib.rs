@@ -6,4 +6,6 @@
 #![deny(missing_docs)]
 
 pub mod app;
+#[cfg(feature = "compact")]
+pub mod builtins;
 pub mod stack;

@@ -139,11 +139,13 @@ fn variants() -> Vec<Variant> {
         });
     }
     // The baked images the flash targets are about, built for size (the `small` profile:
-    // opt-level "z"), for parts with little flash; their frames are run and checked like the rest.
+    // opt-level "z", and the `compact` feature: the compiler's division and memory helpers as
+    // small loops), for parts with little flash; their frames are
+    // run and checked like the rest.
     for (name, scenes, features, what) in [
-        ("qemu-m0-fixed-baked-small", None, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, all five scenes baked, built for size (`small` profile: opt-level \"z\")"),
-        ("qemu-m0-fixed-baked-allfx-small", None, "qemu,scalar-fixed,baked,effects-all", "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on, built for size"),
-        ("qemu-m0-fixed-baked-matte-small", matte, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only, built for size"),
+        ("qemu-m0-fixed-baked-small", None, "qemu,scalar-fixed,baked,compact", "Cortex-M0+, fixed, all five scenes baked, built for size (`small` profile: opt-level \"z\", `compact` feature)"),
+        ("qemu-m0-fixed-baked-allfx-small", None, "qemu,scalar-fixed,baked,effects-all,compact", "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on, built for size"),
+        ("qemu-m0-fixed-baked-matte-small", matte, "qemu,scalar-fixed,baked,compact", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only, built for size"),
     ] {
         v.push(Variant {
             name: name.into(),
@@ -165,7 +167,7 @@ fn variants() -> Vec<Variant> {
         name: TINY.into(),
         target: "thumbv6m-none-eabi",
         profile: "small",
-        features: "tiny,scalar-fixed,baked".into(),
+        features: "tiny,scalar-fixed,baked,compact".into(),
         bin: "qemu",
         machine: Some("mps2-an385"),
         scenes: Some("chair"),
@@ -457,7 +459,7 @@ fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identica
         eprintln!("FAIL {TINY}: {ram} B of RAM in a 4096 B memory map, or no frame");
     }
     writeln!(md, "\n## The tiny build\n")?;
-    writeln!(md, "`{TINY}` (the `tiny` feature, `small` profile): the chair alone in the memory of the smallest")?;
+    writeln!(md, "`{TINY}` (the `tiny` and `compact` features, `small` profile): the chair alone in the memory of the smallest")?;
     writeln!(md, "Cortex-M0 parts, `firmware/tiny/memory.x`: 16 KiB of flash and 4 KiB of RAM, enforced by the linker,")?;
     writeln!(md, "with flip-link placing the stack below the statics so that an overflow faults. The harness logs")?;
     writeln!(md, "through a few bytes of its own (`Line` in `firmware/src/bin/qemu.rs`, not `core::fmt`; core's")?;
@@ -490,7 +492,7 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
         return Ok(());
     };
     writeln!(md, "\n## Baked scenes\n\nWith the `baked` feature `firmware/build.rs` parses each embedded scene and builds its lattice on\nthe host, in the firmware's scalar, and writes both as static tables (`lattice_rt::bake`); the\nfirmware links no parser, no scene set-up (f64 maths) and no lattice build, and keeps neither\nobjects nor lattice in RAM. Every frame is checked bit for bit against host-sim like the others.\n")?;
-    writeln!(md, "The flash targets are measured on the images built for size (`small` profile: opt-level \"z\", the\nchoice for a part with little flash) and, beside them, on the release profile's (opt-level \"s\",\nwhat the other rows of this report run); the instructions each costs are in the table above\n(`m0-fixed-baked` against `m0-fixed-baked-small`).\n")?;
+    writeln!(md, "The flash targets are measured on the images built for size (`small` profile: opt-level \"z\", the\nchoice for a part with little flash, and the firmware's `compact` feature: 32-bit division, memcpy\nand memset as loops of a few dozen bytes instead of compiler-builtins') and, beside them, on the release profile's (opt-level \"s\",\nwhat the other rows of this report run); the instructions each costs are in the table above\n(`m0-fixed-baked` against `m0-fixed-baked-small`).\n")?;
     writeln!(md, "| target | build | measured | limit | met |\n|---|---|---:|---:|---|")?;
     let mut row = |what: &str, build: &str, got: u64, limit: u64| writeln!(md, "| {what} | `{build}` | {got} B | {limit} B | {} |", if got <= limit { "yes" } else { "**no**" });
     for (what, build, limit) in [

@@ -1,0 +1,162 @@
+//! The compiler's helpers for images built for size (the `compact` feature): the ARM EABI's
+//! 32-bit division (`__aeabi_uidiv`, `__aeabi_idiv`, which a Cortex-M0, without a divide
+//! instruction, calls for every `/` by a value known only at run time) and its memory copies
+//! and fills (`__aeabi_memcpy*`, `__aeabi_memset*`, `__aeabi_memclr*`, which the compiler calls
+//! to move and zero structures), each a loop of a few dozen bytes instead of compiler-builtins'
+//! unrolled and specialised code (whose symbols are weak, so these take their place). The
+//! results are the same; they cost more instructions. The copy and fill loops move each word
+//! or byte with a volatile access, so that the compiler cannot turn them back into calls to
+//! themselves.
+
+use core::ptr::{read_volatile, write_volatile};
+
+/// `n / d` truncated, for `d != 0` (Rust checks the divisor before it divides; a zero gives
+/// `u32::MAX`). Restoring division with the divisor shifted up to `n`'s highest set bit: one
+/// step per bit of the quotient (17 for a Q16.16 reciprocal), none of which can overflow.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn __aeabi_uidiv(n: u32, d: u32) -> u32 {
+    if d == 0 {
+        return u32::MAX;
+    }
+    if d > n {
+        return 0;
+    }
+    let shift = d.leading_zeros() - n.leading_zeros();
+    let (mut q, mut r, mut step) = (0u32, n, d << shift);
+    for _ in 0..=shift {
+        q <<= 1;
+        if r >= step {
+            r -= step;
+            q |= 1;
+        }
+        step >>= 1;
+    }
+    q
+}
+
+/// `n / d` truncated towards zero, for `d != 0` and not `i32::MIN / -1` (Rust checks both
+/// before it divides), from [`__aeabi_uidiv`] of the magnitudes.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn __aeabi_idiv(n: i32, d: i32) -> i32 {
+    let q = __aeabi_uidiv(n.unsigned_abs(), d.unsigned_abs()) as i32;
+    if (n < 0) != (d < 0) {
+        q.wrapping_neg()
+    } else {
+        q
+    }
+}
+
+/// Copies `n` bytes from `src` to `dest` (the regions do not overlap), a byte at a time.
+///
+/// # Safety
+/// `dest` and `src` valid for `n` bytes, as the compiler guarantees where it calls it.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memcpy(dest: *mut u8, src: *const u8, n: usize) {
+    for i in 0..n {
+        // SAFETY: both regions hold `n` bytes.
+        unsafe { write_volatile(dest.add(i), read_volatile(src.add(i))) };
+    }
+}
+
+/// [`__aeabi_memcpy`] of word-aligned regions: whole words, then the bytes left.
+///
+/// # Safety
+/// As [`__aeabi_memcpy`], with `dest` and `src` aligned to 4 bytes.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memcpy4(dest: *mut u8, src: *const u8, n: usize) {
+    let words = n / 4;
+    for i in 0..words {
+        // SAFETY: both regions are aligned and hold `words` whole words.
+        unsafe { write_volatile((dest as *mut u32).add(i), read_volatile((src as *const u32).add(i))) };
+    }
+    // SAFETY: the bytes after the words lie in both regions.
+    unsafe { __aeabi_memcpy(dest.add(4 * words), src.add(4 * words), n % 4) };
+}
+
+/// [`__aeabi_memcpy4`] (8-byte alignment is 4-byte alignment too).
+///
+/// # Safety
+/// As [`__aeabi_memcpy4`].
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memcpy8(dest: *mut u8, src: *const u8, n: usize) {
+    // SAFETY: the caller's guarantees are the callee's.
+    unsafe { __aeabi_memcpy4(dest, src, n) }
+}
+
+/// Sets `n` bytes at `dest` to the low byte of `c` (the EABI's argument order: `n` before `c`).
+///
+/// # Safety
+/// `dest` valid for `n` bytes.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memset(dest: *mut u8, n: usize, c: i32) {
+    for i in 0..n {
+        // SAFETY: the region holds `n` bytes.
+        unsafe { write_volatile(dest.add(i), c as u8) };
+    }
+}
+
+/// [`__aeabi_memset`] of a word-aligned region: whole words, then the bytes left.
+///
+/// # Safety
+/// As [`__aeabi_memset`], with `dest` aligned to 4 bytes.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memset4(dest: *mut u8, n: usize, c: i32) {
+    let (words, word) = (n / 4, u32::from(c as u8) * 0x0101_0101);
+    for i in 0..words {
+        // SAFETY: the region is aligned and holds `words` whole words.
+        unsafe { write_volatile((dest as *mut u32).add(i), word) };
+    }
+    // SAFETY: the bytes after the words lie in the region.
+    unsafe { __aeabi_memset(dest.add(4 * words), n % 4, c) };
+}
+
+/// [`__aeabi_memset4`].
+///
+/// # Safety
+/// As [`__aeabi_memset4`].
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memset8(dest: *mut u8, n: usize, c: i32) {
+    // SAFETY: the caller's guarantees are the callee's.
+    unsafe { __aeabi_memset4(dest, n, c) }
+}
+
+/// Zeroes `n` bytes at `dest`.
+///
+/// # Safety
+/// As [`__aeabi_memset`].
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memclr(dest: *mut u8, n: usize) {
+    // SAFETY: the caller's guarantees are the callee's.
+    unsafe { __aeabi_memset(dest, n, 0) }
+}
+
+/// Zeroes a word-aligned region.
+///
+/// # Safety
+/// As [`__aeabi_memset4`].
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memclr4(dest: *mut u8, n: usize) {
+    // SAFETY: the caller's guarantees are the callee's.
+    unsafe { __aeabi_memset4(dest, n, 0) }
+}
+
+/// [`__aeabi_memclr4`].
+///
+/// # Safety
+/// As [`__aeabi_memset4`].
+#[allow(unsafe_code)]
+#[no_mangle]
+pub unsafe extern "C" fn __aeabi_memclr8(dest: *mut u8, n: usize) {
+    // SAFETY: the caller's guarantees are the callee's.
+    unsafe { __aeabi_memset4(dest, n, 0) }
+}
