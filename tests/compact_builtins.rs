@@ -1,44 +1,12 @@
-//! The firmware's `compact` helpers (`firmware/src/builtins.rs`: the ARM EABI's division and
-//! memory copies and fills that images built for size link in place of compiler-builtins'),
-//! run on the host against Rust's own division and slice copies.
+//! The firmware's `compact` helpers (`firmware/src/builtins.rs`: the ARM EABI's memory copies
+//! and fills that images built for size link in place of compiler-builtins'), run on the host
+//! against Rust's own slice copies.
 
 #[allow(dead_code, clippy::missing_safety_doc)]
 mod builtins {
     include!("../firmware/src/builtins.rs");
 }
 use builtins::*;
-
-/// A xorshift generator: the same numbers on every run.
-fn numbers() -> impl FnMut() -> u32 {
-    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
-    move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x as u32
-    }
-}
-
-#[test]
-fn division_is_rusts_quotient() {
-    let mut next = numbers();
-    for i in 0..500_000u32 {
-        // Numerators and divisors of every length, from 1 bit to 32.
-        let n = next() >> (i % 32);
-        let d = (next() >> (next() % 32)).max(1);
-        assert_eq!(__aeabi_uidiv(n, d), n / d, "{n} / {d}");
-        let (a, b) = (n as i32, d as i32);
-        if !(a == i32::MIN && b == -1) {
-            assert_eq!(__aeabi_idiv(a, b), a / b, "{a} / {b}");
-        }
-    }
-    for (n, d) in [(u32::MAX, 1), (u32::MAX, u32::MAX), (u32::MAX, 1 << 31), (1 << 31, (1 << 31) + 1), (0, 5), (7, 7), (u32::MAX, 3), (1 << 16, 3)] {
-        assert_eq!(__aeabi_uidiv(n, d), n / d, "{n} / {d}");
-    }
-    for (a, b) in [(i32::MIN, 1), (i32::MIN, 2), (i32::MAX, -1), (-7, 2), (7, -2), (-7, -2), (i32::MIN, i32::MAX)] {
-        assert_eq!(__aeabi_idiv(a, b), a / b, "{a} / {b}");
-    }
-}
 
 #[test]
 fn copies_and_fills_touch_exactly_their_bytes() {

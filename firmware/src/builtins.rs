@@ -1,43 +1,5 @@
 use core::ptr::{read_volatile, write_volatile};
 
-/// `n / d` truncated, for `d != 0` (Rust checks the divisor before it divides; a zero gives
-/// `u32::MAX`). Restoring division with the divisor shifted up to `n`'s highest set bit: one
-/// step per bit of the quotient (17 for a Q16.16 reciprocal), none of which can overflow.
-#[allow(unsafe_code)]
-#[no_mangle]
-pub extern "C" fn __aeabi_uidiv(n: u32, d: u32) -> u32 {
-    if d == 0 {
-        return u32::MAX;
-    }
-    if d > n {
-        return 0;
-    }
-    let shift = d.leading_zeros() - n.leading_zeros();
-    let (mut q, mut r, mut step) = (0u32, n, d << shift);
-    for _ in 0..=shift {
-        q <<= 1;
-        if r >= step {
-            r -= step;
-            q |= 1;
-        }
-        step >>= 1;
-    }
-    q
-}
-
-/// `n / d` truncated towards zero, for `d != 0` and not `i32::MIN / -1` (Rust checks both
-/// before it divides), from [`__aeabi_uidiv`] of the magnitudes.
-#[allow(unsafe_code)]
-#[no_mangle]
-pub extern "C" fn __aeabi_idiv(n: i32, d: i32) -> i32 {
-    let q = __aeabi_uidiv(n.unsigned_abs(), d.unsigned_abs()) as i32;
-    if (n < 0) != (d < 0) {
-        q.wrapping_neg()
-    } else {
-        q
-    }
-}
-
 /// Copies `n` bytes from `src` to `dest` (the regions do not overlap), a byte at a time.
 ///
 /// # Safety

@@ -139,8 +139,8 @@ fn variants() -> Vec<Variant> {
         });
     }
     // The baked images the flash targets are about, built for size (the `small` profile:
-    // opt-level "z", and the `compact` feature: the compiler's division and memory helpers as
-    // small loops), for parts with little flash; their frames are
+    // opt-level "z", and the `compact` feature: the compiler's memory helpers as small loops),
+    // for parts with little flash; their frames are
     // run and checked like the rest.
     for (name, scenes, features, what) in [
         ("qemu-m0-fixed-baked-small", None, "qemu,scalar-fixed,baked,compact", "Cortex-M0+, fixed, all five scenes baked, built for size (`small` profile: opt-level \"z\", `compact` feature)"),
@@ -492,7 +492,7 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
         return Ok(());
     };
     writeln!(md, "\n## Baked scenes\n\nWith the `baked` feature `firmware/build.rs` parses each embedded scene and builds its lattice on\nthe host, in the firmware's scalar, and writes both as static tables (`lattice_rt::bake`); the\nfirmware links no parser, no scene set-up (f64 maths) and no lattice build, and keeps neither\nobjects nor lattice in RAM. Every frame is checked bit for bit against host-sim like the others.\n")?;
-    writeln!(md, "The flash targets are measured on the images built for size (`small` profile: opt-level \"z\", the\nchoice for a part with little flash, and the firmware's `compact` feature: 32-bit division, memcpy\nand memset as loops of a few dozen bytes instead of compiler-builtins') and, beside them, on the release profile's (opt-level \"s\",\nwhat the other rows of this report run); the instructions each costs are in the table above\n(`m0-fixed-baked` against `m0-fixed-baked-small`).\n")?;
+    writeln!(md, "The flash targets are measured on the images built for size (`small` profile: opt-level \"z\", the\nchoice for a part with little flash, and the firmware's `compact` feature: memcpy and memset as\nloops of a few dozen bytes instead of compiler-builtins') and, beside them, on the release profile's (opt-level \"s\",\nwhat the other rows of this report run); the instructions each costs are in the table above\n(`m0-fixed-baked` against `m0-fixed-baked-small`).\n")?;
     writeln!(md, "| target | build | measured | limit | met |\n|---|---|---:|---:|---|")?;
     let mut row = |what: &str, build: &str, got: u64, limit: u64| writeln!(md, "| {what} | `{build}` | {got} B | {limit} B | {} |", if got <= limit { "yes" } else { "**no**" });
     for (what, build, limit) in [
