@@ -78,7 +78,7 @@ fn sampling_name(s: Sampling) -> &'static str {
 }
 
 impl Settings {
-    /// The frame these settings render (128x64, 8x8 tiles, as the Pico's panel).
+    /// The frame these settings render (128x64, 16x16 tiles, as the Pico's panel).
     pub fn frame(&self) -> Result<Frame, String> {
         let dither = DITHERS
             .iter()
