@@ -604,15 +604,23 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
                     // The right column's hits of the last tile dithered (`dither_tiles`).
                     let mut left = [(0, 0); lattice_rt::dither::MAX_TILE];
                     while band < bands {
-                        // The band's tiles traced since its last part, in order, dithered and
-                        // sent as one part, and freed for the next pass: so once the last tile
-                        // is traced, what is left on the bus is its part, not the whole band.
+                        // A band whose tiles are all traced, dithered and sent in one transfer,
+                        // and its tiles freed for the next pass. The frame's last band goes in
+                        // parts, its tiles traced since its last part each time: so once the last
+                        // tile is traced, what is left on the bus is its part, not the whole band
+                        // (parts of every band cost more addressing bytes than the bus had time
+                        // for in a progressive frame).
+                        let parts = band + 1 == bands && Some(&pass) == PASSES.last();
                         let ready = critical_section::with(|cs| {
                             let mut b = board.borrow(cs).borrow_mut();
                             let row = &mut b.done[band * tiles_x + from..(band + 1) * tiles_x];
+                            let traced = row.iter().take_while(|r| r.is_some()).count();
+                            if traced == 0 || (traced < row.len() && !parts) {
+                                return None;
+                            }
                             let mut out: [Option<Slot<'_>>; TILES_X] = [const { None }; TILES_X];
-                            out.iter_mut().zip(row.iter_mut()).take_while(|(_, r)| r.is_some()).for_each(|(o, r)| *o = r.take());
-                            Some(out).filter(|o| o[0].is_some())
+                            out.iter_mut().zip(row.iter_mut()).take(traced).for_each(|(o, r)| *o = r.take());
+                            Some(out)
                         });
                         if let Some(mut part) = ready {
                             let tile = |tx: usize| part.get(tx.wrapping_sub(from)).and_then(|l| l.as_ref()).map(|l| &*l.kept);
