@@ -82,12 +82,16 @@ fn main() {
         println!("cargo:rustc-cfg=baked_scenes");
     }
     let mut tables = String::new();
+    // Whether the windows answer every ray of every embedded scene (`EyeRays::serve_every_ray`):
+    // then a baked build gives its tracer brute force in place of the lattice, which it never
+    // asks (`windows_only`). The ladder's rungs walk the lattice on purpose.
+    let mut windows_only = baked && !has("ladder");
     for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
         let path = PathBuf::from(format!("../scenes/{name}.scene"));
         println!("cargo:rerun-if-changed={}", path.display());
         let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
         let bake = baked.then_some((name, &mut tables));
-        let (s, e) = if has("scalar-fixed") {
+        let (s, e, serves) = if has("scalar-fixed") {
             plan::<lattice_rt::Fx>(&path, &text, bake)
         } else if has("scalar-micromath") {
             plan::<lattice_rt::F32Micro>(&path, &text, bake)
@@ -97,9 +101,14 @@ fn main() {
             plan::<f32>(&path, &text, bake)
         };
         effects |= e;
+        windows_only &= serves;
         sizes = sizes.max(s);
         let abs = fs::canonicalize(&path).unwrap();
         writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
+    }
+    println!("cargo::rustc-check-cfg=cfg(windows_only)");
+    if windows_only {
+        println!("cargo:rustc-cfg=windows_only");
     }
     let count = list.lines().count();
     if has("effects-all") {
@@ -134,9 +143,10 @@ fn table_name(scene: &str) -> String {
     scene.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect()
 }
 
-/// Storage and effects of one scene in the firmware's scalar; with `bake`, its tables too
-/// (the scene as parsed and its lattice as built in that scalar, as the firmware would).
-fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&str, &mut String)>) -> (Sizes, u8) {
+/// Storage and effects of one scene in the firmware's scalar, and whether its windows serve
+/// every ray; with `bake`, its tables too (the scene as parsed and its lattice as built in
+/// that scalar, as the firmware would).
+fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&str, &mut String)>) -> (Sizes, u8, bool) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
     let mut parts = lattice_rt::Parts::default();
     let scene = lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -151,5 +161,5 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&st
         let lattice = Lattice::build(&scene, &cfg, storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         out.push_str(&lattice_rt::bake::source(&table_name(name), "S", &scene, &lattice));
     }
-    (sizes, effects)
+    (sizes, effects, lattice_rt::EyeRays::serve_every_ray(&scene))
 }

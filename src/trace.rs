@@ -279,6 +279,22 @@ impl EyeRays {
             EyeRays::Accelerator
         }
     }
+
+    /// Whether the windows answer every ray a frame of `scene` casts with its default eye rays
+    /// ([`EyeRays::for_scene`]), whatever effects are compiled in: eye rays by windows, no
+    /// material that mirrors or refracts (no secondary rays), and no light but a first one that
+    /// is directional (shadow rays by its shadow windows). A tracer of such a scene never asks
+    /// its accelerator, so a build whose scenes all qualify can give it [`BruteForce`] in place
+    /// of the lattice: the frames are the same, and the walk's code is not linked.
+    pub fn serve_every_ray<R: Real>(scene: &Scene<'_, R>) -> bool {
+        let secondary = Effects::of(scene).contains(Effects::REFLECTION) || Effects::of(scene).contains(Effects::REFRACTION);
+        let lights = match scene.lights {
+            [] => true,
+            [_] => scene.shadow_basis.is_some(),
+            _ => false,
+        };
+        Self::for_scene(scene) == EyeRays::Windows && !secondary && lights
+    }
 }
 
 /// The nearest hit of an eye ray among the objects whose windows hold it: the tile's

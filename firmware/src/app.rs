@@ -12,7 +12,7 @@ use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::trace::MissingEffects;
 use lattice_rt::dither::{Carry, Ditherer};
-use lattice_rt::{dither_tiles, KeptTile, render_pass, render_share, trace_pass, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
+use lattice_rt::{dither_tiles, Accelerator, KeptTile, render_pass, render_share, trace_pass, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
 
 pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
@@ -319,7 +319,7 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Se
 ) -> Result<Report, AppError<'t, D::Error>> {
     let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
     let Loaded { scene, lattice, scratch } = st.view().load_with(text, &lattice_rt::LatticeConfig::default(), at)?;
-    render_loaded(&scene, &lattice, scratch, target, hooks, shot, board)
+    render_loaded(&scene, (&lattice, lattice.bytes()), scratch, target, hooks, shot, board)
 }
 
 /// Memory a baked scene's frame needs besides the tables in flash: the render's query scratch
@@ -358,7 +358,13 @@ pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Se
         return Err(AppError::BakedCamera);
     }
     let scratch = lattice_rt::Scratch::new(&mut memory.mailbox[..], &mut memory.rows[..]);
-    render_loaded(&baked.scene, &baked.lattice, scratch, target, hooks, shot, board)
+    // Where the windows answer every ray of every embedded scene (`windows_only`, which
+    // `build.rs` finds with `EyeRays::serve_every_ray`), the tracer never asks its accelerator:
+    // brute force stands in for the lattice, and the walk's code is not linked.
+    #[cfg(windows_only)]
+    return render_loaded(&baked.scene, (&lattice_rt::BruteForce, baked.lattice.bytes()), scratch, target, hooks, shot, board);
+    #[cfg(not(windows_only))]
+    render_loaded(&baked.scene, (&baked.lattice, baked.lattice.bytes()), scratch, target, hooks, shot, board)
 }
 
 /// An embedded scene as this build holds it: its text, parsed and set up for every frame.
@@ -399,17 +405,19 @@ pub fn render_embedded_at<D: DrawTarget<Color = BinaryColor, Error: Send> + Send
     return render_baked_at(scene, memory, target, hooks, shot, board);
 }
 
-/// The frame of a scene loaded or baked: its tracer, then every pass of both tile shares.
-fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+/// The frame of a scene loaded or baked: its tracer (over `accel`, with `lattice_bytes` of
+/// lattice), then every pass of both tile shares.
+#[allow(clippy::too_many_arguments)]
+fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     scene: &lattice_rt::Scene<'_, R>,
-    lattice: &lattice_rt::Lattice<'_, R>,
+    (accel, lattice_bytes): (&A, usize),
     mut scratch: lattice_rt::Scratch<'_>,
     target: &mut D,
     hooks: &mut impl Hooks,
     shot: &Shot,
     board: Board<'_, impl Cores>,
 ) -> Result<Report, AppError<'t, D::Error>> {
-    let mut tracer = Tracer::<_, _, EFFECTS>::compiled(scene, lattice).map_err(AppError::Effects)?;
+    let mut tracer = Tracer::<_, _, EFFECTS>::compiled(scene, accel).map_err(AppError::Effects)?;
     if cfg!(feature = "effects-all") {
         tracer.set_effects(Effects::ALL);
     }
@@ -433,7 +441,7 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
     if TRACE_THEN_DITHER {
         let memory = DitherMemory { mailbox, rows, kept, rays, above, band, carries };
         let (s, [there, mine]) = trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown), target)?;
-        return Ok(Report { stats: s, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [mine, there], tiles_at });
+        return Ok(Report { stats: s, objects: scene.objects().len(), lattice_bytes, share_us: [mine, there], tiles_at });
     }
     for &pass in PASSES {
         // One core: both shares straight to the display, one after the other.
@@ -446,7 +454,7 @@ fn render_loaded<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + 
         (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
         shown(pass);
     }
-    Ok(Report { stats, objects: scene.objects().len(), lattice_bytes: lattice.bytes(), share_us: [times[1], times[0]], tiles_at })
+    Ok(Report { stats, objects: scene.objects().len(), lattice_bytes, share_us: [times[1], times[0]], tiles_at })
 }
 
 /// Where [`trace_then_dither`] works: core 1's query scratch, what every tile keeps, the
@@ -528,8 +536,8 @@ type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, usize, Frame, Share
 /// the render's hooks, the board's clock and what to do once each pass is on the display.
 /// Returns both cores' statistics and their times, core 1's first.
 #[allow(clippy::type_complexity)]
-fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
-    tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
+fn trace_then_dither<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+    tracer: &Tracer<'_, '_, R, A, EFFECTS>,
     frame: &Frame,
     cores: &mut impl Cores,
     memory: DitherMemory<'_>,
@@ -664,8 +672,8 @@ fn trace_then_dither<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send
 /// One tile traced for trace, then dither: pass `pass` of a progressive frame (`trace_pass`,
 /// its rays kept in the tile's own storage), or, in a build without the `progressive` feature,
 /// the whole frame's tile (`trace_share`).
-fn trace_tile<R: Real>(
-    tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
+fn trace_tile<R: Real, A: Accelerator<R> + ?Sized>(
+    tracer: &Tracer<'_, '_, R, A, EFFECTS>,
     band: &Frame,
     share: Share,
     pass: u8,
@@ -684,8 +692,8 @@ fn trace_tile<R: Real>(
 /// without the `progressive` feature (whose only pass is 0), the whole frame at once
 /// (`render_share`).
 #[allow(clippy::too_many_arguments)]
-fn draw<R: Real, D: DrawTarget<Color = BinaryColor>>(
-    tracer: &Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>, EFFECTS>,
+fn draw<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>>(
+    tracer: &Tracer<'_, '_, R, A, EFFECTS>,
     frame: &Frame,
     share: Share,
     pass: u8,
