@@ -287,7 +287,8 @@ impl EyeRays {
     /// its accelerator, so a build whose scenes all qualify can give it [`BruteForce`] in place
     /// of the lattice: the frames are the same, and the walk's code is not linked.
     pub fn serve_every_ray<R: Real>(scene: &Scene<'_, R>) -> bool {
-        let secondary = Effects::of(scene).contains(Effects::REFLECTION) || Effects::of(scene).contains(Effects::REFRACTION);
+        let effects = Effects::of(scene);
+        let secondary = effects.contains(Effects::REFLECTION) || effects.contains(Effects::REFRACTION);
         let lights = match scene.lights {
             [] => true,
             [_] => scene.shadow_basis.is_some(),

@@ -362,9 +362,10 @@ pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Se
     // `build.rs` finds with `EyeRays::serve_every_ray`), the tracer never asks its accelerator:
     // brute force stands in for the lattice, and the walk's code is not linked.
     #[cfg(windows_only)]
-    return render_loaded(&baked.scene, (&lattice_rt::BruteForce, baked.lattice.bytes()), scratch, target, hooks, shot, board);
+    let accel = &lattice_rt::BruteForce;
     #[cfg(not(windows_only))]
-    render_loaded(&baked.scene, (&baked.lattice, baked.lattice.bytes()), scratch, target, hooks, shot, board)
+    let accel = &baked.lattice;
+    render_loaded(&baked.scene, (accel, baked.lattice.bytes()), scratch, target, hooks, shot, board)
 }
 
 /// An embedded scene as this build holds it: its text, parsed and set up for every frame.
@@ -407,7 +408,6 @@ pub fn render_embedded_at<D: DrawTarget<Color = BinaryColor, Error: Send> + Send
 
 /// The frame of a scene loaded or baked: its tracer (over `accel`, with `lattice_bytes` of
 /// lattice), then every pass of both tile shares.
-#[allow(clippy::too_many_arguments)]
 fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
     scene: &lattice_rt::Scene<'_, R>,
     (accel, lattice_bytes): (&A, usize),

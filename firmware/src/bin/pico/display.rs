@@ -19,11 +19,11 @@ use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use firmware::app::{HEIGHT, RENDERED, WIDTH};
+use ssd1306::mode::BasicMode;
+use ssd1306::prelude::*;
 
 /// The most rows drawn at once: a band of tiles.
 const BAND_ROWS: usize = RENDERED.tile as usize;
-use ssd1306::mode::BasicMode;
-use ssd1306::prelude::*;
 
 /// Draws areas that start on a page and are at most a band high ([`BAND_ROWS`]) by sending
 /// SSD1306 page bytes; nothing else is supported (there is no framebuffer to merge single pixels

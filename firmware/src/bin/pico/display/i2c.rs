@@ -34,7 +34,7 @@ pub struct QueuedI2c<P> {
 const QUEUED: usize = if cfg!(feature = "progressive") { 4 * 1152 + 96 } else { 2 * (BAND_PAGES * firmware::app::WIDTH as usize + 16) };
 
 /// SSD1306 pages (8 rows each) in a band of tiles.
-const BAND_PAGES: usize = (firmware::app::RENDERED.tile as usize).div_ceil(8);
+const BAND_PAGES: usize = super::BAND_ROWS.div_ceil(8);
 
 /// The bytes on their way to the bus: a ring of IC_DATA_CMD words, and the abort the controller
 /// reported while the queue was being moved into its FIFO.
