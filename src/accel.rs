@@ -81,9 +81,12 @@ pub struct Query<'m> {
     pub stats: Stats,
     mailbox: &'m mut [u32],
     ray_id: u32,
-    /// The window position of the ray being traced when it is an eye ray (see
-    /// [`Query::set_eye_ray`]).
-    eye: Option<[i32; 2]>,
+    /// Whether the ray being traced is an eye ray (see [`Query::set_eye_ray`]).
+    eye_on: bool,
+    /// Its window position, both coordinates packed in one word ([`pack_uv`]): written and read
+    /// whole, so a read finds the write in the store buffer (two narrow stores read as one
+    /// wide load stall until they retire, on x86).
+    eye_uv: u64,
     /// When the ray being traced is a shadow ray towards the scene's first light, and that
     /// light is directional, its position across the light ([`Real::to_raw`] bits of the
     /// coordinates [`crate::Object::shadow_window`]s are in; see [`Query::set_first_light_ray`]).
@@ -111,7 +114,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye: None, first_light: None, axis_normal: None, last_hit: u32::MAX, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye_on: false, eye_uv: 0, first_light: None, axis_normal: None, last_hit: u32::MAX, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -121,7 +124,10 @@ impl<'m> Query<'m> {
     /// [`crate::scene::Camera::window_uv`]), or not one (`None`). The tracer keeps it for the
     /// eye ray alone; objects whose window the eye ray misses are then not tested.
     pub fn set_eye_ray(&mut self, uv: Option<[i32; 2]>) {
-        self.eye = uv;
+        self.eye_on = uv.is_some();
+        if let Some(uv) = uv {
+            self.eye_uv = pack_uv(uv);
+        }
     }
     /// Declares whether the next ray traced is a shadow ray towards the scene's first light,
     /// when that light is directional (its direction the light's `to_light`): objects then take
@@ -171,8 +177,9 @@ impl<'m> Query<'m> {
         self.eye_candidates
     }
     /// The eye-ray window position, if the query is for an eye ray.
+    #[inline]
     pub fn eye_ray(&self) -> Option<[i32; 2]> {
-        self.eye
+        self.eye_on.then(|| unpack_uv(self.eye_uv))
     }
     /// The object that last hid light `l` from a shaded point, if any.
     pub fn occluder(&self, l: usize) -> Option<u32> {
@@ -199,6 +206,7 @@ impl<'m> Query<'m> {
     /// [`crate::Object::world_normal`] of object `i` of the scene this query serves: a unit-axis
     /// normal (a box's face, a cap) that is the last one asked for is given again without
     /// mapping it anew (neighbouring eye rays mostly hit one face, the floor's above all).
+    #[inline]
     pub fn world_normal<R: Real>(&mut self, scene: &Scene<'_, R>, i: u32, n_obj: Vec3<R>) -> Vec3<R> {
         let o = &scene.objects[i as usize];
         let Some(axis) = crate::scene::axis_normal(n_obj) else { return o.world_normal(n_obj) };
@@ -248,6 +256,18 @@ pub fn reach<R: Real>(best: &Option<Hit<R>>, tmax: R) -> R {
     best.map_or(tmax, |b| (b.t + b.tie).min(tmax))
 }
 
+/// A window position packed in one word (see `Query::eye_uv`).
+#[inline]
+fn pack_uv(uv: [i32; 2]) -> u64 {
+    u64::from(uv[0] as u32) | (u64::from(uv[1] as u32) << 32)
+}
+
+/// The window position [`pack_uv`] packed.
+#[inline]
+fn unpack_uv(w: u64) -> [i32; 2] {
+    [w as u32 as i32, (w >> 32) as u32 as i32]
+}
+
 /// Tests object `i` against `ray` on `(tmin, reach]` ([`reach`]) and keeps the better hit: the
 /// nearer, or within [`tie`] of each other the lower object index. Returns whether the object
 /// was hit at all in that range.
@@ -267,7 +287,7 @@ pub fn offer<R: Real>(
     }
     let limit = reach(best, tmax);
     let o = &scene.objects[i];
-    let hit = match q.eye {
+    let hit = match q.eye_ray() {
         Some(uv) => match o.intersect_eye_ray(ray, uv, tmin, limit) {
             Ok(hit) => hit,
             Err(Culled) => {

@@ -496,17 +496,27 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         // Depth-first, each node pushes at most two children and `max_depth <= MAX_DEPTH`, so at
         // most `MAX_DEPTH + 2` nodes wait: no push below can fail.
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
-        let _ = stack.push(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary, leaving: NO_OBJECT });
         let mut total = R::ZERO;
         // The eye ray's window position (if the caller gave one) serves the eye ray alone.
         let eye_uv = q.eye_ray();
-        while let Some(top) = stack.len().checked_sub(1) {
-            // The node is read where it lies, field by field, not moved out whole: a move copies
-            // it in wide loads that straddle the narrower stores it was written with, and such a
-            // load waits for those stores to retire (no store-to-load forwarding on x86).
-            let at = &stack[top];
-            let node = Node { ray: at.ray, weight: at.weight, depth: at.depth, kind: at.kind, leaving: at.leaving };
-            stack.truncate(top);
+        // The eye ray is traced first without a trip through the stack (the stack only holds
+        // children).
+        let mut primary = Some(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary, leaving: NO_OBJECT });
+        loop {
+            let node = if let Some(node) = primary.take() {
+                node
+            } else if let Some(top) = stack.len().checked_sub(1) {
+                // The node is read where it lies, field by field, not moved out whole: a move
+                // copies it in wide loads that straddle the narrower stores it was written with,
+                // and such a load waits for those stores to retire (no store-to-load forwarding
+                // on x86).
+                let at = &stack[top];
+                let node = Node { ray: at.ray, weight: at.weight, depth: at.depth, kind: at.kind, leaving: at.leaving };
+                stack.truncate(top);
+                node
+            } else {
+                break;
+            };
             q.stats.rays[node.kind as usize] += 1;
             q.set_leaving((node.leaving != NO_OBJECT).then_some(node.leaving));
             let found = self.nearest(&node.ray, if node.depth == 0 { eye_uv } else { None }, q);
