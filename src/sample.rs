@@ -248,6 +248,11 @@ fn traced(i: usize, n: usize) -> bool {
     i.is_multiple_of(2) || i + 1 == n
 }
 
+/// The lines [`traced`] picks of `n`, in order: every second one from the first, then the last.
+fn traced_lines(n: usize) -> impl Iterator<Item = usize> {
+    (0..n).step_by(2).chain((n > 0 && n.is_multiple_of(2)).then(|| n - 1))
+}
+
 /// The traced pixels an untraced pixel `(x, y)` of a `tw x th` tile is filled from, as columns
 /// and rows (each pair repeats a line the pixel is on): left and right, above and below, or
 /// the four corners.
@@ -275,8 +280,8 @@ fn adaptive<R: Real>(
     let ids = &mut hits.object;
     let depths = &mut hits.depth;
     let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
-    for y in (0..th).filter(|&y| traced(y, th)) {
-        for x in (0..tw).filter(|&x| traced(x, tw)) {
+    for y in traced_lines(th) {
+        for x in traced_lines(tw) {
             let (cx, cy) = centre(x, y);
             let (v, id, depth) = shoot(cx, cy);
             levels[y * tw + x] = level(v);
@@ -284,49 +289,73 @@ fn adaptive<R: Real>(
             depths[y * tw + x] = depth;
         }
     }
-    // Pixel `i`'s entry: `i` itself, masked to the tiles' storage (a power of two), which every
-    // index here already lies in; so no index is checked at run time.
-    let at = |i: usize| i & (MAX_TILE * MAX_TILE - 1);
+    // The second pass, row by row in pixel order (so rays are shot in the same order): on a
+    // traced row the pixels between two traced ones (odd columns but the last), on any other
+    // row every pixel, from the pixels above and below it or from the four corners.
     for y in 0..th {
-        let row_traced = traced(y, th);
-        for x in 0..tw {
-            let column_traced = traced(x, tw);
-            if row_traced && column_traced {
-                continue;
+        let row = y * tw;
+        if traced(y, th) {
+            for x in (1..tw.saturating_sub(1)).step_by(2) {
+                let i = row + x;
+                if !fill(levels, ids, depths, i, [i - 1, i + 1], contrast) {
+                    shoot_at(shoot, levels, ids, depths, i, centre(x, y));
+                }
             }
-            let i = y * tw + x;
-            // The traced pixels around (`around`): two on the pixel's row or column, each
-            // counted twice in the mean of four, or the four corners; the first of them gives
-            // the object.
-            let (ns, n) = if row_traced {
-                ([i - 1, i + 1, 0, 0], 2)
-            } else if column_traced {
-                ([i - tw, i + tw, 0, 0], 2)
-            } else {
-                ([i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], 4)
-            };
-            let first = ids[at(ns[0])];
-            let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
-            for &k in &ns[..n] {
-                let l = levels[at(k)];
-                lo = lo.min(l);
-                hi = hi.max(l);
-                sum += l as u32;
-                same &= ids[at(k)] == first;
-                near = near.min(depths[at(k)]);
-            }
-            let i = at(i);
-            if same && hi - lo <= contrast {
-                // Two pixels counted twice: (2 sum + 2) / 4 = (sum + 1) / 2, rounded up.
-                let mean = if n == 2 { sum.div_ceil(2) } else { (sum + 2) / 4 };
-                (levels[i], ids[i], depths[i]) = (mean as u8, first, near);
-            } else {
-                let (cx, cy) = centre(x, y);
-                let (v, id, depth) = shoot(cx, cy);
-                (levels[i], ids[i], depths[i]) = (level(v), id, depth);
+        } else {
+            for x in 0..tw {
+                let i = row + x;
+                let filled = if traced(x, tw) {
+                    fill(levels, ids, depths, i, [i - tw, i + tw], contrast)
+                } else {
+                    fill(levels, ids, depths, i, [i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], contrast)
+                };
+                if !filled {
+                    shoot_at(shoot, levels, ids, depths, i, centre(x, y));
+                }
             }
         }
     }
+}
+
+/// Pixel `i`'s entry: `i` itself, masked to the tiles' storage (a power of two), which every
+/// index [`adaptive`] asks for already lies in; so no index is checked at run time.
+#[inline(always)]
+fn at(i: usize) -> usize {
+    i & (MAX_TILE * MAX_TILE - 1)
+}
+
+/// Fills untraced pixel `i` from the traced pixels `ns` around it ([`around`]: two on its row
+/// or column, each counted twice in the mean of four, or the four corners) when they hit one
+/// object and their levels lie within `contrast`: the mean level, the first's object and the
+/// nearest depth. Returns whether it did; else the pixel is traced.
+#[inline(always)]
+fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, ns: [usize; N], contrast: u8) -> bool {
+    let first = ids[at(ns[0])];
+    let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
+    for k in ns {
+        let l = levels[at(k)];
+        lo = lo.min(l);
+        hi = hi.max(l);
+        sum += l as u32;
+        same &= ids[at(k)] == first;
+        near = near.min(depths[at(k)]);
+    }
+    if !(same && hi - lo <= contrast) {
+        return false;
+    }
+    // Two pixels counted twice: (2 sum + 2) / 4 = (sum + 1) / 2, rounded up.
+    let mean = if N == 2 { sum.div_ceil(2) } else { (sum + 2) / 4 };
+    let i = at(i);
+    (levels[i], ids[i], depths[i]) = (mean as u8, first, near);
+    true
+}
+
+/// Traces untraced pixel `i` through its centre `(cx, cy)` (quarter pixels).
+#[inline(always)]
+fn shoot_at<R: Real>(shoot: &mut impl FnMut(usize, usize) -> Shot<R>, levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, (cx, cy): (usize, usize)) {
+    let (v, id, depth) = shoot(cx, cy);
+    let i = at(i);
+    (levels[i], ids[i], depths[i]) = (level(v), id, depth);
 }
 
 /// The mean of four eye rays on a 2x2 grid around the pixel centre `(cx, cy)` (quarter-pixel

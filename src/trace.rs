@@ -309,13 +309,17 @@ fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query
     }
     let all = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
     let mut left = q.eye_candidates() & all;
-    q.stats.culled += u64::from(n as u32 - left.count_ones());
     let mut best = None;
+    // The candidates are counted as they come (cheaper than a population count on a core
+    // without one): the others are culled.
+    let mut candidates = 0u32;
     while left != 0 {
         let i = left.trailing_zeros() as usize;
         left &= left - 1;
+        candidates += 1;
         crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, q);
     }
+    q.stats.culled += u64::from(n as u32 - candidates);
     best
 }
 
@@ -667,16 +671,22 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// The first object (in index order) whose shadow window holds the shadow ray's position
     /// `w` across the first light (directional) and which the ray hits within `reach`.
     fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, q: &mut Query<'_>) -> Option<u32> {
+        // Tests and culls are counted once the loop ends, not per object.
+        let mut tested = 0u32;
+        let mut found = None;
+        let mut seen = self.scene.objects.len();
         for (i, o) in self.scene.objects.iter().enumerate() {
             if !o.shadow_window_holds(w) || q.skips(i as u32) {
-                q.stats.culled += 1;
                 continue;
             }
-            q.stats.object_tests += 1;
+            tested += 1;
             if o.intersect_first_light_ray(ray, R::ZERO, reach).is_some() {
-                return Some(i as u32);
+                (found, seen) = (Some(i as u32), i + 1);
+                break;
             }
         }
-        None
+        q.stats.object_tests += u64::from(tested);
+        q.stats.culled += (seen as u64) - u64::from(tested);
+        found
     }
 }
