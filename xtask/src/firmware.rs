@@ -15,15 +15,15 @@ use std::time::{Duration, Instant};
 
 
 /// One firmware build.
-struct Variant {
-    name: String,
+pub(crate) struct Variant {
+    pub(crate) name: String,
     target: &'static str,
     /// Cargo profile: `release` (opt-level "s"), `speed` (opt-level 3) for the boards with flash
     /// to spare, or `small` (opt-level "z") for the parts with little.
     profile: &'static str,
     features: String,
     bin: &'static str,
-    machine: Option<&'static str>,
+    pub(crate) machine: Option<&'static str>,
     scenes: Option<&'static str>,
     scalar: &'static str,
     what: String,
@@ -202,7 +202,21 @@ fn variants() -> Vec<Variant> {
     v
 }
 
-fn elf_path(root: &Path, v: &Variant) -> PathBuf {
+/// Variant `name` of [`variants`] built with `scene` alone, kept apart from the report's image
+/// (for `cargo xtask profile`).
+pub(crate) fn profiled_variant(name: &str, scene: &str) -> Result<Variant> {
+    let all = variants();
+    let names: Vec<String> = all.iter().filter(|v| v.machine.is_some()).map(|v| v.name.clone()).collect();
+    let Some(mut v) = all.into_iter().find(|v| v.name == name && v.machine.is_some()) else {
+        bail!("no firmware variant `{name}` runs in QEMU; those that do: {}", names.join(", "));
+    };
+    v.name = format!("{name}-profile-{scene}");
+    // A command-line value for the variant's `&'static` list of scenes: one per run.
+    v.scenes = Some(Box::leak(scene.to_string().into_boxed_str()));
+    Ok(v)
+}
+
+pub(crate) fn elf_path(root: &Path, v: &Variant) -> PathBuf {
     host_sim::uf2::kept_image(root, &v.name)
 }
 
@@ -211,7 +225,7 @@ fn cargo_args(v: &Variant) -> [&str; 11] {
     ["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target]
 }
 
-fn build(root: &Path, v: &Variant) -> Result<()> {
+pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
     let args = cargo_args(v);
     let built = Path::new(v.target).join(v.profile).join(v.bin);
     let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);

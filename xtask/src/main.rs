@@ -2,7 +2,8 @@
 //! compile (the xtask convention). Each command builds what it needs (firmware images, host
 //! renders), runs it, checks it and writes its report under docs/: the Pico image on the
 //! emulated board (`board`), the firmware in QEMU (`firmware`), and the studies (`bench`,
-//! `memory`, `tradeoff`, `effects`, `display`, `motion`).
+//! `memory`, `tradeoff`, `effects`, `display`, `motion`), and a QEMU build's exact
+//! instruction profile (`profile`).
 
 mod bench;
 mod board;
@@ -13,6 +14,7 @@ mod memory;
 mod motion;
 mod playground;
 mod plot;
+mod profile;
 mod tradeoff;
 mod versus;
 
@@ -182,6 +184,26 @@ enum Command {
         #[arg(long, default_value = "target/board")]
         board: PathBuf,
     },
+    /// Where a QEMU firmware build's instructions go, per function, counted exactly: QEMU logs
+    /// every block it runs (`-d in_asm,exec,nochain`), each instruction is credited to its
+    /// function and to every function it was inlined into (DWARF). Prints Markdown tables.
+    ///
+    /// Needs qemu-system-arm; the image is built with the one scene embedded.
+    Profile {
+        /// A variant of `cargo xtask firmware` that runs in QEMU (`qemu-m33-f32`, `qemu-m0-fixed-baked`, ...).
+        #[arg(default_value = "qemu-m33-f32")]
+        variant: String,
+        /// The scene the image embeds alone.
+        #[arg(long, default_value = "chair")]
+        scene: String,
+        /// Rows per table.
+        #[arg(long, default_value_t = 25)]
+        top: usize,
+        /// Also break down this function's instructions (by name, as the tables print it: `Tracer::eye_sample`,
+        /// `offer`) by what it inlined and its own source lines.
+        #[arg(long)]
+        under: Option<String>,
+    },
     /// Flicker of each dither while the camera orbits the scenes: docs/motion.md.
     Motion {
         /// Scene files (default: the paper's four and the Whitted showcase).
@@ -214,6 +236,7 @@ fn real_main() -> Result<()> {
         Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv } => tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv),
         Command::Effects { scenes, runs, out, firmware_csv } => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
         Command::Display { scenes, out, images, board } => display::display_cmd(&default_scenes(scenes), &out, &images, &board),
+        Command::Profile { variant, scene, top, under } => profile::profile_cmd(&root, &profile::ProfileArgs { variant, scene, top, under }),
         Command::Motion { scenes, frames, out } => motion::motion_cmd(&default_scenes(scenes), frames, &out),
     }
 }
