@@ -328,17 +328,17 @@ fn at(i: usize) -> usize {
 /// or column, each counted twice in the mean of four, or the four corners) when they hit one
 /// object and their levels lie within `contrast`: the mean level, the first's object and the
 /// nearest depth. Returns whether it did; else the pixel is traced.
-#[inline(always)]
+#[inline]
 fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, ns: [usize; N], contrast: u8) -> bool {
     let first = ids[at(ns[0])];
     let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
-    for k in ns {
-        let l = levels[at(k)];
+    for k in ns.iter().map(|&k| at(k)) {
+        let l = levels[k];
         lo = lo.min(l);
         hi = hi.max(l);
         sum += l as u32;
-        same &= ids[at(k)] == first;
-        near = near.min(depths[at(k)]);
+        same &= ids[k] == first;
+        near = near.min(depths[k]);
     }
     if !(same && hi - lo <= contrast) {
         return false;
@@ -350,8 +350,9 @@ fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; 
     true
 }
 
-/// Traces untraced pixel `i` through its centre `(cx, cy)` (quarter pixels).
-#[inline(always)]
+/// Traces untraced pixel `i` through its centre `(cx, cy)` (quarter pixels). Out of line: the
+/// second pass calls it from two places, and `shoot` (the tracer, inlined into it) is large.
+#[inline(never)]
 fn shoot_at<R: Real>(shoot: &mut impl FnMut(usize, usize) -> Shot<R>, levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, (cx, cy): (usize, usize)) {
     let (v, id, depth) = shoot(cx, cy);
     let i = at(i);

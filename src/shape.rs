@@ -61,7 +61,9 @@ impl<R: Real> Shape<R> {
     /// and the quadratic is solved from the entry point: every square then involves numbers of
     /// about the shape's own size, however far away the ray started. That keeps fixed point
     /// from overflowing and floats from cancelling.
-    #[cfg_attr(target_arch = "x86_64", inline)]
+    // On x86-64 inlined into its callers: its hit comes back through memory otherwise, written
+    // field by field and read in wider moves, which wait for the stores to retire.
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
         let (t0, t1) = self.clip(r, tmin, tmax)?;
         if let Shape::Box = self {

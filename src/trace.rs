@@ -334,6 +334,15 @@ struct Node<R> {
     leaving: u32,
 }
 
+/// A [`Node`] without its ray: what the tracer needs of a node besides the ray.
+#[derive(Clone, Copy)]
+struct Meta<R> {
+    weight: R,
+    depth: u8,
+    kind: RayKind,
+    leaving: u32,
+}
+
 impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
     /// A tracer with every effect compiled in, the scene's own effect set and depth, and no
     /// cutoff.
@@ -505,25 +514,29 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let eye_uv = q.eye_ray();
         // The eye ray is traced first without a trip through the stack (the stack only holds
         // children).
-        let mut primary = Some(Node { ray: eye, weight: R::ONE, depth: 0, kind: RayKind::Primary, leaving: NO_OBJECT });
+        let mut primary = true;
+        let mut popped: Ray<R>;
         loop {
-            let node = if let Some(node) = primary.take() {
-                node
+            // The eye ray is read where the caller left it (copying it would load it in wide
+            // moves that straddle the narrower stores it was written with, which wait for those
+            // stores to retire: no store-to-load forwarding on x86); a child is copied out of
+            // the stack field by field, for the same reason, before its own children take its
+            // place.
+            let (ray, node) = if primary {
+                primary = false;
+                (&eye, Meta { weight: R::ONE, depth: 0, kind: RayKind::Primary, leaving: NO_OBJECT })
             } else if let Some(top) = stack.len().checked_sub(1) {
-                // The node is read where it lies, field by field, not moved out whole: a move
-                // copies it in wide loads that straddle the narrower stores it was written with,
-                // and such a load waits for those stores to retire (no store-to-load forwarding
-                // on x86).
                 let at = &stack[top];
-                let node = Node { ray: at.ray, weight: at.weight, depth: at.depth, kind: at.kind, leaving: at.leaving };
+                popped = Ray::new(at.ray.origin, at.ray.dir);
+                let meta = Meta { weight: at.weight, depth: at.depth, kind: at.kind, leaving: at.leaving };
                 stack.truncate(top);
-                node
+                (&popped, meta)
             } else {
                 break;
             };
             q.stats.rays[node.kind as usize] += 1;
             q.set_leaving((node.leaving != NO_OBJECT).then_some(node.leaving));
-            let found = self.nearest(&node.ray, if node.depth == 0 { eye_uv } else { None }, q);
+            let found = self.nearest(ray, if node.depth == 0 { eye_uv } else { None }, q);
             q.set_leaving(None);
             let Some(hit) = found else {
                 total += node.weight.weigh(scene.background);
@@ -541,7 +554,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let reflects = self.simulates(Effects::REFLECTION) && m.ks > R::ZERO;
             let refracts = self.simulates(Effects::REFRACTION) && m.kt > R::ZERO;
             let children = node.depth < self.max_depth && (reflects || refracts);
-            let d = if children { node.ray.dir.normalize() } else { node.ray.dir };
+            let d = if children { ray.dir.normalize() } else { ray.dir };
             let side = facing(d, q.world_normal(scene, hit.object, hit.normal));
             let n = side.normal;
             // Rays off the outer side of the surface, towards where its normal points (shadow
