@@ -61,8 +61,9 @@ impl<R: Real> Shape<R> {
     /// and the quadratic is solved from the entry point: every square then involves numbers of
     /// about the shape's own size, however far away the ray started. That keeps fixed point
     /// from overflowing and floats from cancelling.
-    // On x86-64 inlined into its callers: its hit comes back through memory otherwise, written
-    // field by field and read in wider moves, which wait for the stores to retire.
+    // On x86-64 inlined into its callers, and the shapes' own tests into it: a hit comes back
+    // through memory otherwise, written field by field and read in wider moves, which wait for
+    // the stores to retire.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
         let (t0, t1) = self.clip(r, tmin, tmax)?;
@@ -197,6 +198,7 @@ fn roots<R: Real>(a: R, b: R, c: R, disc: R) -> [Option<R>; 2] {
     [r1, r2]
 }
 
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 fn sphere<R: Real>(r: &Ray<R>, best: &mut Closest<R>) {
     let (o, d) = (r.origin, r.dir);
     let a = d.dot(d);
@@ -223,6 +225,7 @@ fn sphere<R: Real>(r: &Ray<R>, best: &mut Closest<R>) {
 /// Side of the cone `x^2 + z^2 = (1 + k y)^2` with `k = top - 1` (k = 0 is the cylinder) for
 /// `0 <= y <= 1`, plus the caps. The mirror cone beyond a pointed apex has `y > 1` and is
 /// rejected by the same `y` range test.
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
     let (o, d) = (r.origin, r.dir);
     let k = top - R::ONE;
@@ -269,6 +272,7 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
 
 /// The unit cube, given the ray's parameter range inside it `[t0, t1]` from the slab clip:
 /// the first of entry and exit after `tmin`, with the normal of the face it crosses.
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 fn unit_box<R: Real>(r: &Ray<R>, tmin: R, t0: R, t1: R) -> Option<ShapeHit<R>> {
     let t = if t0 > tmin { t0 } else if t1 > tmin { t1 } else { return None };
     // The face is the one the point lies on: the axis whose coordinate is nearest 0 or 1.
