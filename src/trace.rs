@@ -487,7 +487,10 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     }
 
     /// The nearest hit of `ray`; an eye ray's window position `uv` (when given) lets
-    /// [`EyeRays`] skip objects or the walk. Leaves the query with no eye ray set.
+    /// [`EyeRays`] skip objects or the walk. Leaves the query with no eye ray set. Inlined on
+    /// x86-64: the hit would come back through memory, written field by field and read in wider
+    /// moves that wait for those stores to retire.
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, q: &mut Query<'_>) -> Option<crate::accel::Hit<R>> {
         let found = match uv {
             Some(uv) if self.eye_rays != EyeRays::Plain => {
