@@ -229,6 +229,12 @@ impl Real for f64 {
     fn to_raw(self) -> u64 {
         self.to_bits()
     }
+    /// The sign bit cleared: one instruction (`vabs`, `andpd`) where the default's comparison
+    /// and negation take several. The same value but for -0, which becomes +0 (equal in every
+    /// comparison the tracer makes).
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
     fn from_raw(bits: u64) -> Self {
         f64::from_bits(bits)
     }
@@ -314,6 +320,12 @@ impl Real for f32 {
     }
     fn to_raw(self) -> u64 {
         u64::from(self.to_bits())
+    }
+    /// The sign bit cleared: one instruction (`vabs`, `andpd`) where the default's comparison
+    /// and negation take several. The same value but for -0, which becomes +0 (equal in every
+    /// comparison the tracer makes).
+    fn abs(self) -> Self {
+        f32::abs(self)
     }
     fn from_raw(bits: u64) -> Self {
         f32::from_bits(bits as u32)
