@@ -33,7 +33,7 @@ impl<R: Real> Lattice<'_, R> {
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
-        stack[0] = Some(Walker::start(self, 0, ray, &inv, t0, t1));
+        Walker::start_in(&mut stack[0], self, 0, ray, &inv, t0, t1);
         q.stats.cells_visited += 1;
         while depth > 0 {
             let Some(w) = stack[depth - 1].as_mut() else { break };
@@ -51,7 +51,7 @@ impl<R: Real> Lattice<'_, R> {
                         let limit = reach(&best, tmax);
                         if depth < MAX_NESTING && q.first_visit(self.objects + composite) {
                             if let Some((a, b)) = self.lattices[g].bounds.padded(slack).clip(ray, tmin, limit) {
-                                stack[depth] = Some(Walker::start(self, g, ray, &inv, a, b));
+                                Walker::start_in(&mut stack[depth], self, g, ray, &inv, a, b);
                                 depth += 1;
                                 q.stats.cells_visited += 1;
                             }
@@ -129,10 +129,18 @@ struct Walker<R> {
 
 impl<R: Real> Walker<R> {
     fn start(l: &Lattice<'_, R>, sub: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> Self {
+        let mut slot = None;
+        Self::start_in(&mut slot, l, sub, ray, inv, t0, t1);
+        slot.expect("start_in fills the slot")
+    }
+
+    /// [`Walker::start`] into `slot`, set up where it lies: a walker returned by value is
+    /// copied into the walk's stack whole (a `memcpy` call on a Cortex-M).
+    fn start_in<'s>(slot: &'s mut Option<Self>, l: &Lattice<'_, R>, sub: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> &'s mut Self {
         let g = &l.lattices[sub];
         let p = ray.at(t0);
         let n = g.n.map(i32::from);
-        let mut w = Walker {
+        let w = slot.insert(Walker {
             idx: [0; 3],
             n,
             step: [0; 3],
@@ -143,7 +151,7 @@ impl<R: Real> Walker<R> {
             t_end: t1,
             ref_i: 0,
             ref_end: 0,
-        };
+        });
         let strides = [1, n[0], n[0] * n[1]];
         for a in 0..3 {
             let c = l.coordinate_list(sub, a);
