@@ -335,20 +335,17 @@ fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query
 #[derive(Clone, Copy, Debug)]
 struct Node<R> {
     ray: Ray<R>,
+    meta: Meta<R>,
+}
+
+/// What the tracer keeps of a node of the intersection tree besides its ray.
+#[derive(Clone, Copy, Debug)]
+struct Meta<R> {
     weight: R,
     depth: u8,
     kind: RayKind,
     /// The object the ray leaves from outside (a mirror ray off its surface), which it cannot
     /// hit ([`Query::set_leaving`]), or [`NO_OBJECT`].
-    leaving: u32,
-}
-
-/// A [`Node`] without its ray: what the tracer needs of a node besides the ray.
-#[derive(Clone, Copy)]
-struct Meta<R> {
-    weight: R,
-    depth: u8,
-    kind: RayKind,
     leaving: u32,
 }
 
@@ -551,7 +548,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             } else if let Some(top) = stack.len().checked_sub(1) {
                 let at = &stack[top];
                 popped = Ray::new(at.ray.origin, at.ray.dir);
-                let meta = Meta { weight: at.weight, depth: at.depth, kind: at.kind, leaving: at.leaving };
+                let meta = Meta { weight: at.meta.weight, depth: at.meta.depth, kind: at.meta.kind, leaving: at.meta.leaving };
                 stack.truncate(top);
                 (&popped, meta)
             } else {
@@ -599,7 +596,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             if !children {
                 continue;
             }
-            let child = |ray, w: R, kind, leaving| Node { ray, weight: node.weight * w, depth: node.depth + 1, kind, leaving };
+            let child = |ray, w: R, kind, leaving| Node { ray, meta: Meta { weight: node.weight * w, depth: node.depth + 1, kind, leaving } };
             let cos_i = -d.dot(n);
             let mirror = d + n * (cos_i + cos_i);
             let mut reflect_w = if reflects { m.ks } else { R::ZERO };
