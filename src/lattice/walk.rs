@@ -13,7 +13,8 @@ impl<R: Real> Lattice<'_, R> {
     pub fn walk_cells(&self, ray: &Ray<R>, tmin: R, tmax: R, mut visit: impl FnMut([usize; 3], R, R)) {
         let inv = Inverse::new(ray);
         let Some((t0, t1)) = self.lattices[0].bounds.padded(slack(ray)).clip(ray, tmin, tmax) else { return };
-        let mut w = Walker::start(self, 0, ray, &inv, t0, t1);
+        let mut slot = None;
+        let w = Walker::start_in(&mut slot, self, 0, ray, &inv, t0, t1);
         let mut enter = t0;
         loop {
             let exit = w.exit();
@@ -128,14 +129,9 @@ struct Walker<R> {
 }
 
 impl<R: Real> Walker<R> {
-    fn start(l: &Lattice<'_, R>, sub: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> Self {
-        let mut slot = None;
-        Self::start_in(&mut slot, l, sub, ray, inv, t0, t1);
-        slot.expect("start_in fills the slot")
-    }
-
-    /// [`Walker::start`] into `slot`, set up where it lies: a walker returned by value is
-    /// copied into the walk's stack whole (a `memcpy` call on a Cortex-M).
+    /// A walker of lattice `sub` for `ray` on `[t0, t1]`, set up where it lies in `slot`: a
+    /// walker returned by value is copied into the walk's stack whole (a `memcpy` call on a
+    /// Cortex-M).
     fn start_in<'s>(slot: &'s mut Option<Self>, l: &Lattice<'_, R>, sub: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> &'s mut Self {
         let g = &l.lattices[sub];
         let p = ray.at(t0);

@@ -304,12 +304,22 @@ fn field(line: &str, key: &str) -> u64 {
     0
 }
 
-fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
-    let mut child = Command::new("qemu-system-arm")
-        .args(["-machine", machine, "-nographic", "-monitor", "none", "-serial", "none"])
-        .args(["-semihosting-config", "enable=on,target=native", "-icount", "shift=0", "-kernel"])
+/// QEMU running `elf` on `machine` as every run here does: no display, monitor or serial port,
+/// semihosting for the harness's output, and `-icount shift=0` (one instruction per
+/// nanosecond, the same counts on any host); `extra` options come before the image.
+pub(crate) fn qemu(elf: &Path, machine: &str, extra: &[&str]) -> Command {
+    let mut cmd = Command::new("qemu-system-arm");
+    cmd.args(["-machine", machine, "-nographic", "-monitor", "none", "-serial", "none"])
+        .args(["-semihosting-config", "enable=on,target=native", "-icount", "shift=0"])
+        .args(extra)
+        .arg("-kernel")
         .arg(elf)
-        .stdin(Stdio::null())
+        .stdin(Stdio::null());
+    cmd
+}
+
+fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
+    let mut child = qemu(elf, machine, &[])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 /// What `cargo xtask profile` was asked.
 pub struct ProfileArgs {
@@ -49,12 +49,7 @@ pub fn profile_cmd(root: &Path, args: &ProfileArgs) -> Result<()> {
 /// standard error, read as it comes (a frame of the Whitted scene logs gigabytes), and returns
 /// how often each instruction address ran.
 fn run_logged(elf: &Path, machine: &str) -> Result<HashMap<u32, u64>> {
-    let mut child = Command::new("qemu-system-arm")
-        .args(["-machine", machine, "-nographic", "-monitor", "none", "-serial", "none"])
-        .args(["-semihosting-config", "enable=on,target=native", "-icount", "shift=0"])
-        .args(["-d", "in_asm,exec,nochain", "-D", "/dev/stderr", "-kernel"])
-        .arg(elf)
-        .stdin(Stdio::null())
+    let mut child = firmware::qemu(elf, machine, &["-d", "in_asm,exec,nochain", "-D", "/dev/stderr"])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
