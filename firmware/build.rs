@@ -86,29 +86,35 @@ fn main() {
     // then a baked build gives its tracer brute force in place of the lattice, which it never
     // asks (`windows_only`). The ladder's rungs walk the lattice on purpose.
     let mut windows_only = baked && !has("ladder");
-    for name in names.split(',').map(str::trim).filter(|n| !n.is_empty()) {
-        let path = PathBuf::from(format!("../scenes/{name}.scene"));
-        println!("cargo:rerun-if-changed={}", path.display());
-        let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
-        let bake = baked.then_some((name, &mut tables));
-        let (s, e, serves) = if has("scalar-fixed") {
-            plan::<lattice_rt::Fx>(&path, &text, bake)
-        } else if has("scalar-micromath") {
-            plan::<lattice_rt::F32Micro>(&path, &text, bake)
-        } else if has("scalar-micromath-newton") {
-            plan::<lattice_rt::F32MicroNewton>(&path, &text, bake)
-        } else {
-            plan::<f32>(&path, &text, bake)
-        };
+    let scenes: Vec<(&str, PathBuf, String)> = names
+        .split(',')
+        .map(str::trim)
+        .filter(|n| !n.is_empty())
+        .map(|name| {
+            let path = PathBuf::from(format!("../scenes/{name}.scene"));
+            println!("cargo:rerun-if-changed={}", path.display());
+            let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
+            (name, path, text)
+        })
+        .collect();
+    for (name, path, text) in &scenes {
+        let (s, e, serves) = plan_in_scalar(path, text, None);
         effects |= e;
         windows_only &= serves;
         sizes = sizes.max(s);
-        let abs = fs::canonicalize(&path).unwrap();
+        let abs = fs::canonicalize(path).unwrap();
         writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
     }
     println!("cargo::rustc-check-cfg=cfg(windows_only)");
     if windows_only {
         println!("cargo:rustc-cfg=windows_only");
+    }
+    if baked {
+        // Baked once it is known whether the tracer asks the lattices: where it never does,
+        // they are left out of flash.
+        for (name, path, text) in &scenes {
+            plan_in_scalar(path, text, Some((name, !windows_only, &mut tables)));
+        }
     }
     let count = list.lines().count();
     if has("effects-all") {
@@ -127,7 +133,7 @@ fn main() {
     );
     fs::write(out.join("capacities.rs"), code).unwrap();
     if baked {
-        let names: Vec<String> = names.split(',').map(str::trim).filter(|n| !n.is_empty()).map(|n| format!("({n:?}, &{})", table_name(n))).collect();
+        let names: Vec<String> = scenes.iter().map(|(n, ..)| format!("({n:?}, &{})", table_name(n))).collect();
         writeln!(tables, "/// The baked scenes, by name.\npub static BAKED: [(&str, &Baked<S>); {}] = [{}];", names.len(), names.join(", ")).unwrap();
         fs::write(out.join("baked.rs"), tables).unwrap();
     }
@@ -143,23 +149,47 @@ fn table_name(scene: &str) -> String {
     scene.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect()
 }
 
+/// [`plan`] in the scalar the firmware's features choose.
+fn plan_in_scalar(path: &std::path::Path, text: &str, bake: Option<(&str, bool, &mut String)>) -> (Sizes, u8, bool) {
+    if has("scalar-fixed") {
+        plan::<lattice_rt::Fx>(path, text, bake)
+    } else if has("scalar-micromath") {
+        plan::<lattice_rt::F32Micro>(path, text, bake)
+    } else if has("scalar-micromath-newton") {
+        plan::<lattice_rt::F32MicroNewton>(path, text, bake)
+    } else {
+        plan::<f32>(path, text, bake)
+    }
+}
+
 /// Storage and effects of one scene in the firmware's scalar, and whether its windows serve
-/// every ray; with `bake`, its tables too (the scene as parsed and its lattice as built in
-/// that scalar, as the firmware would).
-fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&str, &mut String)>) -> (Sizes, u8, bool) {
+/// every ray; with `bake`, its tables too (the scene as parsed and, if asked for, its lattice
+/// as built in that scalar, as the firmware would).
+fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&str, bool, &mut String)>) -> (Sizes, u8, bool) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
     let mut parts = lattice_rt::Parts::default();
     let scene = lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    // build.rs's own lattice-rt has every shape: the firmware's may not.
+    for (i, o) in scene.objects().iter().enumerate() {
+        let feature = match o.shape() {
+            lattice_rt::Shape::Sphere => "spheres",
+            lattice_rt::Shape::Cone { .. } => "cones",
+            _ => continue,
+        };
+        if !has(feature) {
+            panic!("{}: object {i} is a {}, which this build leaves out (the firmware's feature `{feature}`, a default one)", path.display(), lattice_rt::shape::SHAPE_NAMES[o.shape().kind()]);
+        }
+    }
     let effects = lattice_rt::Effects::of(&scene).bits();
     let cfg = LatticeConfig::default();
     // The frame this build renders, from its features (as `app::RENDERED` has it).
     let sizes = Sizes::of(&scene, Some(&cfg), &frame::rendered(frame::Build::of(has)));
-    if let Some((name, out)) = bake {
+    if let Some((name, with_lattice, out)) = bake {
         let s = Lattice::plan(&scene, &cfg);
         let (mut lattices, mut coords, mut words) = (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);
         let storage = LatticeStorage { lattices: &mut lattices, coords: &mut coords, words: &mut words };
         let lattice = Lattice::build(&scene, &cfg, storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        out.push_str(&lattice_rt::bake::source(&table_name(name), "S", &scene, &lattice));
+        out.push_str(&lattice_rt::bake::source(&table_name(name), "S", &scene, Some(&lattice).filter(|_| with_lattice)));
     }
     (sizes, effects, lattice_rt::EyeRays::serve_every_ray(&scene))
 }

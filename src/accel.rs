@@ -8,6 +8,7 @@
 //! interval, any accelerator that tests every object the ray can hit up to the best hit's tie
 //! window returns the brute-force answer bit for bit.
 
+use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::{Culled, Scene, MAX_LIGHTS};
@@ -208,7 +209,7 @@ impl<'m> Query<'m> {
     /// mapping it anew (neighbouring eye rays mostly hit one face, the floor's above all).
     #[inline]
     pub fn world_normal<R: Real>(&mut self, scene: &Scene<'_, R>, i: u32, n_obj: Vec3<R>) -> Vec3<R> {
-        let o = &scene.objects[i as usize];
+        let o = at(scene.objects, i as usize);
         let Some(axis) = crate::scene::axis_normal(n_obj) else { return o.world_normal(n_obj) };
         if let Some((j, k, raw)) = self.axis_normal {
             if (j, k) == (i, axis) {
@@ -286,7 +287,7 @@ pub fn offer<R: Real>(
         return false;
     }
     let limit = reach(best, tmax);
-    let o = &scene.objects[i];
+    let o = at(scene.objects, i);
     let hit = match q.eye_ray() {
         Some(uv) => match o.intersect_eye_ray(ray, uv, tmin, limit) {
             Ok(hit) => hit,

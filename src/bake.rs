@@ -221,10 +221,12 @@ mod writer {
         }
     }
 
-    /// Rust source of a `static {name}: Baked<{scalar}>` holding `scene` and `lattice`. The code
+    /// Rust source of a `static {name}: Baked<{scalar}>` holding `scene` and `lattice`, or an
+    /// empty lattice for `None` (a build whose tracer never asks it: every ray is answered by
+    /// the windows, [`EyeRays::serve_every_ray`](crate::EyeRays::serve_every_ray)). The code
     /// that includes it must have the types of [`prelude`](super::prelude) and the scalar
     /// `scalar` in scope.
-    pub fn source<R: Real + Literal>(name: &str, scalar: &str, scene: &Scene<'_, R>, lattice: &Lattice<'_, R>) -> String {
+    pub fn source<R: Real + Literal>(name: &str, scalar: &str, scene: &Scene<'_, R>, lattice: Option<&Lattice<'_, R>>) -> String {
         let mut out = String::new();
         let _ = write!(out, "/// The scene `{name}`, baked.\npub static {name}: Baked<{scalar}> = Baked {{\n    scene: Scene::from_tables(\n        &");
         list(scene.objects, &mut out);
@@ -242,7 +244,8 @@ mod writer {
         arg(&mut out, &scene.world);
         arg(&mut out, &scene.shadow_basis);
         out.push_str(",\n    ),\n    lattice: Lattice::from_tables(\n        ");
-        let (lattices, coords, (cells, refs), entries, narrow) = lattice.tables();
+        let empty = Lattice::from_tables(&[], &[], (&[], &[]), (0, 0), true, scene.objects.len());
+        let (lattices, coords, (cells, refs), entries, narrow) = lattice.unwrap_or(&empty).tables();
         Slice(lattices).literal(&mut out);
         arg(&mut out, &Slice(coords));
         arg(&mut out, &Pair(Slice(cells), Slice(refs)));
@@ -340,7 +343,8 @@ mod tests {
         }
         #[cfg(feature = "bake")]
         {
-            let src = source("TEST", "Fx", &scene, &lattice);
+            let src = source("TEST", "Fx", &scene, Some(&lattice));
+            assert!(source("TEST", "Fx", &scene, None).contains("lattice: Lattice::from_tables(\n        &[],\n        &[],"));
             assert_eq!(src.matches("Object::from_tables(").count(), scene.objects.len());
             assert!(src.starts_with("/// The scene `TEST`, baked.\npub static TEST: Baked<Fx> = Baked {"));
             let mut f = std::string::String::new();

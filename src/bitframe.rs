@@ -9,6 +9,7 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::{PointsIter, Rectangle};
 use embedded_graphics_core::Pixel;
+use crate::bounds::{at_mut, span_mut};
 
 /// A 1-bit frame; `On` pixels are stored as 1 (PBM black).
 #[derive(Debug)]
@@ -102,10 +103,11 @@ impl DrawTarget for BitFrame<'_> {
                 continue;
             }
             let (i, m) = (p.y as usize * stride + p.x as usize / 8, 0x80u8 >> (p.x % 8));
+            let byte = at_mut(self.bits, i);
             if c.is_on() {
-                self.bits[i] |= m;
+                *byte |= m;
             } else {
-                self.bits[i] &= !m;
+                *byte &= !m;
             }
         }
         Ok(())
@@ -123,14 +125,15 @@ impl DrawTarget for BitFrame<'_> {
         let stride = (self.width as usize).div_ceil(8);
         let mut colors = colors.into_iter();
         for y in y0 as usize..y0 as usize + h as usize {
-            let row = &mut self.bits[y * stride..(y + 1) * stride];
+            let row = span_mut(self.bits, y * stride..(y + 1) * stride);
             for x in x0 as usize..x0 as usize + w as usize {
                 let Some(c) = colors.next() else { return Ok(()) };
                 let m = 0x80u8 >> (x % 8);
+                let byte = at_mut(row, x / 8);
                 if c.is_on() {
-                    row[x / 8] |= m;
+                    *byte |= m;
                 } else {
-                    row[x / 8] &= !m;
+                    *byte &= !m;
                 }
             }
         }

@@ -9,6 +9,7 @@
 
 use crate::scene::{Camera, EyeWindow, Scene};
 use core::ops::Range;
+use crate::bounds::{at_mut, span_mut};
 use crate::scalar::Real;
 
 /// A tile's rectangle on the window (2^-16 units, inclusive, as [`Camera::window_uv`] gives):
@@ -83,17 +84,18 @@ impl Tiling {
         let (nx, ny) = self.tiles();
         let (first, end) = (rows.0.min(ny), rows.1.min(ny));
         let Some(cover) = cover.get_mut(..self.len()) else { return false };
-        let (counts, lists) = cover.split_at_mut(nx * ny);
-        counts[first * nx..end * nx].fill(0);
+        let Some((counts, lists)) = cover.split_at_mut_checked(nx * ny) else { return false };
+        span_mut(counts, first * nx..end * nx).fill(0);
         for (i, o) in scene.objects().iter().enumerate() {
             let (cols, rows) = self.met::<R>(o.eye_window);
             for ty in rows.start.max(first)..rows.end.min(end) {
                 for tile in ty * nx + cols.start..ty * nx + cols.end {
-                    let k = counts[tile] as usize;
+                    let count = at_mut(counts, tile);
+                    let k = *count as usize;
+                    *count = count.saturating_add(1);
                     if k < LIST {
-                        lists[tile * LIST + k] = i as u32;
+                        *at_mut(lists, tile * LIST + k) = i as u32;
                     }
-                    counts[tile] = counts[tile].saturating_add(1);
                 }
             }
         }
@@ -119,12 +121,12 @@ impl Tiling {
     }
 
     /// After [`Tiling::count`]: the objects whose window meets tile `(tx, ty)`, if there are
-    /// at most [`LIST`] (`None`: more).
+    /// at most [`LIST`] (`None`: more, or a tile `cover` has no entries for).
     pub fn list<'c>(&self, cover: &'c [u32], (tx, ty): (usize, usize)) -> Option<&'c [u32]> {
         let (nx, ny) = self.tiles();
         let tile = ty * nx + tx;
-        let k = cover[tile] as usize;
-        (k <= LIST).then(|| &cover[nx * ny + tile * LIST..][..k])
+        let k = *cover.get(tile)? as usize;
+        cover.get(nx * ny + tile * LIST..)?.get(..k).filter(|_| k <= LIST)
     }
 }
 

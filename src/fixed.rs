@@ -22,16 +22,20 @@ fn sat(v: i64) -> Fx {
     Fx(v.clamp(-(i32::MAX as i64), i32::MAX as i64) as i32)
 }
 
+// Saturating sums and differences are a dozen bytes each on a Cortex-M0 and the tracer has
+// hundreds: code built for size (`compact`) calls one copy of each.
 impl Add for Fx {
     type Output = Fx;
-    #[inline]
+    #[cfg_attr(not(feature = "compact"), inline)]
+    #[cfg_attr(feature = "compact", inline(never))]
     fn add(self, o: Fx) -> Fx {
         Fx(self.0.saturating_add(o.0).max(-i32::MAX))
     }
 }
 impl Sub for Fx {
     type Output = Fx;
-    #[inline]
+    #[cfg_attr(not(feature = "compact"), inline)]
+    #[cfg_attr(feature = "compact", inline(never))]
     fn sub(self, o: Fx) -> Fx {
         Fx(self.0.saturating_sub(o.0).max(-i32::MAX))
     }

@@ -14,6 +14,7 @@ extern crate alloc;
 // In the order the data flows: numbers, geometry, the scene (text in, validated scene out),
 // the lattice over it, the storage that holds both and the loading that fills it, then tracing, sampling, dithering and the
 // tile loop that writes a display.
+mod bounds;
 pub mod scalar;
 pub use scalar::{F32Micro, F32MicroNewton, Real};
 pub mod fixed;

@@ -284,9 +284,8 @@ fn adaptive<R: Real>(
         for x in traced_lines(tw) {
             let (cx, cy) = centre(x, y);
             let (v, id, depth) = shoot(cx, cy);
-            levels[y * tw + x] = level(v);
-            ids[y * tw + x] = id;
-            depths[y * tw + x] = depth;
+            let i = at(y * tw + x);
+            (levels[i], ids[i], depths[i]) = (level(v), id, depth);
         }
     }
     // The second pass, row by row in pixel order (so rays are shot in the same order): on a

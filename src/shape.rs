@@ -54,6 +54,16 @@ impl<R: Real> Shape<R> {
         }
     }
 
+    /// The Cargo feature this build needs for the shape and lacks (`spheres`, `cones`), if any:
+    /// boxes and cylinders are always in.
+    pub fn left_out(&self) -> Option<&'static str> {
+        match self {
+            Shape::Sphere if !cfg!(feature = "spheres") => Some("spheres"),
+            Shape::Cone { .. } if !cfg!(feature = "cones") => Some("cones"),
+            _ => None,
+        }
+    }
+
     /// Nearest intersection with `tmin < t <= tmax`: the parameter, the outward normal
     /// (not normalised) and the point, in object space.
     ///
@@ -74,10 +84,11 @@ impl<R: Real> Shape<R> {
         let local = Ray::new(r.at(t0), r.dir);
         let mut best = Closest { t: tmax - t0, hit: None, tmin: tmin - t0 };
         match *self {
-            Shape::Sphere => sphere(&local, &mut best),
+            // A shape a build leaves out is refused when the scene is built.
+            Shape::Sphere if cfg!(feature = "spheres") => sphere(&local, &mut best),
             Shape::Cylinder => cone_side_and_caps(&local, R::ONE, &mut best),
-            Shape::Cone { top } => cone_side_and_caps(&local, top, &mut best),
-            Shape::Box => {}
+            Shape::Cone { top } if cfg!(feature = "cones") => cone_side_and_caps(&local, top, &mut best),
+            _ => {}
         }
         best.hit.map(|(normal, point)| ShapeHit { t: best.t + t0, normal, point })
     }

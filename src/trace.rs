@@ -19,6 +19,7 @@
 //! `offset_eps * (1 + size)`.
 
 use crate::accel::{Accelerator, BruteForce, Query, RayKind};
+use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::{Light, Scene};
@@ -89,7 +90,7 @@ impl Effects {
     /// material with `Ks > 0` on some object, refraction one with `Kt > 0`.
     pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
         let used = |f: fn(&crate::scene::Material<R>) -> R| {
-            scene.objects.iter().any(|o| f(&scene.materials[o.material as usize]) > R::ZERO)
+            scene.objects.iter().any(|o| f(at(scene.materials, o.material as usize)) > R::ZERO)
         };
         let mut e = Self::NONE;
         if !scene.lights.is_empty() && scene.objects.len() > 1 {
@@ -566,8 +567,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 first = hit.object;
                 depth = hit.t;
             }
-            let obj = &scene.objects[hit.object as usize];
-            let m = scene.materials[obj.material as usize];
+            let obj = at(scene.objects, hit.object as usize);
+            let m = *at(scene.materials, obj.material as usize);
             let p = obj.surface_point(hit.point, hit.normal);
             // Children (a mirror or a refracted ray) need the unit direction; without them only
             // the side the ray meets is asked, which the direction as traced gives.
@@ -656,7 +657,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             };
             let tried = last.filter(|&i| !q.skips(i) && (i as usize) < self.scene.objects.len());
             if let Some(i) = tried {
-                let o = &self.scene.objects[i as usize];
+                let o = at(self.scene.objects, i as usize);
                 let hit = match across {
                     // Outside its window the remembered occluder cannot hide the light.
                     Some(w) if !o.shadow_window_holds(w) => None,

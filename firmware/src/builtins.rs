@@ -112,3 +112,81 @@ pub unsafe extern "C" fn __aeabi_memclr8(dest: *mut u8, n: usize) {
     // SAFETY: the caller's guarantees are the callee's.
     unsafe { __aeabi_memset4(dest, n, 0) }
 }
+
+/// `n / d` and `n % d` by shifting and subtracting, one step per bit of the quotient: the
+/// divisor is doubled until it reaches the dividend, then halved back, subtracted where it
+/// fits. `d == 0` gives `(u32::MAX, n)` (Rust checks for zero before it divides).
+pub fn divide(mut n: u32, d: u32) -> (u32, u32) {
+    if d == 0 {
+        return (u32::MAX, n);
+    }
+    let (mut step, mut bit, mut q) = (d, 1u32, 0u32);
+    while step < n && step >> 31 == 0 {
+        step <<= 1;
+        bit <<= 1;
+    }
+    while bit != 0 {
+        if n >= step {
+            n -= step;
+            q |= bit;
+        }
+        step >>= 1;
+        bit >>= 1;
+    }
+    (q, n)
+}
+
+/// Unsigned division (the ARM EABI's name for it): [`divide`]'s quotient.
+#[no_mangle]
+pub extern "C" fn __aeabi_uidiv(n: u32, d: u32) -> u32 {
+    divide(n, d).0
+}
+
+/// A quotient and remainder as the EABI returns them: the quotient in `r0`, the remainder in
+/// `r1` (a 64-bit result's low and high words).
+fn in_registers((q, r): (u32, u32)) -> u64 {
+    u64::from(q) | u64::from(r) << 32
+}
+
+/// Unsigned quotient and remainder.
+#[no_mangle]
+pub extern "C" fn __aeabi_uidivmod(n: u32, d: u32) -> u64 {
+    in_registers(divide(n, d))
+}
+
+/// Signed quotient and remainder, truncated towards zero (the remainder has the dividend's
+/// sign), as the magnitudes' [`divide`].
+fn signed(n: i32, d: i32) -> (i32, i32) {
+    let (q, r) = divide(n.unsigned_abs(), d.unsigned_abs());
+    let q = if (n ^ d) < 0 { (q as i32).wrapping_neg() } else { q as i32 };
+    (q, if n < 0 { (r as i32).wrapping_neg() } else { r as i32 })
+}
+
+/// Signed division: [`signed`]'s quotient.
+#[no_mangle]
+pub extern "C" fn __aeabi_idiv(n: i32, d: i32) -> i32 {
+    signed(n, d).0
+}
+
+/// Signed quotient and remainder.
+#[no_mangle]
+pub extern "C" fn __aeabi_idivmod(n: i32, d: i32) -> u64 {
+    let (q, r) = signed(n, d);
+    in_registers((q as u32, r as u32))
+}
+
+/// Leading zero bits of `x` (32 for zero), by halving the width searched five times.
+#[no_mangle]
+pub extern "C" fn __clzsi2(mut x: u32) -> i32 {
+    if x == 0 {
+        return 32;
+    }
+    let mut n = 0;
+    for s in [16, 8, 4, 2, 1] {
+        if x >> (32 - s) == 0 {
+            x <<= s;
+            n += s;
+        }
+    }
+    n
+}

@@ -177,6 +177,9 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         };
         // `place` is `to_world` after an invertible group transform: checking it covers both.
         let inv = checked_inverse(&place)?;
+        if let Some(feature) = shape.left_out() {
+            return Err(SceneError::ShapeLeftOut { feature });
+        }
         let top = match shape {
             Shape::Cone { top } => top,
             _ => 0.0,

@@ -77,6 +77,11 @@ pub enum SceneError {
     },
     /// A size that must be positive is not (radius, height, box extent).
     NonPositiveSize,
+    /// A shape this build leaves out ([`Shape::left_out`](crate::Shape::left_out)).
+    ShapeLeftOut {
+        /// The Cargo feature that has it (`spheres`, `cones`).
+        feature: &'static str,
+    },
     /// A material coefficient below zero, or an index of refraction below 1.
     BadCoefficient,
     /// A camera whose view direction is zero or parallel to its up vector.
@@ -143,6 +148,9 @@ impl fmt::Display for SceneError {
                 if *scalar == "f64" { "" } else { ", or trace in f64" }
             ),
             SceneError::NonPositiveSize => write!(f, "size must be positive"),
+            SceneError::ShapeLeftOut { feature } => {
+                write!(f, "this build leaves out {feature} (lattice-rt's Cargo feature `{feature}`, a default one)")
+            }
             SceneError::BadCoefficient => {
                 write!(f, "coefficients must be >= 0 and the index of refraction >= 1")
             }

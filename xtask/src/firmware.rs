@@ -27,8 +27,10 @@ pub(crate) struct Variant {
     scenes: Option<&'static str>,
     scalar: &'static str,
     what: String,
-    /// The flash size the `tiny` memory map is linked at (`FIRMWARE_FLASH_KIB`), if not its own.
-    flash_kib: Option<u32>,
+    /// The `tiny` build: the flash size its memory map is linked at (`FIRMWARE_FLASH_KIB`). It is
+    /// built without the firmware's default features (the shapes beyond the chair's boxes and
+    /// cylinders).
+    tiny: Option<u32>,
 }
 
 /// The Pico 2 core's variant with the scenes baked, as the Pico 2 image has them.
@@ -57,7 +59,7 @@ fn variants() -> Vec<Variant> {
                 scenes: None,
                 scalar,
                 what: format!("{core}, {scalar}, all five scenes"),
-                flash_kib: None,
+                tiny: None,
             });
         }
     }
@@ -72,7 +74,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "f32",
         what: "Cortex-M33 (the Pico 2's core), f32, all five scenes baked, as the Pico 2 image has them".into(),
-        flash_kib: None,
+        tiny: None,
     });
     for (scalar, feature) in [SCALARS[0], SCALARS[1]] {
         v.push(Variant {
@@ -85,7 +87,7 @@ fn variants() -> Vec<Variant> {
             scenes: Some("chair"),
             scalar,
             what: format!("Cortex-M0+, {scalar}, only the chair embedded"),
-            flash_kib: None,
+            tiny: None,
         });
     }
     // The smallest board: a BBC micro:bit (nRF51822, Cortex-M0, 16 KiB of RAM), the chair alone.
@@ -99,7 +101,7 @@ fn variants() -> Vec<Variant> {
         scenes: Some("chair"),
         scalar: "fixed",
         what: "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, run on QEMU's microbit machine), fixed, only the chair embedded".into(),
-        flash_kib: None,
+        tiny: None,
     });
     // What adaptive sub-sampling saves: the same build tracing one eye ray per pixel.
     v.push(Variant {
@@ -112,7 +114,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Cortex-M0+, fixed, all five scenes, one eye ray per pixel (exact-sampling) instead of adaptive sub-sampling".into(),
-        flash_kib: None,
+        tiny: None,
     });
     // What a progressive frame costs: the same build showing each frame in four passes.
     v.push(Variant {
@@ -125,7 +127,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Cortex-M0+, fixed, all five scenes, each frame in four progressive passes (8x8, 4x4, 2x2 blocks, then the frame; the last pass is the frame checked)".into(),
-        flash_kib: None,
+        tiny: None,
     });
     // What the effect set saves: every effect forced in, and the matte paper scenes with their
     // derived set against every effect (the same scenes, so the difference is the effect code).
@@ -151,7 +153,7 @@ fn variants() -> Vec<Variant> {
             scenes,
             scalar: "fixed",
             what: what.into(),
-            flash_kib: None,
+            tiny: None,
         });
     }
     // The baked images the flash targets are about, built for size (the `small` profile:
@@ -173,7 +175,7 @@ fn variants() -> Vec<Variant> {
             scenes,
             scalar: "fixed",
             what: what.into(),
-            flash_kib: None,
+            tiny: None,
         });
     }
     // The smallest parts: the chair alone in 4 KiB of RAM, linker-enforced (tiny/memory.x), its
@@ -189,7 +191,7 @@ fn variants() -> Vec<Variant> {
         scenes: Some("chair"),
         scalar: "fixed",
         what: "the smallest Cortex-M0 parts' memory (tiny/memory.x: 4 KiB of RAM, linker-enforced, flip-link; flash linked at 32 KiB), fixed, only the chair, baked, built for size".into(),
-        flash_kib: Some(32),
+        tiny: Some(32),
     });
     v.push(Variant {
         name: "pico".into(),
@@ -201,7 +203,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes baked (run on an emulated board by `cargo xtask board`: docs/board.md)".into(),
-        flash_kib: None,
+        tiny: None,
     });
     v.push(Variant {
         name: "pico2".into(),
@@ -213,7 +215,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "f32",
         what: "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes baked (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32-baked)".into(),
-        flash_kib: None,
+        tiny: None,
     });
     v
 }
@@ -237,15 +239,19 @@ pub(crate) fn elf_path(root: &Path, v: &Variant) -> PathBuf {
 }
 
 /// The cargo arguments that build variant `v`.
-fn cargo_args(v: &Variant) -> [&str; 11] {
-    ["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target]
+fn cargo_args(v: &Variant) -> Vec<&str> {
+    let mut args = vec!["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target];
+    if v.tiny.is_some() {
+        args.push("--no-default-features");
+    }
+    args
 }
 
 pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
     let args = cargo_args(v);
     let built = Path::new(v.target).join(v.profile).join(v.bin);
     let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);
-    let vars: Vec<(&str, String)> = v.flash_kib.map(|k| ("FIRMWARE_FLASH_KIB", k.to_string())).into_iter().collect();
+    let vars: Vec<(&str, String)> = v.tiny.map(|k| ("FIRMWARE_FLASH_KIB", k.to_string())).into_iter().collect();
     host_sim::uf2::build_image_with(root, &v.name, &args, scenes, &built, &vars).with_context(|| format!("building firmware variant {} failed", v.name))?;
     Ok(())
 }
@@ -460,15 +466,7 @@ const TINY: &str = "tiny-m0-fixed-chair";
 /// if the image fits, else by how many bytes the flash region overflows (the largest overflow it
 /// reports, that of the last section placed).
 fn tiny_overflow(root: &Path, v: &Variant) -> Result<Option<u64>> {
-    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(root)
-        .args(cargo_args(v))
-        .env_remove("RUSTFLAGS")
-        .env_remove("FIRMWARE_FLASH_KIB")
-        .env("FIRMWARE_SCENES", v.scenes.unwrap_or("chair"))
-        .stdin(Stdio::null())
-        .output()
-        .context("cannot run cargo")?;
+    let out = tiny_build(root, v, v.scenes.unwrap_or("chair"))?;
     if out.status.success() {
         return Ok(None);
     }
@@ -483,6 +481,29 @@ fn tiny_overflow(root: &Path, v: &Variant) -> Result<Option<u64>> {
     }
 }
 
+/// The `tiny` build of `scenes` linked at the 16 KiB of flash its memory map gives, as cargo
+/// left it (the image is not kept).
+fn tiny_build(root: &Path, v: &Variant, scenes: &str) -> Result<std::process::Output> {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .args(cargo_args(v))
+        .env_remove("RUSTFLAGS")
+        .env_remove("FIRMWARE_FLASH_KIB")
+        .env("FIRMWARE_SCENES", scenes)
+        .stdin(Stdio::null())
+        .output()
+        .context("cannot run cargo")
+}
+
+/// What the `tiny` build, which leaves out spheres and cones, says when it is built with a scene
+/// of spheres: the reason it refuses it (`None` if it did not, and would draw it without them).
+fn tiny_refuses_spheres(root: &Path, v: &Variant) -> Result<Option<String>> {
+    let out = tiny_build(root, v, "spheres")?;
+    let text = String::from_utf8_lossy(&out.stderr);
+    let why = text.lines().find_map(|l| Some(l.split_once("spheres.scene: ")?.1.trim().to_string())).filter(|w| w.contains("which this build leaves out"));
+    Ok(why.filter(|_| !out.status.success()))
+}
+
 /// The `tiny` build against its targets: the chair in 16 KiB of flash and 4 KiB of RAM.
 fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identical: &std::collections::BTreeMap<(String, String), bool>, tally: &mut Tally) -> Result<()> {
     let Some((v, r)) = runs.iter().find(|(v, _)| v.name == TINY) else { return Ok(()) };
@@ -490,6 +511,13 @@ fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identica
     let ram = r.statics + r.stack;
     let same = r.scenes.iter().all(|s| identical.get(&(TINY.to_string(), s.name.clone())) == Some(&true));
     let over = tiny_overflow(root, v)?;
+    let refuses = tiny_refuses_spheres(root, v)?;
+    if refuses.is_some() {
+        tally.passed += 1;
+    } else {
+        tally.failed += 1;
+        eprintln!("FAIL {TINY}: a scene with spheres was not refused when built");
+    }
     // The run itself proves the 4 KiB: its memory map holds no more, and flip-link faults on an
     // overflow (a fault fails the run).
     if ram <= 4 << 10 && !r.scenes.is_empty() {
@@ -501,9 +529,15 @@ fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identica
     writeln!(md, "\n## The tiny build\n")?;
     writeln!(md, "`{TINY}` (the `tiny` and `compact` features, `small` profile): the chair alone in the memory of the smallest")?;
     writeln!(md, "Cortex-M0 parts, `firmware/tiny/memory.x`: 16 KiB of flash and 4 KiB of RAM, enforced by the linker,")?;
-    writeln!(md, "with flip-link placing the stack below the statics so that an overflow faults. The harness logs")?;
-    writeln!(md, "through a few bytes of its own (`Line` in `firmware/src/bin/qemu.rs`, not `core::fmt`; core's")?;
-    writeln!(md, "index checks still link its integer formatter for their panic messages).\n")?;
+    writeln!(md, "with flip-link placing the stack below the statics so that an overflow faults. It is built without the")?;
+    writeln!(md, "firmware's default features, `spheres` and `cones`: the chair has boxes and cylinders only, and the")?;
+    writeln!(md, "other shapes' intersection code is left out (built with the spheres scene, it {}).", match &refuses {
+        Some(why) => format!("is refused: *{why}*"),
+        None => "**is not refused**".into(),
+    })?;
+    writeln!(md, "The harness logs through a few bytes of its own (`Line` in `firmware/src/bin/qemu.rs`), and the")?;
+    writeln!(md, "render path's index checks panic without formatting their numbers (`lattice_rt::bounds`), so no")?;
+    writeln!(md, "`core::fmt` code is linked.\n")?;
     writeln!(md, "| target | measured | limit | met |\n|---|---:|---:|---|")?;
     writeln!(md, "| RAM (static + stack high-water, in the 4 KiB map) | {ram} B | 4096 B | {} |", if ram <= 4 << 10 { "yes" } else { "**no**" })?;
     let fits = over.is_none();

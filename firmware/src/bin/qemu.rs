@@ -54,7 +54,7 @@ impl Line {
     /// Appends bytes, sending the line so far when it is full.
     fn put(&mut self, bytes: &[u8]) -> &mut Self {
         for &b in bytes {
-            if self.len == self.bytes.len() {
+            if self.len >= self.bytes.len() {
                 send(&self.bytes);
                 self.len = 0;
             }
@@ -102,10 +102,15 @@ impl Line {
         }
         self
     }
+    /// Appends ` key value`. Called, not inlined: a frame's line has a dozen.
+    #[inline(never)]
+    fn field(&mut self, key: &str, value: u64) -> &mut Self {
+        self.text(" ").text(key).text(" ").dec(value)
+    }
     /// Ends the line and sends it.
     fn end(&mut self) {
         self.put(b"\n");
-        send(&self.bytes[..self.len]);
+        send(&self.bytes[..self.len.min(self.bytes.len())]);
         self.len = 0;
     }
 }
@@ -157,26 +162,22 @@ fn main() -> ! {
             Ok(r) => {
                 let t = ticks() - t0;
                 let s = r.stats;
-                let fields = [
-                    ("ticks", t),
-                    ("tiles", r.share_us[0] + r.share_us[1]),
-                    ("rays", s.total_rays()),
-                    ("primary", s.rays[0]),
-                    ("shadow", s.rays[1]),
-                    ("reflection", s.rays[2]),
-                    ("refraction", s.rays[3]),
-                    ("tests", s.object_tests),
-                    ("cells", s.cells_visited),
-                    ("objects", r.objects as u64),
-                    ("lattice_bytes", r.lattice_bytes as u64),
-                    ("stack_so_far", stack::high_water() as u64),
-                ];
-                let mut line = Line::new();
-                line.text("SCENE ").text(name);
-                for (key, value) in fields {
-                    line.text(" ").text(key).text(" ").dec(value);
-                }
-                line.end();
+                Line::new()
+                    .text("SCENE ")
+                    .text(name)
+                    .field("ticks", t)
+                    .field("tiles", r.share_us[0] + r.share_us[1])
+                    .field("rays", s.total_rays())
+                    .field("primary", s.rays[0])
+                    .field("shadow", s.rays[1])
+                    .field("reflection", s.rays[2])
+                    .field("refraction", s.rays[3])
+                    .field("tests", s.object_tests)
+                    .field("cells", s.cells_visited)
+                    .field("objects", r.objects as u64)
+                    .field("lattice_bytes", r.lattice_bytes as u64)
+                    .field("stack_so_far", stack::high_water() as u64)
+                    .end();
                 for row in frame.raster().chunks(FRAME.width as usize / 8) {
                     Line::new().text("ROW ").hex(row).end();
                 }
