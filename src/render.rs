@@ -572,7 +572,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     // Past 64 objects the tiles' candidate masks hold every object: list the objects whose
     // windows meet each tile instead, when the scratch has room.
     let tiling = crate::cover::Tiling { t, size: (w, h), margin: block };
-    let many = crate::cover::lists(tracer.scene().objects().len());
+    let many = cfg!(feature = "tile-lists") && crate::cover::lists(tracer.scene().objects().len());
     let counted = many && tiling.count(tracer.scene(), (frame.rows.0 as usize, frame.rows.1 as usize), scratch.cover);
     let cover: &[u32] = scratch.cover;
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
@@ -860,7 +860,8 @@ impl<'a> Scratch<'a> {
     /// With room to list which objects' eye windows meet each tile ([`Frame::cover_len`]
     /// entries): in a scene of more than 64 objects, the eye rays of a tile that few windows
     /// meet then test those objects without walking the lattice (the same frame, sooner).
-    /// Without it (or with too few entries) every eye ray walks.
+    /// Without it (or with too few entries, or without the `tile-lists` feature) every eye ray
+    /// walks.
     pub fn with_cover(self, cover: &'a mut [u32]) -> Self {
         Scratch { cover, ..self }
     }
