@@ -4,13 +4,15 @@
 //! message, and that links core's integer formatting (about 1.2 KB on a Cortex-M0) into every
 //! image that indexes, though no firmware panic handler prints the message. The render path
 //! indexes through these instead. With a validated scene and the tile loop's own sizes none of
-//! them fails; if one did, the panic says where, as core's does.
+//! them fails; if one did, the panic says where, as core's does (in code built for size, the
+//! `compact` feature, it names this file instead: each caller's place is a file name and 16
+//! bytes of flash).
 
 use core::ops::Range;
 
 /// `s[i]`.
 #[inline(always)]
-#[track_caller]
+#[cfg_attr(not(feature = "compact"), track_caller)]
 pub(crate) fn at<T>(s: &[T], i: usize) -> &T {
     match s.get(i) {
         Some(v) => v,
@@ -20,7 +22,7 @@ pub(crate) fn at<T>(s: &[T], i: usize) -> &T {
 
 /// `&mut s[i]`.
 #[inline(always)]
-#[track_caller]
+#[cfg_attr(not(feature = "compact"), track_caller)]
 pub(crate) fn at_mut<T>(s: &mut [T], i: usize) -> &mut T {
     match s.get_mut(i) {
         Some(v) => v,
@@ -30,7 +32,7 @@ pub(crate) fn at_mut<T>(s: &mut [T], i: usize) -> &mut T {
 
 /// `&mut s[r]`.
 #[inline(always)]
-#[track_caller]
+#[cfg_attr(not(feature = "compact"), track_caller)]
 pub(crate) fn span_mut<T>(s: &mut [T], r: Range<usize>) -> &mut [T] {
     match s.get_mut(r) {
         Some(v) => v,
@@ -40,7 +42,7 @@ pub(crate) fn span_mut<T>(s: &mut [T], r: Range<usize>) -> &mut [T] {
 
 #[cold]
 #[inline(never)]
-#[track_caller]
+#[cfg_attr(not(feature = "compact"), track_caller)]
 fn out_of_bounds() -> ! {
     panic!("index out of bounds")
 }

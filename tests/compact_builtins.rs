@@ -43,37 +43,3 @@ fn copies_and_fills_touch_exactly_their_bytes() {
         }
     }
 }
-
-/// Dividends and divisors at the edges (0, 1, powers of two and their neighbours, the
-/// extremes) and a spread of others.
-fn edges() -> Vec<u32> {
-    let mut v = vec![0, 1, 2, 3, 7, 10, 255, 256, 65535, 65536, u32::MAX - 1, u32::MAX];
-    for s in 0..32 {
-        v.extend([(1u32 << s).wrapping_sub(1), 1 << s, (1u32 << s) + 1, 0x8000_0000 | (1 << s)]);
-    }
-    let mut x = 0x1234_5678u32;
-    for _ in 0..200 {
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        v.extend([x, x >> (x % 29)]);
-    }
-    v
-}
-
-#[test]
-fn division_and_leading_zeros_agree_with_rust() {
-    let values = edges();
-    for &n in &values {
-        assert_eq!(__clzsi2(n), n.leading_zeros() as i32, "clz of {n:#x}");
-        for &d in values.iter().filter(|&&d| d != 0) {
-            assert_eq!(divide(n, d), (n / d, n % d), "{n} / {d}");
-            assert_eq!(__aeabi_uidivmod(n, d), u64::from(n / d) | u64::from(n % d) << 32);
-            let (a, b) = (n as i32, d as i32);
-            if !(a == i32::MIN && b == -1) {
-                assert_eq!(__aeabi_idiv(a, b), a / b, "{a} / {b}");
-                assert_eq!(__aeabi_idivmod(a, b), u64::from((a / b) as u32) | u64::from((a % b) as u32) << 32);
-            }
-        }
-    }
-}
