@@ -553,9 +553,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let keep = matches!(out, Out::Keep(_));
     check(frame, share, !keep)?;
     resolves(tracer.scene().camera(), frame)?;
-    // `check` refused any other tile side; the clamp tells the compiler so, and the tile loop's
-    // slices of the per-tile buffers then need no bounds checks.
-    let (t, block) = ((frame.tile as usize).clamp(1, MAX_TILE), frame.dither.block() as usize);
+    let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
     let (w, h) = (frame.width as usize, frame.height as usize);
     // Kept levels are dithered later (by `dither_band`): the trace needs no carries, and an
     // ordered mode, which needs no storage, stands in for the frame's dither.

@@ -568,7 +568,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 depth = hit.t;
             }
             let obj = at(scene.objects, hit.object as usize);
-            let m = *at(scene.materials, obj.material as usize);
+            let m = at(scene.materials, obj.material as usize);
             let p = obj.surface_point(hit.point, hit.normal);
             // Children (a mirror or a refracted ray) need the unit direction; without them only
             // the side the ray meets is asked, which the direction as traced gives.
