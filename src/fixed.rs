@@ -179,26 +179,39 @@ impl MulAssign for Fx {
 /// Q16.16 number, in Q16.16. Digit by digit, two bits of the radicand per step, in 32-bit
 /// arithmetic only (the remainder stays below `8 * root + 4 < 2^27`): a Cortex-M0+ has no
 /// 64-bit operations, and this is several times faster than the same method on a `u64`.
+/// `raw`'s digit pairs are taken from the top of a copy shifted left (leading zero pairs
+/// leave root and remainder at zero, so they are skipped), then the 8 zero pairs of `<< 16`:
+/// no shift by a variable amount and no test of which pair comes next, in the loop.
 fn sqrt_q16(raw: u32) -> u32 {
     let (mut root, mut rem) = (0u32, 0u32);
-    // The radicand's 24 digit pairs: `raw`'s 16 from the top, then the 8 zero pairs of `<< 16`;
-    // leading zero pairs leave root and remainder at zero, so they are skipped.
-    let top = 8 + (32 - raw.leading_zeros()).div_ceil(2);
-    for i in (0..top).rev() {
-        let pair = if i >= 8 { (raw >> (2 * (i - 8))) & 3 } else { 0 };
-        rem = (rem << 2) | pair;
-        let trial = (root << 2) | 1;
-        root <<= 1;
-        if rem >= trial {
-            rem -= trial;
-            root |= 1;
-        }
+    let pairs = (32 - raw.leading_zeros()).div_ceil(2);
+    let mut digits = raw.checked_shl(32 - 2 * pairs).unwrap_or(0);
+    for _ in 0..pairs {
+        rem = (rem << 2) | (digits >> 30);
+        digits <<= 2;
+        sqrt_step(&mut root, &mut rem);
+    }
+    for _ in 0..8 {
+        rem <<= 2;
+        sqrt_step(&mut root, &mut rem);
     }
     // `rem = n - root^2`; the nearest integer is `root + 1` when `n > root^2 + root`.
     if rem > root {
         root + 1
     } else {
         root
+    }
+}
+
+/// One digit of [`sqrt_q16`]: the root's next bit, given the remainder with the next digit
+/// pair brought down.
+#[inline(always)]
+fn sqrt_step(root: &mut u32, rem: &mut u32) {
+    let trial = (*root << 2) | 1;
+    *root <<= 1;
+    if *rem >= trial {
+        *rem -= trial;
+        *root |= 1;
     }
 }
 
@@ -543,7 +556,9 @@ mod tests {
         };
         let mut x = 0x9E37_79B9u32;
         let edges = [0u32, 1, 2, 3, 4, 255, 256, 65535, 65536, 65537, i32::MAX as u32 - 1, i32::MAX as u32];
-        for raw in edges.into_iter().chain((0..200_000).map(|_| {
+        // Every radicand below 2^18, each power of two and its neighbours, and a random spread.
+        let powers = (0..31).flat_map(|k| [(1u32 << k) - 1, 1 << k, (1 << k) + 1]);
+        for raw in edges.into_iter().chain(0..1 << 18).chain(powers).chain((0..200_000).map(|_| {
             x ^= x << 13;
             x ^= x >> 17;
             x ^= x << 5;
