@@ -171,11 +171,7 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&st
     let scene = lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     // build.rs's own lattice-rt has every shape: the firmware's may not.
     for (i, o) in scene.objects().iter().enumerate() {
-        let feature = match o.shape() {
-            lattice_rt::Shape::Sphere => "spheres",
-            lattice_rt::Shape::Cone { .. } => "cones",
-            _ => continue,
-        };
+        let Some(feature) = o.shape().feature() else { continue };
         if !has(feature) {
             panic!("{}: object {i} is a {}, which this build leaves out (the firmware's feature `{feature}`, a default one)", path.display(), lattice_rt::shape::SHAPE_NAMES[o.shape().kind()]);
         }

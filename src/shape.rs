@@ -54,12 +54,21 @@ impl<R: Real> Shape<R> {
         }
     }
 
-    /// The Cargo feature this build needs for the shape and lacks (`spheres`, `cones`), if any:
-    /// boxes and cylinders are always in.
+    /// The Cargo feature that has the shape's intersection code (`spheres`, `cones`); `None`
+    /// for boxes and cylinders, which every build has.
+    pub fn feature(&self) -> Option<&'static str> {
+        match self {
+            Shape::Sphere => Some("spheres"),
+            Shape::Cone { .. } => Some("cones"),
+            _ => None,
+        }
+    }
+
+    /// [`Shape::feature`] if this build lacks it.
     pub fn left_out(&self) -> Option<&'static str> {
         match self {
-            Shape::Sphere if !cfg!(feature = "spheres") => Some("spheres"),
-            Shape::Cone { .. } if !cfg!(feature = "cones") => Some("cones"),
+            Shape::Sphere if !cfg!(feature = "spheres") => self.feature(),
+            Shape::Cone { .. } if !cfg!(feature = "cones") => self.feature(),
             _ => None,
         }
     }

@@ -171,15 +171,15 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if self.len >= self.storage.len() || self.len >= 1 << 31 {
             return Err(SceneError::TooManyObjects { capacity: self.storage.len(), needed: self.len + 1 });
         }
+        if let Some(feature) = shape.left_out() {
+            return Err(SceneError::ShapeLeftOut { feature });
+        }
         let place = match &self.open_composite {
             Some((_, g, _)) => g.after(&to_world),
             None => to_world,
         };
         // `place` is `to_world` after an invertible group transform: checking it covers both.
         let inv = checked_inverse(&place)?;
-        if let Some(feature) = shape.left_out() {
-            return Err(SceneError::ShapeLeftOut { feature });
-        }
         let top = match shape {
             Shape::Cone { top } => top,
             _ => 0.0,
