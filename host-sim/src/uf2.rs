@@ -105,15 +105,8 @@ pub enum Scenes<'a> {
 /// target and feature set, not once per image (a folder per image took 14 GB for the project's
 /// checks); the copy keeps an image from being overwritten by the next build of the same binary.
 pub fn build_image(root: &Path, name: &str, args: &[&str], scenes: Scenes, built: &Path) -> Result<PathBuf> {
-    build_image_with(root, name, args, scenes, built, &[])
-}
-
-/// [`build_image`] with these variables set in cargo's environment (the firmware's build script
-/// reads some, such as `FIRMWARE_FLASH_KIB`).
-pub fn build_image_with(root: &Path, name: &str, args: &[&str], scenes: Scenes, built: &Path, vars: &[(&str, String)]) -> Result<PathBuf> {
     let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cmd.current_dir(root).args(args).env_remove("RUSTFLAGS").env_remove("FIRMWARE_FLASH_KIB");
-    cmd.envs(vars.iter().map(|(k, v)| (k, v)));
     match scenes {
         Scenes::Inherited => {}
         Scenes::Default => {

@@ -27,10 +27,10 @@ pub(crate) struct Variant {
     scenes: Option<&'static str>,
     scalar: &'static str,
     what: String,
-    /// The `tiny` build: the flash size its memory map is linked at (`FIRMWARE_FLASH_KIB`). It is
-    /// built without the firmware's default features (the shapes beyond the chair's boxes and
-    /// cylinders).
-    tiny: Option<u32>,
+    /// The `tiny` build: linked at its memory map's 16 KiB of flash (a bigger image fails to
+    /// link, and the report with it), and built without the firmware's default features (the
+    /// shapes beyond the chair's boxes and cylinders).
+    tiny: bool,
 }
 
 /// The Pico 2 core's variant with the scenes baked, as the Pico 2 image has them.
@@ -59,7 +59,7 @@ fn variants() -> Vec<Variant> {
                 scenes: None,
                 scalar,
                 what: format!("{core}, {scalar}, all five scenes"),
-                tiny: None,
+                tiny: false,
             });
         }
     }
@@ -74,7 +74,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "f32",
         what: "Cortex-M33 (the Pico 2's core), f32, all five scenes baked, as the Pico 2 image has them".into(),
-        tiny: None,
+        tiny: false,
     });
     for (scalar, feature) in [SCALARS[0], SCALARS[1]] {
         v.push(Variant {
@@ -87,7 +87,7 @@ fn variants() -> Vec<Variant> {
             scenes: Some("chair"),
             scalar,
             what: format!("Cortex-M0+, {scalar}, only the chair embedded"),
-            tiny: None,
+            tiny: false,
         });
     }
     // The smallest board: a BBC micro:bit (nRF51822, Cortex-M0, 16 KiB of RAM), the chair alone.
@@ -101,7 +101,7 @@ fn variants() -> Vec<Variant> {
         scenes: Some("chair"),
         scalar: "fixed",
         what: "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, run on QEMU's microbit machine), fixed, only the chair embedded".into(),
-        tiny: None,
+        tiny: false,
     });
     // What adaptive sub-sampling saves: the same build tracing one eye ray per pixel.
     v.push(Variant {
@@ -114,7 +114,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Cortex-M0+, fixed, all five scenes, one eye ray per pixel (exact-sampling) instead of adaptive sub-sampling".into(),
-        tiny: None,
+        tiny: false,
     });
     // What a progressive frame costs: the same build showing each frame in four passes.
     v.push(Variant {
@@ -127,7 +127,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Cortex-M0+, fixed, all five scenes, each frame in four progressive passes (8x8, 4x4, 2x2 blocks, then the frame; the last pass is the frame checked)".into(),
-        tiny: None,
+        tiny: false,
     });
     // What the effect set saves: every effect forced in, and the matte paper scenes with their
     // derived set against every effect (the same scenes, so the difference is the effect code).
@@ -153,7 +153,7 @@ fn variants() -> Vec<Variant> {
             scenes,
             scalar: "fixed",
             what: what.into(),
-            tiny: None,
+            tiny: false,
         });
     }
     // The baked images the flash targets are about, built for size (the `small` profile:
@@ -175,11 +175,11 @@ fn variants() -> Vec<Variant> {
             scenes,
             scalar: "fixed",
             what: what.into(),
-            tiny: None,
+            tiny: false,
         });
     }
     // The smallest parts: the chair alone in 16 KiB of flash and 4 KiB of RAM, linker-enforced
-    // (tiny/memory.x; [`tiny_section`] also asks the linker at 16 KiB whatever it is run at).
+    // (tiny/memory.x).
     v.push(Variant {
         name: TINY.into(),
         target: "thumbv6m-none-eabi",
@@ -190,7 +190,7 @@ fn variants() -> Vec<Variant> {
         scenes: Some("chair"),
         scalar: "fixed",
         what: "the smallest Cortex-M0 parts' memory (tiny/memory.x: 16 KiB of flash and 4 KiB of RAM, linker-enforced, flip-link), fixed, only the chair, baked, built for size".into(),
-        tiny: Some(16),
+        tiny: true,
     });
     v.push(Variant {
         name: "pico".into(),
@@ -202,7 +202,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "fixed",
         what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes baked (run on an emulated board by `cargo xtask board`: docs/board.md)".into(),
-        tiny: None,
+        tiny: false,
     });
     v.push(Variant {
         name: "pico2".into(),
@@ -214,7 +214,7 @@ fn variants() -> Vec<Variant> {
         scenes: None,
         scalar: "f32",
         what: "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes baked (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32-baked)".into(),
-        tiny: None,
+        tiny: false,
     });
     v
 }
@@ -240,7 +240,7 @@ pub(crate) fn elf_path(root: &Path, v: &Variant) -> PathBuf {
 /// The cargo arguments that build variant `v`.
 fn cargo_args(v: &Variant) -> Vec<&str> {
     let mut args = vec!["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target];
-    if v.tiny.is_some() {
+    if v.tiny {
         args.push("--no-default-features");
     }
     args
@@ -250,8 +250,7 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
     let args = cargo_args(v);
     let built = Path::new(v.target).join(v.profile).join(v.bin);
     let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);
-    let vars: Vec<(&str, String)> = v.tiny.map(|k| ("FIRMWARE_FLASH_KIB", k.to_string())).into_iter().collect();
-    host_sim::uf2::build_image_with(root, &v.name, &args, scenes, &built, &vars).with_context(|| format!("building firmware variant {} failed", v.name))?;
+    host_sim::uf2::build_image(root, &v.name, &args, scenes, &built).with_context(|| format!("building firmware variant {} failed", v.name))?;
     Ok(())
 }
 
@@ -461,43 +460,18 @@ fn baked_static_bytes(elf: &Path) -> Result<u64> {
 /// The `tiny` build's variant: the chair in the smallest parts' memory map.
 const TINY: &str = "tiny-m0-fixed-chair";
 
-/// What the linker says of the `tiny` build at the 16 KiB of flash its memory map gives: `Ok(None)`
-/// if the image fits, else by how many bytes the flash region overflows (the largest overflow it
-/// reports, that of the last section placed).
-fn tiny_overflow(root: &Path, v: &Variant) -> Result<Option<u64>> {
-    let out = tiny_build(root, v, v.scenes.unwrap_or("chair"))?;
-    if out.status.success() {
-        return Ok(None);
-    }
-    let text = String::from_utf8_lossy(&out.stderr);
-    let over = text
-        .lines()
-        .filter_map(|l| l.split("overflowed by ").nth(1)?.split_whitespace().next()?.parse::<u64>().ok())
-        .max();
-    match over {
-        Some(bytes) => Ok(Some(bytes)),
-        None => bail!("the tiny build failed at 16 KiB for another reason than its size:\n{text}"),
-    }
-}
-
-/// The `tiny` build of `scenes` linked at the 16 KiB of flash its memory map gives, as cargo
-/// left it (the image is not kept).
-fn tiny_build(root: &Path, v: &Variant, scenes: &str) -> Result<std::process::Output> {
-    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+/// What the `tiny` build, which leaves out spheres and cones, says when it is built with a scene
+/// of spheres: the reason it refuses it (`None` if it did not, and would draw it without them).
+fn tiny_refuses_spheres(root: &Path, v: &Variant) -> Result<Option<String>> {
+    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .current_dir(root)
         .args(cargo_args(v))
         .env_remove("RUSTFLAGS")
         .env_remove("FIRMWARE_FLASH_KIB")
-        .env("FIRMWARE_SCENES", scenes)
+        .env("FIRMWARE_SCENES", "spheres")
         .stdin(Stdio::null())
         .output()
-        .context("cannot run cargo")
-}
-
-/// What the `tiny` build, which leaves out spheres and cones, says when it is built with a scene
-/// of spheres: the reason it refuses it (`None` if it did not, and would draw it without them).
-fn tiny_refuses_spheres(root: &Path, v: &Variant) -> Result<Option<String>> {
-    let out = tiny_build(root, v, "spheres")?;
+        .context("cannot run cargo")?;
     let text = String::from_utf8_lossy(&out.stderr);
     let why = text.lines().find_map(|l| Some(l.split_once("spheres.scene: ")?.1.trim().to_string())).filter(|w| w.contains("which this build leaves out"));
     Ok(why.filter(|_| !out.status.success()))
@@ -509,7 +483,6 @@ fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identica
     let flash = elf_sizes(&elf_path(root, v))?.0;
     let ram = r.statics + r.stack;
     let same = r.scenes.iter().all(|s| identical.get(&(TINY.to_string(), s.name.clone())) == Some(&true));
-    let over = tiny_overflow(root, v)?;
     let refuses = tiny_refuses_spheres(root, v)?;
     if refuses.is_some() {
         tally.passed += 1;
@@ -539,21 +512,14 @@ fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identica
     writeln!(md, "`core::fmt` code is linked.\n")?;
     writeln!(md, "| target | measured | limit | met |\n|---|---:|---:|---|")?;
     writeln!(md, "| RAM (static + stack high-water, in the 4 KiB map) | {ram} B | 4096 B | {} |", if ram <= 4 << 10 { "yes" } else { "**no**" })?;
-    let fits = over.is_none();
-    writeln!(md, "| flash | {flash} B | 16384 B | {} |", if fits { "yes" } else { "**no**" })?;
-    match over {
-        None => writeln!(
-            md,
-            "\nLinked at 16 KiB the image fits, {} B to spare, and runs there: the chair's frame {} host-sim's, bit for bit.",
-            (16 << 10) - flash as i64,
-            if same { "equals" } else { "**differs from**" }
-        )?,
-        Some(bytes) => writeln!(
-            md,
-            "\nLinked at 16 KiB the linker refuses the image: its flash region overflows by {bytes} B (`rust-lld`:\n*section will not fit in region 'FLASH'*). So it is linked at 32 KiB (`FIRMWARE_FLASH_KIB=32`) to run:\nthe chair's frame {} host-sim's, bit for bit.",
-            if same { "equals" } else { "**differs from**" }
-        )?,
-    }
+    // The image was linked in that memory map: the flash row can only say yes.
+    writeln!(md, "| flash | {flash} B | 16384 B | {} |", if flash <= 16 << 10 { "yes" } else { "**no**" })?;
+    writeln!(
+        md,
+        "\nLinked at its memory map's 16 KiB (a bigger image fails to link, and this report with it), it has {} B to\nspare, and runs there: the chair's frame {} host-sim's, bit for bit.",
+        (16 << 10) - flash as i64,
+        if same { "equals" } else { "**differs from**" }
+    )?;
     Ok(())
 }
 
