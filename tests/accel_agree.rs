@@ -9,8 +9,8 @@ use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, Q
 use proptest::prelude::*;
 
 /// Rays aimed to hurt: random, axis-aligned with +0.0/-0.0 components, starting on lattice
-/// planes, and through lattice corners.
-fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &mut Rng, n: usize) -> Vec<Ray<R>> {
+/// planes, through lattice corners, and from outside the world, up to `far` times 60 units away.
+fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &mut Rng, n: usize, far: f64) -> Vec<Ray<R>> {
     let w = scene.world();
     let pick = |rng: &mut Rng, a: usize| {
         let c = lat.coordinate_list(0, a);
@@ -39,11 +39,17 @@ fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &m
                 let p = Vec3::new(pick(rng, 0), pick(rng, 1), pick(rng, 2));
                 d = p - o;
             }
-            // Starting outside the world, aimed at its inside.
+            // Starting outside the world (near, or far enough that rounding of the origin
+            // outweighs an object's own padding), aimed at its inside.
             3 => {
                 let target = o;
-                o = Vec3::new(R::from_f64(-50.0), inside(rng, 1), R::from_f64(-60.0));
+                let far = if rng.below(2) == 0 { 1.0 } else { far };
+                o = Vec3::new(R::from_f64(-50.0 * far), inside(rng, 1), R::from_f64(-60.0 * far));
                 d = target - o;
+                if far > 1.0 {
+                    // About unit length, as eye and secondary rays are.
+                    d = d * (R::ONE / d.max_abs());
+                }
             }
             // From the camera, as eye rays do.
             4 => o = scene.camera().eye,
@@ -62,14 +68,15 @@ fn check<R: Real>(p: &RandomScene, cfg: &LatticeConfig, nrays: usize) -> Result<
     let mut parts = lattice_rt::Parts::default();
     let mut b = SceneBuilder::new(&mut storage, &mut parts);
     random_scene(&mut b, p).unwrap();
-    check_scene(&b.finish().unwrap(), cfg, p.seed, nrays)
+    // Up to 2,000 units away in fixed point (a quarter of its coordinate range), 24,000 in floats.
+    check_scene(&b.finish().unwrap(), cfg, p.seed, nrays, (R::LIMIT / 240.0).min(400.0))
 }
 
-fn check_scene<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, seed: u64, nrays: usize) -> Result<(), TestCaseError> {
+fn check_scene<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, seed: u64, nrays: usize, far: f64) -> Result<(), TestCaseError> {
     let mut bufs = lattice_storage(scene, cfg);
     let lat = build_lattice(scene, cfg, &mut bufs);
     let mut rng = Rng::new(seed ^ 0xABCD);
-    let rays = adversarial_rays(&lat, scene, &mut rng, nrays);
+    let rays = adversarial_rays(&lat, scene, &mut rng, nrays, far);
     let mut mb = vec![0; Query::mailbox_len(scene)];
     let mut q = Query::new(&mut mb);
     for ray in &rays {
@@ -195,7 +202,10 @@ fn check_crowded<R: Real>(seed: u64, n: usize, group: usize, cfg: &LatticeConfig
     if n > 12 * cfg.split as usize {
         prop_assert!(lat.lattices().len() > 1 + scene.composites().len(), "no dense cell got its own lattice");
     }
-    check_scene(&scene, cfg, seed, 400)
+    // Fixed point's far rays stay within its object-space range: these objects are small (a
+    // unit of object space is about 0.1), so from 2,000 units away an object-space distance
+    // passes 2^15 and saturates (as `far_away`'s `far_range` keeps to that range too).
+    check_scene(&scene, cfg, seed, 400, (R::LIMIT / 2400.0).min(400.0))
 }
 
 /// A scene of `lead` ungrouped objects followed by one composite of `members` objects, so that

@@ -3,6 +3,7 @@
 
 use super::{index, locate, Lattice, MAX_NESTING};
 use crate::accel::{offer, reach, slack, Hit, Query};
+use crate::bounds::at;
 use crate::math::Ray;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -43,7 +44,7 @@ impl<R: Real> Lattice<'_, R> {
                 w.ref_i += 1;
                 match item {
                     Ok(i) => {
-                        if q.first_visit(i) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
+                        if q.first_visit(i) && inv.may_meet(scene, i, tmin, reach(&best, tmax), q) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                             return best;
                         }
                     }
@@ -84,16 +85,64 @@ struct Inverse<R> {
     moves: [bool; 3],
     origin: [R; 3],
     factor: [R; 3],
+    /// `1 / d` per axis (zero where the ray does not move along it): what [`Inverse::may_meet`]
+    /// multiplies by, in every scalar.
+    inv: [R; 3],
+    /// The largest magnitude of the origin's coordinates.
+    size: R,
+    /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Real::BOX_BEFORE_TEST`]; in
+    /// fixed point only while no direction component reaches 64, so the reciprocal's rounding
+    /// stays within the padding).
+    boxes: bool,
 }
 
 impl<R: Real> Inverse<R> {
     fn new(ray: &Ray<R>) -> Self {
         let d = [ray.dir.x, ray.dir.y, ray.dir.z];
+        let boxes = R::BOX_BEFORE_TEST && (R::WALK_BY_RECIPROCAL || ray.dir.max_abs() < R::from_i32(64));
+        let inv = d.map(|v| if (boxes || R::WALK_BY_RECIPROCAL) && v != R::ZERO { v.recip() } else { R::ZERO });
         Inverse {
             moves: d.map(|v| v != R::ZERO),
             origin: [ray.origin.x, ray.origin.y, ray.origin.z],
-            factor: d.map(|v| if R::WALK_BY_RECIPROCAL && v != R::ZERO { v.recip() } else { v }),
+            factor: if R::WALK_BY_RECIPROCAL { inv } else { d },
+            inv,
+            size: ray.origin.max_abs(),
+            boxes,
         }
+    }
+
+    /// Whether the ray can meet object `i` on `[tmin, limit]`: the slab test of its box, by
+    /// the ray's reciprocals, before the exact test. A cell is bigger than most of the
+    /// objects listed in it, so most rays that pass a small object's cell miss its box, and
+    /// this test is a few products where the exact one maps the ray into object space.
+    ///
+    /// It never rejects an object the exact test would hit: the box is grown by the scalar's
+    /// padding of the origin's size and of its own (what rounding can move a crossing by), and
+    /// the range's ends by that of theirs. Counted as an inside test.
+    #[inline]
+    fn may_meet(&self, scene: &Scene<'_, R>, i: usize, tmin: R, limit: R, q: &mut Query<'_>) -> bool {
+        if !self.boxes {
+            return true;
+        }
+        q.stats.inside_tests += 1;
+        let b = &at(scene.objects, i).bounds;
+        let reach = |v: R| (v.abs() + R::ONE).padding();
+        let pad = reach(self.size);
+        let (mut lo, mut hi) = (tmin - reach(tmin), if limit == R::MAX { limit } else { limit + reach(limit) });
+        for a in 0..3 {
+            let (min, max) = (b.min.axis(a), b.max.axis(a));
+            let pad = pad + reach(min.abs().max(max.abs()));
+            let (min, max) = (min - pad, max + pad);
+            if self.moves[a] {
+                let (ta, tb) = ((min - self.origin[a]) * self.inv[a], (max - self.origin[a]) * self.inv[a]);
+                let (ta, tb) = if ta > tb { (tb, ta) } else { (ta, tb) };
+                lo = lo.max(ta);
+                hi = hi.min(tb);
+            } else if self.origin[a] < min || self.origin[a] > max {
+                return false;
+            }
+        }
+        lo <= hi
     }
 
     /// The ray parameter where the ray crosses `plane` on axis `a` (which it moves along).
