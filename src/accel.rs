@@ -97,6 +97,9 @@ pub struct Query<'m> {
     axis_normal: Option<(u32, u8, [u64; 3])>,
     /// The object the last test that hit was made against.
     last_hit: u32,
+    /// Whether a lattice walk tests an object's box before the object (see
+    /// [`Query::set_box_tests`]).
+    box_tests: bool,
     /// Objects the ray being traced is known to miss, so not tested ([`u32::MAX`]: none): the
     /// one it leaves ([`Query::set_leaving`]) and one already tried ([`Query::set_tried`]).
     skip: [u32; 2],
@@ -115,7 +118,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye_on: false, eye_uv: 0, first_light: None, axis_normal: None, last_hit: u32::MAX, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
+        Query { stats: Stats::default(), mailbox, ray_id: 0, eye_on: false, eye_uv: 0, first_light: None, axis_normal: None, last_hit: u32::MAX, box_tests: true, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -181,6 +184,24 @@ impl<'m> Query<'m> {
     #[inline]
     pub fn eye_ray(&self) -> Option<[i32; 2]> {
         self.eye_on.then(|| unpack_uv(self.eye_uv))
+    }
+    /// Switches a lattice walk's box test before each object's own (on by default; where the
+    /// scalar has it, [`Real::BOX_BEFORE_TEST`]): the same hits, fewer exact tests where objects
+    /// are smaller than their cells.
+    pub fn set_box_tests(&mut self, on: bool) {
+        self.box_tests = on;
+    }
+    /// Whether a lattice walk tests boxes before objects for the rays to come
+    /// ([`Query::set_box_tests`]).
+    #[inline]
+    pub fn box_tests(&self) -> bool {
+        self.box_tests
+    }
+    /// Whether the ray is tested through windows ([`crate::scene::EyeWindow`]s or
+    /// [`crate::scene::ShadowWindow`]s): an eye ray, or a shadow ray towards the first light.
+    #[inline]
+    pub(crate) fn by_windows(&self) -> bool {
+        self.eye_on || self.first_light.is_some()
     }
     /// The object that last hid light `l` from a shaded point, if any.
     pub fn occluder(&self, l: usize) -> Option<u32> {

@@ -182,6 +182,15 @@ impl<R: Real> Aabb<R> {
         let (t0, t1) = slab(o.y, d.y, self.min.y, self.max.y, t0, t1)?;
         slab(o.z, d.z, self.min.z, self.max.z, t0, t1)
     }
+    /// [`Aabb::clip`] of a ray from `origin` whose direction's reciprocal `inv` is known (per
+    /// axis `1 / d`, zero where `d` is zero): three slabs at two products each, no division.
+    #[inline]
+    pub fn clip_by_inverse(&self, origin: Vec3<R>, inv: Vec3<R>, t0: R, t1: R) -> Option<(R, R)> {
+        let (o, i) = (origin, inv);
+        let (t0, t1) = slab_by(o.x, i.x, self.min.x, self.max.x, t0, t1)?;
+        let (t0, t1) = slab_by(o.y, i.y, self.min.y, self.max.y, t0, t1)?;
+        slab_by(o.z, i.z, self.min.z, self.max.z, t0, t1)
+    }
     /// Converts to another scalar, rounding outwards by the target's padding so the box stays
     /// conservative.
     pub fn cast_padded<S: Real>(&self) -> Aabb<S> {
@@ -201,10 +210,16 @@ impl<R: Real> Aabb<R> {
 /// on that axis, cut to the slab `lo..=hi`.
 #[inline(always)]
 fn slab<R: Real>(o: R, d: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
-    if d == R::ZERO {
+    // A nonzero direction's reciprocal is never zero (it saturates in fixed point).
+    slab_by(o, if d == R::ZERO { R::ZERO } else { d.recip() }, lo, hi, t0, t1)
+}
+
+/// [`slab`] given the direction's reciprocal `inv` (zero for a zero direction).
+#[inline(always)]
+fn slab_by<R: Real>(o: R, inv: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
+    if inv == R::ZERO {
         return if o < lo || o > hi { None } else { Some((t0, t1)) };
     }
-    let inv = d.recip();
     cut((lo - o) * inv, (hi - o) * inv, t0, t1)
 }
 

@@ -247,6 +247,8 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     eye_rays: EyeRays,
     /// Whether a shadow ray first tries the object that last hid its light.
     coherence: bool,
+    /// Whether a lattice walk tests an object's box before the object ([`Query::set_box_tests`]).
+    box_tests: bool,
 }
 
 /// How eye rays find their nearest hit. Every eye ray starts at the eye, and each object knows
@@ -362,6 +364,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
             cutoff: R::ZERO,
             eye_rays: EyeRays::for_scene(scene),
             coherence: true,
+            box_tests: true,
         }
     }
 }
@@ -382,6 +385,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             cutoff: R::ZERO,
             eye_rays: EyeRays::for_scene(scene),
             coherence: true,
+            box_tests: true,
         })
     }
 
@@ -404,6 +408,17 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// method as it was, for comparing).
     pub fn set_shadow_coherence(&mut self, on: bool) {
         self.coherence = on;
+    }
+
+    /// Whether a lattice walk tests an object's box before the object (on by default).
+    pub fn box_tests(&self) -> bool {
+        self.box_tests
+    }
+
+    /// Switches the walk's box tests ([`Query::set_box_tests`]; the picture is the same either
+    /// way; off is the paper's walk, which tests every object of every cell it enters).
+    pub fn set_box_tests(&mut self, on: bool) {
+        self.box_tests = on;
     }
 
     /// The scene traced.
@@ -533,6 +548,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let mut total = R::ZERO;
         // The eye ray's window position (if the caller gave one) serves the eye ray alone.
         let eye_uv = q.eye_ray();
+        q.set_box_tests(self.box_tests);
         // The eye ray is traced first without a trip through the stack (the stack only holds
         // children).
         let mut primary = true;

@@ -425,6 +425,7 @@ fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<C
         tracer.set_eye_rays(how);
     }
     tracer.set_shadow_coherence(shot.tuning.shadow_coherence);
+    tracer.set_box_tests(shot.tuning.box_tests);
     let tuned = Frame { sampling: shot.tuning.sampling, ..RENDERED };
     // Every image but the ladder renders the constant RENDERED, whose sizes the compiler folds
     // into the render loop (a division by the window's size becomes a shift); named in each

@@ -107,20 +107,23 @@ pub struct Tuning {
     pub eye_rays: Option<EyeRays>,
     /// Shadow rays try the object that last hid their light first.
     pub shadow_coherence: bool,
+    /// A lattice walk tests an object's box before the object (`Tracer::set_box_tests`).
+    pub box_tests: bool,
     /// Eye rays per pixel.
     pub sampling: Sampling,
 }
 
 /// What the boards run: every lever on.
-pub const TUNING: Tuning = Tuning { eye_rays: None, shadow_coherence: true, sampling: SAMPLING };
+pub const TUNING: Tuning = Tuning { eye_rays: None, shadow_coherence: true, box_tests: true, sampling: SAMPLING };
 
 /// The ladder of the real-time work, from the paper's method to what the boards run, one lever
 /// added per rung (docs/board.md, written by `cargo xtask board` from the `ladder` image).
-pub const LADDER: [(&str, Tuning); 5] = [
-    ("the paper's nested lattice, one ray per pixel", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: false, sampling: Sampling::Center }),
-    ("+ shadow rays try the last occluder first", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, sampling: Sampling::Center }),
-    ("+ eye windows: the walk skips objects whose window misses the eye ray", Tuning { eye_rays: Some(EyeRays::Accelerator), shadow_coherence: true, sampling: Sampling::Center }),
-    ("+ eye rays and first-light shadow rays by windows alone, no walk", Tuning { eye_rays: Some(EyeRays::Windows), shadow_coherence: true, sampling: Sampling::Center }),
+pub const LADDER: [(&str, Tuning); 6] = [
+    ("the paper's nested lattice, one ray per pixel", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: false, box_tests: false, sampling: Sampling::Center }),
+    ("+ shadow rays try the last occluder first", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: false, sampling: Sampling::Center }),
+    ("+ the walk tests an object's box before the object", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
+    ("+ eye windows: the walk skips objects whose window misses the eye ray", Tuning { eye_rays: Some(EyeRays::Accelerator), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
+    ("+ eye rays and first-light shadow rays by windows alone, no walk", Tuning { eye_rays: Some(EyeRays::Windows), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
     ("+ adaptive sub-sampling (the boards' default)", TUNING),
 ];
 

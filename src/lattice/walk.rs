@@ -4,7 +4,7 @@
 use super::{index, locate, Lattice, MAX_NESTING};
 use crate::accel::{offer, reach, slack, Hit, Query};
 use crate::bounds::at;
-use crate::math::Ray;
+use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::Scene;
 
@@ -12,7 +12,7 @@ impl<R: Real> Lattice<'_, R> {
     /// Calls `visit(sub, cell_index, t_enter, t_exit)` for every cell of the world lattice the
     /// ray enters, in order, without testing objects (for tests and statistics).
     pub fn walk_cells(&self, ray: &Ray<R>, tmin: R, tmax: R, mut visit: impl FnMut([usize; 3], R, R)) {
-        let inv = Inverse::new(ray);
+        let inv = Inverse::new(ray, false);
         let Some((t0, t1)) = self.lattices[0].bounds.padded(slack(ray)).clip(ray, tmin, tmax) else { return };
         let mut slot = None;
         let w = Walker::start_in(&mut slot, self, 0, ray, &inv, t0, t1);
@@ -31,7 +31,8 @@ impl<R: Real> Lattice<'_, R> {
         let slack = slack(ray);
         let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
-        let inv = Inverse::new(ray);
+        // A window culls an object before its test for less than the box test costs.
+        let inv = Inverse::new(ray, R::BOX_BEFORE_TEST && q.box_tests() && !q.by_windows());
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
@@ -44,7 +45,7 @@ impl<R: Real> Lattice<'_, R> {
                 w.ref_i += 1;
                 match item {
                     Ok(i) => {
-                        if q.first_visit(i) && inv.may_meet(scene, i, tmin, reach(&best, tmax), q) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
+                        if q.first_visit(i) && inv.may_meet(scene, i, slack, tmin, reach(&best, tmax), q) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                             return best;
                         }
                     }
@@ -87,62 +88,43 @@ struct Inverse<R> {
     factor: [R; 3],
     /// `1 / d` per axis (zero where the ray does not move along it): what [`Inverse::may_meet`]
     /// multiplies by, in every scalar.
-    inv: [R; 3],
-    /// The largest magnitude of the origin's coordinates.
-    size: R,
-    /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Real::BOX_BEFORE_TEST`]; in
-    /// fixed point only while no direction component reaches 64, so the reciprocal's rounding
-    /// stays within the padding).
+    inv: Vec3<R>,
+    /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Real::BOX_BEFORE_TEST`], and
+    /// not through windows; in fixed point only while no direction component reaches 64, so
+    /// the reciprocal's rounding stays within the padding).
     boxes: bool,
 }
 
 impl<R: Real> Inverse<R> {
-    fn new(ray: &Ray<R>) -> Self {
+    /// The ray's inverse, for box tests too where `boxes` ([`Inverse::may_meet`]).
+    fn new(ray: &Ray<R>, boxes: bool) -> Self {
         let d = [ray.dir.x, ray.dir.y, ray.dir.z];
-        let boxes = R::BOX_BEFORE_TEST && (R::WALK_BY_RECIPROCAL || ray.dir.max_abs() < R::from_i32(64));
+        let boxes = boxes && (R::WALK_BY_RECIPROCAL || ray.dir.max_abs() < R::from_i32(64));
         let inv = d.map(|v| if (boxes || R::WALK_BY_RECIPROCAL) && v != R::ZERO { v.recip() } else { R::ZERO });
         Inverse {
             moves: d.map(|v| v != R::ZERO),
             origin: [ray.origin.x, ray.origin.y, ray.origin.z],
             factor: if R::WALK_BY_RECIPROCAL { inv } else { d },
-            inv,
-            size: ray.origin.max_abs(),
+            inv: Vec3::new(inv[0], inv[1], inv[2]),
             boxes,
         }
     }
 
-    /// Whether the ray can meet object `i` on `[tmin, limit]`: the slab test of its box, by
-    /// the ray's reciprocals, before the exact test. A cell is bigger than most of the
-    /// objects listed in it, so most rays that pass a small object's cell miss its box, and
-    /// this test is a few products where the exact one maps the ray into object space.
-    ///
-    /// It never rejects an object the exact test would hit: the box is grown by the scalar's
-    /// padding of the origin's size and of its own (what rounding can move a crossing by), and
-    /// the range's ends by that of theirs. Counted as an inside test.
+    /// Whether the ray can meet object `i` on `[tmin, limit]`: the slab test of its box grown
+    /// by `slack` (the walk's [`slack`]: what it grows every box by), by the ray's reciprocals,
+    /// before the exact test. A cell is bigger than many of the objects listed in it, so many
+    /// rays that pass a small object's cell miss its box, and this test is six products where
+    /// the exact one maps the ray into object space. It rejects no object the exact test would
+    /// hit on that range, as the walk's own clip of a sub-lattice's box rejects none of its
+    /// members. Counted as an inside test.
     #[inline]
-    fn may_meet(&self, scene: &Scene<'_, R>, i: usize, tmin: R, limit: R, q: &mut Query<'_>) -> bool {
+    fn may_meet(&self, scene: &Scene<'_, R>, i: usize, slack: R, tmin: R, limit: R, q: &mut Query<'_>) -> bool {
         if !self.boxes {
             return true;
         }
         q.stats.inside_tests += 1;
-        let b = &at(scene.objects, i).bounds;
-        let reach = |v: R| (v.abs() + R::ONE).padding();
-        let pad = reach(self.size);
-        let (mut lo, mut hi) = (tmin - reach(tmin), if limit == R::MAX { limit } else { limit + reach(limit) });
-        for a in 0..3 {
-            let (min, max) = (b.min.axis(a), b.max.axis(a));
-            let pad = pad + reach(min.abs().max(max.abs()));
-            let (min, max) = (min - pad, max + pad);
-            if self.moves[a] {
-                let (ta, tb) = ((min - self.origin[a]) * self.inv[a], (max - self.origin[a]) * self.inv[a]);
-                let (ta, tb) = if ta > tb { (tb, ta) } else { (ta, tb) };
-                lo = lo.max(ta);
-                hi = hi.min(tb);
-            } else if self.origin[a] < min || self.origin[a] > max {
-                return false;
-            }
-        }
-        lo <= hi
+        let [x, y, z] = self.origin;
+        at(scene.objects, i).bounds.padded(slack).clip_by_inverse(Vec3::new(x, y, z), self.inv, tmin, limit).is_some()
     }
 
     /// The ray parameter where the ray crosses `plane` on axis `a` (which it moves along).

@@ -872,6 +872,7 @@ fn ladder_frame(chair: &Path, tuning: &board_frame::Tuning) -> Result<Vec<u8>> {
             t.set_eye_rays(how);
         }
         t.set_shadow_coherence(tuning.shadow_coherence);
+        t.set_box_tests(tuning.box_tests);
     })?
     .bits)
 }
