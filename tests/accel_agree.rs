@@ -73,10 +73,15 @@ fn check<R: Real>(p: &RandomScene, cfg: &LatticeConfig, nrays: usize) -> Result<
 }
 
 fn check_scene<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, seed: u64, nrays: usize, far: f64) -> Result<(), TestCaseError> {
+    check_rays(scene, cfg, seed, nrays, far, |r| r)
+}
+
+/// [`check_scene`] with each ray first passed through `shape`.
+fn check_rays<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, seed: u64, nrays: usize, far: f64, shape: impl Fn(Ray<R>) -> Ray<R>) -> Result<(), TestCaseError> {
     let mut bufs = lattice_storage(scene, cfg);
     let lat = build_lattice(scene, cfg, &mut bufs);
     let mut rng = Rng::new(seed ^ 0xABCD);
-    let rays = adversarial_rays(&lat, scene, &mut rng, nrays, far);
+    let rays: Vec<Ray<R>> = adversarial_rays(&lat, scene, &mut rng, nrays, far).into_iter().map(shape).collect();
     let mut mb = vec![0; Query::mailbox_len(scene)];
     let mut q = Query::new(&mut mb);
     for ray in &rays {
@@ -118,6 +123,21 @@ proptest! {
     fn accelerators_agree_ray_by_ray_in_fixed_point(seed in any::<u64>(), n in 1usize..40, group in prop_oneof![Just(0usize), Just(3), Just(5)]) {
         let p = RandomScene { objects: n, composite_size: group, spread: 0.0, seed };
         check::<lattice_rt::Fx>(&p, &LatticeConfig::default(), rays_per_scene())?;
+    }
+
+    /// A scene hundreds of units across in fixed point (objects spread over 600 units, the eye
+    /// 700 beyond them): its own rays cross the lattice from far off, where the reciprocal's
+    /// rounding moves a box's crossings most (`slack` grows with the origin for that).
+    #[test]
+    fn wide_scenes_agree_in_fixed_point(seed in any::<u64>(), n in 2usize..40) {
+        let p = RandomScene { objects: n, composite_size: 0, spread: 600.0, seed };
+        let mut storage = vec![Object::<lattice_rt::Fx>::default(); n];
+        let mut parts = lattice_rt::Parts::default();
+        let mut b = SceneBuilder::new(&mut storage, &mut parts);
+        random_scene(&mut b, &p).unwrap();
+        // Directions about unit length, as the tracer's eye, secondary and shadow rays have.
+        let unit = |r: Ray<lattice_rt::Fx>| Ray::new(r.origin, r.dir * (lattice_rt::Fx::ONE / r.dir.max_abs()));
+        check_rays(&b.finish().unwrap(), &LatticeConfig::default(), seed, 400, 1.0, unit)?;
     }
 
     #[test]
