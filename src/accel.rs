@@ -185,9 +185,9 @@ impl<'m> Query<'m> {
     pub fn eye_ray(&self) -> Option<[i32; 2]> {
         self.eye_on.then(|| unpack_uv(self.eye_uv))
     }
-    /// Switches a lattice walk's box test before each object's own (on by default; where the
-    /// scalar has it, [`Real::BOX_BEFORE_TEST`]): the same hits, fewer exact tests where objects
-    /// are smaller than their cells.
+    /// Switches a lattice walk's box test before each object's own (on by default): the same
+    /// hits, fewer exact tests where objects are smaller than the cells that list them, at six
+    /// crossings per object met.
     pub fn set_box_tests(&mut self, on: bool) {
         self.box_tests = on;
     }

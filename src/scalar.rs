@@ -127,10 +127,6 @@ pub trait Real:
     /// the value is the same: fixed point's products by zero and one, and its sums with zero,
     /// are exact.
     const DEAR_PRODUCTS: bool = false;
-    /// Whether a lattice walk tests an object's box before the object itself (the slab test
-    /// by the ray's reciprocals): the same hits, fewer exact tests where objects are smaller
-    /// than the cells that list them, at six crossings per object met.
-    const BOX_BEFORE_TEST: bool = true;
     /// `self * x`, with `self` a weight that is often exactly one: where products are dear
     /// ([`Real::DEAR_PRODUCTS`]) `x` itself then. The same value.
     #[inline]

@@ -32,7 +32,7 @@ impl<R: Real> Lattice<'_, R> {
         let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
         // A window culls an object before its test for less than the box test costs.
-        let inv = Inverse::new(ray, R::BOX_BEFORE_TEST && q.box_tests() && !q.by_windows());
+        let inv = Inverse::new(ray, q.box_tests() && !q.by_windows());
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
@@ -89,9 +89,9 @@ struct Inverse<R> {
     /// `1 / d` per axis (zero where the ray does not move along it): what [`Inverse::may_meet`]
     /// multiplies by, in every scalar.
     inv: Vec3<R>,
-    /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Real::BOX_BEFORE_TEST`], and
-    /// not through windows; in fixed point only while no direction component reaches 64, so
-    /// the reciprocal's rounding stays within the padding).
+    /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Query::box_tests`], and not
+    /// through windows; in fixed point only while no direction component reaches 64, so the
+    /// reciprocal's rounding stays within the padding).
     boxes: bool,
 }
 
