@@ -12,6 +12,7 @@
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
 use crate::outline::Apron;
+use crate::math::Vec3;
 use crate::scalar::Real;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
@@ -585,11 +586,11 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
     // The eye ray through `(sx, sy)` (quarter pixels), its window position given to the query.
-    let mut window = Window::<R>::new(w4, h4);
+    let mut window = Window::<R>::new(cam, w4, h4);
     let mut eye = |q: &mut Query<'_>, sx: usize, sy: usize| {
-        let (uv, u, v) = window.at(sx as i32, sy as i32);
+        let (uv, column, row) = window.at(sx as i32, sy as i32);
         q.set_eye_ray(Some(uv));
-        cam.ray_through(u, v)
+        cam.ray_from(column, row)
     };
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut hits = Hits::new();
@@ -673,32 +674,36 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
 }
 
 /// Where a frame's eye rays pass the window: per quarter-pixel column its window coordinate
-/// ([`Camera::window_u`]) and ray factor ([`Camera::ray_u`]), and the same of the last row
-/// asked for, each kept from the last ray that needed it. Both depend on one position alone,
-/// so a tile's rays (row by row) compute them, each a division, once per column and row
-/// instead of once per ray; the values are the same.
-struct Window<R> {
+/// ([`Camera::window_u`]) and its part of the ray's direction ([`Camera::column`]), and the same
+/// of the last row asked for ([`Camera::row`]), each kept from the last ray that needed it. Each
+/// depends on one position alone, so a tile's rays (row by row) compute them, a division and
+/// three products, once per column and row instead of once per ray; the rays are the same
+/// ([`Camera::ray_from`]).
+struct Window<'c, R> {
+    camera: &'c Camera<R>,
     size: (i32, i32),
-    cols: [(i32, i32, R); MAX_TILE],
-    row: (i32, i32, R),
+    cols: [(i32, i32, Vec3<R>); MAX_TILE],
+    row: (i32, i32, Vec3<R>),
 }
 
-impl<R: Real> Window<R> {
-    fn new(w4: i32, h4: i32) -> Self {
-        Window { size: (w4, h4), cols: [(-1, 0, R::ZERO); MAX_TILE], row: (-1, 0, R::ZERO) }
+impl<'c, R: Real> Window<'c, R> {
+    fn new(camera: &'c Camera<R>, w4: i32, h4: i32) -> Self {
+        let zero = Vec3::new(R::ZERO, R::ZERO, R::ZERO);
+        Window { camera, size: (w4, h4), cols: [(-1, 0, zero); MAX_TILE], row: (-1, 0, zero) }
     }
 
-    /// Window position (2^-16 units) and ray factors `u`, `v` of the eye ray through `(sx, sy)`.
+    /// Window position (2^-16 units) and the column's and row's parts of the direction of the
+    /// eye ray through `(sx, sy)`.
     #[inline]
-    fn at(&mut self, sx: i32, sy: i32) -> ([i32; 2], R, R) {
+    fn at(&mut self, sx: i32, sy: i32) -> ([i32; 2], Vec3<R>, Vec3<R>) {
         let (w4, h4) = self.size;
         let c = &mut self.cols[(sx as usize >> 2) % MAX_TILE];
         if c.0 != sx {
-            *c = (sx, Camera::<R>::window_u(sx, w4), Camera::<R>::ray_u(sx, w4));
+            *c = (sx, Camera::<R>::window_u(sx, w4), self.camera.column(Camera::<R>::ray_u(sx, w4)));
         }
         let r = &mut self.row;
         if r.0 != sy {
-            *r = (sy, Camera::<R>::window_v(sy, h4), Camera::<R>::ray_v(sy, h4));
+            *r = (sy, Camera::<R>::window_v(sy, h4), self.camera.row(Camera::<R>::ray_v(sy, h4)));
         }
         ([c.1, r.1], c.2, r.2)
     }
