@@ -12,7 +12,7 @@
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
 use crate::outline::Apron;
-use crate::math::Vec3;
+use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::sample::Sampler;
@@ -46,6 +46,10 @@ pub struct Frame {
     /// Silhouette lines ([`crate::outline`]): the farther pixel of two neighbours that hit
     /// different objects is drawn black.
     pub outline: bool,
+    /// `Some(k)`: branches of the intersection tree weighing less than 2^-k are not traced, as
+    /// with [`Tracer::set_cutoff`] (the larger of the two cutoffs holds); `None`: the tracer's
+    /// own. 7 is half of one of the 64 gray steps a pixel's level takes.
+    pub cutoff: Option<u8>,
 }
 
 /// One core's share of a frame's tiles ([`render_share`]): tile `(tx, ty)` belongs to share `(tx + ty) % of`, a
@@ -113,6 +117,7 @@ impl Frame {
             rows: (0, u16::MAX),
             tone: Tone::LINEAR,
             outline: false,
+            cutoff: None,
         }
     }
 
@@ -553,6 +558,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
 ) -> Result<Stats, RenderError<D::Error>> {
     let keep = matches!(out, Out::Keep(_));
     check(frame, share, !keep)?;
+    let tracer = &tracer.with_cutoff_at_least(frame.cutoff);
     resolves(tracer.scene().camera(), frame)?;
     let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
     let (w, h) = (frame.width as usize, frame.height as usize);
@@ -588,9 +594,9 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     // The eye ray through `(sx, sy)` (quarter pixels), its window position given to the query.
     let mut window = Window::<R>::new(cam, w4, h4);
     let mut eye = |q: &mut Query<'_>, sx: usize, sy: usize| {
-        let (uv, column, row) = window.at(sx as i32, sy as i32);
+        let (uv, ray) = window.at(sx as i32, sy as i32);
         q.set_eye_ray(Some(uv));
-        cam.ray_from(column, row)
+        ray
     };
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     let mut hits = Hits::new();
@@ -674,38 +680,38 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
 }
 
 /// Where a frame's eye rays pass the window: per quarter-pixel column its window coordinate
-/// ([`Camera::window_u`]) and its part of the ray's direction ([`Camera::column`]), and the same
-/// of the last row asked for ([`Camera::row`]), each kept from the last ray that needed it. Each
-/// depends on one position alone, so a tile's rays (row by row) compute them, a division and
-/// three products, once per column and row instead of once per ray; the rays are the same
-/// ([`Camera::ray_from`]).
+/// ([`Camera::window_u`]) and ray factor ([`Camera::ray_u`]), and of the last row asked for its
+/// window coordinate and its part of the ray's direction ([`Camera::row`]), each kept from the
+/// last ray that needed it. Each depends on one position alone, so a tile's rays (row by row)
+/// compute them, a division (and for a row three products), once per column and row instead
+/// of once per ray; the rays are the same ([`Camera::ray_from`]). (Keeping each column's part
+/// of the direction too would save three more products a ray, for 64 more bytes of stack
+/// with 8x8 tiles, which the smallest boards do not have.)
 struct Window<'c, R> {
     camera: &'c Camera<R>,
     size: (i32, i32),
-    cols: [(i32, i32, Vec3<R>); MAX_TILE],
+    cols: [(i32, i32, R); MAX_TILE],
     row: (i32, i32, Vec3<R>),
 }
 
 impl<'c, R: Real> Window<'c, R> {
     fn new(camera: &'c Camera<R>, w4: i32, h4: i32) -> Self {
-        let zero = Vec3::new(R::ZERO, R::ZERO, R::ZERO);
-        Window { camera, size: (w4, h4), cols: [(-1, 0, zero); MAX_TILE], row: (-1, 0, zero) }
+        Window { camera, size: (w4, h4), cols: [(-1, 0, R::ZERO); MAX_TILE], row: (-1, 0, Vec3::new(R::ZERO, R::ZERO, R::ZERO)) }
     }
 
-    /// Window position (2^-16 units) and the column's and row's parts of the direction of the
-    /// eye ray through `(sx, sy)`.
+    /// Window position (2^-16 units) and the eye ray through `(sx, sy)`.
     #[inline]
-    fn at(&mut self, sx: i32, sy: i32) -> ([i32; 2], Vec3<R>, Vec3<R>) {
+    fn at(&mut self, sx: i32, sy: i32) -> ([i32; 2], Ray<R>) {
         let (w4, h4) = self.size;
         let c = &mut self.cols[(sx as usize >> 2) % MAX_TILE];
         if c.0 != sx {
-            *c = (sx, Camera::<R>::window_u(sx, w4), self.camera.column(Camera::<R>::ray_u(sx, w4)));
+            *c = (sx, Camera::<R>::window_u(sx, w4), Camera::<R>::ray_u(sx, w4));
         }
         let r = &mut self.row;
         if r.0 != sy {
             *r = (sy, Camera::<R>::window_v(sy, h4), self.camera.row(Camera::<R>::ray_v(sy, h4)));
         }
-        ([c.1, r.1], c.2, r.2)
+        ([c.1, r.1], self.camera.ray_from(self.camera.column(c.2), r.2))
     }
 }
 

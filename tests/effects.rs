@@ -74,39 +74,60 @@ fn a_tracer_without_refraction_refuses_glass() {
 #[test]
 fn forcing_every_effect_on_changes_no_pixel_of_any_scene() {
     for s in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
-        let text = scene_text(s);
-        let mut storage = vec![Object::<f64>::default(); 64];
-        let mut parts = lattice_rt::Parts::default();
-        let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
-        let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
-        let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
-        let frame = Frame::new(160, 100);
-        let derived = Tracer::new(&scene, &lat);
-        let mut all = Tracer::new(&scene, &lat);
-        all.set_effects(Effects::ALL);
-        let (a, sa) = render_tracer(&derived, &frame);
-        let (b, sb) = render_tracer(&all, &frame);
-        assert!(a == b, "{s}: forcing all effects changed the image");
-        assert!(sa.total_rays() <= sb.total_rays(), "{s}");
+        with_lattice::<f64, _>(s, |scene, lat| {
+            let frame = Frame::new(160, 100);
+            let derived = Tracer::new(scene, lat);
+            let mut all = Tracer::new(scene, lat);
+            all.set_effects(Effects::ALL);
+            let (a, sa) = render_tracer(&derived, &frame);
+            let (b, sb) = render_tracer(&all, &frame);
+            assert!(a == b, "{s}: forcing all effects changed the image");
+            assert!(sa.total_rays() <= sb.total_rays(), "{s}");
+        });
     }
 }
 
 #[test]
 fn a_one_level_cutoff_prunes_the_whitted_tree_and_barely_changes_the_frame() {
-    let text = scene_text("whitted");
-    let mut storage = vec![Object::<f64>::default(); 64];
-    let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
-    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
-    let frame = Frame::new(128, 64);
-    let exact = Tracer::new(&scene, &lat);
-    let mut pruned = Tracer::new(&scene, &lat);
-    pruned.set_cutoff(1.0 / 64.0);
-    let (a, sa) = render_tracer(&exact, &frame);
-    let (b, sb) = render_tracer(&pruned, &frame);
+    let ((a, sa), (b, sb)) = with_lattice::<f64, _>("whitted", |scene, lat| {
+        let frame = Frame::new(128, 64);
+        let exact = Tracer::new(scene, lat);
+        let mut pruned = Tracer::new(scene, lat);
+        pruned.set_cutoff(1.0 / 64.0);
+        (render_tracer(&exact, &frame), render_tracer(&pruned, &frame))
+    });
     let fewer = 1.0 - sb.total_rays() as f64 / sa.total_rays() as f64;
     let changed: u32 = a.iter().zip(&b).map(|(x, y)| (x ^ y).count_ones()).sum();
     assert!(fewer >= 0.30, "only {:.1} % fewer rays", 100.0 * fewer);
     assert!(changed as f64 <= 0.001 * 128.0 * 64.0, "{changed} pixels changed");
+}
+
+#[test]
+fn a_frames_cutoff_is_the_tracers_and_the_larger_holds() {
+    // A frame's cutoff of 2^-k renders what the tracer's own cutoff of 2^-k renders, rays
+    // counted alike; of two cutoffs the larger prunes; a scene without mirrors or glass
+    // traces the same rays either way.
+    for s in ["whitted", "spheres", "chair"] {
+        with_lattice::<f64, _>(s, |scene, lat| {
+            let plain = Frame::new(128, 64);
+            let framed = Frame { cutoff: Some(7), ..plain };
+            let exact = Tracer::new(scene, lat);
+            let mut own = Tracer::new(scene, lat);
+            own.set_cutoff(1.0 / 128.0);
+            let (a, sa) = render_tracer(&exact, &framed);
+            let (b, sb) = render_tracer(&own, &plain);
+            assert!(a == b && sa == sb, "{s}: the frame's cutoff and the tracer's differ");
+            let mut coarser = Tracer::new(scene, lat);
+            coarser.set_cutoff(1.0 / 64.0);
+            let (c, sc) = render_tracer(&coarser, &plain);
+            let (d, sd) = render_tracer(&coarser, &framed);
+            assert!(c == d && sc == sd, "{s}: a finer frame cutoff overrode the tracer's coarser one");
+            let (e, se) = render_tracer(&exact, &plain);
+            if s == "chair" {
+                assert!(e == a && se == sa, "chair: a cutoff changed a scene without mirrors or glass");
+            } else {
+                assert!(sa.total_rays() < se.total_rays(), "{s}: the frame's cutoff pruned nothing");
+            }
+        });
+    }
 }

@@ -7,36 +7,32 @@ mod common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, render_pass, render_share, BitFrame, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Tone, Traced, Tracer};
+use lattice_rt::{parse, render_pass, render_share, BitFrame, Dither, Frame, Fx, HeapScratch, NoHooks, Real, Sampling, Share, Tone, Traced, Tracer};
 
 /// The frames of each pass (shares rendered one after the other into one bitmap), the eye rays
 /// of all passes, and the plain frame with its eye rays.
 fn passes<R: Real>(name: &str, frame: Frame, of: u8) -> (Vec<Vec<u8>>, u64, Vec<u8>, u64) {
-    let text = scene_text(name);
-    let mut storage = vec![Object::<R>::default(); 64];
-    let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
-    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
-    let tracer = Tracer::new(&scene, &lat);
-    let (w, h) = (frame.width as u32, frame.height as u32);
-    let shares: Vec<Share> = (0..of).map(|index| Share { index, of }).collect();
-    let mut traced: Vec<Vec<Traced>> = shares.iter().map(|s| vec![Traced::default(); frame.traced_len(*s)]).collect();
-    let (mut frames, mut rays) = (Vec::new(), 0);
-    for pass in [8u8, 4, 2, 1] {
-        let mut bits = vec![0u8; BitFrame::bytes(w, h)];
-        let mut target = BitFrame::new(w, h, &mut bits).unwrap();
-        for (s, kept) in shares.iter().zip(traced.iter_mut()) {
-            let mut scratch = HeapScratch::new(&scene, &frame);
-            rays += render_pass(&tracer, &frame, *s, pass, kept, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap().rays[0];
+    with_lattice::<R, _>(name, |scene, lat| {
+        let tracer = Tracer::new(scene, lat);
+        let (w, h) = (frame.width as u32, frame.height as u32);
+        let shares: Vec<Share> = (0..of).map(|index| Share { index, of }).collect();
+        let mut traced: Vec<Vec<Traced>> = shares.iter().map(|s| vec![Traced::default(); frame.traced_len(*s)]).collect();
+        let (mut frames, mut rays) = (Vec::new(), 0);
+        for pass in [8u8, 4, 2, 1] {
+            let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+            let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+            for (s, kept) in shares.iter().zip(traced.iter_mut()) {
+                let mut scratch = HeapScratch::new(scene, &frame);
+                rays += render_pass(&tracer, &frame, *s, pass, kept, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap().rays[0];
+            }
+            frames.push(bits);
         }
-        frames.push(bits);
-    }
-    let mut plain = vec![0u8; BitFrame::bytes(w, h)];
-    let mut target = BitFrame::new(w, h, &mut plain).unwrap();
-    let mut scratch = HeapScratch::new(&scene, &frame);
-    let stats = render_share(&tracer, &frame, Share::ALL, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
-    (frames, rays, plain, stats.rays[0])
+        let mut plain = vec![0u8; BitFrame::bytes(w, h)];
+        let mut target = BitFrame::new(w, h, &mut plain).unwrap();
+        let mut scratch = HeapScratch::new(scene, &frame);
+        let stats = render_share(&tracer, &frame, Share::ALL, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
+        (frames, rays, plain, stats.rays[0])
+    })
 }
 
 #[test]

@@ -6,29 +6,25 @@ mod common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;
-use lattice_rt::{dither_band, parse, render_pass, trace_pass, KeptTile, render, render_share, trace_share, BitFrame, Traced, Dither, Frame, Fx, HeapScratch, LatticeConfig, NoHooks, Real, Sampling, Share, Stats, Tracer};
+use lattice_rt::{dither_band, parse, render_pass, trace_pass, KeptTile, render, render_share, trace_share, BitFrame, Traced, Dither, Frame, Fx, HeapScratch, NoHooks, Real, Sampling, Share, Stats, Tracer};
 
 /// Renders `name` into a fresh 1-bit frame for each frame in `frames`, all into one bitmap.
 fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
-    let text = scene_text(name);
-    let mut storage = vec![Object::<R>::default(); 64];
-    let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
-    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
-    let mut tracer = Tracer::new(&scene, &lat);
-    tracer.set_shadow_coherence(coherence);
-    let (w, h) = (frames[0].0.width as u32, frames[0].0.height as u32);
-    let mut bits = vec![0u8; BitFrame::bytes(w, h)];
-    let mut target = BitFrame::new(w, h, &mut bits).unwrap();
-    let mut stats = Stats::default();
-    for (f, share) in frames {
-        let mut scratch = HeapScratch::new(&scene, f);
-        let s = render_share(&tracer, f, *share, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
-        stats.object_tests += s.object_tests;
-        stats.rays[0] += s.rays[0];
-    }
-    (bits, stats)
+    with_lattice::<R, _>(name, |scene, lat| {
+        let mut tracer = Tracer::new(scene, lat);
+        tracer.set_shadow_coherence(coherence);
+        let (w, h) = (frames[0].0.width as u32, frames[0].0.height as u32);
+        let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+        let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+        let mut stats = Stats::default();
+        for (f, share) in frames {
+            let mut scratch = HeapScratch::new(scene, f);
+            let s = render_share(&tracer, f, *share, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
+            stats.object_tests += s.object_tests;
+            stats.rays[0] += s.rays[0];
+        }
+        (bits, stats)
+    })
 }
 
 fn shares_of(frame: Frame, of: u8) -> Vec<(Frame, Share)> {
@@ -129,48 +125,44 @@ fn shares_count_their_tiles_as_the_checkerboard_holds_them() {
 /// is dithered in parts of that many tiles (`dither_tiles`, as the two-core board dithers the
 /// tiles traced so far); with none, whole (`dither_band`).
 fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8, part: Option<usize>) -> Vec<u8> {
-    let text = scene_text(name);
-    let mut storage = vec![Object::<R>::default(); 64];
-    let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
-    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
-    let tracer = Tracer::new(&scene, &lat);
-    let (w, h) = (frame.width as u32, frame.height as u32);
-    let mut bits = vec![0u8; BitFrame::bytes(w, h)];
-    let mut target = BitFrame::new(w, h, &mut bits).unwrap();
-    let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
-    let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
-    let bands = (h as usize).div_ceil(frame.tile as usize) as u16;
-    let mut above = vec![(0u16, 0u16); w as usize];
-    let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * frame.tile as usize];
-    for ty in 0..bands {
-        let band = Frame { rows: (ty, ty + 1), ..frame };
-        let kept: Vec<Vec<KeptTile>> = (0..of)
-            .map(|index| {
-                let share = Share { index, of };
-                let mut kept = vec![KeptTile::EMPTY; band.tiles_len(share)];
-                let mut scratch = HeapScratch::new(&scene, &band);
-                trace_share(&tracer, &band, share, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
-                kept
-            })
-            .collect();
-        // Share s holds the tiles tx = s - ty (mod of) of this row: tile tx is its (tx / of)-th.
-        let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
-        match part {
-            None => dither_band(&frame, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap(),
-            Some(part) => {
-                let (tiles, mut from, mut left) = ((w as usize).div_ceil(frame.tile as usize), 0, [(0, 0); lattice_rt::dither::MAX_TILE]);
-                while from < tiles {
-                    let upto = |tx: usize| if tx < from + part { tile(tx) } else { None };
-                    let next = lattice_rt::dither_tiles(&frame, (ty as usize, from), upto, (&mut above, &mut band_bits, &mut left), &mut ditherer, &mut target).unwrap();
-                    assert_eq!(next, (from + part).min(tiles), "a part ends where its tiles end");
-                    from = next;
+    with_lattice::<R, _>(name, |scene, lat| {
+        let tracer = Tracer::new(scene, lat);
+        let (w, h) = (frame.width as u32, frame.height as u32);
+        let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+        let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+        let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
+        let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
+        let bands = (h as usize).div_ceil(frame.tile as usize) as u16;
+        let mut above = vec![(0u16, 0u16); w as usize];
+        let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * frame.tile as usize];
+        for ty in 0..bands {
+            let band = Frame { rows: (ty, ty + 1), ..frame };
+            let kept: Vec<Vec<KeptTile>> = (0..of)
+                .map(|index| {
+                    let share = Share { index, of };
+                    let mut kept = vec![KeptTile::EMPTY; band.tiles_len(share)];
+                    let mut scratch = HeapScratch::new(scene, &band);
+                    trace_share(&tracer, &band, share, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                    kept
+                })
+                .collect();
+            // Share s holds the tiles tx = s - ty (mod of) of this row: tile tx is its (tx / of)-th.
+            let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
+            match part {
+                None => dither_band(&frame, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap(),
+                Some(part) => {
+                    let (tiles, mut from, mut left) = ((w as usize).div_ceil(frame.tile as usize), 0, [(0, 0); lattice_rt::dither::MAX_TILE]);
+                    while from < tiles {
+                        let upto = |tx: usize| if tx < from + part { tile(tx) } else { None };
+                        let next = lattice_rt::dither_tiles(&frame, (ty as usize, from), upto, (&mut above, &mut band_bits, &mut left), &mut ditherer, &mut target).unwrap();
+                        assert_eq!(next, (from + part).min(tiles), "a part ends where its tiles end");
+                        from = next;
+                    }
                 }
             }
         }
-    }
-    bits
+        bits
+    })
 }
 
 #[test]
@@ -214,60 +206,56 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
 #[test]
 fn traced_passes_dithered_in_order_give_every_pass() {
     for name in ["chair", "whitted"] {
-        let text = scene_text(name);
-        let mut storage = vec![Object::<Fx>::default(); 64];
-        let mut parts = lattice_rt::Parts::default();
-        let scene = parse::<Fx>(&text, &mut storage, &mut parts).unwrap();
-        let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
-        let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
-        let tracer = Tracer::new(&scene, &lat);
-        let frame = Frame { dither: Dither::BlueNoise, outline: true, sampling: Sampling::Adaptive { contrast: 4 }, ..Frame::new(128, 64) };
-        let (w, h) = (128u32, 64u32);
-        // What render_pass draws, pass by pass.
-        let mut want = Vec::new();
-        let mut bits = vec![0u8; BitFrame::bytes(w, h)];
-        let mut traced = vec![Traced::default(); frame.traced_len(Share::ALL)];
-        for pass in [8, 4, 2, 1] {
-            let mut target = BitFrame::new(w, h, &mut bits).unwrap();
-            let mut scratch = HeapScratch::new(&scene, &frame);
-            render_pass(&tracer, &frame, Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
-            want.push(bits.clone());
-        }
-        {
-            // Each tile keeps its own rays between passes (16 per 8x8 tile), as the board's do.
-            let mut traced = vec![vec![Traced::default(); 16]; frame.tiles_len(Share::ALL)];
-            for (k, pass) in [8, 4, 2, 1].into_iter().enumerate() {
-                let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+        with_lattice::<Fx, _>(name, |scene, lat| {
+            let tracer = Tracer::new(scene, lat);
+            let frame = Frame { dither: Dither::BlueNoise, outline: true, sampling: Sampling::Adaptive { contrast: 4 }, ..Frame::new(128, 64) };
+            let (w, h) = (128u32, 64u32);
+            // What render_pass draws, pass by pass.
+            let mut want = Vec::new();
+            let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+            let mut traced = vec![Traced::default(); frame.traced_len(Share::ALL)];
+            for pass in [8, 4, 2, 1] {
                 let mut target = BitFrame::new(w, h, &mut bits).unwrap();
-                let shown = Frame { outline: frame.outline && pass == 1, ..frame };
-                let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
-                let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
-                let mut above = vec![(0u16, 0u16); w as usize];
-                let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * 8];
-                for ty in 0..(h / 8) as u16 {
-                    let band = Frame { rows: (ty, ty + 1), ..frame };
-                    // The band's tiles in `of` shares, each tile traced alone (`Share::single`).
-                    let tiles_x = 16;
-                    let kept: Vec<KeptTile> = (0..tiles_x)
-                        .map(|tx| {
-                            let share = Share::single(tx, ty as usize, tiles_x);
-                            let mut kept = [KeptTile::EMPTY];
-                            let mut scratch = HeapScratch::new(&scene, &band);
-                            let rays = &mut traced[ty as usize * tiles_x + tx];
-                            trace_pass(&tracer, &band, share, pass, rays, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
-                            kept[0]
-                        })
-                        .collect();
-                    let tile = |tx: usize| kept.get(tx);
-                    dither_band(&shown, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap();
-                }
-                assert_eq!(bits, want[k], "{name}, pass {pass}");
+                let mut scratch = HeapScratch::new(scene, &frame);
+                render_pass(&tracer, &frame, Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                want.push(bits.clone());
             }
-        }
-        // A frame that cannot be progressive, or a pass that is not one, is refused.
-        let mut kept = vec![KeptTile::EMPTY; frame.tiles_len(Share::ALL)];
-        let mut scratch = HeapScratch::new(&scene, &frame);
-        let err = trace_pass(&tracer, &frame, Share::ALL, 3, &mut traced, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap_err();
-        assert_eq!(err, RenderError::NotProgressive);
+            {
+                // Each tile keeps its own rays between passes (16 per 8x8 tile), as the board's do.
+                let mut traced = vec![vec![Traced::default(); 16]; frame.tiles_len(Share::ALL)];
+                for (k, pass) in [8, 4, 2, 1].into_iter().enumerate() {
+                    let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+                    let mut target = BitFrame::new(w, h, &mut bits).unwrap();
+                    let shown = Frame { outline: frame.outline && pass == 1, ..frame };
+                    let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
+                    let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
+                    let mut above = vec![(0u16, 0u16); w as usize];
+                    let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * 8];
+                    for ty in 0..(h / 8) as u16 {
+                        let band = Frame { rows: (ty, ty + 1), ..frame };
+                        // The band's tiles in `of` shares, each tile traced alone (`Share::single`).
+                        let tiles_x = 16;
+                        let kept: Vec<KeptTile> = (0..tiles_x)
+                            .map(|tx| {
+                                let share = Share::single(tx, ty as usize, tiles_x);
+                                let mut kept = [KeptTile::EMPTY];
+                                let mut scratch = HeapScratch::new(scene, &band);
+                                let rays = &mut traced[ty as usize * tiles_x + tx];
+                                trace_pass(&tracer, &band, share, pass, rays, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                                kept[0]
+                            })
+                            .collect();
+                        let tile = |tx: usize| kept.get(tx);
+                        dither_band(&shown, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap();
+                    }
+                    assert_eq!(bits, want[k], "{name}, pass {pass}");
+                }
+            }
+            // A frame that cannot be progressive, or a pass that is not one, is refused.
+            let mut kept = vec![KeptTile::EMPTY; frame.tiles_len(Share::ALL)];
+            let mut scratch = HeapScratch::new(scene, &frame);
+            let err = trace_pass(&tracer, &frame, Share::ALL, 3, &mut traced, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap_err();
+            assert_eq!(err, RenderError::NotProgressive);
+        });
     }
 }

@@ -233,6 +233,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
         sampling: a.sampling.mode(),
         outline: !a.no_outline,
         tone: lattice_rt::Tone { gamma_tenths: a.gamma },
+        cutoff: a.cutoff,
         ..Frame::new(a.size.0, a.size.1)
     };
     let mut out = render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true)?;

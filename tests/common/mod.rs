@@ -44,6 +44,18 @@ pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, 
     (pbm, stats)
 }
 
+/// Calls `f` with scene `name` (from `scenes/`), parsed in `R`, and its lattice built with the
+/// default configuration.
+pub fn with_lattice<R: Real, T>(name: &str, f: impl FnOnce(&Scene<'_, R>, &Lattice<'_, R>) -> T) -> T {
+    let text = scene_text(name);
+    let mut storage = vec![Object::<R>::default(); 64];
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
+    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
+    f(&scene, &lat)
+}
+
 /// Parses `text` and renders it with one accelerator and the scene's own settings.
 pub fn render_text<R: Real>(text: &str, accel: Accel, frame: &Frame) -> (Vec<u8>, Stats) {
     let mut storage = vec![Object::<R>::default(); text.lines().count()];

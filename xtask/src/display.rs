@@ -55,6 +55,7 @@ impl Look {
             outline: self.outline,
             tone: Tone { gamma_tenths: self.gamma },
             tile: board_frame::PANEL_TILE,
+            cutoff: board_frame::CUTOFF,
             ..Frame::new(w, h)
         }
     }

@@ -47,7 +47,7 @@ fn configs() -> Vec<Config> {
     for d in 0..=4u8 {
         v.push(Config { knob: "depth", label: format!("depth {d}"), depth: Some(d), ..base.clone() });
     }
-    for (c, l) in [(1.0 / 256.0, "1/256"), (1.0 / 64.0, "1/64 (one level)"), (1.0 / 16.0, "1/16")] {
+    for (c, l) in [(1.0 / 256.0, "1/256"), (boards_cutoff(), BOARDS_CUTOFF), (1.0 / 64.0, "1/64 (one level)"), (1.0 / 16.0, "1/16")] {
         v.push(Config { knob: "cutoff", label: format!("cutoff {l}"), cutoff: c, ..base.clone() });
     }
     for n in [8u8, 4, 2] {
@@ -65,6 +65,14 @@ fn configs() -> Vec<Config> {
     v.push(Config { knob: "dither", label: "floyd-steinberg".into(), dither: Dither::FloydSteinberg, ..base.clone() });
     v.push(Config { knob: "dither", label: "atkinson".into(), dither: Dither::Atkinson, ..base.clone() });
     v
+}
+
+/// The label of the boards' cutoff ([`board_records::frame::CUTOFF`]).
+const BOARDS_CUTOFF: &str = "1/128 (half a level: the boards' frames)";
+
+/// The boards' cutoff as a weight (0 with none).
+fn boards_cutoff() -> f64 {
+    board_records::frame::CUTOFF.map_or(0.0, |k| 0.5f64.powi(i32::from(k)))
 }
 
 /// The label of adaptive sampling in the Pico's 16x16 tiles (the QEMU boards' frames have 8x8).
@@ -335,12 +343,18 @@ fn targets_section(md: &mut String, configs: &[Config], tallies: &[Tally], names
             }
         }
     }
-    for (what, label) in [("the QEMU boards' 8x8 tiles", "adaptive, contrast <= 4"), ("the Pico's 16x16 tiles", PICO_ADAPTIVE)] {
+    let cutoff = format!("cutoff {BOARDS_CUTOFF}");
+    let boards = [
+        (format!("the boards' contribution cutoff, {BOARDS_CUTOFF}"), cutoff.as_str(), "without"),
+        ("adaptive sub-sampling (the boards' default, contrast 4) in the QEMU boards' 8x8 tiles".into(), "adaptive, contrast <= 4", "with one ray per pixel"),
+        ("adaptive sub-sampling (the boards' default, contrast 4) in the Pico's 16x16 tiles".into(), PICO_ADAPTIVE, "with one ray per pixel"),
+    ];
+    for (what, label, against) in boards {
         if let (Some(one), Some(a)) = (find("f64, 1 ray"), find(label)) {
             let err = |t: &Tally| t.abs_sum / t.pixels.max(1) as f64;
             writeln!(
                 md,
-                "- adaptive sub-sampling (the boards' default, contrast 4) in {what}: mean gray error {:.3} against {:.3} with one ray per pixel ({:+.1} %), at {:.2}x the host time and {:.2}x the rays.",
+                "- {what}: mean gray error {:.3} against {:.3} {against} ({:+.1} %), at {:.2}x the host time and {:.2}x the rays.",
                 err(a),
                 err(one),
                 100.0 * (err(a) / err(one) - 1.0),
