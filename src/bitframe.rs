@@ -124,9 +124,28 @@ impl DrawTarget for BitFrame<'_> {
         }
         let stride = (self.width as usize).div_ceil(8);
         let mut colors = colors.into_iter();
+        let (x0, x1) = (x0 as usize, x0 as usize + w as usize);
         for y in y0 as usize..y0 as usize + h as usize {
             let row = span_mut(self.bits, y * stride..(y + 1) * stride);
-            for x in x0 as usize..x0 as usize + w as usize {
+            let mut x = x0;
+            while x < x1 {
+                if x % 8 == 0 && x1 - x >= 8 {
+                    // A whole byte of the row: its eight pixels packed, then stored at once.
+                    let mut byte = 0u8;
+                    for k in 0..8 {
+                        let Some(c) = colors.next() else {
+                            // Fewer colors than pixels: the first `k` pixels alone are drawn.
+                            let keep = 0xFFu8.checked_shr(k).unwrap_or(0);
+                            let b = at_mut(row, x / 8);
+                            *b = (*b & keep) | (byte << (8 - k) & !keep);
+                            return Ok(());
+                        };
+                        byte = byte << 1 | u8::from(c.is_on());
+                    }
+                    *at_mut(row, x / 8) = byte;
+                    x += 8;
+                    continue;
+                }
                 let Some(c) = colors.next() else { return Ok(()) };
                 let m = 0x80u8 >> (x % 8);
                 let byte = at_mut(row, x / 8);
@@ -135,6 +154,7 @@ impl DrawTarget for BitFrame<'_> {
                 } else {
                     *byte &= !m;
                 }
+                x += 1;
             }
         }
         Ok(())
@@ -150,7 +170,7 @@ mod tests {
     /// its pixels one by one sets.
     #[test]
     fn fill_contiguous_is_draw_iter() {
-        for (x, y, w, h) in [(0, 0, 8, 8), (8, 16, 8, 8), (3, 5, 7, 3), (20, 10, 8, 8), (-3, -2, 6, 5), (0, 0, 21, 13), (0, 0, 0, 4)] {
+        for (x, y, w, h) in [(0, 0, 8, 8), (8, 16, 8, 8), (3, 5, 7, 3), (20, 10, 8, 8), (-3, -2, 6, 5), (0, 0, 21, 13), (0, 0, 0, 4), (8, 1, 13, 4), (16, 0, 5, 2), (5, 3, 16, 2)] {
             let area = Rectangle::new(Point::new(x, y), Size::new(w, h));
             let colors = (0..w * h).map(|i| BinaryColor::from((i * 7 + i / 3) % 5 < 2));
             let (mut a, mut b) = ([0x5au8; 3 * 13], [0x5au8; 3 * 13]);
@@ -159,6 +179,20 @@ mod tests {
             let mut fb = BitFrame::wrap(21, 13, &mut b).unwrap();
             fb.draw_iter(area.points().zip(colors).map(|(p, c)| Pixel(p, c))).unwrap();
             assert_eq!(a, b, "area ({x}, {y}) {w}x{h}");
+        }
+    }
+
+    /// With fewer colors than the area has pixels, the pixels they reach are drawn and the rest
+    /// keep their bits, as drawing them one by one does.
+    #[test]
+    fn fill_contiguous_with_fewer_colors_draws_what_they_reach() {
+        for n in [0u32, 3, 8, 11, 16, 20] {
+            let area = Rectangle::new(Point::new(8, 2), Size::new(13, 3));
+            let colors = (0..n).map(|i| BinaryColor::from(i % 3 == 0));
+            let (mut a, mut b) = ([0x5au8; 3 * 13], [0x5au8; 3 * 13]);
+            BitFrame::wrap(21, 13, &mut a).unwrap().fill_contiguous(&area, colors.clone()).unwrap();
+            BitFrame::wrap(21, 13, &mut b).unwrap().draw_iter(area.points().zip(colors).map(|(p, c)| Pixel(p, c))).unwrap();
+            assert_eq!(a, b, "{n} colors");
         }
     }
 }
