@@ -144,18 +144,22 @@ fn floyd_steinberg(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColo
     let (row, below) = (&mut above[y], &mut below[0]);
     // `right`: the error arriving at the pixel; `b0`, `b1`: the row below's entries under the
     // pixel's left neighbour and under the pixel, with the shares they have so far.
-    let (mut right, mut b0, mut b1) = (row[1], below[0], below[1]);
+    // The carried errors stay far inside i16 (a pixel's error is within a level range of 0, and
+    // its shares sum to it), so they are summed as i32, which a Cortex-M0+ does without
+    // sign-extending every step, and stored back as they were: the same values.
+    let (mut right, mut b0, mut b1) = (i32::from(row[1]), i32::from(below[0]), i32::from(below[1]));
     for x in 0..w {
-        let (on, err) = quantize(levels[x], right);
+        let (on, err) = quantize(levels[x], right as i16);
         out[x] = BinaryColor::from(on);
-        right = row[x + 2] + err * 7 / 16;
-        below[x] = b0 + err * 3 / 16;
+        let err = i32::from(err);
+        right = i32::from(row[x + 2]) + err * 7 / 16;
+        below[x] = (b0 + err * 3 / 16) as i16;
         b0 = b1 + err * 5 / 16;
-        b1 = below[x + 2] + err / 16;
+        b1 = i32::from(below[x + 2]) + err / 16;
     }
-    row[w + 1] = right;
-    below[w] = b0;
-    below[w + 1] = b1;
+    row[w + 1] = right as i16;
+    below[w] = b0 as i16;
+    below[w + 1] = b1 as i16;
 }
 
 /// Atkinson: 1/8 to each of two right, three below and one two rows below (6/8 of the error).
