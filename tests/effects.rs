@@ -105,8 +105,8 @@ fn a_one_level_cutoff_prunes_the_whitted_tree_and_barely_changes_the_frame() {
 #[test]
 fn a_frames_cutoff_is_the_tracers_and_the_larger_holds() {
     // A frame's cutoff of 2^-k renders what the tracer's own cutoff of 2^-k renders, rays
-    // counted alike; of two cutoffs the larger prunes; a scene without mirrors or glass
-    // traces the same rays either way.
+    // counted alike; of two cutoffs the larger prunes; the chair's frame (no mirror or glass,
+    // and no light term below 1/128 at its camera) is the same either way.
     for s in ["whitted", "spheres", "chair"] {
         with_lattice::<f64, _>(s, |scene, lat| {
             let plain = Frame::new(128, 64);
@@ -124,7 +124,7 @@ fn a_frames_cutoff_is_the_tracers_and_the_larger_holds() {
             assert!(c == d && sc == sd, "{s}: a finer frame cutoff overrode the tracer's coarser one");
             let (e, se) = render_tracer(&exact, &plain);
             if s == "chair" {
-                assert!(e == a && se == sa, "chair: a cutoff changed a scene without mirrors or glass");
+                assert!(e == a && se == sa, "chair: the cutoff changed its frame");
             } else {
                 assert!(sa.total_rays() < se.total_rays(), "{s}: the frame's cutoff pruned nothing");
             }

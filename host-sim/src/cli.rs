@@ -186,9 +186,9 @@ pub struct RenderArgs {
     /// them unchanged).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u8).range(5..=20))]
     pub gamma: u8,
-    /// Contribution cutoff: mirror and glass branches weighing less than 2^-K of a pixel are
-    /// not traced (7: half a gray step, what the boards do; 1 to 30). Without it every branch
-    /// is traced.
+    /// Contribution cutoff: mirror and glass rays, and shadow rays of light terms, weighing
+    /// less than 2^-K of a pixel are not traced (7: half a gray step, what the boards do; 1 to
+    /// 30). Without it every branch is traced.
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u8).range(1..=30))]
     pub cutoff: Option<u8>,
 }

@@ -19,7 +19,9 @@ pub const SAMPLING: Sampling = Sampling::Adaptive { contrast: 4 };
 /// intersection tree weighing less than 2^-7, half of one of the 64 gray steps of a pixel's
 /// level, are not traced. Whitted's frame traces 28 % fewer rays with it (QEMU's Cortex-M0+
 /// build, `cargo xtask firmware`); what it changes is in docs/accuracy.md (`cargo xtask
-/// tradeoff`, cutoff 1/128). A scene without mirrors or glass traces the same rays.
+/// tradeoff`, cutoff 1/128). Besides mirror and glass rays it leaves out the shadow rays of a
+/// light whose term at a point is that faint (the light then counts as seen): a matte scene's
+/// frame changes only where light grazes a surface (the chair's default frame not at all).
 pub const CUTOFF: Option<u8> = Some(7);
 
 /// The frame of the boards without a panel (the QEMU machines and the micro:bit, whose frames

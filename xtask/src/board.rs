@@ -951,8 +951,8 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
     writeln!(md, "rp2040-hal's launch handshake, per-core SIO FIFOs, divider, NVIC and MPU stack guard), the **16 KiB")?;
     writeln!(md, "XIP flash cache** and the **I2C bus's timing**, with an SSD1306 model on I2C0. It decodes the defmt log")?;
     writeln!(md, "and requires every frame the panel shows to be bit-identical to host-sim's render of the scene")?;
-    writeln!(md, "(128x64, fixed point, Floyd-Steinberg error diffusion with silhouette lines, mirror and glass branches")?;
-    writeln!(md, "weighing less than half a gray step not traced, `board_frame::rendered`):")?;
+    writeln!(md, "(128x64, fixed point, Floyd-Steinberg error diffusion with silhouette lines, mirror, glass and shadow")?;
+    writeln!(md, "rays weighing less than half a gray step not traced, `board_frame::rendered`):")?;
     writeln!(md, "the two cores take the tiles one at a time as they come free, and core 0 dithers each band of tiles")?;
     writeln!(md, "in order once all its tiles are traced, then sends it (trace, then dither). The scenes are baked")?;
     writeln!(md, "into flash at build time (each parsed and its lattice built by `firmware/build.rs`, in fixed point as")?;

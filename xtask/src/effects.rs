@@ -42,7 +42,7 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
     let fw = firmware_figures(firmware_csv);
     let mut md = String::new();
     writeln!(md, "# Simulating only the effects a scene calls for\n")?;
-    writeln!(md, "Written by `cargo xtask effects` (128x64, f64 on the host, median of {} interleaved\nruns; Cortex-M figures from `docs/firmware.csv`, written by `cargo xtask firmware`: QEMU `-icount\nshift=0`, fixed point, Cortex-M0+ build).\n", runs.max(1))?;
+    writeln!(md, "Written by `cargo xtask effects` (128x64, f64 on the host, median of {} interleaved\nruns; Cortex-M figures from `docs/firmware.csv`, written by `cargo xtask firmware`: QEMU `-icount\nshift=0`, fixed point, Cortex-M0+ build, the boards' frames: they leave out mirror, glass and\nshadow rays weighing less than half a gray step, the contribution cutoff of 1/128 below; the host's\nrays trace them all).\n", runs.max(1))?;
     writeln!(md, "## Derived effect set against every effect forced on\n\nRays are primary / shadow / reflection / refraction. \"All\" forces every effect on at run time\n(and, on the Cortex-M, compiles every effect in).\n")?;
     writeln!(md, "| scene | effect set | rays, derived | rays, all | host ms derived | host ms all | all / derived | same image | M0 Minstr derived | M0 Minstr all |\n|---|---|---|---|---|---|---|---|---|---|")?;
     let mut cut_rows = Vec::new();
