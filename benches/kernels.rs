@@ -73,6 +73,24 @@ fn levers(c: &mut Criterion) {
     let (x, p) = (Fx::from_f64(2.71), Fx::from_f64(0.125));
     c.bench_function("fixed times 2^-3: product", |b| b.iter(|| black_box(x) * black_box(p)));
     c.bench_function("fixed times 2^-3: shift", |b| b.iter(|| black_box(x).mul_pow2(black_box(Fx::pow2(-3)))));
+    // An eye ray: its direction from the pixel's factors (six products), or from the column's
+    // and the row's parts a tile keeps (three sums), the same ray.
+    let cam = scene.camera();
+    let (u, v) = (Fx::from_f64(0.3), Fx::from_f64(-0.2));
+    c.bench_function("eye ray, fixed: forward + right u + up v", |b| b.iter(|| cam.ray_through(black_box(u), black_box(v))));
+    let (column, row) = (cam.column(u), cam.row(v));
+    c.bench_function("eye ray, fixed: the column's and the row's parts kept", |b| b.iter(|| cam.ray_from(black_box(column), black_box(row))));
+    // Floyd-Steinberg over a 16x16 tile (the Pico's), from a band's carries.
+    let levels: Vec<u8> = (0..256).map(|i| ((i * 37) % 65) as u8).collect();
+    let mut carries = vec![0i16; lattice_rt::dither::Carry::len(16)];
+    let mut out = [embedded_graphics::pixelcolor::BinaryColor::Off; 256];
+    c.bench_function("floyd-steinberg, 16x16 tile", |b| {
+        b.iter(|| {
+            let mut carry = lattice_rt::dither::Carry::new(&mut carries, 16).unwrap();
+            carry.next_band();
+            carry.tile(lattice_rt::Dither::FloydSteinberg, 0, 16, 16, black_box(&levels), &mut out);
+        })
+    });
 }
 
 criterion_group!(benches, primitives, walk_and_tile, levers);
