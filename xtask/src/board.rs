@@ -945,7 +945,7 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
     let mhz = s.clk_hz / 1e6;
     writeln!(md, "# The Pico image on an emulated board\n")?;
     writeln!(md, "Written by `cargo xtask board` (also run by `.ci/run`). It builds the image")?;
-    writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, flip-link), writes its UF2 file, and runs that")?;
+    writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, opt-level 2, flip-link), writes its UF2 file, and runs that")?;
     writeln!(md, "file on an RP2040 as silicon runs it: [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 with what")?;
     writeln!(md, "`firmware/board/silicon.mjs` adds from the RP2040 datasheet, **core 1** (started by the B1 bootrom and")?;
     writeln!(md, "rp2040-hal's launch handshake, per-core SIO FIFOs, divider, NVIC and MPU stack guard), the **16 KiB")?;
