@@ -4,7 +4,7 @@
 use super::{index, locate, Lattice, MAX_NESTING};
 use crate::accel::{offer, reach, slack, Hit, Query};
 use crate::bounds::at;
-use crate::math::{Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::Scene;
 
@@ -29,10 +29,10 @@ impl<R: Real> Lattice<'_, R> {
 
     pub(super) fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
         let slack = slack(ray);
-        let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
-        q.next_ray();
         // A window culls an object before its test for less than the box test costs.
         let inv = Inverse::new(ray, q.box_tests() && !q.by_windows());
+        let (t0, t1) = inv.clip(&self.lattices[0].bounds.padded(slack), ray, tmin, tmax)?;
+        q.next_ray();
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
@@ -53,7 +53,7 @@ impl<R: Real> Lattice<'_, R> {
                         let g = composite + 1;
                         let limit = reach(&best, tmax);
                         if depth < MAX_NESTING && q.first_visit(self.objects + composite) {
-                            if let Some((a, b)) = self.lattices[g].bounds.padded(slack).clip(ray, tmin, limit) {
+                            if let Some((a, b)) = inv.clip(&self.lattices[g].bounds.padded(slack), ray, tmin, limit) {
                                 Walker::start_in(&mut stack[depth], self, g, ray, &inv, a, b);
                                 depth += 1;
                                 q.stats.cells_visited += 1;
@@ -125,6 +125,18 @@ impl<R: Real> Inverse<R> {
         q.stats.inside_tests += 1;
         let [x, y, z] = self.origin;
         at(scene.objects, i).bounds.padded(slack).clip_by_inverse(Vec3::new(x, y, z), self.inv, tmin, limit).is_some()
+    }
+
+    /// [`Aabb::clip`] of the ray to `b`, by the reciprocals this inverse keeps where it keeps
+    /// them (the same reciprocals, so the same range) instead of computing them again.
+    #[inline]
+    fn clip(&self, b: &Aabb<R>, ray: &Ray<R>, t0: R, t1: R) -> Option<(R, R)> {
+        if self.boxes || R::WALK_BY_RECIPROCAL {
+            let [x, y, z] = self.origin;
+            b.clip_by_inverse(Vec3::new(x, y, z), self.inv, t0, t1)
+        } else {
+            b.clip(ray, t0, t1)
+        }
     }
 
     /// The ray parameter where the ray crosses `plane` on axis `a` (which it moves along).
