@@ -186,10 +186,19 @@ impl<R: Real> Aabb<R> {
     /// axis `1 / d`, zero where `d` is zero): three slabs at two products each, no division.
     #[inline]
     pub fn clip_by_inverse(&self, origin: Vec3<R>, inv: Vec3<R>, t0: R, t1: R) -> Option<(R, R)> {
-        let (o, i) = (origin, inv);
-        let (t0, t1) = slab_by(o.x, i.x, self.min.x, self.max.x, t0, t1)?;
-        let (t0, t1) = slab_by(o.y, i.y, self.min.y, self.max.y, t0, t1)?;
-        slab_by(o.z, i.z, self.min.z, self.max.z, t0, t1)
+        self.clip_grown_by_inverse((origin, origin), inv, t0, t1)
+    }
+    /// [`Aabb::clip_by_inverse`] of this box grown by `pad` on every side, with the growth moved
+    /// onto the ray's origin, given as `(o + pad, o - pad)`: the crossings of the sides are
+    /// taken as `(min - (o + pad)) / d` and `(max - (o - pad)) / d`, from origins a caller makes
+    /// once per ray, not as `((min - pad) - o) / d` from a box grown at every test. The same
+    /// value in fixed point (its sums are exact); in floats within a rounding of it.
+    #[inline]
+    pub fn clip_grown_by_inverse(&self, (near, far): (Vec3<R>, Vec3<R>), inv: Vec3<R>, t0: R, t1: R) -> Option<(R, R)> {
+        let i = inv;
+        let (t0, t1) = slab_by((near.x, far.x), i.x, self.min.x, self.max.x, t0, t1)?;
+        let (t0, t1) = slab_by((near.y, far.y), i.y, self.min.y, self.max.y, t0, t1)?;
+        slab_by((near.z, far.z), i.z, self.min.z, self.max.z, t0, t1)
     }
     /// Converts to another scalar, rounding outwards by the target's padding so the box stays
     /// conservative.
@@ -211,16 +220,18 @@ impl<R: Real> Aabb<R> {
 #[inline(always)]
 fn slab<R: Real>(o: R, d: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
     // A nonzero direction's reciprocal is never zero (it saturates in fixed point).
-    slab_by(o, if d == R::ZERO { R::ZERO } else { d.recip() }, lo, hi, t0, t1)
+    slab_by((o, o), if d == R::ZERO { R::ZERO } else { d.recip() }, lo, hi, t0, t1)
 }
 
-/// [`slab`] given the direction's reciprocal `inv` (zero for a zero direction).
+/// [`slab`] given the direction's reciprocal `inv` (zero for a zero direction), the origin
+/// taken as `near` against the side `lo` and as `far` against `hi` (both the origin for the
+/// slab itself; [`Aabb::clip_grown_by_inverse`] for a grown one).
 #[inline(always)]
-fn slab_by<R: Real>(o: R, inv: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
+fn slab_by<R: Real>((near, far): (R, R), inv: R, lo: R, hi: R, t0: R, t1: R) -> Option<(R, R)> {
     if inv == R::ZERO {
-        return if o < lo || o > hi { None } else { Some((t0, t1)) };
+        return if near < lo || far > hi { None } else { Some((t0, t1)) };
     }
-    cut((lo - o) * inv, (hi - o) * inv, t0, t1)
+    cut((lo - near) * inv, (hi - far) * inv, t0, t1)
 }
 
 /// The range `[t0, t1]` cut to a slab the ray crosses at `ta` and `tb` (either order), or

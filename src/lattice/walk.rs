@@ -4,7 +4,7 @@
 use super::{index, locate, Lattice, MAX_NESTING};
 use crate::accel::{offer, reach, slack, Hit, Query};
 use crate::bounds::at;
-use crate::math::{Aabb, Ray, Vec3};
+use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::Scene;
 
@@ -12,7 +12,7 @@ impl<R: Real> Lattice<'_, R> {
     /// Calls `visit(sub, cell_index, t_enter, t_exit)` for every cell of the world lattice the
     /// ray enters, in order, without testing objects (for tests and statistics).
     pub fn walk_cells(&self, ray: &Ray<R>, tmin: R, tmax: R, mut visit: impl FnMut([usize; 3], R, R)) {
-        let inv = Inverse::new(ray, false);
+        let inv = Inverse::new(ray, false, R::ZERO);
         let Some((t0, t1)) = self.lattices[0].bounds.padded(slack(ray)).clip(ray, tmin, tmax) else { return };
         let mut slot = None;
         let w = Walker::start_in(&mut slot, self, 0, ray, &inv, t0, t1);
@@ -30,8 +30,8 @@ impl<R: Real> Lattice<'_, R> {
     pub(super) fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
         let slack = slack(ray);
         // A window culls an object before its test for less than the box test costs.
-        let inv = Inverse::new(ray, q.box_tests() && !q.by_windows());
-        let (t0, t1) = inv.clip(&self.lattices[0].bounds.padded(slack), ray, tmin, tmax)?;
+        let inv = Inverse::new(ray, q.box_tests() && !q.by_windows(), slack);
+        let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
@@ -45,7 +45,7 @@ impl<R: Real> Lattice<'_, R> {
                 w.ref_i += 1;
                 match item {
                     Ok(i) => {
-                        if q.first_visit(i) && inv.may_meet(scene, i, slack, tmin, reach(&best, tmax), q) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
+                        if q.first_visit(i) && inv.may_meet(scene, i, tmin, reach(&best, tmax), q) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                             return best;
                         }
                     }
@@ -53,7 +53,7 @@ impl<R: Real> Lattice<'_, R> {
                         let g = composite + 1;
                         let limit = reach(&best, tmax);
                         if depth < MAX_NESTING && q.first_visit(self.objects + composite) {
-                            if let Some((a, b)) = inv.clip(&self.lattices[g].bounds.padded(slack), ray, tmin, limit) {
+                            if let Some((a, b)) = self.lattices[g].bounds.padded(slack).clip(ray, tmin, limit) {
                                 Walker::start_in(&mut stack[depth], self, g, ray, &inv, a, b);
                                 depth += 1;
                                 q.stats.cells_visited += 1;
@@ -93,11 +93,15 @@ struct Inverse<R> {
     /// through windows; in fixed point only while no direction component reaches 64, so the
     /// reciprocal's rounding stays within the padding).
     boxes: bool,
+    /// The origin plus and minus the walk's slack: what [`Inverse::may_meet`] takes the sides
+    /// of an object's box from ([`Aabb::clip_grown_by_inverse`]), instead of growing the box.
+    grown: (Vec3<R>, Vec3<R>),
 }
 
 impl<R: Real> Inverse<R> {
-    /// The ray's inverse, for box tests too where `boxes` ([`Inverse::may_meet`]).
-    fn new(ray: &Ray<R>, boxes: bool) -> Self {
+    /// The ray's inverse, for box tests too where `boxes` ([`Inverse::may_meet`]) with boxes
+    /// grown by `slack`.
+    fn new(ray: &Ray<R>, boxes: bool, slack: R) -> Self {
         let d = [ray.dir.x, ray.dir.y, ray.dir.z];
         let boxes = boxes && (R::WALK_BY_RECIPROCAL || ray.dir.max_abs() < R::from_i32(64));
         let inv = d.map(|v| if (boxes || R::WALK_BY_RECIPROCAL) && v != R::ZERO { v.recip() } else { R::ZERO });
@@ -107,6 +111,7 @@ impl<R: Real> Inverse<R> {
             factor: if R::WALK_BY_RECIPROCAL { inv } else { d },
             inv: Vec3::new(inv[0], inv[1], inv[2]),
             boxes,
+            grown: if boxes { (ray.origin + Vec3::new(slack, slack, slack), ray.origin - Vec3::new(slack, slack, slack)) } else { (ray.origin, ray.origin) },
         }
     }
 
@@ -118,25 +123,12 @@ impl<R: Real> Inverse<R> {
     /// hit on that range, as the walk's own clip of a sub-lattice's box rejects none of its
     /// members. Counted as an inside test.
     #[inline]
-    fn may_meet(&self, scene: &Scene<'_, R>, i: usize, slack: R, tmin: R, limit: R, q: &mut Query<'_>) -> bool {
+    fn may_meet(&self, scene: &Scene<'_, R>, i: usize, tmin: R, limit: R, q: &mut Query<'_>) -> bool {
         if !self.boxes {
             return true;
         }
         q.stats.inside_tests += 1;
-        let [x, y, z] = self.origin;
-        at(scene.objects, i).bounds.padded(slack).clip_by_inverse(Vec3::new(x, y, z), self.inv, tmin, limit).is_some()
-    }
-
-    /// [`Aabb::clip`] of the ray to `b`, by the reciprocals this inverse keeps where it keeps
-    /// them (the same reciprocals, so the same range) instead of computing them again.
-    #[inline]
-    fn clip(&self, b: &Aabb<R>, ray: &Ray<R>, t0: R, t1: R) -> Option<(R, R)> {
-        if self.boxes || R::WALK_BY_RECIPROCAL {
-            let [x, y, z] = self.origin;
-            b.clip_by_inverse(Vec3::new(x, y, z), self.inv, t0, t1)
-        } else {
-            b.clip(ray, t0, t1)
-        }
+        at(scene.objects, i).bounds.clip_grown_by_inverse(self.grown, self.inv, tmin, limit).is_some()
     }
 
     /// The ray parameter where the ray crosses `plane` on axis `a` (which it moves along).
