@@ -118,7 +118,16 @@ impl Div for Fx {
         }
         let neg = (self.0 < 0) != (o.0 < 0);
         let (a, b) = (self.0.unsigned_abs(), o.0.unsigned_abs());
-        let q = if b < 1 << 23 {
+        let q = if a < 1 << FRAC {
+            // A numerator below 1: `a << 16` fits 32 bits, so one division gives the quotient
+            // and remainder the long division below finds in three.
+            let (q, r) = ((a << FRAC) / b, (a << FRAC) % b);
+            if r >= b - r {
+                q + 1
+            } else {
+                q
+            }
+        } else if b < 1 << 23 {
             let (q0, r) = (a / b, a % b);
             if q0 >= 1 << 15 {
                 i32::MAX as u32
