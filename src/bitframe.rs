@@ -135,9 +135,11 @@ impl DrawTarget for BitFrame<'_> {
                     for k in 0..8 {
                         let Some(c) = colors.next() else {
                             // Fewer colors than pixels: the first `k` pixels alone are drawn.
-                            let keep = 0xFFu8.checked_shr(k).unwrap_or(0);
-                            let b = at_mut(row, x / 8);
-                            *b = (*b & keep) | (byte << (8 - k) & !keep);
+                            if k > 0 {
+                                let keep = 0xFFu8 >> k;
+                                let b = at_mut(row, x / 8);
+                                *b = (*b & keep) | (byte << (8 - k) & !keep);
+                            }
                             return Ok(());
                         };
                         byte = byte << 1 | u8::from(c.is_on());
