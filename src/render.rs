@@ -47,8 +47,9 @@ pub struct Frame {
     /// different objects is drawn black.
     pub outline: bool,
     /// `Some(k)`: branches of the intersection tree weighing less than 2^-k are not traced, as
-    /// with [`Tracer::set_cutoff`] (the larger of the two cutoffs holds); `None`: the tracer's
-    /// own. 7 is half of one of the 64 gray steps a pixel's level takes.
+    /// with [`Tracer::set_cutoff`] (the larger of the two cutoffs holds; `k` above 14 counts as
+    /// 14, [`Real::div_pow2`]); `None`: the tracer's own. 7 is half of
+    /// one of the 64 gray steps a pixel's level takes.
     pub cutoff: Option<u8>,
 }
 

@@ -467,7 +467,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     }
 
     /// This tracer with its cutoff raised to 2^-k where `at_least` is `Some(k)` (a frame's
-    /// [`Frame::cutoff`](crate::Frame::cutoff)), else as it is.
+    /// [`Frame::cutoff`](crate::Frame::cutoff); `k` above 14 counts as 14), else as it is.
     pub fn with_cutoff_at_least(&self, at_least: Option<u8>) -> Self {
         let floor = at_least.map_or(R::ZERO, |k| R::ONE.div_pow2(u32::from(k)));
         Tracer { cutoff: self.cutoff.max(floor), ..*self }

@@ -188,8 +188,8 @@ pub struct RenderArgs {
     pub gamma: u8,
     /// Contribution cutoff: mirror and glass rays, and shadow rays of light terms, weighing
     /// less than 2^-K of a pixel are not traced (7: half a gray step, what the boards do; 1 to
-    /// 30). Without it every branch is traced.
-    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u8).range(1..=30))]
+    /// 14). Without it every branch is traced.
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u8).range(1..=14))]
     pub cutoff: Option<u8>,
 }
 
