@@ -22,7 +22,7 @@ pub struct Hit<R> {
     pub object: u32,
     /// Outward normal in object space (not normalised).
     pub normal: Vec3<R>,
-    /// The point in object space, as the ray reached it ([`crate::Object::surface_point`] puts
+    /// The point in object space, as the ray reached it ([`crate::scene::Object::surface_point`] puts
     /// it on the surface and in the world).
     pub point: Vec3<R>,
     /// How far beyond `t` another object's hit still counts as the same point ([`tie`]).
@@ -90,7 +90,7 @@ pub struct Query<'m> {
     eye_uv: u64,
     /// When the ray being traced is a shadow ray towards the scene's first light, and that
     /// light is directional, its position across the light ([`Real::to_raw`] bits of the
-    /// coordinates [`crate::Object::shadow_window`]s are in; see [`Query::set_first_light_ray`]).
+    /// coordinates [`crate::scene::Object::shadow_window`]s are in; see [`Query::set_first_light_ray`]).
     first_light: Option<[u64; 2]>,
     /// The last world normal [`Query::world_normal`] mapped from a unit axis: the object, the
     /// axis ([`crate::scene::axis_normal`]) and the normal's components as [`Real::to_raw`] bits.
@@ -135,7 +135,7 @@ impl<'m> Query<'m> {
     }
     /// Declares whether the next ray traced is a shadow ray towards the scene's first light,
     /// when that light is directional (its direction the light's `to_light`): objects then take
-    /// the direction's object-space image from the scene ([`crate::Object::intersect_first_light_ray`]).
+    /// the direction's object-space image from the scene ([`crate::scene::Object::intersect_first_light_ray`]).
     /// `at` is the ray's position across the light (the origin's products with the two axes of
     /// the scene's shadow basis): objects whose shadow window does not hold it are not tested.
     pub fn set_first_light_ray<R: Real>(&mut self, at: Option<[R; 2]>) {
@@ -225,7 +225,7 @@ impl<'m> Query<'m> {
     pub fn forget_occluders(&mut self) {
         self.occluders = [u32::MAX; MAX_LIGHTS];
     }
-    /// [`crate::Object::world_normal`] of object `i` of the scene this query serves: a unit-axis
+    /// [`crate::scene::Object::world_normal`] of object `i` of the scene this query serves: a unit-axis
     /// normal (a box's face, a cap) that is the last one asked for is given again without
     /// mapping it anew (neighbouring eye rays mostly hit one face, the floor's above all).
     #[inline]

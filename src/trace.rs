@@ -8,7 +8,7 @@
 //!
 //! Secondary rays start at `p + n * eps` on the side they travel to, with `n` the normal
 //! flipped to face the incoming ray, `p` the hit put on the object's surface in object space
-//! and mapped to the world ([`crate::Object::surface_point`]: its error does not depend on
+//! and mapped to the world ([`crate::scene::Object::surface_point`]: its error does not depend on
 //! where the ray came from), and `eps = Real::offset(max|p|, size of the object hit)`. That is
 //! local: a far object or a far eye does not change it. In floating point it is
 //! `point_eps * max|p| + offset_eps * size`: above the rounding of `p` wherever the object sits
