@@ -29,10 +29,10 @@ impl<R: Real> Lattice<'_, R> {
 
     pub(super) fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
         let slack = slack(ray);
-        // A window culls an object before its test for less than the box test costs.
-        let inv = Inverse::new(ray, q.box_tests() && !q.by_windows(), slack);
         let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
+        // A window culls an object before its test for less than the box test costs.
+        let inv = Inverse::new(ray, q.box_tests() && !q.by_windows(), slack);
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
