@@ -686,8 +686,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
 /// last ray that needed it. Each depends on one position alone, so a tile's rays (row by row)
 /// compute them, a division (and for a row three products), once per column and row instead
 /// of once per ray; the rays are the same ([`Camera::ray_from`]). (Keeping each column's part
-/// of the direction too would save three more products a ray, for 64 more bytes of stack
-/// with 8x8 tiles, which the smallest boards do not have.)
+/// of the direction too would save three more products a ray, for 88 more bytes of stack
+/// with 8x8 tiles, which the 4 KiB board does not have.)
 struct Window<'c, R> {
     camera: &'c Camera<R>,
     size: (i32, i32),
