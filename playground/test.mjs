@@ -96,7 +96,7 @@ async function main() {
 
     // The page renders the boards' frame, whose cutoff (board_frame::CUTOFF, 2^-7) leaves out
     // branches below half a gray step: host-sim is asked for the same.
-    const pico = ['--scalar', 'fixed', '--sampling', 'adaptive', '--dither', 'fs', '--tile', '16', '--cutoff', '7'];
+    const pico = ['--scalar', 'fixed', '--sampling', 'coarse', '--dither', 'fs', '--tile', '16', '--cutoff', '7'];
     const scenes = await page.evaluate(() => Array.from(document.querySelectorAll('#scene option'), (o) => o.value));
     check(scenes.length === 5, `the page offers ${scenes.length} scenes: ${scenes.join(', ')}`);
     for (const scene of scenes) {

@@ -203,6 +203,9 @@ pub enum RenderError<E> {
     /// The frame asks for edge sampling and the core was built without its `edge-sampling`
     /// feature.
     EdgesNotCompiled,
+    /// The frame asks for two-level adaptive sampling and the core was built without its
+    /// `coarse-sampling` feature.
+    CoarseNotCompiled,
     /// The frame asks for error diffusion (Floyd-Steinberg, Atkinson) and the core was built
     /// without its `diffusion` feature.
     DiffusionNotCompiled,
@@ -237,6 +240,7 @@ impl RenderError<core::convert::Infallible> {
             RenderError::Cancelled => RenderError::Cancelled,
             RenderError::BadTile => RenderError::BadTile,
             RenderError::EdgesNotCompiled => RenderError::EdgesNotCompiled,
+            RenderError::CoarseNotCompiled => RenderError::CoarseNotCompiled,
             RenderError::DiffusionNotCompiled => RenderError::DiffusionNotCompiled,
             RenderError::ScratchTooSmall { needed } => RenderError::ScratchTooSmall { needed },
             RenderError::BadShare => RenderError::BadShare,
@@ -255,6 +259,7 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
                 write!(f, "tile side must be 1..={MAX_TILE} and a multiple of the pattern block")
             }
             RenderError::EdgesNotCompiled => write!(f, "this build leaves out edge sampling (the core's `edge-sampling` feature)"),
+            RenderError::CoarseNotCompiled => write!(f, "this build leaves out two-level adaptive sampling (the core's `coarse-sampling` feature)"),
             RenderError::DiffusionNotCompiled => write!(f, "this build leaves out error diffusion (the core's `diffusion` feature)"),
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
@@ -538,6 +543,26 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
     render_tiles(tracer, frame, share, Some(Pass { n: pass, traced, whole_share: true }), Out::Draw(target), scratch, hooks)
 }
 
+/// Whether the pixels of a tile at `(x0, y0)` between columns `xs` and rows `ys` (inclusive),
+/// whose corners' eye rays hit object `id` (or nothing), may be filled from those rays in the
+/// coarse level of adaptive sampling: no other object among the tile's `candidates` has an eye
+/// window that meets them, and the object neither mirrors nor refracts (in the effects
+/// simulated). A tile with more than 64 objects' candidates is never filled so.
+fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '_, R, A, E>, candidates: u64, (x0, y0): (usize, usize), (xs, ys): ([usize; 2], [usize; 2]), id: u16, size: (i32, i32)) -> bool {
+    let scene = tracer.scene();
+    if candidates == u64::MAX || scene.objects().len() > 64 {
+        return false;
+    }
+    if let Some(o) = scene.objects().get(id as usize) {
+        let m = crate::bounds::at(scene.materials(), o.material as usize);
+        if (tracer.simulates(crate::Effects::REFLECTION) && m.ks > R::ZERO) || (tracer.simulates(crate::Effects::REFRACTION) && m.kt > R::ZERO) {
+            return false;
+        }
+    }
+    let (u, v) = crate::cover::tile_window::<R>((x0 + xs[0], xs[1] + 1 - xs[0]), (y0 + ys[0], ys[1] + 1 - ys[0]), 0, size);
+    scene.eye_candidates_among(candidates, u, v) & !(1u64.checked_shl(id as u32).unwrap_or(0)) == 0
+}
+
 /// A pass of a progressive frame as the tile loop takes it: which pass, and the rays kept
 /// between passes, for the whole share (its tiles before `frame`'s rows first) or for the tiles
 /// of `frame`'s rows alone.
@@ -613,11 +638,15 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
             let (x0, y0) = (tx * t, ty * t);
             let (tw, th) = (t.min(w - x0), t.min(h - y0));
             let at = Block { x0, y0, tw, th, t };
-            if many {
+            let candidates = if many {
                 q.set_eye_list(if counted { tiling.list(cover, (tx, ty)) } else { None });
+                u64::MAX
             } else {
-                q.set_eye_candidates(tile_candidates(tracer.scene(), at, block, (w4, h4)));
-            }
+                let c = tile_candidates(tracer.scene(), at, block, (w4, h4));
+                q.set_eye_candidates(c);
+                c
+            };
+            let mut alone = |xs: [usize; 2], ys: [usize; 2], id: u16| alone(tracer, candidates, (x0, y0), (xs, ys), id, (w4, h4));
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 let ray = eye(&mut q, sx, sy);
                 let (v, id, depth) = tracer.eye_sample(ray, &mut q);
@@ -625,10 +654,10 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 (v, id as u16, if frame.outline { depth.depth_key() } else { u16::MAX })
             };
             match pass.as_mut() {
-                None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut levels, &mut hits),
+                None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut alone, &mut levels, &mut hits),
                 Some(Pass { n, traced, whole_share }) => {
                     let k = if *whole_share { skipped } else { 0 } + done as usize;
-                    pass_tile(*n, &mut sampler, at, &mut traced[k * per_tile..(k + 1) * per_tile], &mut shoot, &mut levels, &mut hits);
+                    pass_tile(*n, &mut sampler, at, &mut traced[k * per_tile..(k + 1) * per_tile], &mut shoot, &mut alone, &mut levels, &mut hits);
                 }
             }
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
@@ -726,12 +755,22 @@ fn tile_candidates<R: Real>(scene: &Scene<'_, R>, at: Block, block: usize, size:
 
 /// A tile of pass `n` of a progressive frame: a preview of `n`x`n` blocks (each side a constant
 /// in its own copy of the loop: no division), or the finished tile (`n` 1) from the rays `kept`.
-fn pass_tile<R: Real>(n: u8, sampler: &mut Sampler<'_>, at: Block, kept: &mut [Traced], shoot: &mut impl FnMut(usize, usize) -> Shot<R>, levels: &mut [u8; MAX_TILE * MAX_TILE], hits: &mut Hits) {
+#[allow(clippy::too_many_arguments)]
+fn pass_tile<R: Real>(
+    n: u8,
+    sampler: &mut Sampler<'_>,
+    at: Block,
+    kept: &mut [Traced],
+    shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+    alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
+    levels: &mut [u8; MAX_TILE * MAX_TILE],
+    hits: &mut Hits,
+) {
     match n {
         8 => preview_tile::<R, 8>(at, kept, shoot, levels),
         4 => preview_tile::<R, 4>(at, kept, shoot, levels),
         2 => preview_tile::<R, 2>(at, kept, shoot, levels),
-        _ => finish_tile(sampler, at, kept, shoot, levels, hits),
+        _ => finish_tile(sampler, at, kept, shoot, alone, levels, hits),
     }
 }
 
@@ -745,6 +784,9 @@ fn check<E>(frame: &Frame, share: Share, dithered: bool) -> Result<(), RenderErr
     }
     if frame.edges() && !cfg!(feature = "edge-sampling") {
         return Err(RenderError::EdgesNotCompiled);
+    }
+    if matches!(frame.sampling, Sampling::Adaptive { coarse: true, .. }) && !cfg!(feature = "coarse-sampling") {
+        return Err(RenderError::CoarseNotCompiled);
     }
     if frame.dither.diffuses() && !cfg!(feature = "diffusion") {
         return Err(RenderError::DiffusionNotCompiled);
@@ -806,6 +848,7 @@ fn finish_tile<R: Real>(
     Block { x0, y0, tw, th, t }: Block,
     kept: &[Traced],
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+    alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
     hits: &mut Hits,
 ) {
@@ -819,7 +862,7 @@ fn finish_tile<R: Real>(
             shoot(sx, sy)
         }
     };
-    sampler.tile(x0, y0, tw, th, &mut reuse, levels, hits)
+    sampler.tile(x0, y0, tw, th, &mut reuse, alone, levels, hits)
 }
 
 /// One tile of preview pass `N` (8, 4 or 2): one ray per `N`x`N` block, through its top-left

@@ -32,6 +32,15 @@ pub enum Sampling {
     Adaptive {
         /// Largest gray-level difference (of 64) between traced neighbours that is filled in.
         contrast: u8,
+        /// Two levels: the first pass traces every fourth row and column (and the last), a
+        /// second fills or traces the pixels of every second line between them in the same
+        /// way, except where the eye window of another object than the one their rays hit
+        /// meets the pixels between, or where that object mirrors or refracts (the caller's
+        /// `alone`, [`Sampler::tile`]); the third is the one-level sampler's second pass. About
+        /// a third fewer eye rays where the picture is smooth; no object the windows show is
+        /// skipped, but a shadow or a gradient narrower than four pixels between traced pixels
+        /// of one object can be. Needs the core's `coarse-sampling` feature (on by default).
+        coarse: bool,
     },
 }
 
@@ -114,7 +123,11 @@ impl<'r> Sampler<'r> {
 
     /// Gray levels of the `tw x th` tile at `(x0, y0)` into `levels` (row-major), and what
     /// each pixel's ray hit into `hits`. `shoot(sx, sy)` traces the eye ray through
-    /// `(sx / 4, sy / 4)` pixels from the top-left corner.
+    /// `(sx / 4, sy / 4)` pixels from the top-left corner. `alone(xs, ys, object)` says whether
+    /// the pixels of the tile's columns `xs[0]..=xs[1]` and rows `ys[0]..=ys[1]`, whose corners'
+    /// rays all hit `object`, may be filled from them in the coarse level of
+    /// [`Sampling::Adaptive`] (no other object's eye window meets them, and `object` neither
+    /// mirrors nor refracts); no other sampling asks it.
     #[allow(clippy::too_many_arguments)]
     pub fn tile<R: Real>(
         &mut self,
@@ -123,12 +136,13 @@ impl<'r> Sampler<'r> {
         tw: usize,
         th: usize,
         shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+        alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
         levels: &mut [u8; MAX_TILE * MAX_TILE],
         hits: &mut Hits,
     ) {
         let block = self.block;
-        if let (Sampling::Adaptive { contrast }, 1) = (self.mode, block) {
-            return adaptive(x0, y0, tw, th, contrast, shoot, levels, hits);
+        if let (Sampling::Adaptive { contrast, coarse }, 1) = (self.mode, block) {
+            return adaptive((x0, y0), (tw, th), contrast, coarse, shoot, alone, levels, hits);
         }
         // One ray per block through the block's centre; Grid2x2 takes four per pixel.
         for by in (0..th).step_by(block) {
@@ -154,15 +168,16 @@ impl<'r> Sampler<'r> {
     /// Whether what pixel `(x, y)` of a `tw x th` tile hit (`hits`, as [`Sampler::tile`] left
     /// them) is what the eye ray through its centre hits, whatever the scene: one ray per pixel
     /// through its centre, a pixel the adaptive first pass traces, or one between traced pixels
-    /// that hit different objects (the second pass traces those). (Other filled pixels, blocks
+    /// that hit different objects (the next pass traces those). (Other filled pixels, blocks
     /// and 2x2 grids are not.)
     pub fn exact(&self, x: usize, y: usize, tw: usize, th: usize, hits: &Hits) -> bool {
         match (self.mode, self.block) {
-            (Sampling::Adaptive { .. }, 1) => {
-                if traced(x, tw) && traced(y, th) {
+            (Sampling::Adaptive { coarse, .. }, 1) => {
+                let on = |i: usize, n: usize| if coarse { coarse_line(i, n) } else { traced(i, n) };
+                if on(x, tw) && on(y, th) {
                     return true;
                 }
-                let (xs, ys) = around(x, y, tw, th);
+                let (xs, ys) = if traced(x, tw) && traced(y, th) { (between(x, tw), between(y, th)) } else { around(x, y, tw, th) };
                 let id = |(nx, ny): (usize, usize)| hits.object[ny * tw + nx];
                 let first = id((xs[0], ys[0]));
                 (0..4).any(|i| id((xs[i % 2], ys[i / 2])) != first)
@@ -177,11 +192,22 @@ impl<'r> Sampler<'r> {
     /// `i`'s centre hits. With adaptive sampling a pixel between two traced ones whose rays hit
     /// the same object takes that object and the nearer depth, as the sampler's fill does, so
     /// neither the tile nor its neighbour traces a ray for it (about 6 of a tile's 15 side
-    /// pixels); every other pixel takes its exact hit.
+    /// pixels); every other pixel takes its exact hit. With the coarse level the pixels of
+    /// every fourth line (and the last) take their exact hits, then those between two of them
+    /// on every second line are filled (or not) in the same way from the two, then the rest.
     pub fn side(&self, n: usize, mut exact: impl FnMut(usize) -> (u16, u16), out: &mut [(u16, u16)]) {
-        let fills = matches!((self.mode, self.block), (Sampling::Adaptive { .. }, 1));
-        for i in (0..n).filter(|&i| !fills || traced(i, n)) {
+        let (fills, coarse) = match (self.mode, self.block) {
+            (Sampling::Adaptive { coarse, .. }, 1) => (true, coarse),
+            _ => (false, false),
+        };
+        for i in (0..n).filter(|&i| !fills || if coarse { coarse_line(i, n) } else { traced(i, n) }) {
             out[i] = exact(i);
+        }
+        if coarse {
+            for i in (0..n).filter(|&i| traced(i, n) && !coarse_line(i, n)) {
+                let [a, b] = between(i, n).map(|k| out[k]);
+                out[i] = if a.0 == b.0 { (a.0, a.1.min(b.1)) } else { exact(i) };
+            }
         }
         if fills {
             for i in (0..n).filter(|&i| !traced(i, n)) {
@@ -253,6 +279,27 @@ fn traced_lines(n: usize) -> impl Iterator<Item = usize> {
     (0..n).step_by(2).chain((n > 0 && n.is_multiple_of(2)).then(|| n - 1))
 }
 
+/// Whether tile row or column `i` of `n` is traced in the coarse level's first pass: every
+/// fourth one, and the last.
+fn coarse_line(i: usize, n: usize) -> bool {
+    i.is_multiple_of(4) || i + 1 == n
+}
+
+/// The lines [`coarse_line`] picks of `n`, in order.
+fn coarse_lines(n: usize) -> impl Iterator<Item = usize> {
+    (0..n).step_by(4).chain((n > 0 && !(n - 1).is_multiple_of(4)).then(|| n - 1))
+}
+
+/// The coarse lines a line `i` of `n` lies on or between: `[i, i]` on one, else the one two
+/// before and the next (two after, or the last line, one after).
+fn between(i: usize, n: usize) -> [usize; 2] {
+    if coarse_line(i, n) {
+        [i, i]
+    } else {
+        [i - 2, (i + 2).min(n - 1)]
+    }
+}
+
 /// The traced pixels an untraced pixel `(x, y)` of a `tw x th` tile is filled from, as columns
 /// and rows (each pair repeats a line the pixel is on): left and right, above and below, or
 /// the four corners.
@@ -265,27 +312,54 @@ fn around(x: usize, y: usize, tw: usize, th: usize) -> ([usize; 2], [usize; 2]) 
 /// [`Sampling::Adaptive`] over one tile: the first pass traces the pixels of traced rows and
 /// columns, the second fills or traces each other pixel from its two or four traced
 /// neighbours (they are one pixel away: traced lines are at most two apart). A filled pixel
-/// takes the object of its neighbours and the nearest of their depths.
+/// takes the object of its neighbours and the nearest of their depths. With `coarse` the first
+/// pass traces the pixels of every fourth line (and the last) and a pass between fills or
+/// traces the rest of the traced lines' pixels from them (two lines away, or one before the
+/// last), where `alone` allows.
 #[allow(clippy::too_many_arguments)]
 fn adaptive<R: Real>(
-    x0: usize,
-    y0: usize,
-    tw: usize,
-    th: usize,
+    (x0, y0): (usize, usize),
+    (tw, th): (usize, usize),
     contrast: u8,
+    coarse: bool,
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+    alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
     hits: &mut Hits,
 ) {
     let ids = &mut hits.object;
     let depths = &mut hits.depth;
     let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
-    for y in traced_lines(th) {
-        for x in traced_lines(tw) {
-            let (cx, cy) = centre(x, y);
-            let (v, id, depth) = shoot(cx, cy);
-            let i = at(y * tw + x);
-            (levels[i], ids[i], depths[i]) = (level(v), id, depth);
+    // Without the feature the branch is a constant false and its code is not linked (the
+    // render refuses such frames: `RenderError::CoarseNotCompiled`).
+    if cfg!(feature = "coarse-sampling") && coarse {
+        for y in coarse_lines(th) {
+            for x in coarse_lines(tw) {
+                shoot_at(shoot, levels, ids, depths, y * tw + x, centre(x, y));
+            }
+        }
+        // The pass between, row by row in pixel order.
+        for y in traced_lines(th) {
+            let ys = between(y, th);
+            for x in traced_lines(tw).filter(|&x| !(coarse_line(x, tw) && coarse_line(y, th))) {
+                let xs = between(x, tw);
+                let i = y * tw + x;
+                // Two neighbours on a coarse line, else the four corners.
+                let filled = if xs[0] == xs[1] || ys[0] == ys[1] {
+                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id| alone(xs, ys, id))
+                } else {
+                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[0] * tw + xs[1], ys[1] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id| alone(xs, ys, id))
+                };
+                if !filled {
+                    shoot_at(shoot, levels, ids, depths, i, centre(x, y));
+                }
+            }
+        }
+    } else {
+        for y in traced_lines(th) {
+            for x in traced_lines(tw) {
+                shoot_at(shoot, levels, ids, depths, y * tw + x, centre(x, y));
+            }
         }
     }
     // The second pass, row by row in pixel order (so rays are shot in the same order): on a
@@ -296,7 +370,7 @@ fn adaptive<R: Real>(
         if traced(y, th) {
             for x in (1..tw.saturating_sub(1)).step_by(2) {
                 let i = row + x;
-                if !fill(levels, ids, depths, i, [i - 1, i + 1], contrast) {
+                if !fill(levels, ids, depths, i, [i - 1, i + 1], contrast, |_| true) {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
                 }
             }
@@ -304,9 +378,9 @@ fn adaptive<R: Real>(
             for x in 0..tw {
                 let i = row + x;
                 let filled = if traced(x, tw) {
-                    fill(levels, ids, depths, i, [i - tw, i + tw], contrast)
+                    fill(levels, ids, depths, i, [i - tw, i + tw], contrast, |_| true)
                 } else {
-                    fill(levels, ids, depths, i, [i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], contrast)
+                    fill(levels, ids, depths, i, [i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], contrast, |_| true)
                 };
                 if !filled {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
@@ -326,9 +400,9 @@ fn at(i: usize) -> usize {
 /// Fills untraced pixel `i` from the traced pixels `ns` around it ([`around`]: two on its row
 /// or column, each counted twice in the mean of four, or the four corners) when they hit one
 /// object and their levels lie within `contrast`: the mean level, the first's object and the
-/// nearest depth. Returns whether it did; else the pixel is traced.
+/// nearest depth, if `allowed(object)` too. Returns whether it did; else the pixel is traced.
 #[inline]
-fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, ns: [usize; N], contrast: u8) -> bool {
+fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, ns: [usize; N], contrast: u8, allowed: impl FnOnce(u16) -> bool) -> bool {
     let first = ids[at(ns[0])];
     let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
     for k in ns.iter().map(|&k| at(k)) {
@@ -339,7 +413,7 @@ fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; 
         same &= ids[k] == first;
         near = near.min(depths[k]);
     }
-    if !(same && hi - lo <= contrast) {
+    if !(same && hi - lo <= contrast && allowed(first)) {
         return false;
     }
     // Two pixels counted twice: (2 sum + 2) / 4 = (sum + 1) / 2, rounded up.
@@ -349,8 +423,9 @@ fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; 
     true
 }
 
-/// Traces untraced pixel `i` through its centre `(cx, cy)` (quarter pixels). Out of line: the
-/// second pass calls it from two places, and `shoot` (the tracer, inlined into it) is large.
+/// Traces pixel `i` through its centre `(cx, cy)` (quarter pixels). Out of line: every pass
+/// calls it, and `shoot` (the tracer, inlined into it) is large; so its stack is taken only
+/// while a ray is traced, not beside the passes' own.
 #[inline(never)]
 fn shoot_at<R: Real>(shoot: &mut impl FnMut(usize, usize) -> Shot<R>, levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, (cx, cy): (usize, usize)) {
     let (v, id, depth) = shoot(cx, cy);
@@ -416,11 +491,122 @@ mod tests {
             );
             (asked, out)
         };
-        let (asked, out) = side(Sampling::Adaptive { contrast: 4 });
+        let (asked, out) = side(Sampling::Adaptive { contrast: 4, coarse: false });
         assert_eq!(asked, [0, 2, 4, 6, 7, 3, usize::MAX, usize::MAX]);
         assert_eq!(out, [(5, 10), (5, 10), (5, 12), (9, 3), (9, 4), (9, 4), (9, 6), (9, 7)]);
         let (asked, out) = side(Sampling::Center);
         assert_eq!(asked, [0, 1, 2, 3, 4, 5, 6, 7]);
         assert_eq!(out, truth);
+    }
+
+    /// A made-up picture for the sampler's tests, per quarter-pixel position: two objects with
+    /// a gradient and a shadow, crossed by thin diagonal stripes of a third.
+    fn picture(sx: usize, sy: usize) -> Shot<f64> {
+        let (x, y) = (sx / 4, sy / 4);
+        let id = if (x * 7 + y * 3) % 23 < 2 { 3 } else if x < 20 { 1 } else { 2 };
+        let v = match id {
+            1 => ((x + y) % 64) as f64 / 64.0,
+            2 if (x / 3 + y / 5) % 7 == 0 => 0.2,
+            _ => 0.5,
+        };
+        (v, id, (x + 2 * y) as u16)
+    }
+
+    /// Samples one tile of [`picture`] at `(x0, y0)` with `mode`, `alone` answering the coarse
+    /// level; returns the levels, the hits and the eye rays traced.
+    fn sample(mode: Sampling, at: (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
+        sample_of(picture, mode, at, alone)
+    }
+
+    /// [`sample`] of another picture.
+    fn sample_of(picture: fn(usize, usize) -> Shot<f64>, mode: Sampling, (x0, y0, tw, th): (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
+        let mut sampler = Sampler::new(mode, 1, 64, &mut []).unwrap();
+        let (mut levels, mut hits, mut rays) = ([0; MAX_TILE * MAX_TILE], Hits::new(), 0);
+        let mut shoot = |sx: usize, sy: usize| {
+            rays += 1;
+            picture(sx, sy)
+        };
+        sampler.tile(x0, y0, tw, th, &mut shoot, alone, &mut levels, &mut hits);
+        (levels, hits, rays)
+    }
+
+    /// What the coarse level asks before it fills pixels.
+    type Alone<'a> = dyn FnMut([usize; 2], [usize; 2], u16) -> bool + 'a;
+
+    const ONE_LEVEL: Sampling = Sampling::Adaptive { contrast: 4, coarse: false };
+    const TWO_LEVELS: Sampling = Sampling::Adaptive { contrast: 4, coarse: true };
+
+    /// In every tile size, with either level count and whatever `alone` answers, a pixel
+    /// [`Sampler::exact`] calls exact holds what its centre's ray hits; with `alone` always
+    /// false, two levels sample what one does.
+    #[test]
+    fn exact_pixels_hold_their_rays_in_every_tile_size() {
+        let mut coin = 0x9e37_79b9u32;
+        for tw in 1..=MAX_TILE {
+            for th in 1..=MAX_TILE {
+                let at = (3 * tw, 5 * th, tw, th);
+                let alones: [&mut Alone<'_>; 3] = [&mut |_, _, _| true, &mut |_, _, _| false, &mut |_, _, _| {
+                    coin ^= coin << 13;
+                    coin ^= coin >> 17;
+                    coin ^= coin << 5;
+                    coin & 1 == 0
+                }];
+                for (k, alone) in alones.into_iter().enumerate() {
+                    for mode in [ONE_LEVEL, TWO_LEVELS] {
+                        let (_, hits, _) = sample(mode, at, &mut |xs, ys, id| alone(xs, ys, id));
+                        let sampler = Sampler::new(mode, 1, 64, &mut []).unwrap();
+                        for (x, y) in (0..th).flat_map(|y| (0..tw).map(move |x| (x, y))).filter(|&(x, y)| sampler.exact(x, y, tw, th, &hits)) {
+                            let (_, id, depth) = picture(4 * (at.0 + x) + 2, 4 * (at.1 + y) + 2);
+                            assert_eq!((hits.object[y * tw + x], hits.depth[y * tw + x]), (id, depth), "{tw}x{th} {mode:?} alone #{k}: pixel ({x}, {y})");
+                        }
+                    }
+                }
+                let (one, one_hits, one_rays) = sample(ONE_LEVEL, at, &mut |_, _, _| true);
+                let (two, two_hits, two_rays) = sample(TWO_LEVELS, at, &mut |_, _, _| false);
+                assert_eq!((one, one_hits.object, one_hits.depth, one_rays), (two, two_hits.object, two_hits.depth, two_rays), "{tw}x{th}");
+            }
+        }
+    }
+
+    /// Where the picture is one object of one level, two levels trace the 5x5 pixels of every
+    /// fourth line of a 16x16 tile, and the window's answer is what holds them back.
+    #[test]
+    fn two_levels_trace_every_fourth_line_where_the_picture_is_smooth() {
+        let at = (40, 32, MAX_TILE, MAX_TILE);
+        let flat: fn(usize, usize) -> Shot<f64> = |_, _| (0.5, 2, 7);
+        let lines = coarse_lines(MAX_TILE).count();
+        let mut asked = 0;
+        let (levels, _, rays) = sample_of(flat, TWO_LEVELS, at, &mut |xs, ys, id| {
+            asked += 1;
+            assert!(xs[0] <= xs[1] && ys[0] <= ys[1] && xs[1] < MAX_TILE && ys[1] < MAX_TILE && id == 2);
+            true
+        });
+        assert_eq!(rays, lines * lines);
+        assert!(asked > 0 && levels[..MAX_TILE * MAX_TILE].iter().all(|&l| l == 32));
+        let (_, _, one_rays) = sample_of(flat, ONE_LEVEL, at, &mut |_, _, _| true);
+        let (_, _, held) = sample_of(flat, TWO_LEVELS, at, &mut |_, _, _| false);
+        assert!(rays < one_rays && held == one_rays, "{rays} {one_rays} {held}");
+    }
+
+    /// With two levels a tile side asks for the exact hits of every fourth pixel and the last,
+    /// then of those between on every second line whose two neighbours there differ, then of
+    /// the rest whose neighbours differ.
+    #[test]
+    fn a_side_in_two_levels_asks_every_fourth_pixel_first() {
+        let truth = [(5, 10), (5, 11), (5, 12), (5, 13), (9, 3), (9, 4), (9, 5), (9, 6), (9, 7), (9, 8)];
+        let sampler = Sampler::new(TWO_LEVELS, 1, 16, &mut []).unwrap();
+        let (mut asked, mut out) = (std::vec::Vec::new(), [(0, 0); 10]);
+        sampler.side(
+            10,
+            |i| {
+                asked.push(i);
+                truth[i]
+            },
+            &mut out,
+        );
+        // 0, 4, 8, 9 first; 2 lies between 0 and 4 (objects 5 and 9): asked; 6 between 4 and
+        // 8 (9 and 9): filled; then 1 (5, 5) and 5, 7 (9, 9) filled, 3 between 2 and 4 (5, 9).
+        assert_eq!(asked, [0, 4, 8, 9, 2, 3]);
+        assert_eq!(out, [(5, 10), (5, 10), (5, 12), (5, 13), (9, 3), (9, 3), (9, 3), (9, 3), (9, 7), (9, 8)]);
     }
 }

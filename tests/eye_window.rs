@@ -125,7 +125,7 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
                     }
                 }
             }
-            for frame in [lattice_rt::Frame::new(48, 32), lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4 }, ..lattice_rt::Frame::new(37, 21) }] {
+            for frame in [lattice_rt::Frame::new(48, 32), lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false }, ..lattice_rt::Frame::new(37, 21) }, lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: true }, ..lattice_rt::Frame::new(37, 21) }] {
                 let mut by_tiles = Tracer::new(&scene, &BruteForce);
                 by_tiles.set_eye_rays(EyeRays::Windows);
                 let mut by_rays = Tracer::new(&scene, &BruteForce);
@@ -248,7 +248,8 @@ fn tile_lists_change_no_pixel() {
                 let Ok(scene) = b.finish() else { continue };
                 let frames = [
                     lattice_rt::Frame::new(64, 40),
-                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4 }, outline: true, dither: lattice_rt::Dither::FloydSteinberg, ..lattice_rt::Frame::new(53, 35) },
+                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false }, outline: true, dither: lattice_rt::Dither::FloydSteinberg, ..lattice_rt::Frame::new(53, 35) },
+                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: true }, outline: true, tile: 16, ..lattice_rt::Frame::new(53, 35) },
                     lattice_rt::Frame { sampling: lattice_rt::Sampling::Edges { contrast: 8 }, rows: (1, 3), ..lattice_rt::Frame::new(48, 40) },
                 ];
                 for frame in &frames {

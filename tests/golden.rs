@@ -61,11 +61,11 @@ fn error_diffusion_in_tiles_keeps_the_mean_gray() {
 }
 
 /// Error diffusion bit for bit: the Pico's panel frame (Floyd-Steinberg with silhouette lines,
-/// adaptive sampling, branches below half a gray step not traced) in fixed point, the same at a size whose edge tiles are partial, and
+/// adaptive sampling in two levels, branches below half a gray step not traced) in fixed point, the same at a size whose edge tiles are partial, and
 /// Atkinson's kernel.
 #[test]
 fn error_diffused_frames_match_golden_images() {
-    let panel = Frame { dither: Dither::FloydSteinberg, sampling: lattice_rt::render::Sampling::Adaptive { contrast: 4 }, outline: true, cutoff: Some(7), ..Frame::new(128, 64) };
+    let panel = Frame { dither: Dither::FloydSteinberg, sampling: lattice_rt::render::Sampling::Adaptive { contrast: 4, coarse: true }, outline: true, cutoff: Some(7), ..Frame::new(128, 64) };
     for s in SCENES {
         let (pbm, _) = render_text::<lattice_rt::Fx>(&scene_text(s), Accel::Lattice, &panel);
         assert_golden(&format!("{s}-panel-fixed"), &pbm);

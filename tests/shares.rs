@@ -34,7 +34,7 @@ fn shares_of(frame: Frame, of: u8) -> Vec<(Frame, Share)> {
 #[test]
 fn shares_rendered_apart_give_the_whole_frame() {
     for name in ["chair", "spheres", "whitted"] {
-        for sampling in [Sampling::Center, Sampling::Adaptive { contrast: 4 }] {
+        for sampling in [Sampling::Center, Sampling::Adaptive { contrast: 4, coarse: false }, Sampling::Adaptive { contrast: 4, coarse: true }] {
             // Silhouette lines too: each tile traces its own apron, so they split like the rest.
             for outline in [false, true] {
                 // 100x60: the last tile column and row are partial.
@@ -168,7 +168,7 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8, part: Option<
 #[test]
 fn traced_shares_dithered_in_order_give_the_whole_frame() {
     for name in ["chair", "desk", "whitted"] {
-        let samplings = [Sampling::Adaptive { contrast: 4 }, Sampling::Center, Sampling::Grid2x2];
+        let samplings = [Sampling::Adaptive { contrast: 4, coarse: true }, Sampling::Center, Sampling::Grid2x2];
         for (dither, sampling) in [Dither::FloydSteinberg, Dither::Atkinson, Dither::BlueNoise].into_iter().zip(samplings) {
             for (width, height, outline, tile) in [(128, 64, true, 8), (100, 60, true, 8), (100, 60, false, 8), (128, 64, true, 16), (100, 60, true, 16)] {
                 let frame = Frame { dither, outline, sampling, tile, ..Frame::new(width, height) };
@@ -208,7 +208,7 @@ fn traced_passes_dithered_in_order_give_every_pass() {
     for name in ["chair", "whitted"] {
         with_lattice::<Fx, _>(name, |scene, lat| {
             let tracer = Tracer::new(scene, lat);
-            let frame = Frame { dither: Dither::BlueNoise, outline: true, sampling: Sampling::Adaptive { contrast: 4 }, ..Frame::new(128, 64) };
+            let frame = Frame { dither: Dither::BlueNoise, outline: true, sampling: Sampling::Adaptive { contrast: 4, coarse: true }, ..Frame::new(128, 64) };
             let (w, h) = (128u32, 64u32);
             // What render_pass draws, pass by pass.
             let mut want = Vec::new();

@@ -35,7 +35,7 @@ impl<R: Real> Accelerator<R> for Counting<'_, R> {
 /// lines: hit-only apron rays too) and one ray per pixel with four at edges.
 fn frames() -> [Frame; 2] {
     [
-        Frame { tile: 16, sampling: Sampling::Adaptive { contrast: 4 }, dither: Dither::FloydSteinberg, outline: true, ..Frame::new(128, 64) },
+        Frame { tile: 16, sampling: Sampling::Adaptive { contrast: 4, coarse: true }, dither: Dither::FloydSteinberg, outline: true, ..Frame::new(128, 64) },
         Frame { sampling: Sampling::Edges { contrast: 16 }, ..Frame::new(96, 60) },
     ]
 }

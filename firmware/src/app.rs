@@ -125,6 +125,7 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Render(RenderError::Cancelled) => defmt::write!(f, "render cancelled"),
             AppError::Render(RenderError::BadTile) => defmt::write!(f, "bad tile size"),
             AppError::Render(RenderError::EdgesNotCompiled) => defmt::write!(f, "edge sampling not compiled in"),
+            AppError::Render(RenderError::CoarseNotCompiled) => defmt::write!(f, "two-level sampling not compiled in"),
             AppError::Render(RenderError::DiffusionNotCompiled) => defmt::write!(f, "error diffusion not compiled in"),
             AppError::Render(RenderError::BadShare) => defmt::write!(f, "bad tile share"),
             AppError::Render(RenderError::NotProgressive) => defmt::write!(f, "frame cannot be rendered progressively"),

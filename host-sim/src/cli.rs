@@ -85,9 +85,13 @@ pub enum SamplingArg {
     Edges,
     /// One ray per pixel, four at object edges and where neighbours differ by 16 of 64 levels.
     EdgesContrast,
-    /// Adaptive sub-sampling (the boards' default): every second pixel traced, the rest
+    /// Adaptive sub-sampling (the QEMU boards' default): every second pixel traced, the rest
     /// filled in where the traced pixels around hit one object and differ by at most 4 levels.
     Adaptive,
+    /// Adaptive sub-sampling in two levels (the panels' default): every fourth pixel traced
+    /// first, then every second filled in the same way where no other object's eye window and
+    /// no mirror or glass lies between, then the rest.
+    Coarse,
 }
 
 impl SamplingArg {
@@ -99,7 +103,8 @@ impl SamplingArg {
             SamplingArg::Four => Sampling::Grid2x2,
             SamplingArg::Edges => Sampling::Edges { contrast: u8::MAX },
             SamplingArg::EdgesContrast => Sampling::Edges { contrast: 16 },
-            SamplingArg::Adaptive => Sampling::Adaptive { contrast: 4 },
+            SamplingArg::Adaptive => Sampling::Adaptive { contrast: 4, coarse: false },
+            SamplingArg::Coarse => Sampling::Adaptive { contrast: 4, coarse: true },
         }
     }
 }

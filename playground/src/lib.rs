@@ -70,7 +70,7 @@ fn dither_name(d: Dither) -> &'static str {
 }
 
 fn sampling_name(s: Sampling) -> &'static str {
-    if s == board_frame::SAMPLING {
+    if s == board_frame::PANEL_SAMPLING {
         "adaptive"
     } else {
         "one"
@@ -86,7 +86,7 @@ impl Settings {
             .map(|(_, d)| *d)
             .ok_or_else(|| format!("unknown dither `{}` (one of {})", self.dither, DITHERS.map(|d| d.0).join(", ")))?;
         let sampling = match self.sampling.as_str() {
-            "adaptive" => board_frame::SAMPLING,
+            "adaptive" => board_frame::PANEL_SAMPLING,
             "one" => Sampling::Center,
             other => return Err(format!("unknown sampling `{other}` (adaptive or one)")),
         };

@@ -9,11 +9,19 @@ pub const WIDTH: u16 = 128;
 /// Display height.
 pub const HEIGHT: u16 = 64;
 
-/// How the boards spend eye rays: adaptive sub-sampling (every second pixel traced, the rest
-/// filled where the traced pixels around agree to 4 levels of 64; its error is in
-/// docs/accuracy.md). The firmware's `exact-sampling` feature traces one ray per pixel instead
-/// (`app::RENDERED`).
-pub const SAMPLING: Sampling = Sampling::Adaptive { contrast: 4 };
+/// How the boards without a panel spend eye rays: adaptive sub-sampling (every second pixel
+/// traced, the rest filled where the traced pixels around agree to 4 levels of 64; its error
+/// is in docs/accuracy.md). The firmware's `exact-sampling` feature traces one ray per pixel
+/// instead (`app::RENDERED`).
+pub const SAMPLING: Sampling = Sampling::Adaptive { contrast: 4, coarse: false };
+
+/// How the boards with a panel spend eye rays: adaptive sub-sampling in two levels (every
+/// fourth pixel traced, then every second, filled in the same way where no other object's eye
+/// window and no mirror or glass lies between, then the rest; its error is in
+/// docs/accuracy.md). In 16x16 tiles it traces a third fewer of the chair's eye rays with the
+/// same gray levels; the boards without a panel, whose tiny image has no room for its code
+/// (the core's `coarse-sampling` feature), keep [`SAMPLING`].
+pub const PANEL_SAMPLING: Sampling = Sampling::Adaptive { contrast: 4, coarse: true };
 
 /// The contribution cutoff of every board's frame ([`Frame::cutoff`]): branches of the
 /// intersection tree weighing less than 2^-7, half of one of the 64 gray steps of a pixel's
@@ -97,7 +105,11 @@ pub const fn rendered(b: Build) -> Frame {
         Some(on) => on,
         None => b.panel,
     };
-    let sampling = if b.exact_sampling { Sampling::Center } else { SAMPLING };
+    let sampling = match (b.exact_sampling, b.panel) {
+        (true, _) => Sampling::Center,
+        (false, true) => PANEL_SAMPLING,
+        (false, false) => SAMPLING,
+    };
     let tile = if b.panel { PANEL_TILE } else { FRAME.tile };
     Frame { dither, outline, sampling, tile, ..FRAME }
 }
@@ -128,13 +140,14 @@ pub const TUNING: Tuning = Tuning { eye_rays: None, shadow_coherence: true, box_
 
 /// The ladder of the real-time work, from the paper's method to what the boards run, one lever
 /// added per rung (docs/board.md, written by `cargo xtask board` from the `ladder` image).
-pub const LADDER: [(&str, Tuning); 6] = [
+pub const LADDER: [(&str, Tuning); 7] = [
     ("the paper's nested lattice, one ray per pixel", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: false, box_tests: false, sampling: Sampling::Center }),
     ("+ shadow rays try the last occluder first", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: false, sampling: Sampling::Center }),
     ("+ the walk tests an object's box before the object", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
     ("+ eye windows: the walk skips objects whose window misses the eye ray", Tuning { eye_rays: Some(EyeRays::Accelerator), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
     ("+ eye rays and first-light shadow rays by windows alone, no walk", Tuning { eye_rays: Some(EyeRays::Windows), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
-    ("+ adaptive sub-sampling (the boards' default)", TUNING),
+    ("+ adaptive sub-sampling: every second pixel traced first", TUNING),
+    ("+ in two levels: every fourth pixel first (the panels' default)", Tuning { sampling: PANEL_SAMPLING, ..TUNING }),
 ];
 
 /// Tile shares a frame is rendered in (`Share`): one per RP2040 core. Where only one core runs

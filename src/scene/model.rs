@@ -193,11 +193,16 @@ impl<R: Real> Camera<R> {
 }
 
 /// `(n << 16) / d` (`d` at least 1) truncated towards zero, clamped to `i32`: one 32-bit
-/// division while `n` is small (a microcontroller's divider does that in a few cycles), else
+/// division while `n` is small (a microcontroller's divider does that in a few cycles), a shift
+/// when `d` is a power of two too (every board's window: a Cortex-M0+ has no divider), else
 /// long division in 32 bits (no 64-bit division routine linked).
 fn window_coord(n: i32, d: i32) -> i32 {
     let d = d.max(1);
     if n.unsigned_abs() < 1 << 15 {
+        if d & (d - 1) == 0 {
+            let q = ((n.unsigned_abs() << 16) >> d.trailing_zeros()) as i32;
+            return if n < 0 { -q } else { q };
+        }
         (n << 16) / d
     } else {
         window_coord_far(n, d)
@@ -358,6 +363,14 @@ impl<R: Real> Object<R> {
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
         self.intersect_local(self.point_local(ray.origin), self.direction_local(ray.dir), tmin, tmax)
+    }
+
+    /// Whether the object's eye window meets the window rectangle `u` x `v` (2^-16 units,
+    /// inclusive bounds, see [`EyeWindow`]).
+    #[inline]
+    pub fn eye_window_meets(&self, u: [i32; 2], v: [i32; 2]) -> bool {
+        let w = &self.eye_window;
+        w[0] <= u[1] && u[0] <= w[1] && w[2] <= v[1] && v[0] <= w[3]
     }
 
     /// [`Object::intersect`] for an eye ray (its origin the camera's eye) through window
@@ -589,8 +602,7 @@ impl<'a, R: Real> Scene<'a, R> {
     pub fn eye_candidates(&self, u: [i32; 2], v: [i32; 2]) -> u64 {
         let mut mask = 0u64;
         for (i, o) in self.objects.iter().enumerate().take(64) {
-            let w = &o.eye_window;
-            if w[0] <= u[1] && u[0] <= w[1] && w[2] <= v[1] && v[0] <= w[3] {
+            if o.eye_window_meets(u, v) {
                 mask |= 1 << i;
             }
         }
@@ -599,6 +611,20 @@ impl<'a, R: Real> Scene<'a, R> {
         } else {
             mask
         }
+    }
+    /// Of the objects in `among` (bit `i`: object `i`, the first 64 objects), those whose eye
+    /// windows meet the window rectangle `u` x `v`, as [`Scene::eye_candidates`] finds them.
+    pub fn eye_candidates_among(&self, among: u64, u: [i32; 2], v: [i32; 2]) -> u64 {
+        let (mut rest, mut mask) = (among, 0u64);
+        while rest != 0 {
+            let i = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let Some(o) = self.objects.get(i) else { break };
+            if o.eye_window_meets(u, v) {
+                mask |= 1 << i;
+            }
+        }
+        mask
     }
     /// All primitives; the objects of a composite are contiguous.
     pub fn objects(&self) -> &'a [Object<R>] {

@@ -51,7 +51,7 @@ impl Look {
     fn frame(self, w: u16, h: u16) -> Frame {
         Frame {
             dither: DITHERS[self.dither].1,
-            sampling: board_frame::SAMPLING,
+            sampling: board_frame::PANEL_SAMPLING,
             outline: self.outline,
             tone: Tone { gamma_tenths: self.gamma },
             tile: board_frame::PANEL_TILE,

@@ -59,9 +59,10 @@ fn configs() -> Vec<Config> {
         v.push(Config { knob: "sampling", label: format!("edges + contrast >= {c}: 4 rays there"), sampling: Sampling::Edges { contrast: c }, ..base.clone() });
     }
     for c in [2u8, 4, 8] {
-        v.push(Config { knob: "sampling", label: format!("adaptive, contrast <= {c}: every 2nd pixel traced, the rest filled"), sampling: Sampling::Adaptive { contrast: c }, ..base.clone() });
+        v.push(Config { knob: "sampling", label: format!("adaptive, contrast <= {c}: every 2nd pixel traced, the rest filled"), sampling: Sampling::Adaptive { contrast: c, coarse: false }, ..base.clone() });
     }
-    v.push(Config { knob: "sampling", label: PICO_ADAPTIVE.into(), sampling: board_records::frame::SAMPLING, tile: board_records::frame::PANEL_TILE, ..base.clone() });
+    v.push(Config { knob: "sampling", label: PICO_ONE_LEVEL.into(), sampling: board_records::frame::SAMPLING, tile: board_records::frame::PANEL_TILE, ..base.clone() });
+    v.push(Config { knob: "sampling", label: PICO_ADAPTIVE.into(), sampling: board_records::frame::PANEL_SAMPLING, tile: board_records::frame::PANEL_TILE, ..base.clone() });
     v.push(Config { knob: "dither", label: "floyd-steinberg".into(), dither: Dither::FloydSteinberg, ..base.clone() });
     v.push(Config { knob: "dither", label: "atkinson".into(), dither: Dither::Atkinson, ..base.clone() });
     v
@@ -76,7 +77,9 @@ fn boards_cutoff() -> f64 {
 }
 
 /// The label of adaptive sampling in the Pico's 16x16 tiles (the QEMU boards' frames have 8x8).
-const PICO_ADAPTIVE: &str = "adaptive in 16x16 tiles (the Pico's frame), contrast <= 4";
+const PICO_ADAPTIVE: &str = "adaptive in two levels in 16x16 tiles (the Pico's frame), contrast <= 4";
+/// The row of one-level adaptive sampling in the Pico's tiles.
+const PICO_ONE_LEVEL: &str = "adaptive in one level in 16x16 tiles, contrast <= 4";
 
 /// One render's outcome.
 struct Shot {
@@ -346,8 +349,9 @@ fn targets_section(md: &mut String, configs: &[Config], tallies: &[Tally], names
     let cutoff = format!("cutoff {BOARDS_CUTOFF}");
     let boards = [
         (format!("the boards' contribution cutoff, {BOARDS_CUTOFF}"), cutoff.as_str(), "without"),
-        ("adaptive sub-sampling (the boards' default, contrast 4) in the QEMU boards' 8x8 tiles".into(), "adaptive, contrast <= 4", "with one ray per pixel"),
-        ("adaptive sub-sampling (the boards' default, contrast 4) in the Pico's 16x16 tiles".into(), PICO_ADAPTIVE, "with one ray per pixel"),
+        ("adaptive sub-sampling (the QEMU boards' default, contrast 4) in their 8x8 tiles".into(), "adaptive, contrast <= 4", "with one ray per pixel"),
+        ("adaptive sub-sampling in one level (contrast 4) in the Pico's 16x16 tiles".into(), PICO_ONE_LEVEL, "with one ray per pixel"),
+        ("adaptive sub-sampling in two levels (the panels' default, contrast 4) in the Pico's 16x16 tiles".into(), PICO_ADAPTIVE, "with one ray per pixel"),
     ];
     for (what, label, against) in boards {
         if let (Some(one), Some(a)) = (find("f64, 1 ray"), find(label)) {
