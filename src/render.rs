@@ -559,8 +559,12 @@ fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '
             return false;
         }
     }
+    let others = candidates & !(1u64.checked_shl(id as u32).unwrap_or(0));
+    if others == 0 {
+        return true;
+    }
     let (u, v) = crate::cover::tile_window::<R>((x0 + xs[0], xs[1] + 1 - xs[0]), (y0 + ys[0], ys[1] + 1 - ys[0]), 0, size);
-    scene.eye_candidates_among(candidates, u, v) & !(1u64.checked_shl(id as u32).unwrap_or(0)) == 0
+    !scene.eye_window_among_meets(others, u, v)
 }
 
 /// A pass of a progressive frame as the tile loop takes it: which pass, and the rays kept

@@ -612,19 +612,14 @@ impl<'a, R: Real> Scene<'a, R> {
             mask
         }
     }
-    /// Of the objects in `among` (bit `i`: object `i`, the first 64 objects), those whose eye
-    /// windows meet the window rectangle `u` x `v`, as [`Scene::eye_candidates`] finds them.
-    pub fn eye_candidates_among(&self, among: u64, u: [i32; 2], v: [i32; 2]) -> u64 {
-        let (mut rest, mut mask) = (among, 0u64);
-        while rest != 0 {
-            let i = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            let Some(o) = self.objects.get(i) else { break };
-            if o.eye_window_meets(u, v) {
-                mask |= 1 << i;
-            }
-        }
-        mask
+    /// Whether any of the objects in `among` (bit `i`: object `i`, of the first 64) has an eye
+    /// window that meets the window rectangle `u` x `v`, as [`Scene::eye_candidates`] finds
+    /// them.
+    pub fn eye_window_among_meets(&self, among: u64, u: [i32; 2], v: [i32; 2]) -> bool {
+        // The mask by halves of 32 bits: a Cortex-M0+ shifts those in one instruction, and
+        // 64-bit values in library calls.
+        let halves = [among as u32, (among >> 32) as u32];
+        self.objects.iter().take(64).enumerate().any(|(i, o)| (halves[i / 32] >> (i % 32)) & 1 != 0 && o.eye_window_meets(u, v))
     }
     /// All primitives; the objects of a composite are contiguous.
     pub fn objects(&self) -> &'a [Object<R>] {
