@@ -550,6 +550,7 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
 /// simulated). A tile with more than 64 objects' candidates is never filled so.
 fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '_, R, A, E>, candidates: u64, (x0, y0): (usize, usize), (xs, ys): ([usize; 2], [usize; 2]), id: u16, size: (i32, i32)) -> bool {
     let scene = tracer.scene();
+    let others = candidates & !(1u64.checked_shl(id as u32).unwrap_or(0));
     if candidates == u64::MAX || scene.objects().len() > 64 {
         return false;
     }
@@ -559,7 +560,6 @@ fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '
             return false;
         }
     }
-    let others = candidates & !(1u64.checked_shl(id as u32).unwrap_or(0));
     if others == 0 {
         return true;
     }

@@ -616,10 +616,19 @@ impl<'a, R: Real> Scene<'a, R> {
     /// window that meets the window rectangle `u` x `v`, as [`Scene::eye_candidates`] finds
     /// them.
     pub fn eye_window_among_meets(&self, among: u64, u: [i32; 2], v: [i32; 2]) -> bool {
-        // The mask by halves of 32 bits: a Cortex-M0+ shifts those in one instruction, and
-        // 64-bit values in library calls.
-        let halves = [among as u32, (among >> 32) as u32];
-        self.objects.iter().take(64).enumerate().any(|(i, o)| (halves[i / 32] >> (i % 32)) & 1 != 0 && o.eye_window_meets(u, v))
+        // The mask's set bits, by halves of 32 bits: a Cortex-M0+ handles those in a few
+        // instructions, and 64-bit values in library calls.
+        for (half, base) in [(among as u32, 0), ((among >> 32) as u32, 32)] {
+            let mut rest = half;
+            while rest != 0 {
+                let i = base + rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                if self.objects.get(i).is_some_and(|o| o.eye_window_meets(u, v)) {
+                    return true;
+                }
+            }
+        }
+        false
     }
     /// All primitives; the objects of a composite are contiguous.
     pub fn objects(&self) -> &'a [Object<R>] {
