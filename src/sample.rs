@@ -358,7 +358,10 @@ fn adaptive<R: Real>(
     } else {
         for y in traced_lines(th) {
             for x in traced_lines(tw) {
-                shoot_at(shoot, levels, ids, depths, y * tw + x, centre(x, y));
+                let (cx, cy) = centre(x, y);
+                let (v, id, depth) = shoot(cx, cy);
+                let i = at(y * tw + x);
+                (levels[i], ids[i], depths[i]) = (level(v), id, depth);
             }
         }
     }
@@ -423,9 +426,9 @@ fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; 
     true
 }
 
-/// Traces pixel `i` through its centre `(cx, cy)` (quarter pixels). Out of line: every pass
-/// calls it, and `shoot` (the tracer, inlined into it) is large; so its stack is taken only
-/// while a ray is traced, not beside the passes' own.
+/// Traces untraced pixel `i` through its centre `(cx, cy)` (quarter pixels). Out of line: the
+/// later passes call it from several places, and `shoot` (the tracer, inlined into it) is
+/// large.
 #[inline(never)]
 fn shoot_at<R: Real>(shoot: &mut impl FnMut(usize, usize) -> Shot<R>, levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, (cx, cy): (usize, usize)) {
     let (v, id, depth) = shoot(cx, cy);

@@ -193,16 +193,11 @@ impl<R: Real> Camera<R> {
 }
 
 /// `(n << 16) / d` (`d` at least 1) truncated towards zero, clamped to `i32`: one 32-bit
-/// division while `n` is small (a microcontroller's divider does that in a few cycles), a shift
-/// when `d` is a power of two too (every board's window: a Cortex-M0+ has no divider), else
+/// division while `n` is small (a microcontroller's divider does that in a few cycles), else
 /// long division in 32 bits (no 64-bit division routine linked).
 fn window_coord(n: i32, d: i32) -> i32 {
     let d = d.max(1);
     if n.unsigned_abs() < 1 << 15 {
-        if d & (d - 1) == 0 {
-            let q = ((n.unsigned_abs() << 16) >> d.trailing_zeros()) as i32;
-            return if n < 0 { -q } else { q };
-        }
         (n << 16) / d
     } else {
         window_coord_far(n, d)
