@@ -93,5 +93,30 @@ fn levers(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, primitives, walk_and_tile, levers);
+/// The chair's frame as the Pico renders it (fixed point, 16x16 tiles, Floyd-Steinberg, lines,
+/// the boards' cutoff), sampled adaptively in one level and in two (the panels'): the whole
+/// frame, eye rays and the sampler's fills together.
+fn sampling(c: &mut Criterion) {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/chair.scene")).unwrap();
+    let mut st = Default::default();
+    let scene = scene_parts::<Fx>(&text, &mut st);
+    let cfg = LatticeConfig::default();
+    let panel = Frame { tile: 16, dither: lattice_rt::Dither::FloydSteinberg, outline: true, cutoff: Some(7), ..Frame::new(128, 64) };
+    let mut storage = HeapStorage::new(Sizes { objects: 0, ..Sizes::of(&scene, Some(&cfg), &panel) });
+    let (lat, _) = storage.view().split().1.lattice(&scene, &cfg).unwrap();
+    let tracer = Tracer::new(&scene, &lat);
+    for (name, coarse) in [("one level", false), ("two levels", true)] {
+        let frame = Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse }, ..panel };
+        let mut scratch = lattice_rt::HeapScratch::new(&scene, &frame);
+        c.bench_function(&format!("chair frame, fixed, the Pico's: adaptive in {name}"), |b| {
+            b.iter(|| {
+                let mut bits = [0u8; 128 * 64 / 8];
+                let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
+                render(&tracer, black_box(&frame), &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap()
+            })
+        });
+    }
+}
+
+criterion_group!(benches, primitives, walk_and_tile, levers, sampling);
 criterion_main!(benches);
