@@ -714,23 +714,56 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
 }
 
 /// Where a frame's eye rays pass the window: per quarter-pixel column its window coordinate
-/// ([`Camera::window_u`]) and ray factor ([`Camera::ray_u`]), and of the last row asked for its
-/// window coordinate and its part of the ray's direction ([`Camera::row`]), each kept from the
+/// ([`Camera::window_u`]) and its part of the ray's direction ([`Camera::column`]), and of the
+/// last row asked for its window coordinate and its part ([`Camera::row`]), each kept from the
 /// last ray that needed it. Each depends on one position alone, so a tile's rays (row by row)
-/// compute them, a division (and for a row three products), once per column and row instead
-/// of once per ray; the rays are the same ([`Camera::ray_from`]). (Keeping each column's part
-/// of the direction too would save three more products a ray, for 88 more bytes of stack
-/// with 8x8 tiles, which the 4 KiB board does not have.)
+/// compute them, a division and three products, once per column and row instead of once per
+/// ray; the rays are the same ([`Camera::ray_from`]). With 8x8 tiles (the `tile8` feature: the
+/// 4 KiB boards) a column keeps its ray factor ([`Camera::ray_u`]) instead and each ray takes
+/// the three products: its part would take 88 more bytes of stack, which those boards do not
+/// have.
 struct Window<'c, R> {
     camera: &'c Camera<R>,
     size: (i32, i32),
-    cols: [(i32, i32, R); MAX_TILE],
+    cols: [(i32, i32, ColumnPart<R>); MAX_TILE],
     row: (i32, i32, Vec3<R>),
+}
+
+/// What [`Window`] keeps of a column for its rays: the ray factor ([`Camera::ray_u`]) with 8x8
+/// tiles, else the column's part of the direction.
+#[cfg(feature = "tile8")]
+type ColumnPart<R> = R;
+/// What [`Window`] keeps of a column for its rays: the ray factor ([`Camera::ray_u`]) with 8x8
+/// tiles, else the column's part of the direction.
+#[cfg(not(feature = "tile8"))]
+type ColumnPart<R> = Vec3<R>;
+
+/// The [`ColumnPart`] of ray factor `u`.
+#[cfg(feature = "tile8")]
+fn column_part<R: Real>(_: &Camera<R>, u: R) -> ColumnPart<R> {
+    u
+}
+/// The [`ColumnPart`] of ray factor `u`.
+#[cfg(not(feature = "tile8"))]
+fn column_part<R: Real>(camera: &Camera<R>, u: R) -> ColumnPart<R> {
+    camera.column(u)
+}
+
+/// The column's part of the direction ([`Camera::column`]) from what the window kept of it.
+#[cfg(feature = "tile8")]
+fn column_of<R: Real>(camera: &Camera<R>, part: ColumnPart<R>) -> Vec3<R> {
+    camera.column(part)
+}
+/// The column's part of the direction ([`Camera::column`]) from what the window kept of it.
+#[cfg(not(feature = "tile8"))]
+fn column_of<R: Real>(_: &Camera<R>, part: ColumnPart<R>) -> Vec3<R> {
+    part
 }
 
 impl<'c, R: Real> Window<'c, R> {
     fn new(camera: &'c Camera<R>, w4: i32, h4: i32) -> Self {
-        Window { camera, size: (w4, h4), cols: [(-1, 0, R::ZERO); MAX_TILE], row: (-1, 0, Vec3::new(R::ZERO, R::ZERO, R::ZERO)) }
+        let none = column_part(camera, R::ZERO);
+        Window { camera, size: (w4, h4), cols: [(-1, 0, none); MAX_TILE], row: (-1, 0, Vec3::new(R::ZERO, R::ZERO, R::ZERO)) }
     }
 
     /// Window position (2^-16 units) and the eye ray through `(sx, sy)`.
@@ -739,13 +772,13 @@ impl<'c, R: Real> Window<'c, R> {
         let (w4, h4) = self.size;
         let c = &mut self.cols[(sx as usize >> 2) % MAX_TILE];
         if c.0 != sx {
-            *c = (sx, Camera::<R>::window_u(sx, w4), Camera::<R>::ray_u(sx, w4));
+            *c = (sx, Camera::<R>::window_u(sx, w4), column_part(self.camera, Camera::<R>::ray_u(sx, w4)));
         }
         let r = &mut self.row;
         if r.0 != sy {
             *r = (sy, Camera::<R>::window_v(sy, h4), self.camera.row(Camera::<R>::ray_v(sy, h4)));
         }
-        ([c.1, r.1], self.camera.ray_from(self.camera.column(c.2), r.2))
+        ([c.1, r.1], self.camera.ray_from(column_of(self.camera, c.2), r.2))
     }
 }
 
