@@ -550,16 +550,16 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
 /// simulated). A tile with more than 64 objects' candidates is never filled so.
 fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '_, R, A, E>, candidates: u64, (x0, y0): (usize, usize), (xs, ys): ([usize; 2], [usize; 2]), id: u16, size: (i32, i32)) -> bool {
     let scene = tracer.scene();
-    let others = candidates & !(1u64.checked_shl(id as u32).unwrap_or(0));
-    if candidates == u64::MAX || scene.objects().len() > 64 {
+    // A scene of more than 64 objects gives every tile this mask (`Scene::eye_candidates`).
+    if candidates == u64::MAX {
         return false;
     }
     if let Some(o) = scene.objects().get(id as usize) {
-        let m = crate::bounds::at(scene.materials(), o.material as usize);
-        if (tracer.simulates(crate::Effects::REFLECTION) && m.ks > R::ZERO) || (tracer.simulates(crate::Effects::REFRACTION) && m.kt > R::ZERO) {
+        if tracer.branches(crate::bounds::at(scene.materials(), o.material as usize)) != (false, false) {
             return false;
         }
     }
+    let others = candidates & !(1u64.checked_shl(id as u32).unwrap_or(0));
     if others == 0 {
         return true;
     }

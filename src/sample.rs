@@ -173,8 +173,7 @@ impl<'r> Sampler<'r> {
     pub fn exact(&self, x: usize, y: usize, tw: usize, th: usize, hits: &Hits) -> bool {
         match (self.mode, self.block) {
             (Sampling::Adaptive { coarse, .. }, 1) => {
-                let on = |i: usize, n: usize| if coarse { coarse_line(i, n) } else { traced(i, n) };
-                if on(x, tw) && on(y, th) {
+                if first_pass(coarse, x, tw) && first_pass(coarse, y, th) {
                     return true;
                 }
                 let (xs, ys) = if traced(x, tw) && traced(y, th) { (between(x, tw), between(y, th)) } else { around(x, y, tw, th) };
@@ -200,7 +199,7 @@ impl<'r> Sampler<'r> {
             (Sampling::Adaptive { coarse, .. }, 1) => (true, coarse),
             _ => (false, false),
         };
-        for i in (0..n).filter(|&i| !fills || if coarse { coarse_line(i, n) } else { traced(i, n) }) {
+        for i in (0..n).filter(|&i| !fills || first_pass(coarse, i, n)) {
             out[i] = exact(i);
         }
         if coarse {
@@ -277,6 +276,16 @@ fn traced(i: usize, n: usize) -> bool {
 /// The lines [`traced`] picks of `n`, in order: every second one from the first, then the last.
 fn traced_lines(n: usize) -> impl Iterator<Item = usize> {
     (0..n).step_by(2).chain((n > 0 && n.is_multiple_of(2)).then(|| n - 1))
+}
+
+/// Whether tile row or column `i` of `n` is traced in the first pass of adaptive sampling in
+/// one level ([`traced`]) or in two ([`coarse_line`]).
+fn first_pass(coarse: bool, i: usize, n: usize) -> bool {
+    if coarse {
+        coarse_line(i, n)
+    } else {
+        traced(i, n)
+    }
 }
 
 /// Whether tile row or column `i` of `n` is traced in the coarse level's first pass: every

@@ -22,7 +22,7 @@ use crate::accel::{Accelerator, BruteForce, Query, RayKind};
 use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
-use crate::scene::{Light, Scene};
+use crate::scene::{Light, Material, Scene};
 use heapless::Vec;
 
 /// The object id reported for an eye ray that hits nothing.
@@ -89,7 +89,7 @@ impl Effects {
     /// primitive is convex, so a lone object never shadows itself); reflection needs a
     /// material with `Ks > 0` on some object, refraction one with `Kt > 0`.
     pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
-        let used = |f: fn(&crate::scene::Material<R>) -> R| {
+        let used = |f: fn(&Material<R>) -> R| {
             scene.objects.iter().any(|o| f(at(scene.materials, o.material as usize)) > R::ZERO)
         };
         let mut e = Self::NONE;
@@ -479,6 +479,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         Effects::from_bits(E).contains(effect) && self.effects.contains(effect)
     }
 
+    /// Whether a hit on material `m` casts a mirror ray and whether it casts a refracted one, in
+    /// the effects simulated (each ray also needs the tree's depth left).
+    #[inline(always)]
+    pub fn branches(&self, m: &Material<R>) -> (bool, bool) {
+        (self.simulates(Effects::REFLECTION) && m.ks > R::ZERO, self.simulates(Effects::REFRACTION) && m.kt > R::ZERO)
+    }
+
     /// Brightness (0 black .. 1 white, clamped) seen along an eye ray.
     pub fn radiance(&self, eye: Ray<R>, q: &mut Query<'_>) -> R {
         self.radiance_and_object(eye, q).0
@@ -595,8 +602,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             let p = obj.surface_point(hit.point, hit.normal);
             // Children (a mirror or a refracted ray) need the unit direction; without them only
             // the side the ray meets is asked, which the direction as traced gives.
-            let reflects = self.simulates(Effects::REFLECTION) && m.ks > R::ZERO;
-            let refracts = self.simulates(Effects::REFRACTION) && m.kt > R::ZERO;
+            let (reflects, refracts) = self.branches(m);
             let children = node.depth < self.max_depth && (reflects || refracts);
             let d = if children { ray.dir.normalize() } else { ray.dir };
             let side = facing(d, q.world_normal(scene, hit.object, hit.normal));
