@@ -19,7 +19,7 @@ pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, O
 /// What this build asks of its frame (its features; `board_records::frame::Build::of` reads
 /// the same names for build.rs and the checks).
 pub const BUILD: Build = Build {
-    panel: cfg!(feature = "rp"),
+    panel: cfg!(any(feature = "rp", feature = "panel-frame")),
     orbit: cfg!(feature = "orbit"),
     progressive: cfg!(feature = "progressive"),
     lines: if cfg!(feature = "outline") {
@@ -246,8 +246,9 @@ const fn second(n: usize) -> usize {
 /// and every pass of a progressive one. Error diffusion carries error from tile to tile, so the
 /// cores cannot each draw their own tiles; silhouette lines then need no apron rays; and a band
 /// goes to the display in one transfer (a progressive pass's 128 tiles sent one by one took
-/// twice the bytes).
-const TRACE_THEN_DITHER: bool = SECOND_CORE;
+/// twice the bytes). A one-core board rendering a panel's frame (`panel-frame`) takes the same
+/// path: its core traces every tile and dithers the bands in order.
+const TRACE_THEN_DITHER: bool = SECOND_CORE || cfg!(feature = "panel-frame");
 /// Rays each tile keeps between the passes of a progressive frame on a two-core board (the
 /// cores take tiles one at a time, so each has its own: one per pixel of its 2x2 grid); none
 /// otherwise.

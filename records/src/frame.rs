@@ -70,7 +70,8 @@ pub const MOTION_DITHER: Dither = Dither::BlueNoise;
 /// What a firmware build asks of its frame: its features.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Build {
-    /// The board shows its frames to a person on a panel (the Raspberry Pi boards' SSD1306).
+    /// The board renders the frame of a panel (the Raspberry Pi boards' SSD1306, or the
+    /// firmware's `panel-frame` feature on a board without one).
     pub panel: bool,
     /// Orbit mode (`orbit`): frames in motion.
     pub orbit: bool,
@@ -85,7 +86,7 @@ pub struct Build {
 
 impl Build {
     /// The build of a firmware whose Cargo features `has` answers for by name (`rp` is a
-    /// panel).
+    /// panel, and `panel-frame` renders its frame).
     pub fn of(has: impl Fn(&str) -> bool) -> Build {
         let lines = if has("outline") {
             Some(true)
@@ -94,7 +95,7 @@ impl Build {
         } else {
             None
         };
-        Build { panel: has("rp"), orbit: has("orbit"), progressive: has("progressive"), lines, exact_sampling: has("exact-sampling") }
+        Build { panel: has("rp") || has("panel-frame"), orbit: has("orbit"), progressive: has("progressive"), lines, exact_sampling: has("exact-sampling") }
     }
 }
 
