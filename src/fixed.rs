@@ -62,10 +62,9 @@ impl Mul for Fx {
 
 /// `(a * b + 2^15) >> 16` for magnitudes `a`, `b` not both below 2^16, saturated to
 /// `i32::MAX`, from 16-bit halves with 32-bit multiplies only (a Cortex-M0+ has no 32x32->64
-/// multiply). With both factors 1 or more the partial products are summed in 64 bits (two
-/// instructions an add on a Cortex-M0+), so no step needs an overflow check. Out of line:
-/// inlined at every product, its paths made the tracer's deepest frames larger (the chair's
-/// baked M0 build, 488 B more stack) and the image 5 KB larger, for 0.7 % fewer instructions.
+/// multiply). Out of line: inlined at every product, its paths made the tracer's deepest frames
+/// larger (the chair's baked M0 build, 488 B more stack) and the image 5 KB larger, for 0.7 %
+/// fewer instructions.
 #[inline(never)]
 fn product(a: u32, b: u32) -> i32 {
     if a >> 16 == 0 || b >> 16 == 0 {
@@ -74,9 +73,28 @@ fn product(a: u32, b: u32) -> i32 {
         let (big, small) = if a >> 16 == 0 { (b, a) } else { (a, b) };
         return ((big >> 16) * small + (((big & 0xFFFF) * small + 0x8000) >> 16)).min(i32::MAX as u32) as i32;
     }
+    // Built for size (`compact`: the tiny image has no room for the second path), every
+    // product of factors 1 or more takes the wide one.
+    if cfg!(feature = "compact") || (a | b) >> 23 != 0 {
+        return wide_product(a, b);
+    }
+    // (a * b + 2^15) >> 16 = ah*bh << 16 + ah*bl + al*bh + (al*bl + 2^15) >> 16, whose first
+    // two terms are ah * b. Both factors below 128 (ah, bh < 2^7): ah * b < 2^30 and al * bh <
+    // 2^23, so the sum stays below 2^31 in 32 bits: three multiplies, no 64-bit sum and no
+    // saturation check.
     let (ah, al, bh, bl) = (a >> 16, a & 0xFFFF, b >> 16, b & 0xFFFF);
-    // (a * b + 2^15) >> 16 = ah*bh << 16 + ah*bl + al*bh + (al*bl + 2^15) >> 16; each product
-    // fits 32 bits (ah, bh <= 2^15), and al*bl + 2^15 < 2^32.
+    (ah * b + al * bh + ((al * bl + 0x8000) >> 16)) as i32
+}
+
+/// [`product`] of factors both 1 or more, one of them 128 or more: the partial products summed
+/// in 64 bits (two instructions an add on a Cortex-M0+), so no step needs an overflow check.
+/// Out of line and cold: rare in a frame, and its registers would make every product save more
+/// (inlined into it where built for size, as one function is smaller).
+#[cfg_attr(not(feature = "compact"), cold, inline(never))]
+#[cfg_attr(feature = "compact", inline(always))]
+fn wide_product(a: u32, b: u32) -> i32 {
+    let (ah, al, bh, bl) = (a >> 16, a & 0xFFFF, b >> 16, b & 0xFFFF);
+    // Each product fits 32 bits (ah, bh <= 2^15), and al*bl + 2^15 < 2^32.
     let m = (u64::from(ah * bh) << 16) + u64::from(ah * bl) + u64::from(al * bh) + u64::from((al * bl + 0x8000) >> 16);
     if m > i32::MAX as u64 {
         i32::MAX
@@ -84,6 +102,7 @@ fn product(a: u32, b: u32) -> i32 {
         m as i32
     }
 }
+
 /// `(a << 16) / b` for `b > 0` as a quotient and remainder, by restoring long division in base
 /// 2 in 32 bits (the remainder stays below `b < 2^32`, and below 2^31 doubling it fits), not a
 /// 64-bit division: its sixteen fraction bits after the integer quotient `a / b`, which must be
@@ -389,6 +408,29 @@ mod tests {
         assert_eq!(fx(2.0).sqrt().0, 92682); // sqrt(2) * 65536 = 92681.9
         assert_eq!(fx(0.0).sqrt(), Fx(0));
         assert_eq!(fx(-4.0).sqrt(), Fx(0));
+    }
+
+    #[test]
+    fn product_is_the_rounded_wide_product() {
+        // Every path of `product` (a factor below 1, both below 128, the rest) against the
+        // 64-bit product, on magnitudes of every size and at the paths' edges.
+        let want = |a: u32, b: u32| ((u64::from(a) * u64::from(b) + 0x8000) >> 16).min(i32::MAX as u64) as i32;
+        let edges = [0u32, 1, 0xFFFF, 0x1_0000, 0x1_0001, 0x7F_FFFF, 0x80_0000, 0x80_0001, 0xFF_FFFF, 0x7FFF_FFFF, 0x8000_0000];
+        for &a in &edges {
+            for &b in &edges {
+                if a >> 16 != 0 || b >> 16 != 0 {
+                    assert_eq!(product(a, b), want(a, b), "{a:#x} * {b:#x}");
+                }
+            }
+        }
+        let mut x = 0x5DEE_CE66_D1CE_4E5Bu64;
+        for _ in 0..200_000 {
+            xorshift(&mut x);
+            let (a, b) = ((x as u32) >> (x % 17) as u32, ((x >> 32) as u32) >> ((x >> 8) % 17) as u32);
+            if a >> 16 != 0 || b >> 16 != 0 {
+                assert_eq!(product(a, b), want(a, b), "{a:#x} * {b:#x}");
+            }
+        }
     }
 
     #[test]
