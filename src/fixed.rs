@@ -283,20 +283,15 @@ impl Real for Fx {
     }
     #[inline]
     fn recip(self) -> Self {
-        // 2^32 / |b| rounded half away from zero, as `ONE / self` divides: 2^32 = q b + r from
-        // the one division of 2^32 - 1. |b| <= 2 saturates (and 1 / 0 is the largest value).
+        // 2^32 / |b| rounded half away from zero, as `ONE / self` divides: the floor of
+        // (2^32 + |b| / 2) / |b| (an odd |b|'s half rounded down changes no floor), one
+        // division of 2^32 - |b| + |b| / 2, which fits 32 bits, plus one. |b| <= 2 saturates
+        // (and 1 / 0 is the largest value).
         let b = self.0.unsigned_abs();
         if b <= 2 {
             return Fx::ONE / self;
         }
-        let (mut q, mut r) = (u32::MAX / b, u32::MAX % b + 1);
-        if r == b {
-            (q, r) = (q + 1, 0);
-        }
-        if r >= b - r {
-            q += 1;
-        }
-        let q = q as i32;
+        let q = ((b >> 1).wrapping_sub(b) / b + 1) as i32;
         Fx(if self.0 < 0 { -q } else { q })
     }
     /// The exponent `k` itself, as the raw bits.
