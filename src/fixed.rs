@@ -429,6 +429,28 @@ mod tests {
     }
 
     #[test]
+    fn mul_is_the_rounded_signed_product() {
+        // Every path of `Fx * Fx` against the 64-bit product: |a| |b| rounded half away from
+        // zero, saturated, then signed.
+        let want = |a: i32, b: i32| {
+            let m = ((u64::from(a.unsigned_abs()) * u64::from(b.unsigned_abs()) + 0x8000) >> 16).min(i32::MAX as u64) as i32;
+            if (a ^ b) < 0 { -m } else { m }
+        };
+        let edges = [0, 1, -1, 0x7FFF, 0x8000, -0x8000, 46_340, -46_341, 0xFFFF, -0xFFFF, 0x1_0000, -0x1_0000, i32::MAX, -i32::MAX];
+        for &a in &edges {
+            for &b in &edges {
+                assert_eq!((Fx(a) * Fx(b)).0, want(a, b), "{a} * {b}");
+            }
+        }
+        let mut x = 0x0123_4567_89AB_CDEFu64;
+        for _ in 0..200_000 {
+            xorshift(&mut x);
+            let (a, b) = (((x as i32) >> (x % 31) as i32).max(-i32::MAX), (((x >> 32) as i32) >> ((x >> 8) % 31) as i32).max(-i32::MAX));
+            assert_eq!((Fx(a) * Fx(b)).0, want(a, b), "{a} * {b}");
+        }
+    }
+
+    #[test]
     fn overflow_saturates_instead_of_wrapping() {
         let big = fx(30000.0);
         assert_eq!(big * big, Fx::MAX);
