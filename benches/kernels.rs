@@ -73,6 +73,12 @@ fn levers(c: &mut Criterion) {
     let (x, p) = (Fx::from_f64(2.71), Fx::from_f64(0.125));
     c.bench_function("fixed times 2^-3: product", |b| b.iter(|| black_box(x) * black_box(p)));
     c.bench_function("fixed times 2^-3: shift", |b| b.iter(|| black_box(x).mul_pow2(black_box(Fx::pow2(-3)))));
+    // The slab test's product (an origin several units off times a reciprocal above 1) and its
+    // reciprocal: both factors 1 or more, below 128.
+    let (o, d) = (Fx::from_f64(5.3), Fx::from_f64(0.37));
+    let inv = d.recip();
+    c.bench_function("fixed product, factors 1 to 128", |b| b.iter(|| black_box(o) * black_box(inv)));
+    c.bench_function("fixed reciprocal", |b| b.iter(|| black_box(d).recip()));
     // An eye ray: its direction from the pixel's factors (six products), or from the column's
     // and the row's parts a tile keeps (three sums), the same ray.
     let cam = scene.camera();
