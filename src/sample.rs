@@ -274,8 +274,32 @@ fn traced(i: usize, n: usize) -> bool {
 }
 
 /// The lines [`traced`] picks of `n`, in order: every second one from the first, then the last.
-fn traced_lines(n: usize) -> impl Iterator<Item = usize> {
-    (0..n).step_by(2).chain((n > 0 && n.is_multiple_of(2)).then(|| n - 1))
+fn traced_lines(n: usize) -> Lines {
+    Lines { at: 0, step: 2, n }
+}
+
+/// Lines `0, step, 2 step, ...` of `n`, then the last if it is not one of them, in order: a
+/// counter and two tests per line (a stepped range chained with the last line took a Cortex-M0+
+/// and a Cortex-M33 several times that).
+#[derive(Clone, Copy, Debug)]
+struct Lines {
+    at: usize,
+    step: usize,
+    n: usize,
+}
+
+impl Iterator for Lines {
+    type Item = usize;
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        let i = self.at;
+        if i >= self.n {
+            return None;
+        }
+        // After the last line, none; else the next step, or the last line if that is nearer.
+        self.at = if i + 1 == self.n { self.n } else { (i + self.step).min(self.n - 1) };
+        Some(i)
+    }
 }
 
 /// Whether tile row or column `i` of `n` is traced in the first pass of adaptive sampling in
@@ -295,8 +319,8 @@ fn coarse_line(i: usize, n: usize) -> bool {
 }
 
 /// The lines [`coarse_line`] picks of `n`, in order.
-fn coarse_lines(n: usize) -> impl Iterator<Item = usize> {
-    (0..n).step_by(4).chain((n > 0 && !(n - 1).is_multiple_of(4)).then(|| n - 1))
+fn coarse_lines(n: usize) -> Lines {
+    Lines { at: 0, step: 4, n }
 }
 
 /// The coarse lines a line `i` of `n` lies on or between: `[i, i]` on one, else the one two
@@ -380,11 +404,13 @@ fn adaptive<R: Real>(
     for y in 0..th {
         let row = y * tw;
         if traced(y, th) {
-            for x in (1..tw.saturating_sub(1)).step_by(2) {
+            let mut x = 1;
+            while x + 1 < tw {
                 let i = row + x;
                 if !fill(levels, ids, depths, i, [i - 1, i + 1], contrast, |_| true) {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
                 }
+                x += 2;
             }
         } else {
             for x in 0..tw {
@@ -540,6 +566,21 @@ mod tests {
         };
         sampler.tile(x0, y0, tw, th, &mut shoot, alone, &mut levels, &mut hits);
         (levels, hits, rays)
+    }
+
+    /// The lines a pass walks are every `step`-th from the first, then the last, in order and
+    /// once each, in every tile size.
+    #[test]
+    fn lines_are_every_step_and_the_last() {
+        for n in 0..=MAX_TILE {
+            for step in [2, 4] {
+                let mut want: std::vec::Vec<usize> = (0..n).step_by(step).collect();
+                if n > 0 && !(n - 1).is_multiple_of(step) {
+                    want.push(n - 1);
+                }
+                assert_eq!(Lines { at: 0, step, n }.collect::<std::vec::Vec<_>>(), want, "{n} by {step}");
+            }
+        }
     }
 
     /// What the coarse level asks before it fills pixels.
