@@ -279,8 +279,8 @@ fn traced_lines(n: usize) -> Lines {
 }
 
 /// Lines `0, step, 2 step, ...` of `n`, then the last if it is not one of them, in order: a
-/// counter and two tests per line (a stepped range chained with the last line took a Cortex-M0+
-/// and a Cortex-M33 several times that).
+/// counter and two tests per line, fewer instructions than a stepped range chained with the
+/// last line (the panels' chair frame on QEMU: 0.5 % fewer on the Cortex-M0+, 0.3 % on the M33).
 #[derive(Clone, Copy, Debug)]
 struct Lines {
     at: usize,
