@@ -202,16 +202,20 @@ impl<'r> Sampler<'r> {
         for i in (0..n).filter(|&i| !fills || first_pass(coarse, i, n)) {
             out[i] = exact(i);
         }
+        // A pixel between two whose hits are one object takes it and the nearer depth, as the
+        // sampler's fill does; else its exact hit.
+        let mut fill = |out: &mut [(u16, u16)], i: usize, [a, b]: [usize; 2]| {
+            let (a, b) = (out[a], out[b]);
+            out[i] = if a.0 == b.0 { (a.0, a.1.min(b.1)) } else { exact(i) };
+        };
         if coarse {
             for i in (0..n).filter(|&i| traced(i, n) && !coarse_line(i, n)) {
-                let [a, b] = between(i, n).map(|k| out[k]);
-                out[i] = if a.0 == b.0 { (a.0, a.1.min(b.1)) } else { exact(i) };
+                fill(out, i, between(i, n));
             }
         }
         if fills {
             for i in (0..n).filter(|&i| !traced(i, n)) {
-                let (a, b) = (out[i - 1], out[i + 1]);
-                out[i] = if a.0 == b.0 { (a.0, a.1.min(b.1)) } else { exact(i) };
+                fill(out, i, [i - 1, i + 1]);
             }
         }
     }

@@ -374,8 +374,7 @@ impl<R: Real> Object<R> {
     /// object-space position taken from the scene instead of transformed again.
     #[inline]
     pub fn intersect_eye_ray(&self, ray: &Ray<R>, uv: [i32; 2], tmin: R, tmax: R) -> Result<Option<ShapeHit<R>>, Culled> {
-        let w = &self.eye_window;
-        if uv[0] < w[0] || uv[0] > w[1] || uv[1] < w[2] || uv[1] > w[3] {
+        if !self.eye_window_meets([uv[0]; 2], [uv[1]; 2]) {
             return Err(Culled);
         }
         Ok(self.intersect_local(self.eye_local, self.direction_local(ray.dir), tmin, tmax))
