@@ -64,10 +64,13 @@ fn borders(tw: usize, th: usize, left: impl Fn(usize) -> Option<(u16, u16)>, top
 pub fn tile(tw: usize, th: usize, hits: &Hits, apron: Apron<'_>, levels: &mut [u8]) {
     let n = (tw * th).min(levels.len()).min(hits.object.len());
     let (objects, depths, levels) = (&hits.object[..n], &hits.depth[..n], &mut levels[..n]);
+    // The objects first: most pairs are of one object, and their depths are not read.
     let mut pair = |i: usize, j: usize| {
-        let (a, b) = ((objects[i], depths[i]), (objects[j], depths[j]));
-        if differ(a, b) {
-            levels[if a.1 > b.1 { i } else { j }] = 0;
+        if objects[i] != objects[j] {
+            let (a, b) = (depths[i], depths[j]);
+            if a != b {
+                levels[if a > b { i } else { j }] = 0;
+            }
         }
     };
     for row in (0..n).step_by(tw.max(1)) {
