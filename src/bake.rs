@@ -181,7 +181,11 @@ mod writer {
         fn literal(&self, out: &mut String) {
             let o = self;
             out.push_str("Object::from_tables(");
-            let parts: [&dyn Literal; 14] = [
+            #[cfg(feature = "eye-hulls")]
+            let hull = &o.eye_hull;
+            #[cfg(not(feature = "eye-hulls"))]
+            let hull = &crate::scene::NO_HULL;
+            let parts: [&dyn Literal; 15] = [
                 &o.shape,
                 &o.to_object,
                 &o.to_world,
@@ -195,6 +199,7 @@ mod writer {
                 &o.eye_local,
                 &o.light_local,
                 &o.eye_window,
+                hull,
                 &o.shadow_window,
             ];
             for (i, p) in parts.iter().enumerate() {

@@ -545,8 +545,8 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
 
 /// Whether the pixels of a tile at `(x0, y0)` between columns `xs` and rows `ys` (inclusive),
 /// whose corners' eye rays hit object `id` (or nothing), may be filled from those rays in the
-/// coarse level of adaptive sampling: no other object among the tile's `candidates` has an eye
-/// window that meets them, and the object neither mirrors nor refracts (in the effects
+/// coarse level of adaptive sampling: no other object among the tile's `candidates` can appear
+/// in them ([`Scene::eye_region_among_meets`]), and the object neither mirrors nor refracts (in the effects
 /// simulated). A tile with more than 64 objects' candidates is never filled so.
 fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '_, R, A, E>, candidates: u64, (x0, y0): (usize, usize), (xs, ys): ([usize; 2], [usize; 2]), id: u16, size: (i32, i32)) -> bool {
     let scene = tracer.scene();
@@ -564,7 +564,7 @@ fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '
         return true;
     }
     let (u, v) = crate::cover::tile_window::<R>((x0 + xs[0], xs[1] + 1 - xs[0]), (y0 + ys[0], ys[1] + 1 - ys[0]), 0, size);
-    !scene.eye_window_among_meets(others, u, v)
+    !scene.eye_region_among_meets(others, u, v)
 }
 
 /// A pass of a progressive frame as the tile loop takes it: which pass, and the rays kept

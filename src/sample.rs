@@ -34,8 +34,9 @@ pub enum Sampling {
         contrast: u8,
         /// Two levels: the first pass traces every fourth row and column (and the last), a
         /// second fills or traces the pixels of every second line between them in the same
-        /// way, except where the eye window of another object than the one their rays hit
-        /// meets the pixels between, or where that object mirrors or refracts (the caller's
+        /// way, except where another object than the one their rays hit can appear in the
+        /// pixels between (its eye window meets them, and its eye hull where the build keeps
+        /// one, `scene::EyeHull`), or where that object mirrors or refracts (the caller's
         /// `alone`, [`Sampler::tile`]); the third is the one-level sampler's second pass. About
         /// a third fewer eye rays where the picture is smooth; no object the windows show is
         /// skipped, but a shadow or a gradient narrower than four pixels between traced pixels
@@ -126,8 +127,8 @@ impl<'r> Sampler<'r> {
     /// `(sx / 4, sy / 4)` pixels from the top-left corner. `alone(xs, ys, object)` says whether
     /// the pixels of the tile's columns `xs[0]..=xs[1]` and rows `ys[0]..=ys[1]`, whose corners'
     /// rays all hit `object`, may be filled from them in the coarse level of
-    /// [`Sampling::Adaptive`] (no other object's eye window meets them, and `object` neither
-    /// mirrors nor refracts); no other sampling asks it.
+    /// [`Sampling::Adaptive`] (no other object can appear there, as `Scene::eye_candidates`
+    /// finds them, and `object` neither mirrors nor refracts); no other sampling asks it.
     #[allow(clippy::too_many_arguments)]
     pub fn tile<R: Real>(
         &mut self,

@@ -83,24 +83,33 @@ fn generated<'a>(storage: &'a mut [Object<f64>], parts: &'a mut lattice_rt::Part
     b.finish().ok()
 }
 
-#[test]
-fn generated_scenes_and_cameras_inside_or_beside_objects_render_the_same() {
-    let (mut built, mut culled) = (0, 0);
+/// `each` over generated scenes (six seeds) seen from far off, from inside and from beside
+/// their objects, each with what names it: how many scenes were built, and the sum of what
+/// `each` counted.
+fn over_generated(mut each: impl FnMut(&Scene<'_, f64>, &str) -> u64) -> (u32, u64) {
+    let (mut built, mut counted) = (0, 0);
     for seed in 0..6u64 {
         for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0)), ((3.0, 0.0, 0.0), (-3.0, 0.5, 0.0))] {
             let (mut storage, mut parts) = (vec![Object::<f64>::default(); 40], lattice_rt::Parts::default());
             let Some(scene) = generated(&mut storage, &mut parts, seed, eye, look) else { continue };
             built += 1;
-            culled += same_with_and_without(&scene, 32, 20, &format!("seed {seed}, eye {eye:?}"));
+            counted += each(&scene, &format!("seed {seed}, eye {eye:?}"));
         }
     }
+    (built, counted)
+}
+
+#[test]
+fn generated_scenes_and_cameras_inside_or_beside_objects_render_the_same() {
+    let (built, culled) = over_generated(|scene, what| same_with_and_without(scene, 32, 20, what));
     assert!(built >= 12 && culled > 0, "{built} scenes built, {culled} tests skipped");
 }
 
-/// A render checks each tile's eye rays only against the objects whose window meets the tile
-/// (`Scene::eye_candidates`). Every object left out must be one whose window culls every eye
-/// ray through the tile, and frames rendered so must equal those whose eye rays check every
-/// object's window one by one (`EyeRays::Accelerator` over brute force).
+/// A render checks each tile's eye rays only against the objects that can appear in the tile
+/// (`Scene::eye_candidates`: their windows meet it, and their eye hulls). Every object left out
+/// must be one that no eye ray through the tile hits (its window culls the ray, or the ray
+/// misses it), and frames rendered so must equal those whose eye rays check every object's
+/// window one by one (`EyeRays::Accelerator` over brute force).
 #[test]
 fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
     let (mut checked, mut left_out) = (0, 0);
@@ -120,7 +129,7 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
                         for x in sx[0]..=sx[1] {
                             let ray = scene.camera().ray(x, y, w4, h4);
                             let uv = Camera::<f64>::window_uv(x, y, w4, h4);
-                            assert!(o.intersect_eye_ray(&ray, uv, 0.0, f64::MAX).is_err(), "seed {seed}, eye {eye:?}: object {i} left out of tile ({tx}, {ty}) but not culled at ({x}, {y})");
+                            assert!(!matches!(o.intersect_eye_ray(&ray, uv, 0.0, f64::MAX), Ok(Some(_))), "seed {seed}, eye {eye:?}: object {i} left out of tile ({tx}, {ty}) but hit at ({x}, {y})");
                         }
                     }
                 }
@@ -136,6 +145,49 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
         }
     }
     assert!(checked >= 8 && left_out > 0, "{checked} frames checked, {left_out} objects left out of tiles");
+}
+
+/// Every eye ray that hits an object passes inside the object's eye hull (`Object::
+/// eye_region_meets` at the ray's window position), in every scalar, for the paper's scenes and
+/// generated scenes seen from inside, beside and far from their objects; and the hulls cull
+/// eye rays the windows alone let through, so the check is not empty.
+#[test]
+fn eye_rays_that_hit_an_object_pass_inside_its_eye_hull() {
+    fn check<R: Real>(scene: &Scene<'_, R>, what: &str) -> (u64, u64) {
+        let (w4, h4) = (4 * 64, 4 * 32);
+        let (mut hits, mut culled) = (0, 0);
+        for sy in 0..=h4 {
+            for sx in 0..=w4 {
+                let ray = scene.camera().ray(sx, sy, w4, h4);
+                let uv = Camera::<R>::window_uv(sx, sy, w4, h4);
+                for (i, o) in scene.objects().iter().enumerate() {
+                    let inside = o.eye_region_meets([uv[0]; 2], [uv[1]; 2]);
+                    culled += u64::from(o.eye_window_meets([uv[0]; 2], [uv[1]; 2]) && !inside);
+                    if o.intersect(&ray, R::ZERO, R::MAX).is_some() {
+                        hits += 1;
+                        assert!(inside, "{what}, {}: the eye ray ({sx}, {sy}) of ({w4}, {h4}) hits object {i} outside its eye hull", R::NAME);
+                    }
+                }
+            }
+        }
+        (hits, culled)
+    }
+    fn paper<R: Real>() -> (u64, u64) {
+        let mut sum = (0, 0);
+        for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
+            let mut storage = vec![Object::<R>::default(); 64];
+            let mut parts = lattice_rt::Parts::default();
+            let scene = parse::<R>(&scene_text(name), &mut storage, &mut parts).unwrap();
+            let (h, c) = check(&scene, name);
+            sum = (sum.0 + h, sum.1 + c);
+        }
+        sum
+    }
+    for (hits, culled) in [paper::<f64>(), paper::<f32>(), paper::<Fx>()] {
+        assert!(hits > 10_000 && culled > 10_000, "{hits} hits, {culled} rays culled by hulls alone");
+    }
+    let (built, culled) = over_generated(|scene, what| check(scene, what).1);
+    assert!(built >= 12 && culled > 0, "{built} scenes built, {culled} rays culled by hulls alone");
 }
 
 /// A shadow ray towards the first light (directional) takes its direction's object-space image

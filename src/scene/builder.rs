@@ -5,6 +5,7 @@ use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, reso
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
+use super::hull::Projection;
 
 /// Builds and validates a [`Scene`] into caller-provided object storage.
 #[derive(Debug)]
@@ -239,6 +240,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             light_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             eye_window: WHOLE_PLANE,
+            #[cfg(feature = "eye-hulls")]
+            eye_hull: super::hull::NO_HULL,
             shadow_window: shadow_whole_plane(),
         };
         self.len += 1;
@@ -303,6 +306,15 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
                 _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             };
             o.eye_window = eye_window(&o.bounds, &camera);
+            #[cfg(feature = "eye-hulls")]
+            {
+                // The padding the object's world box got (`Aabb::padded_for`), on its own box.
+                let pad = R::pad_eps().to_f64() * (1.0 + o.bounds.min.max_abs().max(o.bounds.max.max_abs()).to_f64());
+                o.eye_hull = match Projection::new(&camera) {
+                    Some(p) => super::hull::eye_hull(o, &p, pad),
+                    None => super::hull::NO_HULL,
+                };
+            }
             o.shadow_window = match shadow_basis {
                 Some((a, b)) => shadow_window(&o.bounds, a.cast(), b.cast(), margin),
                 None => shadow_whole_plane(),
@@ -357,19 +369,13 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
 /// [`EYE_MARGIN`]. The image of a box wholly in front of the eye is the convex hull of its
 /// corners' images, so every eye ray that meets the box passes inside.
 fn eye_window<R: Real>(b: &Aabb<R>, cam: &Camera<R>) -> EyeWindow {
-    let (f, r, u) = (cam.forward.cast::<f64>(), cam.right.cast::<f64>(), cam.up.cast::<f64>());
-    // Columns forward, right, up: a direction's coordinates (s, s u, s v) along them.
-    let to_window = Affine { m: [[f.x, r.x, u.x, 0.0], [f.y, r.y, u.y, 0.0], [f.z, r.z, u.z, 0.0]] };
-    let Some(from_eye) = to_window.inverse() else { return WHOLE_PLANE };
-    let (eye, min, max) = (cam.eye.cast::<f64>(), b.min.cast::<f64>(), b.max.cast::<f64>());
+    let Some(projection) = Projection::new(cam) else { return WHOLE_PLANE };
+    let (min, max) = (b.min.cast::<f64>(), b.max.cast::<f64>());
     let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
     for p in (Aabb { min, max }).corners() {
-        let k = from_eye.vector(p - eye);
         // A corner on or behind the eye plane: the box's image is unbounded.
-        if !(k.x > 1e-6 * (p - eye).max_abs()) {
-            return WHOLE_PLANE;
-        }
-        for (a, w) in [k.y / k.x, k.z / k.x].into_iter().enumerate() {
+        let Some(image) = projection.window(p) else { return WHOLE_PLANE };
+        for (a, w) in image.into_iter().enumerate() {
             lo[a] = lo[a].min(w);
             hi[a] = hi[a].max(w);
         }

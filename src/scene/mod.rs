@@ -7,16 +7,18 @@
 //! slice, so the capacity is the caller's choice and running out is an ordinary error.
 //!
 //! Rooms: [`model`] (what a validated scene is), [`builder`] (how one is validated),
-//! [`error`] (why one is refused) and [`text`] (the plain-text format, one function per
-//! statement).
+//! [`hull`] (where on the image an object can appear), [`error`] (why one is refused) and
+//! [`text`] (the plain-text format, one function per statement).
 
 pub mod builder;
 pub mod error;
+pub mod hull;
 pub mod model;
 pub mod text;
 
 pub use builder::{check_value, SceneBuilder, IOR};
 pub use error::SceneError;
+pub use hull::{EyeHull, HULL_EDGES, NO_HULL};
 pub use model::{
     axis_normal, Camera, CameraDesc, Composite, Culled, EyeWindow, ShadowWindow, Light, Material, Object, Parts, Scene, EYE_MARGIN, VIEW_MARGIN, MAX_COMPOSITES, MAX_LIGHTS,
     MAX_MATERIALS, NO_COMPOSITE, WHOLE_PLANE,

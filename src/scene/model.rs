@@ -3,6 +3,9 @@
 use crate::math::{Aabb, Affine, Linear, Ray, Vec3};
 use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
+use super::hull::EyeHull;
+#[cfg(feature = "eye-hulls")]
+use super::hull::NO_HULL;
 use heapless::Vec;
 
 /// Most materials a scene may define.
@@ -269,6 +272,9 @@ pub struct Object<R> {
     pub(crate) light_local: Vec3<R>,
     /// The part of the image the object can appear in, as an [`EyeWindow`].
     pub(crate) eye_window: EyeWindow,
+    /// The same part more tightly, as an [`EyeHull`] (with the `eye-hulls` feature).
+    #[cfg(feature = "eye-hulls")]
+    pub(crate) eye_hull: EyeHull,
     /// Where a shadow ray towards the scene's first light can meet it, as a [`ShadowWindow`].
     pub(crate) shadow_window: ShadowWindow<R>,
 }
@@ -322,6 +328,8 @@ impl<R: Real> Default for Object<R> {
             eye_local: z,
             light_local: z,
             eye_window: WHOLE_PLANE,
+            #[cfg(feature = "eye-hulls")]
+            eye_hull: NO_HULL,
             shadow_window: shadow_whole_plane(),
         }
     }
@@ -346,9 +354,30 @@ impl<R> Object<R> {
         eye_local: Vec3<R>,
         light_local: Vec3<R>,
         eye_window: EyeWindow,
+        eye_hull: EyeHull,
         shadow_window: ShadowWindow<R>,
     ) -> Self {
-        Object { shape, to_object, to_world, unscale, dir_factor, material, composite, bounds, dir_scale, inv_dir_scale, eye_local, light_local, eye_window, shadow_window }
+        // A build without the feature keeps no hull (a baked table's is dropped here).
+        #[cfg(not(feature = "eye-hulls"))]
+        let _ = eye_hull;
+        Object {
+            shape,
+            to_object,
+            to_world,
+            unscale,
+            dir_factor,
+            material,
+            composite,
+            bounds,
+            dir_scale,
+            inv_dir_scale,
+            eye_local,
+            light_local,
+            eye_window,
+            #[cfg(feature = "eye-hulls")]
+            eye_hull,
+            shadow_window,
+        }
     }
 }
 
@@ -366,6 +395,17 @@ impl<R: Real> Object<R> {
     pub fn eye_window_meets(&self, u: [i32; 2], v: [i32; 2]) -> bool {
         let w = &self.eye_window;
         w[0] <= u[1] && u[0] <= w[1] && w[2] <= v[1] && v[0] <= w[3]
+    }
+
+    /// Whether the object can appear in the window rectangle `u` x `v` (as
+    /// [`Object::eye_window_meets`] takes it): its eye window meets it, and so does its
+    /// [`EyeHull`] where the build keeps one (the `eye-hulls` feature).
+    #[inline]
+    pub fn eye_region_meets(&self, u: [i32; 2], v: [i32; 2]) -> bool {
+        #[cfg(feature = "eye-hulls")]
+        return self.eye_window_meets(u, v) && super::hull::hull_meets(&self.eye_hull, u, v);
+        #[cfg(not(feature = "eye-hulls"))]
+        return self.eye_window_meets(u, v);
     }
 
     /// [`Object::intersect`] for an eye ray (its origin the camera's eye) through window
@@ -590,13 +630,14 @@ impl<'a, R> Scene<'a, R> {
 }
 
 impl<'a, R: Real> Scene<'a, R> {
-    /// The objects (bit `i`: object `i`, for the first 64) whose eye window meets the window
-    /// rectangle `u` x `v` (2^-16 units, inclusive bounds, see [`EyeWindow`]): an eye ray
-    /// through that rectangle can hit no other. Objects past the 64th are always included.
+    /// The objects (bit `i`: object `i`, for the first 64) that can appear in the window
+    /// rectangle `u` x `v` (2^-16 units, inclusive bounds, see [`EyeWindow`];
+    /// [`Object::eye_region_meets`]): an eye ray through that rectangle can hit no other.
+    /// Objects past the 64th are always included.
     pub fn eye_candidates(&self, u: [i32; 2], v: [i32; 2]) -> u64 {
         let mut mask = 0u64;
         for (i, o) in self.objects.iter().enumerate().take(64) {
-            if o.eye_window_meets(u, v) {
+            if o.eye_region_meets(u, v) {
                 mask |= 1 << i;
             }
         }
@@ -606,10 +647,9 @@ impl<'a, R: Real> Scene<'a, R> {
             mask
         }
     }
-    /// Whether any of the objects in `among` (bit `i`: object `i`, of the first 64) has an eye
-    /// window that meets the window rectangle `u` x `v`, as [`Scene::eye_candidates`] finds
-    /// them.
-    pub fn eye_window_among_meets(&self, among: u64, u: [i32; 2], v: [i32; 2]) -> bool {
+    /// Whether any of the objects in `among` (bit `i`: object `i`, of the first 64) can appear
+    /// in the window rectangle `u` x `v`, as [`Scene::eye_candidates`] finds them.
+    pub fn eye_region_among_meets(&self, among: u64, u: [i32; 2], v: [i32; 2]) -> bool {
         // The mask's set bits, by halves of 32 bits: a Cortex-M0+ handles those in a few
         // instructions, and 64-bit values in library calls.
         for (half, base) in [(among as u32, 0), ((among >> 32) as u32, 32)] {
@@ -617,7 +657,7 @@ impl<'a, R: Real> Scene<'a, R> {
             while rest != 0 {
                 let i = base + rest.trailing_zeros() as usize;
                 rest &= rest - 1;
-                if self.objects.get(i).is_some_and(|o| o.eye_window_meets(u, v)) {
+                if self.objects.get(i).is_some_and(|o| o.eye_region_meets(u, v)) {
                     return true;
                 }
             }

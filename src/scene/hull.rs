@@ -1,0 +1,181 @@
+//! Eye hulls: where on the image an object can appear, more tightly than its eye window.
+//!
+//! An [`EyeWindow`](super::EyeWindow) is the rectangle around an object's padded box as the eye
+//! sees it. A box turned about an axis, a thin leg seen at a slant, or a floor whose far edge
+//! runs across the image shows in only part of that rectangle, so a tile or a block of pixels
+//! inside the rectangle may lie wholly outside the object's image. The [`EyeHull`] is the
+//! convex hull of the object's own box (its canonical shape's box through its placement, padded
+//! as its world box is) projected through the eye: the image of a convex body is the convex
+//! hull of its corners' images, and the object lies in that box, so an eye ray that meets the
+//! object passes inside the hull. It is kept as half-planes in integers, so a tile or a block
+//! of pixels is tested against it without a division or a float.
+
+use super::model::Camera;
+#[cfg(feature = "eye-hulls")]
+use super::model::{Object, EYE_MARGIN};
+use crate::math::{Affine, Vec3};
+use crate::scalar::Real;
+
+/// Edges an [`EyeHull`] keeps: the image of a box seen from outside has at most six.
+pub const HULL_EDGES: usize = 6;
+
+/// Where on the image an object can appear: up to [`HULL_EDGES`] half-planes `a u + b v <= c`,
+/// each `[a, b, c]`, in units of 2^-10 of the camera's window coordinates `u` and `v` (each
+/// running -1..1 across the image), `a` and `b` at most 2^14 in size. Their intersection holds
+/// the image of the object's padded box widened by [`EYE_MARGIN`]; an edge that culls nothing
+/// is `[0, 0, i32::MAX]` ([`NO_HULL`]).
+pub type EyeHull = [[i32; 3]; HULL_EDGES];
+
+/// The hull that culls nothing: for an object whose box is not wholly in front of the eye.
+pub const NO_HULL: EyeHull = [[0, 0, i32::MAX]; HULL_EDGES];
+
+/// Largest size of an edge's `a` and `b`: with window coordinates within 2^15 units, each of
+/// `a u` and `b v` stays within 2^29 and their sum within `i32`.
+#[cfg(feature = "eye-hulls")]
+const NORMAL: f64 = (1 << 14) as f64;
+/// Window coordinates are taken within 2^15 units of 2^-10 (32 times the image's half-width):
+/// every tile's and pixel's lies well within.
+const REACH: i32 = 1 << 21;
+/// 2^-16 units (an [`EyeWindow`](super::EyeWindow)'s) per unit of the hull's 2^-10.
+const SHIFT: u32 = 6;
+
+/// Whether the window rectangle `u` x `v` (2^-16 units, inclusive bounds, as an
+/// [`EyeWindow`](super::EyeWindow) takes it) meets the hull: no edge has the whole rectangle
+/// outside. The rectangle is rounded outwards to the hull's units.
+#[inline]
+pub fn hull_meets(hull: &EyeHull, u: [i32; 2], v: [i32; 2]) -> bool {
+    let below = |x: i32| x.clamp(-REACH, REACH) >> SHIFT;
+    let above = |x: i32| (x.clamp(-REACH, REACH) + (1 << SHIFT) - 1) >> SHIFT;
+    let (u0, u1, v0, v1) = (below(u[0]), above(u[1]), below(v[0]), above(v[1]));
+    // Each edge's smallest `a u + b v` over the rectangle is at the corner its normal points
+    // away from.
+    hull.iter().all(|&[a, b, c]| a * if a > 0 { u0 } else { u1 } + b * if b > 0 { v0 } else { v1 } <= c)
+}
+
+/// The window position `(u, v)` of world points as eye rays reach them, in `f64`: a point `p`
+/// lies on the eye ray `eye + s (forward + u right + v up)`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Projection {
+    eye: Vec3<f64>,
+    from_eye: Affine<f64>,
+}
+
+impl Projection {
+    /// The projection of `cam` (from its vectors as the scalar holds them), or `None` if they
+    /// span no volume.
+    pub(crate) fn new<R: Real>(cam: &Camera<R>) -> Option<Self> {
+        let (f, r, u) = (cam.forward.cast::<f64>(), cam.right.cast::<f64>(), cam.up.cast::<f64>());
+        // Columns forward, right, up: a direction's coordinates (s, s u, s v) along them.
+        let to_window = Affine { m: [[f.x, r.x, u.x, 0.0], [f.y, r.y, u.y, 0.0], [f.z, r.z, u.z, 0.0]] };
+        Some(Projection { eye: cam.eye.cast(), from_eye: to_window.inverse()? })
+    }
+
+    /// `p`'s window position, or `None` for a point on or behind the eye's plane (whose
+    /// image is unbounded).
+    pub(crate) fn window(&self, p: Vec3<f64>) -> Option<[f64; 2]> {
+        let k = self.from_eye.vector(p - self.eye);
+        (k.x > 1e-6 * (p - self.eye).max_abs()).then(|| [k.y / k.x, k.z / k.x])
+    }
+}
+
+/// The [`EyeHull`] of an object seen through `projection`: the hull of its box's eight corners'
+/// images gives the edges' directions, and each edge's bound is the largest it takes over the
+/// images of the box padded by `pad` on every side (the 64 corners of the corners' padding
+/// cubes, whose hull is the padded box), widened by [`EYE_MARGIN`]. [`NO_HULL`] if a corner
+/// lies on or behind the eye's plane.
+#[cfg(feature = "eye-hulls")]
+pub(crate) fn eye_hull<R: Real>(o: &Object<R>, projection: &Projection, pad: f64) -> EyeHull {
+    let place = o.to_world.cast::<f64>();
+    let (lo, hi) = o.shape.bounds();
+    let corners: [Vec3<f64>; 8] = core::array::from_fn(|c| {
+        let pick = |bit: usize, l: R, h: R| if c & bit == 0 { l.to_f64() } else { h.to_f64() };
+        place.point(Vec3::new(pick(1, lo.x, hi.x), pick(2, lo.y, hi.y), pick(4, lo.z, hi.z)))
+    });
+    let mut images = [[0.0; 2]; 8];
+    let mut padded = [[0.0; 2]; 64];
+    for (c, &p) in corners.iter().enumerate() {
+        let Some(w) = projection.window(p) else { return NO_HULL };
+        images[c] = w;
+        for (k, image) in padded[8 * c..8 * c + 8].iter_mut().enumerate() {
+            let s = |bit: usize| if k & bit == 0 { -pad } else { pad };
+            let Some(w) = projection.window(p + Vec3::new(s(1), s(2), s(4))) else { return NO_HULL };
+            *image = w;
+        }
+    }
+    let mut hull = NO_HULL;
+    let (ring, n) = convex_hull(images);
+    let margin = f64::from(EYE_MARGIN >> SHIFT);
+    // Past [`HULL_EDGES`] edges (only rounding makes more) the further ones are left out,
+    // which only culls less.
+    for (k, edge) in hull.iter_mut().enumerate().take(n) {
+        let (p, q) = (ring[k], ring[(k + 1) % n]);
+        // Outward normal of a counter-clockwise ring's edge, scaled so its larger part is 2^14.
+        let (nx, ny) = (q[1] - p[1], p[0] - q[0]);
+        let size = nx.abs().max(ny.abs());
+        if !(size > 0.0) {
+            continue;
+        }
+        let (a, b) = (libm::round(nx / size * NORMAL), libm::round(ny / size * NORMAL));
+        let scale = f64::from(1u32 << 10);
+        let reach = padded.iter().map(|w| a * w[0] * scale + b * w[1] * scale).fold(f64::MIN, f64::max);
+        let c = libm::ceil(reach + margin * (a.abs() + b.abs())) + 1.0;
+        // An edge whose bound leaves `i32` culls nothing; one far below only widens to -2^30.
+        *edge = if c < (1u32 << 30) as f64 { [a as i32, b as i32, c.max(-((1u32 << 30) as f64)) as i32] } else { NO_HULL[0] };
+    }
+    hull
+}
+
+/// The convex hull of eight points: its corners counter-clockwise, and how many there are.
+#[cfg(feature = "eye-hulls")]
+fn convex_hull(mut points: [[f64; 2]; 8]) -> ([[f64; 2]; 16], usize) {
+    points.sort_unstable_by(|p, q| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])));
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    // Andrew's monotone chain: the lower hull left to right, then the upper right to left.
+    let (mut ring, mut n) = ([[0.0; 2]; 16], 0);
+    for pass in 0..2 {
+        let start = n;
+        for i in 0..8 {
+            let p = points[if pass == 0 { i } else { 7 - i }];
+            while n >= start + 2 && cross(ring[n - 2], ring[n - 1], p) <= 0.0 {
+                n -= 1;
+            }
+            ring[n] = p;
+            n += 1;
+        }
+        // The last point of each chain is the first of the other.
+        n -= 1;
+    }
+    (ring, n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A square's hull test: rectangles inside, across an edge, and wholly outside one edge.
+    #[test]
+    fn a_rectangle_outside_an_edge_is_culled() {
+        // The diamond |u| + |v| <= 1 (units of 2^-10: 1024), as four edges with a, b = 2^14.
+        let n = 1 << 14;
+        let mut hull = NO_HULL;
+        for (k, (a, b)) in [(n, n), (-n, n), (-n, -n), (n, -n)].into_iter().enumerate() {
+            hull[k] = [a, b, n * 1024];
+        }
+        let unit = 1 << 16;
+        assert!(hull_meets(&hull, [0, 0], [0, 0]));
+        assert!(hull_meets(&hull, [unit / 4, unit], [unit / 4, unit]));
+        // The corner square beyond the edge u + v = 1.
+        assert!(!hull_meets(&hull, [unit * 3 / 5, unit], [unit * 3 / 5, unit]));
+        assert!(!hull_meets(&hull, [-unit, -unit * 3 / 5], [-unit, -unit * 3 / 5]));
+        assert!(hull_meets(&NO_HULL, [i32::MIN, i32::MIN], [i32::MAX, i32::MAX]));
+    }
+
+    /// The hull of a square's corners and four points inside is the square, counter-clockwise.
+    #[cfg(feature = "eye-hulls")]
+    #[test]
+    fn the_hull_of_eight_points_is_their_outer_ring() {
+        let pts = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5], [0.2, 0.7], [0.9, 0.1], [0.5, 0.0]];
+        let (ring, n) = convex_hull(pts);
+        assert_eq!(&ring[..n], &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+    }
+}
