@@ -563,8 +563,12 @@ fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '
     if others == 0 {
         return true;
     }
-    let (u, v) = crate::cover::tile_window::<R>((x0 + xs[0], xs[1] + 1 - xs[0]), (y0 + ys[0], ys[1] + 1 - ys[0]), 0, size);
-    !scene.eye_region_among_meets(others, u, v)
+    // The rays that matter are those through the pixels' centres: the rectangle from the first
+    // corner's centre to the last's (window `v` runs up the image).
+    let (w4, h4) = size;
+    let centre = |p: usize| 4 * p as i32 + 2;
+    let (lo, hi) = (Camera::<R>::window_uv(centre(x0 + xs[0]), centre(y0 + ys[1]), w4, h4), Camera::<R>::window_uv(centre(x0 + xs[1]), centre(y0 + ys[0]), w4, h4));
+    !scene.eye_region_among_meets(others, [lo[0], hi[0]], [lo[1], hi[1]])
 }
 
 /// A pass of a progressive frame as the tile loop takes it: which pass, and the rays kept
