@@ -299,21 +299,20 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         // their rounding can reach anywhere in the world (the scalar's padding at its corners).
         let reach = world.min.max_abs().max(world.max.max_abs()).to_f64();
         let margin = R::pad_eps().to_f64() * (1.0 + reach);
+        // One projection for every object's eye window and hull.
+        let projection = Projection::new(&camera);
         for o in self.storage[..self.len].iter_mut() {
             o.eye_local = o.point_local(camera.eye);
             o.light_local = match self.parts.lights.first() {
                 Some(Light::Directional { to_light, .. }) => o.direction_local(*to_light),
                 _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             };
-            o.eye_window = eye_window(&o.bounds, &camera);
+            o.eye_window = projection.as_ref().map_or(WHOLE_PLANE, |p| eye_window(&o.bounds, p));
             #[cfg(feature = "eye-hulls")]
             {
                 // The padding the object's world box got (`Aabb::padded_for`), on its own box.
                 let pad = R::pad_eps().to_f64() * (1.0 + o.bounds.min.max_abs().max(o.bounds.max.max_abs()).to_f64());
-                o.eye_hull = match Projection::new(&camera) {
-                    Some(p) => super::hull::eye_hull(o, &p, pad),
-                    None => super::hull::NO_HULL,
-                };
+                o.eye_hull = projection.as_ref().map_or(super::hull::NO_HULL, |p| super::hull::eye_hull(o, p, pad));
             }
             o.shadow_window = match shadow_basis {
                 Some((a, b)) => shadow_window(&o.bounds, a.cast(), b.cast(), margin),
@@ -365,11 +364,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
 }
 
 /// The [`EyeWindow`] of a box: its eight corners projected through the camera's eye onto the
-/// window plane (in `f64`, from the camera's vectors as the scalar holds them), widened by
-/// [`EYE_MARGIN`]. The image of a box wholly in front of the eye is the convex hull of its
-/// corners' images, so every eye ray that meets the box passes inside.
-fn eye_window<R: Real>(b: &Aabb<R>, cam: &Camera<R>) -> EyeWindow {
-    let Some(projection) = Projection::new(cam) else { return WHOLE_PLANE };
+/// window plane (`projection`: in `f64`, from the camera's vectors as the scalar holds them),
+/// widened by [`EYE_MARGIN`]. The image of a box wholly in front of the eye is the convex hull
+/// of its corners' images, so every eye ray that meets the box passes inside.
+fn eye_window<R: Real>(b: &Aabb<R>, projection: &Projection) -> EyeWindow {
     let (min, max) = (b.min.cast::<f64>(), b.max.cast::<f64>());
     let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
     for p in (Aabb { min, max }).corners() {

@@ -64,6 +64,9 @@ pub fn hull_meets(hull: &EyeHull, u: [i32; 2], v: [i32; 2]) -> bool {
 pub(crate) struct Projection {
     eye: Vec3<f64>,
     from_eye: Affine<f64>,
+    /// Per row of `from_eye`, the sum of its entries' magnitudes.
+    #[cfg(feature = "eye-hulls")]
+    rows: [f64; 3],
 }
 
 impl Projection {
@@ -73,7 +76,13 @@ impl Projection {
         let (f, r, u) = (cam.forward.cast::<f64>(), cam.right.cast::<f64>(), cam.up.cast::<f64>());
         // Columns forward, right, up: a direction's coordinates (s, s u, s v) along them.
         let to_window = Affine { m: [[f.x, r.x, u.x, 0.0], [f.y, r.y, u.y, 0.0], [f.z, r.z, u.z, 0.0]] };
-        Some(Projection { eye: cam.eye.cast(), from_eye: to_window.inverse()? })
+        let from_eye = to_window.inverse()?;
+        Some(Projection {
+            eye: cam.eye.cast(),
+            from_eye,
+            #[cfg(feature = "eye-hulls")]
+            rows: from_eye.m.map(|r| r[0].abs() + r[1].abs() + r[2].abs()),
+        })
     }
 
     /// `p`'s window position, or `None` for a point on or behind the eye's plane (whose
@@ -82,31 +91,59 @@ impl Projection {
         let k = self.from_eye.vector(p - self.eye);
         (k.x > 1e-6 * (p - self.eye).max_abs()).then(|| [k.y / k.x, k.z / k.x])
     }
+
+    /// The window-space image `F (p - eye)` of a point `p` (`F` the map to the window's
+    /// coordinates: a point's image `k` lies on the eye ray through `(k.y / k.x, k.z / k.x)`).
+    #[cfg(feature = "eye-hulls")]
+    fn image(&self, p: Vec3<f64>) -> Vec3<f64> {
+        self.from_eye.vector(p - self.eye)
+    }
+
+    /// The window position `(u, v)` of a point whose image is `k` ([`Projection::image`]),
+    /// and how far from it along `u` and `v` the window position of any point within `pad` of
+    /// it on every axis can lie; `None` if such a point can lie on or behind the eye's plane. A
+    /// move `d` of the point moves `k` by `F d`, each part at most `pad` times its row's sum of
+    /// magnitudes, and `u = k.y / k.x` by at most `(|F d|.y + |u| |F d|.x) / (k.x - |F d|.x)`;
+    /// likewise `v`.
+    #[cfg(feature = "eye-hulls")]
+    fn window_within(&self, k: Vec3<f64>, pad: f64) -> Option<([f64; 2], [f64; 2])> {
+        let [dx, dy, dz] = self.rows.map(|r| pad * r);
+        let near = k.x - dx;
+        if !(near > 1e-6 * k.max_abs()) {
+            return None;
+        }
+        let (u, v) = (k.y / k.x, k.z / k.x);
+        Some(([u, v], [(dy + u.abs() * dx) / near, (dz + v.abs() * dx) / near]))
+    }
 }
 
 /// The [`EyeHull`] of an object seen through `projection`: the hull of its box's eight corners'
 /// images gives the edges' directions, and each edge's bound is the largest it takes over the
-/// images of the box padded by `pad` on every side (the 64 corners of the corners' padding
-/// cubes, whose hull is the padded box), widened by [`MARGIN`]. [`NO_HULL`] if a corner
-/// lies on or behind the eye's plane.
+/// images of the box padded by `pad` on every side (the padded box is the hull of the cubes of
+/// side `2 pad` around its corners, and each cube's image lies within a rectangle around its
+/// corner's, [`Projection::window_within`]), widened by [`MARGIN`]. [`NO_HULL`] if a padded
+/// corner can lie on or behind the eye's plane.
 #[cfg(feature = "eye-hulls")]
 pub(crate) fn eye_hull<R: Real>(o: &Object<R>, projection: &Projection, pad: f64) -> EyeHull {
+    // The box's corners' images, by linearity: the image of its lowest corner plus, per axis
+    // where a corner lies high, the image of that edge (no point mapped eight times over).
     let place = o.to_world.cast::<f64>();
     let (lo, hi) = o.shape.bounds();
-    let corners: [Vec3<f64>; 8] = core::array::from_fn(|c| {
-        let pick = |bit: usize, l: R, h: R| if c & bit == 0 { l.to_f64() } else { h.to_f64() };
-        place.point(Vec3::new(pick(1, lo.x, hi.x), pick(2, lo.y, hi.y), pick(4, lo.z, hi.z)))
-    });
+    let (lo, hi) = (lo.cast::<f64>(), hi.cast::<f64>());
+    let base = projection.image(place.point(lo));
+    let m = &place.m;
+    let edge = |i: usize, len: f64| projection.from_eye.vector(Vec3::new(m[0][i], m[1][i], m[2][i]) * len);
+    let edges = [edge(0, hi.x - lo.x), edge(1, hi.y - lo.y), edge(2, hi.z - lo.z)];
+    // Each corner's window position, and the rectangle (in the hull's units) that the
+    // positions of the points within `pad` of the corner on every axis lie in.
     let mut images = [[0.0; 2]; 8];
-    let mut padded = [[0.0; 2]; 64];
-    for (c, &p) in corners.iter().enumerate() {
-        let Some(w) = projection.window(p) else { return NO_HULL };
+    let mut spans = [[[0.0; 2]; 2]; 8];
+    let scale = f64::from(1u32 << 10);
+    for c in 0..8 {
+        let k = (0..3).filter(|&i| c & (1 << i) != 0).fold(base, |k, i| k + edges[i]);
+        let Some((w, d)) = projection.window_within(k, pad) else { return NO_HULL };
         images[c] = w;
-        for (k, image) in padded[8 * c..8 * c + 8].iter_mut().enumerate() {
-            let s = |bit: usize| if k & bit == 0 { -pad } else { pad };
-            let Some(w) = projection.window(p + Vec3::new(s(1), s(2), s(4))) else { return NO_HULL };
-            *image = w;
-        }
+        spans[c] = [[(w[0] - d[0]) * scale, (w[0] + d[0]) * scale], [(w[1] - d[1]) * scale, (w[1] + d[1]) * scale]];
     }
     let mut hull = NO_HULL;
     let (ring, n) = convex_hull(images);
@@ -121,9 +158,11 @@ pub(crate) fn eye_hull<R: Real>(o: &Object<R>, projection: &Projection, pad: f64
             continue;
         }
         let (a, b) = (libm::round(nx / size * NORMAL), libm::round(ny / size * NORMAL));
-        let scale = f64::from(1u32 << 10);
-        let reach = padded.iter().map(|w| a * w[0] * scale + b * w[1] * scale).fold(f64::MIN, f64::max);
-        let c = libm::ceil(reach + MARGIN * (a.abs() + b.abs())) + 1.0;
+        // Over each corner's rectangle the edge's `a u + b v` is largest at the corner its
+        // normal points to.
+        let (i, j) = (usize::from(a > 0.0), usize::from(b > 0.0));
+        let far = spans.iter().map(|s| a * s[0][i] + b * s[1][j]).fold(f64::MIN, f64::max);
+        let c = libm::ceil(far + MARGIN * (a.abs() + b.abs())) + 1.0;
         // An edge whose bound leaves `i32` culls nothing; one far below only widens to -2^30.
         *edge = if c < (1u32 << 30) as f64 { [a as i32, b as i32, c.max(-((1u32 << 30) as f64)) as i32] } else { NO_HULL[0] };
     }
