@@ -281,6 +281,18 @@ impl Real for Fx {
         let mantissa = ((raw << lz) >> 20) & 0x7ff;
         (((31 - lz) << 11) | mantissa) as u16
     }
+    /// The smallest raw value whose key is above `key`: its leading one at bit `(key + 1) >> 11`,
+    /// then the eleven mantissa bits of `key + 1` (below bit 11, the fewest bits the leading
+    /// one leaves them, rounded up: that may carry into the next power of two).
+    fn key_bound(key: u16) -> Self {
+        let Some(next) = key.checked_add(1) else { return Fx::MAX };
+        let (lead, mantissa) = (u32::from(next >> 11), u32::from(next & 0x7ff));
+        if lead > 30 {
+            return Fx::MAX;
+        }
+        let raw = if lead >= 11 { (1 << lead) | (mantissa << (lead - 11)) } else { (1 << lead) + mantissa.div_ceil(1 << (11 - lead)) };
+        Fx(raw as i32)
+    }
     #[inline]
     fn recip(self) -> Self {
         // 2^32 / |b| rounded half away from zero, as `ONE / self` divides: the floor of
@@ -403,6 +415,20 @@ mod tests {
         assert_eq!(fx(2.0).sqrt().0, 92682); // sqrt(2) * 65536 = 92681.9
         assert_eq!(fx(0.0).sqrt(), Fx(0));
         assert_eq!(fx(-4.0).sqrt(), Fx(0));
+    }
+
+    /// Every key's bound is the first raw value past it: its own key is later, the value
+    /// before it has a key no later than the one asked for.
+    #[test]
+    fn key_bound_is_the_first_value_of_a_later_key() {
+        for key in 0..=u16::MAX {
+            let b = Fx::key_bound(key);
+            if b == Fx::MAX {
+                assert!(key >= (31 << 11) - 1, "{key}");
+                continue;
+            }
+            assert!(b.depth_key() > key && Fx(b.0 - 1).depth_key() <= key, "{key}: {}", b.0);
+        }
     }
 
     #[test]

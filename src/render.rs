@@ -544,11 +544,13 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
 }
 
 /// Whether the pixels of a tile at `(x0, y0)` between columns `xs` and rows `ys` (inclusive),
-/// whose corners' eye rays hit object `id` (or nothing), may be filled from those rays in the
-/// coarse level of adaptive sampling: no other object among the tile's `candidates` can appear
-/// in them ([`Scene::eye_region_among_meets`]), and the object neither mirrors nor refracts (in the effects
-/// simulated). A tile with more than 64 objects' candidates is never filled so.
-fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '_, R, A, E>, candidates: u64, (x0, y0): (usize, usize), (xs, ys): ([usize; 2], [usize; 2]), id: u16, size: (i32, i32)) -> bool {
+/// whose corners' eye rays hit object `id` (or nothing), the farthest at depth key `far`, may be
+/// filled from those rays in the coarse level of adaptive sampling: no other object among the
+/// tile's `candidates` can appear in them ([`Scene::eye_region_among_meets`]) but behind `id`
+/// ([`crate::scene::hull::behind`]), and the object neither mirrors nor refracts (in the
+/// effects simulated). A tile with more than 64 objects' candidates is never filled so.
+#[allow(clippy::too_many_arguments)]
+fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '_, R, A, E>, candidates: u64, (x0, y0): (usize, usize), (xs, ys): ([usize; 2], [usize; 2]), id: u16, far: u16, size: (i32, i32)) -> bool {
     let scene = tracer.scene();
     // A scene of more than 64 objects gives every tile this mask (`Scene::eye_candidates`).
     if candidates == u64::MAX {
@@ -568,7 +570,16 @@ fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '
     let (w4, h4) = size;
     let centre = |p: usize| 4 * p as i32 + 2;
     let (lo, hi) = (Camera::<R>::window_uv(centre(x0 + xs[0]), centre(y0 + ys[1]), w4, h4), Camera::<R>::window_uv(centre(x0 + xs[1]), centre(y0 + ys[0]), w4, h4));
-    !scene.eye_region_among_meets(others, [lo[0], hi[0]], [lo[1], hi[1]])
+    let (u, v) = ([lo[0], hi[0]], [lo[1], hi[1]]);
+    if !scene.eye_region_among_meets(others, u, v) {
+        return true;
+    }
+    // Another object can appear there: unless it lies behind `id` all over the block.
+    let us = [Camera::<R>::ray_u(centre(x0 + xs[0]), w4), Camera::<R>::ray_u(centre(x0 + xs[1]), w4)];
+    let vs = [Camera::<R>::ray_v(centre(y0 + ys[0]), h4), Camera::<R>::ray_v(centre(y0 + ys[1]), h4)];
+    let dirs = crate::scene::hull::block_directions(scene.camera(), us, vs);
+    let hidden = crate::scene::hull::behind(scene, others, id as usize, far, &dirs);
+    hidden != 0 && !scene.eye_region_among_meets(others & !hidden, u, v)
 }
 
 /// A pass of a progressive frame as the tile loop takes it: which pass, and the rays kept
@@ -608,6 +619,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let mut sampler = Sampler::new(frame.sampling, frame.dither.block(), w, above).ok_or_else(too_small)?;
     // The outline is drawn on finished frames: a progressive frame's last pass, not its previews.
     let outline = frame.outline && pass.as_ref().is_none_or(|p| p.n == 1);
+    let keys = frame.outline || matches!(frame.sampling, Sampling::Adaptive { coarse: true, .. });
     // Past 64 objects the tiles' candidate masks hold every object: list the objects whose
     // windows meet each tile instead, when the scratch has room.
     let tiling = crate::cover::Tiling { t, size: (w, h), margin: block };
@@ -654,12 +666,13 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 q.set_eye_candidates(c);
                 c
             };
-            let mut alone = |xs: [usize; 2], ys: [usize; 2], id: u16| alone(tracer, candidates, (x0, y0), (xs, ys), id, (w4, h4));
+            let mut alone = |xs: [usize; 2], ys: [usize; 2], id: u16, far: u16| alone(tracer, candidates, (x0, y0), (xs, ys), id, far, (w4, h4));
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 let ray = eye(&mut q, sx, sy);
                 let (v, id, depth) = tracer.eye_sample(ray, &mut q);
-                // Only the outline reads depths: a frame without it keys none.
-                (v, id as u16, if frame.outline { depth.depth_key() } else { u16::MAX })
+                // Only the outline and two-level sampling read depths: a frame without either
+                // keys none.
+                (v, id as u16, if keys { depth.depth_key() } else { u16::MAX })
             };
             match pass.as_mut() {
                 None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut alone, &mut levels, &mut hits),
@@ -803,7 +816,7 @@ fn pass_tile<R: Real>(
     at: Block,
     kept: &mut [Traced],
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
-    alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
+    alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
     hits: &mut Hits,
 ) {
@@ -889,7 +902,7 @@ fn finish_tile<R: Real>(
     Block { x0, y0, tw, th, t }: Block,
     kept: &[Traced],
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
-    alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
+    alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
     hits: &mut Hits,
 ) {

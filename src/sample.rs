@@ -124,9 +124,10 @@ impl<'r> Sampler<'r> {
 
     /// Gray levels of the `tw x th` tile at `(x0, y0)` into `levels` (row-major), and what
     /// each pixel's ray hit into `hits`. `shoot(sx, sy)` traces the eye ray through
-    /// `(sx / 4, sy / 4)` pixels from the top-left corner. `alone(xs, ys, object)` says whether
-    /// the pixels of the tile's columns `xs[0]..=xs[1]` and rows `ys[0]..=ys[1]`, whose corners'
-    /// rays all hit `object`, may be filled from them in the coarse level of
+    /// `(sx / 4, sy / 4)` pixels from the top-left corner. `alone(xs, ys, object, far)` says
+    /// whether the pixels of the tile's columns `xs[0]..=xs[1]` and rows `ys[0]..=ys[1]`, whose
+    /// corners' rays all hit `object` (the farthest at depth key `far`), may be filled from them
+    /// in the coarse level of
     /// [`Sampling::Adaptive`] (no other object can appear there, as `Scene::eye_candidates`
     /// finds them, and `object` neither mirrors nor refracts); no other sampling asks it.
     #[allow(clippy::too_many_arguments)]
@@ -137,7 +138,7 @@ impl<'r> Sampler<'r> {
         tw: usize,
         th: usize,
         shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
-        alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
+        alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool,
         levels: &mut [u8; MAX_TILE * MAX_TILE],
         hits: &mut Hits,
     ) {
@@ -361,7 +362,7 @@ fn adaptive<R: Real>(
     contrast: u8,
     coarse: bool,
     shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
-    alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool,
+    alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool,
     levels: &mut [u8; MAX_TILE * MAX_TILE],
     hits: &mut Hits,
 ) {
@@ -384,9 +385,9 @@ fn adaptive<R: Real>(
                 let i = y * tw + x;
                 // Two neighbours on a coarse line, else the four corners.
                 let filled = if xs[0] == xs[1] || ys[0] == ys[1] {
-                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id| alone(xs, ys, id))
+                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id, far| alone(xs, ys, id, far))
                 } else {
-                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[0] * tw + xs[1], ys[1] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id| alone(xs, ys, id))
+                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[0] * tw + xs[1], ys[1] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id, far| alone(xs, ys, id, far))
                 };
                 if !filled {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
@@ -412,7 +413,7 @@ fn adaptive<R: Real>(
             let mut x = 1;
             while x + 1 < tw {
                 let i = row + x;
-                if !fill(levels, ids, depths, i, [i - 1, i + 1], contrast, |_| true) {
+                if !fill(levels, ids, depths, i, [i - 1, i + 1], contrast, |_, _| true) {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
                 }
                 x += 2;
@@ -421,9 +422,9 @@ fn adaptive<R: Real>(
             for x in 0..tw {
                 let i = row + x;
                 let filled = if traced(x, tw) {
-                    fill(levels, ids, depths, i, [i - tw, i + tw], contrast, |_| true)
+                    fill(levels, ids, depths, i, [i - tw, i + tw], contrast, |_, _| true)
                 } else {
-                    fill(levels, ids, depths, i, [i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], contrast, |_| true)
+                    fill(levels, ids, depths, i, [i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], contrast, |_, _| true)
                 };
                 if !filled {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
@@ -443,9 +444,10 @@ fn at(i: usize) -> usize {
 /// Fills untraced pixel `i` from the traced pixels `ns` around it ([`around`]: two on its row
 /// or column, each counted twice in the mean of four, or the four corners) when they hit one
 /// object and their levels lie within `contrast`: the mean level, the first's object and the
-/// nearest depth, if `allowed(object)` too. Returns whether it did; else the pixel is traced.
+/// nearest depth, if `allowed(object, farthest depth)` too. Returns whether it did; else the
+/// pixel is traced.
 #[inline]
-fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, ns: [usize; N], contrast: u8, allowed: impl FnOnce(u16) -> bool) -> bool {
+fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, ns: [usize; N], contrast: u8, allowed: impl FnOnce(u16, u16) -> bool) -> bool {
     let first = ids[at(ns[0])];
     let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
     for k in ns.iter().map(|&k| at(k)) {
@@ -456,7 +458,7 @@ fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; 
         same &= ids[k] == first;
         near = near.min(depths[k]);
     }
-    if !(same && hi - lo <= contrast && allowed(first)) {
+    if !(same && hi - lo <= contrast && allowed(first, ns.iter().map(|&k| depths[at(k)]).fold(0, u16::max))) {
         return false;
     }
     // Two pixels counted twice: (2 sum + 2) / 4 = (sum + 1) / 2, rounded up.
@@ -557,12 +559,12 @@ mod tests {
 
     /// Samples one tile of [`picture`] at `(x0, y0)` with `mode`, `alone` answering the coarse
     /// level; returns the levels, the hits and the eye rays traced.
-    fn sample(mode: Sampling, at: (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
+    fn sample(mode: Sampling, at: (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
         sample_of(picture, mode, at, alone)
     }
 
     /// [`sample`] of another picture.
-    fn sample_of(picture: fn(usize, usize) -> Shot<f64>, mode: Sampling, (x0, y0, tw, th): (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
+    fn sample_of(picture: fn(usize, usize) -> Shot<f64>, mode: Sampling, (x0, y0, tw, th): (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
         let mut sampler = Sampler::new(mode, 1, 64, &mut []).unwrap();
         let (mut levels, mut hits, mut rays) = ([0; MAX_TILE * MAX_TILE], Hits::new(), 0);
         let mut shoot = |sx: usize, sy: usize| {
@@ -589,7 +591,7 @@ mod tests {
     }
 
     /// What the coarse level asks before it fills pixels.
-    type Alone<'a> = dyn FnMut([usize; 2], [usize; 2], u16) -> bool + 'a;
+    type Alone<'a> = dyn FnMut([usize; 2], [usize; 2], u16, u16) -> bool + 'a;
 
     const ONE_LEVEL: Sampling = Sampling::Adaptive { contrast: 4, coarse: false };
     const TWO_LEVELS: Sampling = Sampling::Adaptive { contrast: 4, coarse: true };
@@ -603,7 +605,7 @@ mod tests {
         for tw in 1..=MAX_TILE {
             for th in 1..=MAX_TILE {
                 let at = (3 * tw, 5 * th, tw, th);
-                let alones: [&mut Alone<'_>; 3] = [&mut |_, _, _| true, &mut |_, _, _| false, &mut |_, _, _| {
+                let alones: [&mut Alone<'_>; 3] = [&mut |_, _, _, _| true, &mut |_, _, _, _| false, &mut |_, _, _, _| {
                     coin ^= coin << 13;
                     coin ^= coin >> 17;
                     coin ^= coin << 5;
@@ -611,7 +613,7 @@ mod tests {
                 }];
                 for (k, alone) in alones.into_iter().enumerate() {
                     for mode in [ONE_LEVEL, TWO_LEVELS] {
-                        let (_, hits, _) = sample(mode, at, &mut |xs, ys, id| alone(xs, ys, id));
+                        let (_, hits, _) = sample(mode, at, &mut |xs, ys, id, far| alone(xs, ys, id, far));
                         let sampler = Sampler::new(mode, 1, 64, &mut []).unwrap();
                         for (x, y) in (0..th).flat_map(|y| (0..tw).map(move |x| (x, y))).filter(|&(x, y)| sampler.exact(x, y, tw, th, &hits)) {
                             let (_, id, depth) = picture(4 * (at.0 + x) + 2, 4 * (at.1 + y) + 2);
@@ -619,8 +621,8 @@ mod tests {
                         }
                     }
                 }
-                let (one, one_hits, one_rays) = sample(ONE_LEVEL, at, &mut |_, _, _| true);
-                let (two, two_hits, two_rays) = sample(TWO_LEVELS, at, &mut |_, _, _| false);
+                let (one, one_hits, one_rays) = sample(ONE_LEVEL, at, &mut |_, _, _, _| true);
+                let (two, two_hits, two_rays) = sample(TWO_LEVELS, at, &mut |_, _, _, _| false);
                 assert_eq!((one, one_hits.object, one_hits.depth, one_rays), (two, two_hits.object, two_hits.depth, two_rays), "{tw}x{th}");
             }
         }
@@ -634,15 +636,15 @@ mod tests {
         let flat: fn(usize, usize) -> Shot<f64> = |_, _| (0.5, 2, 7);
         let lines = coarse_lines(MAX_TILE).count();
         let mut asked = 0;
-        let (levels, _, rays) = sample_of(flat, TWO_LEVELS, at, &mut |xs, ys, id| {
+        let (levels, _, rays) = sample_of(flat, TWO_LEVELS, at, &mut |xs, ys, id, _| {
             asked += 1;
             assert!(xs[0] <= xs[1] && ys[0] <= ys[1] && xs[1] < MAX_TILE && ys[1] < MAX_TILE && id == 2);
             true
         });
         assert_eq!(rays, lines * lines);
         assert!(asked > 0 && levels[..MAX_TILE * MAX_TILE].iter().all(|&l| l == 32));
-        let (_, _, one_rays) = sample_of(flat, ONE_LEVEL, at, &mut |_, _, _| true);
-        let (_, _, held) = sample_of(flat, TWO_LEVELS, at, &mut |_, _, _| false);
+        let (_, _, one_rays) = sample_of(flat, ONE_LEVEL, at, &mut |_, _, _, _| true);
+        let (_, _, held) = sample_of(flat, TWO_LEVELS, at, &mut |_, _, _, _| false);
         assert!(rays < one_rays && held == one_rays, "{rays} {one_rays} {held}");
     }
 

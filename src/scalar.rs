@@ -108,6 +108,14 @@ pub trait Real:
     fn depth_key(self) -> u16 {
         f32_key(self.to_f64() as f32)
     }
+    /// A value above every value whose [`Real::depth_key`] is at most `key` (the smallest whose
+    /// key is the next, or the largest value). The default inverts the `f32` key.
+    fn key_bound(key: u16) -> Self {
+        match key.checked_add(1) {
+            Some(next) => Self::from_f64(f64::from(f32::from_bits(u32::from(next) << 16))),
+            None => Self::MAX,
+        }
+    }
     /// `1 / self`: the same value as `Self::ONE / self`, which is what the default does; fixed
     /// point needs one 32-bit division for it instead of three.
     #[inline]
@@ -401,6 +409,12 @@ mod tests {
         let differ = |a: f64| R::from_f64(a).depth_key() < R::from_f64(a * 1.03).depth_key();
         assert!([0.01, 0.1, 1.0, 10.0, 100.0].into_iter().all(differ), "{}", R::NAME);
         assert!(R::MAX.depth_key() > R::from_f64(1000.0).depth_key());
+        // A key's bound lies above every value of that key, and is the first value of a later one.
+        for &v in &values {
+            let key = R::from_f64(v).depth_key();
+            let bound = R::key_bound(key);
+            assert!(bound > R::from_f64(v) && bound.depth_key() > key, "{}: {v} has key {key}, bound {}", R::NAME, bound.to_f64());
+        }
     }
 
     #[test]
