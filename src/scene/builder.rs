@@ -189,6 +189,15 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if top < 0.0 {
             return Err(SceneError::NonPositiveSize);
         }
+        // The canonical cone narrows from radius 1 at its base (the sides of its box lie at 1):
+        // one wider at its top is the cone of the top's radius turned over onto it.
+        let (shape, place, inv) = if top > 1.0 {
+            let over = Affine::translate(Vec3::new(0.0, 1.0, 0.0)).after(&Affine::rotate(0, 180.0)).after(&Affine::scale(Vec3::new(top, 1.0, top)));
+            let place = place.after(&over);
+            (Shape::Cone { top: 1.0 / top }, place, checked_inverse(&place)?)
+        } else {
+            (shape, place, inv)
+        };
         let bounds = world_bounds(&shape, &place);
         // The padded box is what the lattice registers: it must be in range too.
         let padded = bounds.padded_for::<R>();

@@ -740,6 +740,28 @@ pub fn parse_with<'a, 't, R: Real>(
 mod tests {
     use super::parse_number;
 
+    /// A cone whose top is wider than its base is the frustum it describes, in every scalar:
+    /// level rays across it hit it where its radius at their height reaches them, and miss it
+    /// where it does not (the canonical cone's box would cut it to its base's radius).
+    #[test]
+    fn a_cone_wider_at_its_top_is_the_frustum_it_describes() {
+        fn check<R: crate::Real>() {
+            let text = "camera eye 0 1 -6 look 0 1 0\ncone base 0 0 0 radius 0.5 height 2 top 1.5\n";
+            let (mut storage, mut parts) = (std::vec![crate::scene::Object::<R>::default(); 4], crate::Parts::default());
+            let scene = crate::parse::<R>(text, &mut storage, &mut parts).unwrap();
+            let o = &scene.objects()[0];
+            // The radius at height y is 0.5 + y / 2: a level ray at distance d from the axis hits
+            // below the radius, misses beyond it.
+            for (y, d, hits) in [(1.9, 1.4, true), (1.9, 1.5, false), (0.1, 0.5, true), (0.1, 0.6, false), (1.0, 0.95, true), (1.0, 1.05, false)] {
+                let ray = crate::Ray::new(crate::Vec3::new(-5.0, y, d).cast::<R>(), crate::Vec3::new(1.0, 0.0, 0.0).cast());
+                assert_eq!(o.intersect(&ray, R::ZERO, R::MAX).is_some(), hits, "{}: height {y}, distance {d}", R::NAME);
+            }
+        }
+        check::<f64>();
+        check::<f32>();
+        check::<crate::Fx>();
+    }
+
     #[test]
     fn numbers_parse_like_core_for_scene_values() {
         for t in ["0", "1", "-2.5", "0.42", "+3", ".5", "5.", "1e3", "-1.25E-2", "123456.789", "0.1", "2.2", "1e-7", "3.14159"] {
