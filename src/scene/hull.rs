@@ -8,7 +8,13 @@
 //! as its world box is) projected through the eye: the image of a convex body is the convex
 //! hull of its corners' images, and the object lies in that box, so an eye ray that meets the
 //! object passes inside the hull. It is kept as half-planes in integers, so a tile or a block
-//! of pixels is tested against it without a division or a float.
+//! of pixels is tested against it without a division or a float. A sphere's, cylinder's or
+//! cone's hull is drawn in further, to its outline (the images of its caps, or of the circle
+//! where the eye's rays graze the sphere).
+//!
+//! [`behind`] answers the other half of two-level sampling's question, whether a block of
+//! pixels whose corners hit one object may be filled: which of the objects that can appear
+//! there that object hides all over the block.
 
 use super::model::{Camera, Scene};
 use crate::math::Aabb;
