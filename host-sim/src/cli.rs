@@ -89,8 +89,9 @@ pub enum SamplingArg {
     /// filled in where the traced pixels around hit one object and differ by at most 4 levels.
     Adaptive,
     /// Adaptive sub-sampling in two levels (the panels' default): every fourth pixel traced
-    /// first, then every second filled in the same way where no other object's eye window and
-    /// no mirror or glass lies between, then the rest.
+    /// first, then every second filled in the same way where no other object can show between
+    /// (by its eye window and hull, or as hidden behind the traced one) and no mirror or glass
+    /// lies there, then the rest.
     Coarse,
 }
 
