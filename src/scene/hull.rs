@@ -351,6 +351,41 @@ fn convex_hull(mut points: [[f64; 2]; 8]) -> ([[f64; 2]; 16], usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::{Object, Parts, SceneBuilder};
+
+    /// `each` over the paper's five scenes in scalar `R`, with the scene's name: the sum of what
+    /// it counted.
+    fn over_paper<R: Real>(mut each: impl FnMut(&Scene<'_, R>, &str) -> usize) -> usize {
+        let mut sum = 0;
+        for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
+            let text = std::fs::read_to_string(std::format!("{}/scenes/{name}.scene", env!("CARGO_MANIFEST_DIR"))).unwrap();
+            let (mut storage, mut parts) = (std::vec![Object::<R>::default(); 64], Parts::default());
+            let scene = crate::parse::<R>(&text, &mut storage, &mut parts).unwrap();
+            sum += each(&scene, name);
+        }
+        sum
+    }
+
+    /// `each` over generated scenes of turned, sheared and scaled objects (eight seeds) in fixed
+    /// point, seen from far off and from among them, with what names each: how many scenes were
+    /// built, and the sum of what `each` counted.
+    fn over_generated(mut each: impl FnMut(&Scene<'_, crate::Fx>, &str) -> usize) -> (usize, usize) {
+        let (mut built, mut sum) = (0, 0);
+        for seed in 0..8u64 {
+            for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((3.0, 4.0, 3.0), (6.0, 5.0, 9.0))] {
+                let (mut storage, mut parts) = (std::vec![Object::<crate::Fx>::default(); 24], Parts::default());
+                let mut b = SceneBuilder::new(&mut storage, &mut parts);
+                crate::generate::random_scene(&mut b, &crate::generate::RandomScene { objects: 24, composite_size: 3, spread: 12.0, seed }).unwrap();
+                b.camera.eye = Vec3::new(eye.0, eye.1, eye.2);
+                b.camera.look = Vec3::new(look.0, look.1, look.2);
+                b.camera.fov = (70.0, 50.0);
+                let Ok(scene) = b.finish() else { continue };
+                built += 1;
+                sum += each(&scene, &std::format!("seed {seed}, eye {eye:?}"));
+            }
+        }
+        (built, sum)
+    }
 
     /// A square's hull test: rectangles inside, across an edge, and wholly outside one edge.
     #[test]
@@ -377,9 +412,6 @@ mod tests {
     #[cfg(feature = "eye-hulls")]
     #[test]
     fn no_eye_ray_just_outside_a_hull_edge_hits_the_object() {
-        use crate::generate::{random_scene, RandomScene};
-        use crate::scene::{Object, Parts, SceneBuilder};
-        use std::vec::Vec;
         fn along_edges<R: Real>(objects: &[Object<R>], cam: &Camera<R>, what: &str, every_object: bool) -> usize {
             let mut rays = 0;
             for (i, o) in objects.iter().enumerate() {
@@ -412,34 +444,15 @@ mod tests {
             }
             rays
         }
-        fn paper<R: Real>() -> usize {
-            let mut rays = 0;
-            for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
-                let text = std::fs::read_to_string(std::format!("{}/scenes/{name}.scene", env!("CARGO_MANIFEST_DIR"))).unwrap();
-                let (mut storage, mut parts) = (std::vec![Object::<R>::default(); 64], Parts::default());
-                let scene = crate::parse::<R>(&text, &mut storage, &mut parts).unwrap();
-                rays += along_edges(scene.objects(), scene.camera(), name, true);
-            }
-            rays
+        // On the paper's scenes, objects seen well in front of the eye: every object's hull is checked
+        // to meet its window.
+        fn paper<R: Real>(scene: &Scene<'_, R>, name: &str) -> usize {
+            along_edges(scene.objects(), scene.camera(), name, true)
         }
-        for rays in [paper::<f64>(), paper::<f32>(), paper::<crate::Fx>()] {
+        for rays in [over_paper::<f64>(paper), over_paper::<f32>(paper), over_paper::<crate::Fx>(paper)] {
             assert!(rays > 10_000, "{rays} rays along the hulls' edges");
         }
-        let mut built = 0;
-        for seed in 0..8u64 {
-            for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((3.0, 4.0, 3.0), (6.0, 5.0, 9.0))] {
-                let (mut storage, mut parts) = (std::vec![Object::<crate::Fx>::default(); 24], Parts::default());
-                let mut b = SceneBuilder::new(&mut storage, &mut parts);
-                random_scene(&mut b, &RandomScene { objects: 24, composite_size: 3, spread: 12.0, seed }).unwrap();
-                b.camera.eye = Vec3::new(eye.0, eye.1, eye.2);
-                b.camera.look = Vec3::new(look.0, look.1, look.2);
-                b.camera.fov = (70.0, 50.0);
-                let Ok(scene) = b.finish() else { continue };
-                built += 1;
-                let objects: Vec<_> = scene.objects().to_vec();
-                along_edges(&objects, scene.camera(), &std::format!("seed {seed}, eye {eye:?}"), false);
-            }
-        }
+        let (built, _) = over_generated(|s, what| along_edges(s.objects(), s.camera(), what, false));
         assert!(built >= 10, "{built} generated scenes");
     }
 
@@ -448,9 +461,8 @@ mod tests {
     /// generated ones; and some objects are counted hidden, so the check is not empty.
     #[test]
     fn objects_behind_a_block_s_object_show_in_none_of_its_pixels() {
-        use crate::scene::{Object, Parts, SceneBuilder};
         use crate::{BruteForce, Query, Tracer};
-        fn blocks<R: Real>(scene: &Scene<'_, R>, what: &str) -> u32 {
+        fn blocks<R: Real>(scene: &Scene<'_, R>, what: &str) -> usize {
             let (w, h) = (64usize, 32usize);
             let (w4, h4) = (4 * w as i32, 4 * h as i32);
             let tracer = Tracer::new(scene, &BruteForce);
@@ -479,7 +491,7 @@ mod tests {
                         let us = [Camera::<R>::ray_u(centre(xs[0]), w4), Camera::<R>::ray_u(centre(xs[1]), w4)];
                         let vs = [Camera::<R>::ray_v(centre(ys[0]), h4), Camera::<R>::ray_v(centre(ys[1]), h4)];
                         let hidden = behind(scene, all & !(1 << id), id as usize, far, &block_directions(scene.camera(), us, vs));
-                        counted += hidden.count_ones();
+                        counted += hidden.count_ones() as usize;
                         for y in ys[0]..=ys[1] {
                             for x in xs[0]..=xs[1] {
                                 let seen = pixels[y * w + x].0;
@@ -491,33 +503,10 @@ mod tests {
             }
             counted
         }
-        fn paper<R: Real>() -> u32 {
-            ["chair", "desk", "polyhedron", "spheres", "whitted"]
-                .iter()
-                .map(|name| {
-                    let text = std::fs::read_to_string(std::format!("{}/scenes/{name}.scene", env!("CARGO_MANIFEST_DIR"))).unwrap();
-                    let (mut storage, mut parts) = (std::vec![Object::<R>::default(); 64], Parts::default());
-                    let scene = crate::parse::<R>(&text, &mut storage, &mut parts).unwrap();
-                    blocks(&scene, name)
-                })
-                .sum()
-        }
-        for counted in [paper::<f64>(), paper::<f32>(), paper::<crate::Fx>()] {
+        for counted in [over_paper::<f64>(blocks), over_paper::<f32>(blocks), over_paper::<crate::Fx>(blocks)] {
             assert!(counted > 1000, "{counted} objects counted hidden");
         }
-        let mut counted = 0;
-        for seed in 0..6u64 {
-            for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((3.0, 4.0, 3.0), (6.0, 5.0, 9.0))] {
-                let (mut storage, mut parts) = (std::vec![Object::<crate::Fx>::default(); 24], Parts::default());
-                let mut b = SceneBuilder::new(&mut storage, &mut parts);
-                crate::generate::random_scene(&mut b, &crate::generate::RandomScene { objects: 24, composite_size: 3, spread: 12.0, seed }).unwrap();
-                b.camera.eye = Vec3::new(eye.0, eye.1, eye.2);
-                b.camera.look = Vec3::new(look.0, look.1, look.2);
-                b.camera.fov = (70.0, 50.0);
-                let Ok(scene) = b.finish() else { continue };
-                counted += blocks(&scene, &std::format!("seed {seed}, eye {eye:?}"));
-            }
-        }
+        let (_, counted) = over_generated(blocks);
         assert!(counted > 0, "no object counted hidden in the generated scenes");
     }
 
