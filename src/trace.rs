@@ -321,32 +321,15 @@ fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query
     }
     let mut best = None;
     // The candidates are counted as they come (cheaper than a population count on a core
-    // without one): the others are culled. The mask is taken by halves of 32 bits (a
-    // Cortex-M0+ shifts and counts 64-bit values in library calls), each cut to the objects
-    // there are.
+    // without one): the others are culled.
     let mut candidates = 0u32;
-    let mask = q.eye_candidates();
-    for (half, base) in [(mask as u32, 0), ((mask >> 32) as u32, 32)] {
-        let mut left = half & low_bits(n.saturating_sub(base));
-        while left != 0 {
-            let i = base + left.trailing_zeros() as usize;
-            left &= left - 1;
-            candidates += 1;
-            crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, q);
-        }
-    }
+    crate::scene::model::any_object(q.eye_candidates(), n, |i| {
+        candidates += 1;
+        crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, q);
+        false
+    });
     q.stats.culled += u64::from(n as u32 - candidates);
     best
-}
-
-/// The lowest `n` bits set (all 32 from 32 on).
-#[inline]
-fn low_bits(n: usize) -> u32 {
-    if n >= 32 {
-        u32::MAX
-    } else {
-        (1u32 << n) - 1
-    }
 }
 
 #[derive(Clone, Copy, Debug)]

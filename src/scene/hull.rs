@@ -16,7 +16,7 @@
 //! pixels whose corners hit one object may be filled: which of the objects that can appear
 //! there that object hides all over the block.
 
-use super::model::{Camera, Scene};
+use super::model::{any_object, Camera, Scene};
 use crate::math::Aabb;
 #[cfg(feature = "eye-hulls")]
 use super::model::Object;
@@ -91,16 +91,12 @@ pub fn behind<R: Real>(scene: &Scene<'_, R>, among: u64, front: usize, far: u16,
     // Beyond every parameter whose key is within the slack of the farthest corner's.
     let beyond = R::key_bound(far.saturating_add(BEHIND_SLACK));
     let mut hidden = 0;
-    for (half, base) in [(among as u32, 0), ((among >> 32) as u32, 32)] {
-        let mut rest = half;
-        while rest != 0 {
-            let i = base + rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            if scene.objects.get(i).is_some_and(|o| beyond_reach(&o.bounds, eye, dirs, beyond)) {
-                hidden |= 1 << i;
-            }
+    any_object(among, scene.objects.len(), |i| {
+        if scene.objects.get(i).is_some_and(|o| beyond_reach(&o.bounds, eye, dirs, beyond)) {
+            hidden |= 1 << i;
         }
-    }
+        false
+    });
     hidden
 }
 

@@ -629,6 +629,27 @@ impl<'a, R> Scene<'a, R> {
     }
 }
 
+/// Calls `f` with each object of a mask (bit `i`: object `i`, of the first 64) that a scene of
+/// `n` objects has, lowest first, until `f` answers true; returns whether it did. The mask is
+/// taken by halves of 32 bits (a Cortex-M0+ counts and shifts 64-bit values in library calls),
+/// each cut to the objects there are; two plain loops, which the tracer's eye rays run faster
+/// than an iterator's state.
+#[inline(always)]
+pub(crate) fn any_object(mask: u64, n: usize, mut f: impl FnMut(usize) -> bool) -> bool {
+    let below = |n: usize| if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
+    for (half, base) in [(mask as u32, 0), ((mask >> 32) as u32, 32)] {
+        let mut left = half & below(n.saturating_sub(base));
+        while left != 0 {
+            let i = base + left.trailing_zeros() as usize;
+            left &= left - 1;
+            if f(i) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
 impl<'a, R: Real> Scene<'a, R> {
     /// The objects (bit `i`: object `i`, for the first 64) that can appear in the window
     /// rectangle `u` x `v` (2^-16 units, inclusive bounds, see [`EyeWindow`];
@@ -650,19 +671,7 @@ impl<'a, R: Real> Scene<'a, R> {
     /// Whether any of the objects in `among` (bit `i`: object `i`, of the first 64) can appear
     /// in the window rectangle `u` x `v`, as [`Scene::eye_candidates`] finds them.
     pub fn eye_region_among_meets(&self, among: u64, u: [i32; 2], v: [i32; 2]) -> bool {
-        // The mask's set bits, by halves of 32 bits: a Cortex-M0+ handles those in a few
-        // instructions, and 64-bit values in library calls.
-        for (half, base) in [(among as u32, 0), ((among >> 32) as u32, 32)] {
-            let mut rest = half;
-            while rest != 0 {
-                let i = base + rest.trailing_zeros() as usize;
-                rest &= rest - 1;
-                if self.objects.get(i).is_some_and(|o| o.eye_region_meets(u, v)) {
-                    return true;
-                }
-            }
-        }
-        false
+        any_object(among, self.objects.len(), |i| self.objects.get(i).is_some_and(|o| o.eye_region_meets(u, v)))
     }
     /// All primitives; the objects of a composite are contiguous.
     pub fn objects(&self) -> &'a [Object<R>] {
