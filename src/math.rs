@@ -206,10 +206,14 @@ impl<R: Real> Aabb<R> {
         let p = self.padded_for::<S>();
         Aabb { min: p.min.cast(), max: p.max.cast() }
     }
+    /// The padding (in `f64`, on every side) [`Aabb::cast_padded`] gives the box in `S`: the
+    /// scalar's padding at the box's farthest coordinate.
+    pub fn pad_for<S: Real>(&self) -> f64 {
+        S::pad_eps().to_f64() * (1.0 + self.min.max_abs().max(self.max.max_abs()).to_f64())
+    }
     /// The box grown (in `f64`) by the padding [`Aabb::cast_padded`] gives it in `S`.
     pub fn padded_for<S: Real>(&self) -> Aabb<f64> {
-        let ext = self.min.max_abs().max(self.max.max_abs()).to_f64();
-        let pad = S::pad_eps().to_f64() * (1.0 + ext);
+        let pad = self.pad_for::<S>();
         let grow = |v: Vec3<R>, s: f64| Vec3::new(v.x.to_f64() + s * pad, v.y.to_f64() + s * pad, v.z.to_f64() + s * pad);
         Aabb { min: grow(self.min, -1.0), max: grow(self.max, 1.0) }
     }

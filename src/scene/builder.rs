@@ -306,8 +306,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let shadow_basis = shadow_basis(&self.parts.lights);
         // A point's light-window position is two dot products in R: widen every window by what
         // their rounding can reach anywhere in the world (the scalar's padding at its corners).
-        let reach = world.min.max_abs().max(world.max.max_abs()).to_f64();
-        let margin = R::pad_eps().to_f64() * (1.0 + reach);
+        let margin = world.pad_for::<R>();
         // One projection for every object's eye window and hull.
         let projection = Projection::new(&camera);
         for o in self.storage[..self.len].iter_mut() {
@@ -319,8 +318,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             o.eye_window = projection.as_ref().map_or(WHOLE_PLANE, |p| eye_window(&o.bounds, p));
             #[cfg(feature = "eye-hulls")]
             {
-                // The padding the object's world box got (`Aabb::padded_for`), on its own box.
-                let pad = R::pad_eps().to_f64() * (1.0 + o.bounds.min.max_abs().max(o.bounds.max.max_abs()).to_f64());
+                // The padding the object's world box got (`Aabb::pad_for`), on its own box.
+                let pad = o.bounds.pad_for::<R>();
                 o.eye_hull = projection.as_ref().map_or(super::hull::NO_HULL, |p| super::hull::eye_hull(o, p, pad));
             }
             o.shadow_window = match shadow_basis {
