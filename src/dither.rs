@@ -11,7 +11,9 @@
 //! Error diffusion in tile order: error flowing right or down reaches its pixel exactly as in
 //! raster order, across tile borders too. Error flowing down-left into a tile that is already
 //! drawn is given to the pixel straight below instead, so no error is lost; this is the only
-//! difference from a raster-order pass.
+//! difference from a raster-order pass. At the image's left edge the down-left share goes
+//! straight below as well, rather than out of the image: no error is lost there either, and the
+//! border columns are lit as often as the rest (a dropped share drew a seam).
 
 use embedded_graphics_core::pixelcolor::BinaryColor;
 
@@ -117,8 +119,17 @@ impl Tone {
 }
 
 /// A tile's error accumulator with its border: `acc[y][x + 1]` is the error arriving at tile
-/// pixel `(x, y)`, for `x` in `-1..w + 2` and `y` in `0..h + 2`.
-type Acc = [[i16; MAX_TILE + 3]; MAX_TILE + 2];
+/// pixel `(x, y)`, for `x` in `-1..w + 2` and `y` in `0..h + 2` (a tile at the image's left
+/// edge counts the [`EDGE_PAD`] columns left of the image among its pixels).
+type Acc = [[i16; MAX_TILE + EDGE_PAD + 3]; MAX_TILE + 2];
+
+/// Columns dithered left of the image and not drawn, each row carrying its first pixel's gray:
+/// the image's first column then gets error from its left as every other column does. Without
+/// them the border columns were lit too seldom or too often (a seam at the left edge); six
+/// bring both kernels' border columns within their interior's spread
+/// (`error_diffusion_draws_no_seam_at_the_edges`; four left Floyd-Steinberg's outside it at
+/// some grays).
+pub const EDGE_PAD: usize = 6;
 
 // An error-diffusion kernel dithers one row `y` of a tile: each pixel's level plus the error
 // arriving at it (`acc[y][x + 1]`) is set or not, and its error `err` goes to its neighbours,
@@ -139,7 +150,7 @@ fn quantize(level: u8, arriving: i16) -> (bool, i16) {
 /// the row: per pixel one entry of each row is read and one of the row below written.
 #[inline(always)]
 fn floyd_steinberg(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColor]) {
-    let w = levels.len().min(out.len()).min(MAX_TILE);
+    let w = levels.len().min(out.len()).min(MAX_TILE + EDGE_PAD);
     let (above, below) = acc.split_at_mut(y + 1);
     let (row, below) = (&mut above[y], &mut below[0]);
     // `right`: the error arriving at the pixel; `b0`, `b1`: the row below's entries under the
@@ -165,7 +176,7 @@ fn floyd_steinberg(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColo
 /// Atkinson: 1/8 to each of two right, three below and one two rows below (6/8 of the error).
 #[inline(always)]
 fn atkinson(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColor]) {
-    for (x, (&l, px)) in levels.iter().zip(out.iter_mut()).enumerate().take(MAX_TILE) {
+    for (x, (&l, px)) in levels.iter().zip(out.iter_mut()).enumerate().take(MAX_TILE + EDGE_PAD) {
         let (on, err) = quantize(l, acc[y][x + 1]);
         *px = BinaryColor::from(on);
         let (e, c) = (err / 8, x + 1);
@@ -184,8 +195,9 @@ pub const MAX_TILE: usize = if cfg!(feature = "tile8") { 8 } else { 16 };
 /// Error units per gray level.
 const SCALE: i16 = 16;
 
-/// Error-diffusion state carried between tiles: `4 * width` entries of caller storage (two rows
-/// arriving at the current band, two rows leaving it) and two columns per tile row.
+/// Error-diffusion state carried between tiles: `4 * (width + EDGE_PAD)` entries of caller
+/// storage (two rows arriving at the current band, two rows leaving it, each with the columns
+/// left of the image) and two columns per tile row.
 #[derive(Debug)]
 pub struct Carry<'c> {
     rows: &'c mut [i16],
@@ -197,7 +209,7 @@ pub struct Carry<'c> {
 impl<'c> Carry<'c> {
     /// Entries of storage needed for an image `width` pixels wide.
     pub const fn len(width: usize) -> usize {
-        4 * width
+        4 * (width + EDGE_PAD)
     }
     /// Carry state over caller storage of at least [`Carry::len`] entries (it is cleared).
     pub fn new(rows: &'c mut [i16], width: usize) -> Option<Self> {
@@ -205,8 +217,9 @@ impl<'c> Carry<'c> {
         rows.iter_mut().for_each(|v| *v = 0);
         Some(Carry { rows, width, right: [[0; 2]; MAX_TILE], incoming: 0 })
     }
+    /// Row `k` of the half `which`: entry `EDGE_PAD + x` for image column `x`.
     fn row(&mut self, which: usize, k: usize) -> &mut [i16] {
-        let w = self.width;
+        let w = self.width + EDGE_PAD;
         let i = (which * 2 + k) * w;
         &mut self.rows[i..i + w]
     }
@@ -215,7 +228,7 @@ impl<'c> Carry<'c> {
         // The rows that left the previous band (the half `1 - incoming`) are the rows arriving
         // at this one (the half `incoming`).
         let out = 1 - self.incoming;
-        let w = self.width;
+        let w = self.width + EDGE_PAD;
         // The two halves never overlap: a copy between them (`copy_within` would link a
         // `memmove` of 1.3 KB into the firmware for this one use).
         let (first, second) = self.rows[..4 * w].split_at_mut(2 * w);
@@ -245,59 +258,69 @@ impl<'c> Carry<'c> {
     /// rows below), so every pixel sends its error with the same unchecked additions; the
     /// border is then handed on: the left column to the tile's first column as its row starts
     /// (the pixel there is already drawn, so its error goes straight below instead), the right
-    /// columns to the next tile, the rows below to the next band, and what falls outside the
-    /// image is dropped.
+    /// columns to the next tile, the rows below to the next band, and what falls beyond the
+    /// image's right edge or last row is dropped. A tile at the left edge dithers the
+    /// [`EDGE_PAD`] columns left of the image first, as pixels that are not drawn.
     #[inline(always)]
     fn diffuse(&mut self, kernel: impl Fn(&mut Acc, usize, &[u8], &mut [BinaryColor]), x0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
         // No tile is larger (the render's tiles are at most MAX_TILE on a side); saying so lets
         // the kernel's indices go unchecked.
         let (w, h) = (w.min(MAX_TILE), h.min(MAX_TILE));
-        let mut acc: Acc = [[0; MAX_TILE + 3]; MAX_TILE + 2];
+        // Columns dithered before the tile's own: the pad at the image's left edge.
+        let lead = if x0 == 0 { EDGE_PAD } else { 0 };
+        // The carry rows' entry of the tile's accumulator column 1 (its first column dithered).
+        let first = x0 + EDGE_PAD - lead;
+        let mut acc: Acc = [[0; MAX_TILE + EDGE_PAD + 3]; MAX_TILE + 2];
         // Gather what earlier tiles sent here.
         let inc = self.incoming;
         for k in 0..2.min(h) {
             let row = self.row(inc, k);
-            for (x, a) in acc[k][1..].iter_mut().enumerate().take(w) {
-                *a += row[x0 + x];
-                row[x0 + x] = 0;
+            for (a, r) in acc[k][1..].iter_mut().zip(&mut row[first..first + lead + w]) {
+                *a += core::mem::take(r);
             }
         }
         for y in 0..h {
-            acc[y][1] += self.right[y][0];
+            acc[y][1 + lead] += self.right[y][0];
             if w > 1 {
-                acc[y][2] += self.right[y][1];
+                acc[y][2 + lead] += self.right[y][1];
             }
         }
         self.right = [[0; 2]; MAX_TILE];
         for y in 0..h {
-            // The left border's error, at the image's left edge dropped.
+            // The left border's error (what went down-left) to the pixel straight below.
             let left = core::mem::take(&mut acc[y][0]);
-            if x0 > 0 {
-                acc[y][1] += left;
+            acc[y][1] += left;
+            let (row, px) = (&levels[y * w..(y + 1) * w], &mut out[y * w..(y + 1) * w]);
+            if lead == 0 {
+                kernel(&mut acc, y, row, px);
+            } else {
+                // The pad's columns carry the row's first gray; their pixels are not drawn.
+                let mut padded = [row[0]; MAX_TILE + EDGE_PAD];
+                padded[lead..lead + w].copy_from_slice(row);
+                let mut drawn = [BinaryColor::Off; MAX_TILE + EDGE_PAD];
+                kernel(&mut acc, y, &padded[..lead + w], &mut drawn[..lead + w]);
+                px.copy_from_slice(&drawn[lead..lead + w]);
             }
-            kernel(&mut acc, y, &levels[y * w..(y + 1) * w], &mut out[y * w..(y + 1) * w]);
         }
         // The right border to the next tile, unless beyond the image's right edge.
         for (y, row) in acc.iter().enumerate().take(h) {
             for k in 0..2 {
                 if x0 + w + k < self.width {
-                    self.right[y][k] += row[w + 1 + k];
+                    self.right[y][k] += row[lead + w + 1 + k];
                 }
             }
         }
-        // The rows below to the next band: the left border's column to the tile's first (or
-        // dropped at the image's left edge), the others where they fall in the image.
+        // The rows below to the next band: the left border's column to the tile's first, the
+        // others where they fall in the image (or its pad).
         let out_rows = 1 - inc;
-        let width = self.width;
+        let end = self.width + EDGE_PAD;
         for k in 0..2 {
             let below = acc[h + k];
             let row = self.row(out_rows, k);
-            if x0 > 0 {
-                row[x0] += below[0];
-            }
-            for (c, &e) in below[1..w + 3].iter().enumerate() {
-                if x0 + c < width {
-                    row[x0 + c] += e;
+            row[first] += below[0];
+            for (c, &e) in below[1..lead + w + 3].iter().enumerate() {
+                if first + c < end {
+                    row[first + c] += e;
                 }
             }
         }
@@ -474,7 +497,7 @@ mod tests {
     #[test]
     fn floyd_steinberg_half_gray_in_tiles_keeps_half_the_dots() {
         let (w, h, t) = (16usize, 16usize, 8usize);
-        let mut store = [0i16; 64];
+        let mut store = [0i16; Carry::len(16)];
         let mut carry = Carry::new(&mut store, w).unwrap();
         let mut img = [BinaryColor::Off; 256];
         for by in 0..h / t {
@@ -493,15 +516,72 @@ mod tests {
         assert_eq!(on, 128, "\n{}", art(w, &img));
     }
 
+    /// Per column, how many of an `w x h` flat field of `level` are lit, dithered by `mode` in
+    /// tiles of `t x t` as the render orders them.
+    fn column_counts(mode: Dither, w: usize, h: usize, t: usize, level: u8) -> std::vec::Vec<u32> {
+        let mut store = std::vec![0i16; Carry::len(w)];
+        let mut carry = Carry::new(&mut store, w).unwrap();
+        let mut lit = std::vec![0u32; w];
+        for y0 in (0..h).step_by(t) {
+            carry.next_band();
+            for x0 in (0..w).step_by(t) {
+                let (tw, th) = (t.min(w - x0), t.min(h - y0));
+                let mut out = [BinaryColor::Off; MAX_TILE * MAX_TILE];
+                carry.tile(mode, x0, tw, th, &[level; MAX_TILE * MAX_TILE][..tw * th], &mut out[..tw * th]);
+                for (i, px) in out[..tw * th].iter().enumerate() {
+                    lit[x0 + i % tw] += u32::from(px.is_on());
+                }
+            }
+        }
+        lit
+    }
+
+    #[test]
+    fn error_diffusion_draws_no_seam_at_the_edges() {
+        // A seam is a few border columns lit more or less often than the field's mean. Columns
+        // of error diffusion have a texture of their own (period-2 stripes at some grays, sparse
+        // dots on a lattice at the darkest), so columns are taken in windows of four, and the
+        // windows at both edges must stay as near the mean as binomial noise allows (3 standard
+        // deviations) or as the interior's own windows do, whichever is more.
+        // Atkinson in 4-pixel tiles is left out: it drops a quarter of every error, and handed
+        // down-left into drawn tiles every four columns its darkest grays (level 8 of 64) leave
+        // the first four columns of a 400-pixel row unlit; the boards' tiles are 8 or 16.
+        let cases = [(Dither::FloydSteinberg, 4), (Dither::FloydSteinberg, 8), (Dither::FloydSteinberg, MAX_TILE), (Dither::Atkinson, 8), (Dither::Atkinson, MAX_TILE)];
+        for (mode, t) in cases {
+            for (w, h) in [(128, 64), (400, 240), (72, 40)] {
+                {
+                    for level in (2..63).step_by(3) {
+                        let lit = column_counts(mode, w, h, t, level);
+                        let total: u32 = lit.iter().sum();
+                        let p = f64::from(total) / (w * h) as f64;
+                        let (mean, sd) = (4.0 * p * h as f64, (4.0 * h as f64 * p * (1.0 - p)).sqrt().max(1.0));
+                        let dev = |x: usize| (f64::from(lit[x..x + 4].iter().sum::<u32>()) - mean) / sd;
+                        let texture = (4..w - 8).map(|x| dev(x).abs()).fold(3.0, f64::max);
+                        for x in [0, w - 4] {
+                            let (window, dev) = (lit[x..x + 4].iter().sum::<u32>(), dev(x));
+                            assert!(
+                                dev.abs() <= texture,
+                                "{mode:?} {w}x{h} tiles {t} level {level}: columns {x}..{} lit {window} against a mean of {mean:.1} ({dev:.2} sd, the interior within {texture:.2}): {:?}",
+                                x + 4,
+                                &lit[x..x + 4]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn atkinson_mid_gray_tile_pattern() {
-        let mut store = [0i16; 16];
+        let mut store = [0i16; Carry::len(4)];
         let mut carry = Carry::new(&mut store, 4).unwrap();
         carry.next_band();
         let mut out = [BinaryColor::Off; 16];
         carry.tile(Dither::Atkinson, 0, 4, 4, &[40u8; 16], &mut out);
-        // Row 0 is all on (errors -48, -54, -60 keep each pixel above 512 of 1024); the
-        // negative error it leaves turns pixels of the next rows off.
-        assert_eq!(art(4, &out), "####\n#..#\n###.\n.##.\n");
+        // Row 0 is all on (the pad's six columns before it, at the same gray, hand on negative
+        // errors too small to turn a pixel off); the negative error it leaves turns pixels of
+        // the next rows off.
+        assert_eq!(art(4, &out), "####\n.#.#\n##.#\n.##.\n");
     }
 }
