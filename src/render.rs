@@ -107,6 +107,11 @@ impl Share {
 }
 
 impl Frame {
+    /// Width and height as `[u32; 2]` (what a camera is fitted to: [`crate::scene::CameraDesc::frame`]).
+    pub fn size(&self) -> [u32; 2] {
+        [u32::from(self.width), u32::from(self.height)]
+    }
+
     /// A frame with 8x8 tiles, Bayer dithering and one ray per pixel.
     pub fn new(width: u16, height: u16) -> Self {
         Frame {
@@ -225,6 +230,14 @@ pub enum RenderError<E> {
         /// The scalar's name.
         scalar: &'static str,
     },
+    /// The frame's shape is not the one the scene's camera was fitted to (pixels would not be
+    /// square): load the scene for this frame ([`crate::scene::CameraDesc::frame`]).
+    FrameShape {
+        /// The shape the camera was fitted to, in lowest terms.
+        fitted: [u32; 2],
+        /// The frame's width and height.
+        frame: [u32; 2],
+    },
     /// A progressive pass was asked of a frame that cannot be rendered progressively
     /// ([`Frame::progressive`]), or the pass is not 8, 4, 2 or 1, or the [`Traced`] storage is
     /// shorter than [`Frame::traced_len`].
@@ -245,6 +258,7 @@ impl RenderError<core::convert::Infallible> {
             RenderError::ScratchTooSmall { needed } => RenderError::ScratchTooSmall { needed },
             RenderError::BadShare => RenderError::BadShare,
             RenderError::ViewTooNarrow { most, scalar } => RenderError::ViewTooNarrow { most, scalar },
+            RenderError::FrameShape { fitted, frame } => RenderError::FrameShape { fitted, frame },
             RenderError::NotProgressive => RenderError::NotProgressive,
         }
     }
@@ -269,6 +283,11 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
                 f,
                 "the view is too narrow for {scalar} at this size: through it {scalar} resolves at most {}x{} pixels (widen the field of view, render fewer pixels, or trace in f64)",
                 most[0], most[1]
+            ),
+            RenderError::FrameShape { fitted, frame } => write!(
+                f,
+                "the scene's view was fitted to frames of shape {}:{}, not {}x{} (pixels would not be square): load the scene for this frame",
+                fitted[0], fitted[1], frame[0], frame[1]
             ),
             RenderError::NotProgressive => write!(f, "progressive passes need tiles of a multiple of 8, one ray per pixel, a pass of 8, 4, 2 or 1 and room for the traced samples"),
         }
@@ -852,10 +871,15 @@ fn check<E>(frame: &Frame, share: Share, dithered: bool) -> Result<(), RenderErr
     Ok(())
 }
 
-/// Whether `R` resolves the angle between neighbouring pixels of `frame` through `camera`.
+/// Whether `frame` has the shape `camera` was fitted to, and `R` resolves the angle between
+/// neighbouring pixels of `frame` through `camera`.
 fn resolves<R: Real, E>(camera: &Camera<R>, frame: &Frame) -> Result<(), RenderError<E>> {
+    let size = [u32::from(frame.width), u32::from(frame.height)];
+    if crate::scene::lowest_terms(size) != camera.shape {
+        return Err(RenderError::FrameShape { fitted: camera.shape, frame: size });
+    }
     let [w, h] = camera.resolves;
-    if u32::from(frame.width) <= w && u32::from(frame.height) <= h {
+    if size[0] <= w && size[1] <= h {
         Ok(())
     } else {
         Err(RenderError::ViewTooNarrow { most: camera.resolves, scalar: R::NAME })

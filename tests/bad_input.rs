@@ -29,7 +29,7 @@ fn accepted<R: Real>(text: &str) -> bool {
 fn gray<R: Real>(text: &str, frame: &Frame) -> Vec<u8> {
     let mut storage = vec![Object::<R>::default(); 16];
     let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", R::NAME));
+    let scene = parse_for::<R>(text, &mut storage, &mut parts, frame.size()).unwrap_or_else(|e| panic!("{}: {e}", R::NAME));
     let cfg = LatticeConfig::default();
     let mut bufs = lattice_storage(&scene, &cfg);
     let lat = build_lattice(&scene, &cfg, &mut bufs);

@@ -72,14 +72,20 @@ fn the_paper_scenes_render_the_same_with_windows_in_every_scalar() {
     scenes_in::<Fx>();
 }
 
-/// A random scene of 40 objects (4 per composite) seen from `eye` towards `look`, or `None`
-/// if the camera is refused.
+/// A random scene of 40 objects (4 per composite) seen from `eye` towards `look` (the view
+/// fitted to frames of 48x32), or `None` if the camera is refused.
 fn generated<'a>(storage: &'a mut [Object<f64>], parts: &'a mut lattice_rt::Parts<f64>, seed: u64, eye: (f64, f64, f64), look: (f64, f64, f64)) -> Option<Scene<'a, f64>> {
+    generated_for(storage, parts, seed, eye, look, [48, 32])
+}
+
+/// [`generated`] with the view fitted to frames of `shape`.
+fn generated_for<'a>(storage: &'a mut [Object<f64>], parts: &'a mut lattice_rt::Parts<f64>, seed: u64, eye: (f64, f64, f64), look: (f64, f64, f64), shape: [u32; 2]) -> Option<Scene<'a, f64>> {
     let mut b = SceneBuilder::new(storage, parts);
     random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
     b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
     b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
-    b.camera.fov = (70.0, 50.0);
+    b.camera.fov = lattice_rt::scene::FieldOfView::Within(70.0, 50.0);
+    b.camera.frame = shape;
     b.finish().ok()
 }
 
@@ -135,6 +141,8 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
                 }
             }
             for frame in [lattice_rt::Frame::new(48, 32), lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false }, ..lattice_rt::Frame::new(37, 21) }, lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: true }, ..lattice_rt::Frame::new(37, 21) }] {
+                let (mut storage, mut parts) = (vec![Object::<f64>::default(); 40], lattice_rt::Parts::default());
+                let Some(scene) = generated_for(&mut storage, &mut parts, seed, eye, look, frame.size()) else { continue };
                 let mut by_tiles = Tracer::new(&scene, &BruteForce);
                 by_tiles.set_eye_rays(EyeRays::Windows);
                 let mut by_rays = Tracer::new(&scene, &BruteForce);
@@ -290,14 +298,6 @@ fn tile_lists_change_no_pixel() {
         let (mut checked, mut fewer_walks) = (0, 0);
         for (seed, composite_size, spread) in [(1u64, 0, 0.0), (2, 0, 40.0), (3, 25, 0.0), (4, 0, 6.0)] {
             for (eye, look) in [((0.0, 8.0, -60.0), (0.0, 0.0, 0.0)), ((0.3, 0.2, 0.1), (5.0, 1.0, 2.0)), ((40.0, 3.0, 5.0), (0.0, 0.0, 0.0))] {
-                let mut storage = vec![Object::<R>::default(); 150];
-                let mut parts = lattice_rt::Parts::default();
-                let mut b = SceneBuilder::new(&mut storage, &mut parts);
-                random_scene(&mut b, &RandomScene { objects: 150, composite_size, spread, seed }).unwrap();
-                b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
-                b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
-                b.camera.fov = (60.0, 40.0);
-                let Ok(scene) = b.finish() else { continue };
                 let frames = [
                     lattice_rt::Frame::new(64, 40),
                     lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false }, outline: true, dither: lattice_rt::Dither::FloydSteinberg, ..lattice_rt::Frame::new(53, 35) },
@@ -305,6 +305,15 @@ fn tile_lists_change_no_pixel() {
                     lattice_rt::Frame { sampling: lattice_rt::Sampling::Edges { contrast: 8 }, rows: (1, 3), ..lattice_rt::Frame::new(48, 40) },
                 ];
                 for frame in &frames {
+                    let mut storage = vec![Object::<R>::default(); 150];
+                    let mut parts = lattice_rt::Parts::default();
+                    let mut b = SceneBuilder::new(&mut storage, &mut parts);
+                    random_scene(&mut b, &RandomScene { objects: 150, composite_size, spread, seed }).unwrap();
+                    b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
+                    b.camera.look = lattice_rt::Vec3::new(look.0, look.1, look.2);
+                    b.camera.fov = lattice_rt::scene::FieldOfView::Within(60.0, 40.0);
+                    b.camera.frame = frame.size();
+                    let Ok(scene) = b.finish() else { continue };
                     let (with, without) = (render_cover(&scene, frame, true), render_cover(&scene, frame, false));
                     let at = format!("{}, seed {seed}, eye {eye:?}, {}x{}", R::NAME, frame.width, frame.height);
                     assert_eq!((&with.0, &with.1), (&without.0, &without.1), "{at}");

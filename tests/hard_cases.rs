@@ -25,9 +25,14 @@ macro_rules! every_scalar {
     )*};
 }
 
-fn scene_in<'a, R: Real>(text: &str, (storage, parts): &'a mut (Vec<Object<R>>, lattice_rt::Parts<R>)) -> Scene<'a, R> {
+fn scene_in<'a, R: Real>(text: &str, st: &'a mut (Vec<Object<R>>, lattice_rt::Parts<R>)) -> Scene<'a, R> {
+    scene_for(text, st, lattice_rt::scene::DEFAULT_FRAME)
+}
+
+/// [`scene_in`] with the view fitted to frames of `shape`.
+fn scene_for<'a, R: Real>(text: &str, (storage, parts): &'a mut (Vec<Object<R>>, lattice_rt::Parts<R>), shape: [u32; 2]) -> Scene<'a, R> {
     *storage = vec![Object::default(); text.lines().count().max(1)];
-    parse::<R>(text, storage, parts).unwrap_or_else(|e| panic!("{} : {e}", R::NAME))
+    parse_for::<R>(text, storage, parts, shape).unwrap_or_else(|e| panic!("{} : {e}", R::NAME))
 }
 
 /// Calls `f` with each accelerator over the scene (a lattice with `cfg`).
@@ -65,8 +70,8 @@ fn gray_all<R: Real>(scene: &Scene<'_, R>, frame: &Frame, shadows: bool) -> Vec<
 fn no_self_shadow_acne<R: Real>() {
     let text = "camera eye 0 3 -8 look 0 0.5 0\nlight directional dir 1 -1 1\nsphere center -1.5 1 0 radius 1\nbox min 1 0 -1 max 3 1.5 1\n";
     let mut st = Default::default();
-    let scene = scene_in::<R>(text, &mut st);
     let frame = Frame::new(96, 64);
+    let scene = scene_for::<R>(text, &mut st, frame.size());
     assert_eq!(gray_all(&scene, &frame, true), gray_all(&scene, &frame, false), "{}: acne", R::NAME);
 }
 

@@ -96,7 +96,10 @@ fn camera_looking_along_its_up_vector() {
 
 #[test]
 fn bad_field_of_view() {
-    check("camera fov 180 25\nsphere", "line 1, column 1 at `camera`: field of view must be between 0 and 180 degrees");
+    // The error points at the angle out of range, not at the statement.
+    check("camera fov 180 25\nsphere", "line 1, column 12 at `180`: field of view must be between 0 and 180 degrees");
+    check("camera fov 40 0\nsphere", "line 1, column 15 at `0`: field of view must be between 0 and 180 degrees");
+    check("camera fov -5\nsphere", "line 1, column 12 at `-5`: field of view must be between 0 and 180 degrees");
 }
 
 #[test]

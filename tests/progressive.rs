@@ -13,7 +13,7 @@ use lattice_rt::{parse, render_pass, render_share, BitFrame, Dither, Frame, Fx, 
 /// The frames of each pass (shares rendered one after the other into one bitmap), the eye rays
 /// of all passes, and the plain frame with its eye rays.
 fn passes<R: Real>(name: &str, frame: Frame, of: u8) -> (Vec<Vec<u8>>, u64, Vec<u8>, u64) {
-    with_lattice::<R, _>(name, |scene, lat| {
+    with_lattice::<R, _>(name, frame.size(), |scene, lat| {
         let tracer = Tracer::new(scene, lat);
         let (w, h) = (frame.width as u32, frame.height as u32);
         let shares: Vec<Share> = (0..of).map(|index| Share { index, of }).collect();

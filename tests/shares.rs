@@ -10,7 +10,7 @@ use lattice_rt::{dither_band, parse, render_pass, trace_pass, KeptTile, render, 
 
 /// Renders `name` into a fresh 1-bit frame for each frame in `frames`, all into one bitmap.
 fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
-    with_lattice::<R, _>(name, |scene, lat| {
+    with_lattice::<R, _>(name, frames[0].0.size(), |scene, lat| {
         let mut tracer = Tracer::new(scene, lat);
         tracer.set_shadow_coherence(coherence);
         let (w, h) = (frames[0].0.width as u32, frames[0].0.height as u32);
@@ -125,7 +125,7 @@ fn shares_count_their_tiles_as_the_checkerboard_holds_them() {
 /// is dithered in parts of that many tiles (`dither_tiles`, as the two-core board dithers the
 /// tiles traced so far); with none, whole (`dither_band`).
 fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8, part: Option<usize>) -> Vec<u8> {
-    with_lattice::<R, _>(name, |scene, lat| {
+    with_lattice::<R, _>(name, frame.size(), |scene, lat| {
         let tracer = Tracer::new(scene, lat);
         let (w, h) = (frame.width as u32, frame.height as u32);
         let mut bits = vec![0u8; BitFrame::bytes(w, h)];
@@ -206,7 +206,7 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
 #[test]
 fn traced_passes_dithered_in_order_give_every_pass() {
     for name in ["chair", "whitted"] {
-        with_lattice::<Fx, _>(name, |scene, lat| {
+        with_lattice::<Fx, _>(name, [128, 64], |scene, lat| {
             let tracer = Tracer::new(scene, lat);
             let frame = Frame { dither: Dither::BlueNoise, outline: true, sampling: Sampling::Adaptive { contrast: 4, coarse: true }, ..Frame::new(128, 64) };
             let (w, h) = (128u32, 64u32);

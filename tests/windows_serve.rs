@@ -8,7 +8,7 @@ use common::*;
 use lattice_rt::accel::{Hit, Query};
 use lattice_rt::render::Sampling;
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, Accelerator, BruteForce, Dither, EyeRays, Frame, Fx, LatticeConfig, Ray, Real, Scene, Tracer};
+use lattice_rt::{Accelerator, BruteForce, Dither, EyeRays, Frame, Fx, LatticeConfig, Ray, Real, Scene, Tracer};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The lattice, counting the rays it is asked about.
@@ -43,15 +43,16 @@ fn frames() -> [Frame; 2] {
 /// Whether `text` qualifies, and for each frame the rays its lattice was asked about and
 /// whether brute force in its place drew the same frame.
 fn check<R: Real>(text: &str) -> (bool, Vec<(u32, bool)>) {
-    let mut storage = vec![Object::<R>::default(); text.lines().count()];
-    let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{e}"));
-    let mut st = lattice_storage(&scene, &LatticeConfig::default());
-    let lattice = build_lattice(&scene, &LatticeConfig::default(), &mut st);
-    let serves = EyeRays::serve_every_ray(&scene);
+    let mut serves = true;
     let runs = frames()
         .iter()
         .map(|frame| {
+            let mut storage = vec![Object::<R>::default(); text.lines().count()];
+            let mut parts = lattice_rt::Parts::default();
+            let scene = parse_for::<R>(text, &mut storage, &mut parts, frame.size()).unwrap_or_else(|e| panic!("{e}"));
+            let mut st = lattice_storage(&scene, &LatticeConfig::default());
+            let lattice = build_lattice(&scene, &LatticeConfig::default(), &mut st);
+            serves &= EyeRays::serve_every_ray(&scene);
             let counting = Counting { lattice: &lattice, asked: AtomicU32::new(0) };
             let (with_lattice, _) = render_tracer(&Tracer::new(&scene, &counting), frame);
             let (with_brute, _) = render_tracer(&Tracer::new(&scene, &BruteForce), frame);

@@ -5,7 +5,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::lattice::LatticeSizes;
 use lattice_rt::scene::text::{object_count, text_from_bytes};
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, Frame, HeapStorage, Lattice, LatticeConfig, Parts, Real, Scene, SceneBuilder, Sizes};
+use lattice_rt::scene::text::parse_with;
+use lattice_rt::{Frame, HeapStorage, Lattice, LatticeConfig, Parts, Real, Scene, SceneBuilder, Sizes};
 use std::io::Read;
 use std::path::Path;
 
@@ -65,9 +66,10 @@ pub fn object_storage<R: Real>(text: &str) -> Result<SceneStore<R>> {
     Ok(SceneStore { objects: vec![Object::default(); n.max(1)], parts: Parts::new() })
 }
 
-/// Parses `text` into `storage`, turning errors into messages that name the file.
-pub fn parse_scene<'a, R: Real>(path: &Path, text: &str, storage: &'a mut SceneStore<R>) -> Result<Scene<'a, R>> {
-    parse::<R>(text, &mut storage.objects, &mut storage.parts).map_err(|e| anyhow!("{}: {e}", path.display()))
+/// Parses `text` into `storage` with its camera fitted to `frame`'s shape (square pixels),
+/// turning errors into messages that name the file.
+pub fn parse_scene<'a, R: Real>(path: &Path, text: &str, storage: &'a mut SceneStore<R>, frame: &Frame) -> Result<Scene<'a, R>> {
+    parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| c.frame = frame.size()).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 /// The most memory a lattice may take on the host (so that no flag makes host-sim allocate
@@ -110,7 +112,7 @@ mod tests {
         let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/chair.scene"));
         let text = read(path).unwrap();
         let mut storage = object_storage::<f64>(&text).unwrap();
-        let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
+        let scene = parse_scene::<f64>(path, &text, &mut storage, &Frame::new(128, 64)).unwrap();
         let err = lattice_storage(&scene, &crate::cli::lattice_config(Some([1024, 1024, 1024]), None)).expect_err("refused");
         let msg = format!("{err:#}");
         assert!(msg.contains("--cells") && msg.contains(&MAX_LATTICE_BYTES.to_string()), "{msg}");

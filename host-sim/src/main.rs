@@ -51,6 +51,9 @@ enum Command {
         /// File to write.
         #[arg(short, long, default_value = "out/scene.pov")]
         output: PathBuf,
+        /// The frame the view is fitted to (its shape: square pixels), as `render --size`.
+        #[arg(long, default_value = "128x64", value_parser = host_sim::cli::parse_size)]
+        size: (u16, u16),
     },
     /// The camera circles a scene (around the vertical line through the point it looks at):
     /// the frames as the Pico renders and shows them (128x64, fixed point, its sampling and
@@ -104,13 +107,13 @@ fn real_main() -> Result<()> {
                 Scalar::Fixed => run::render_cmd::<lattice_rt::Fx>(&a),
             }
         }
-        Some(Command::Export { scene, pov, ids, output }) => {
+        Some(Command::Export { scene, pov, ids, output, size }) => {
             if !pov {
                 bail!("say which format: --pov is the one there is");
             }
             let text = load::read(&scene)?;
             let mut storage = load::object_storage::<f64>(&text)?;
-            let s = load::parse_scene::<f64>(&scene, &text, &mut storage)?;
+            let s = load::parse_scene::<f64>(&scene, &text, &mut storage, &lattice_rt::Frame::new(size.0, size.1))?;
             let out = pov::export(&s, if ids { pov::PovMode::Ids } else { pov::PovMode::Full }).map_err(|e| {
                 match e.downcast_ref::<pov::Unrepresentable>() {
                     Some(u) => {

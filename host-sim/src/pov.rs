@@ -268,7 +268,7 @@ mod tests {
             let name = path.file_stem().unwrap().to_string_lossy().to_string();
             let text = read(path).unwrap();
             let mut storage = object_storage::<f64>(&text).unwrap();
-            let scene = parse_scene::<f64>(path, &text, &mut storage).unwrap();
+            let scene = parse_scene::<f64>(path, &text, &mut storage, &Frame::new(W as u16, H as u16)).unwrap();
             let (agree, mean, far) = compare(&name, &scene);
             report.push_str(&format!("{name}: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n", agree * 100.0, far * 100.0));
             if agree < 0.995 || mean > 2.0 || far > 0.01 {
@@ -280,6 +280,7 @@ mod tests {
         let mut parts = lattice_rt::Parts::default();
         let mut b = SceneBuilder::new(&mut storage, &mut parts);
         random_scene(&mut b, &RandomScene { objects: 30, composite_size: 0, spread: 0.0, seed: 42 }).unwrap();
+        b.camera.frame = [W, H];
         let scene = b.finish().unwrap();
         let (agree, mean, far) = compare("random30", &scene);
         report.push_str(&format!("random30: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n", agree * 100.0, far * 100.0));

@@ -116,11 +116,12 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
 pub fn with_tracer<R: Real, T>(
     path: &Path,
     text: &str,
+    frame: &Frame,
     tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>),
     work: impl FnOnce(&lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>) -> Result<T>,
 ) -> Result<T> {
     let mut storage = object_storage::<R>(text)?;
-    let scene = parse_scene::<R>(path, text, &mut storage)?;
+    let scene = parse_scene::<R>(path, text, &mut storage, frame)?;
     let cfg = LatticeConfig::default();
     let mut bufs = lattice_storage(&scene, &cfg)?;
     let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
@@ -137,7 +138,7 @@ pub fn render_text<R: Real>(
     frame: &lattice_rt::Frame,
     tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>),
 ) -> Result<Rendered> {
-    with_tracer(path, text, tune, |tracer| render_band(tracer, frame, false))
+    with_tracer(path, text, frame, tune, |tracer| render_band(tracer, frame, false))
 }
 
 /// One pass of a progressive frame as the panel shows it once the pass is drawn.
@@ -155,7 +156,7 @@ pub struct Pass {
 /// The passes of a progressive frame (8, 4, 2, 1; `render_pass`) of scene text with its default
 /// lattice, in scalar `R`.
 pub fn progressive_passes<R: Real>(path: &Path, text: &str, frame: &Frame) -> Result<Vec<Pass>> {
-    with_tracer::<R, _>(path, text, |_| {}, |tracer| {
+    with_tracer::<R, _>(path, text, frame, |_| {}, |tracer| {
         let (w, h) = (frame.width as u32, frame.height as u32);
         let mut scratch = HeapScratch::new(tracer.scene(), frame);
         let mut traced = vec![lattice_rt::Traced::default(); frame.traced_len(lattice_rt::Share::ALL)];
@@ -225,8 +226,6 @@ fn print_stats(label: &str, s: &Stats, elapsed: Duration) {
 pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     crate::output::check_png_size(a.size.0 as u32, a.size.1 as u32, a.scale)?;
     let text = read(&a.scene)?;
-    let mut storage = object_storage::<R>(&text)?;
-    let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
     let frame = Frame {
         tile: a.tile,
         dither: a.dither.mode(),
@@ -236,6 +235,8 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
         cutoff: a.cutoff,
         ..Frame::new(a.size.0, a.size.1)
     };
+    let mut storage = object_storage::<R>(&text)?;
+    let scene = parse_scene::<R>(&a.scene, &text, &mut storage, &frame)?;
     let mut out = render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true)?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
     // Every output under a temporary name first: if one cannot be written, none is left.
@@ -260,8 +261,9 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
 /// `host-sim stats`.
 pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let text = read(&a.scene)?;
+    let frame = Frame::new(a.size.0, a.size.1);
     let mut storage = object_storage::<R>(&text)?;
-    let scene = parse_scene::<R>(&a.scene, &text, &mut storage)?;
+    let scene = parse_scene::<R>(&a.scene, &text, &mut storage, &frame)?;
     let cfg = crate::cli::lattice_config(a.cells, a.budget);
     let mut bufs = lattice_storage(&scene, &cfg)?;
     let t0 = Instant::now();
@@ -292,7 +294,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
         lattice.bytes(),
         build.as_secs_f64() * 1e3
     );
-    per_accelerator(&scene, &cfg, Frame::new(a.size.0, a.size.1), a.runs)
+    per_accelerator(&scene, &cfg, frame, a.runs)
 }
 
 
@@ -354,10 +356,10 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
     for name in PAPER_SCENES {
         let path = scenes.join(format!("{name}.scene"));
         let text = read(&path)?;
-        let mut storage = object_storage::<f64>(&text)?;
-        let scene = parse_scene::<f64>(&path, &text, &mut storage)?;
         for (w, h) in [(160u16, 100u16), (128, 64)] {
             let frame = Frame::new(w, h);
+            let mut storage = object_storage::<f64>(&text)?;
+            let scene = parse_scene::<f64>(&path, &text, &mut storage, &frame)?;
             let mut r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true, true)?;
             let f = BitFrame::wrap(w as u32, h as u32, &mut r.bits).expect("sized by render");
             let png = out.join(format!("{name}-{w}x{h}.png"));
@@ -383,7 +385,7 @@ mod tests {
             let path = std::path::PathBuf::from(format!("{}/../scenes/{name}.scene", env!("CARGO_MANIFEST_DIR")));
             let text = read(&path).unwrap();
             let mut storage = object_storage::<f64>(&text).unwrap();
-            let scene = parse_scene::<f64>(&path, &text, &mut storage).unwrap();
+            let scene = parse_scene::<f64>(&path, &text, &mut storage, &Frame::new(160, 100)).unwrap();
             let cfg = LatticeConfig::default();
             let mut bufs = lattice_storage(&scene, &cfg).expect("lattice fits");
             let lat = build_lattice(&mut bufs, &scene, &cfg).unwrap();

@@ -1,7 +1,7 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Parts, Scene, NO_COMPOSITE};
+use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, lowest_terms, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Parts, Scene, NO_COMPOSITE};
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
@@ -271,10 +271,11 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let c = self.camera;
         check_range::<R>(c.eye)?;
         check_range::<R>(c.look)?;
-        check_finite(&[c.up.x, c.up.y, c.up.z, c.fov.0, c.fov.1])?;
+        let (angles, _) = c.fov.angles();
+        check_finite(&[c.up.x, c.up.y, c.up.z, angles[0], angles[1]])?;
         check_value::<R>("ambient", self.ambient)?;
         check_value::<R>("background", self.background)?;
-        if !(c.fov.0 > 0.0 && c.fov.0 < 180.0 && c.fov.1 > 0.0 && c.fov.1 < 180.0) {
+        if !angles.iter().all(|a| *a > 0.0 && *a < 180.0) || c.frame.contains(&0) {
             return Err(SceneError::BadFieldOfView);
         }
         let forward = (c.look - c.eye).normalize();
@@ -289,8 +290,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             // Directions so short (subnormal) or long that normalising them overflowed.
             return Err(SceneError::DegenerateCamera);
         }
-        let tx = libm::tan(c.fov.0.to_radians_core() / 2.0);
-        let ty = libm::tan(c.fov.1.to_radians_core() / 2.0);
+        let (tx, ty) = c.fov.half_tangents(c.frame);
         let camera =
             Camera {
                 eye: c.eye.cast(),
@@ -298,6 +298,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
                 right: (right * tx).cast(),
                 up: (up * ty).cast(),
                 resolves: [resolvable_pixels::<R>(tx), resolvable_pixels::<R>(ty)],
+                shape: lowest_terms(c.frame),
             };
         let mut world = Aabb { min: camera.eye, max: camera.eye };
         for o in &self.storage[..self.len] {
@@ -489,15 +490,6 @@ fn pow2_at_least(x: f64) -> f64 {
         p *= 0.5;
     }
     p
-}
-
-trait ToRadians {
-    fn to_radians_core(self) -> f64;
-}
-impl ToRadians for f64 {
-    fn to_radians_core(self) -> f64 {
-        self * core::f64::consts::PI / 180.0
-    }
 }
 
 /// World box of a placed primitive: exact for spheres (an ellipsoid's extent along axis `i`

@@ -374,7 +374,7 @@ mod tests {
                 crate::generate::random_scene(&mut b, &crate::generate::RandomScene { objects: 24, composite_size: 3, spread: 12.0, seed }).unwrap();
                 b.camera.eye = Vec3::new(eye.0, eye.1, eye.2);
                 b.camera.look = Vec3::new(look.0, look.1, look.2);
-                b.camera.fov = (70.0, 50.0);
+                b.camera.fov = crate::scene::FieldOfView::Within(70.0, 50.0);
                 let Ok(scene) = b.finish() else { continue };
                 built += 1;
                 sum += each(&scene, &std::format!("seed {seed}, eye {eye:?}"));

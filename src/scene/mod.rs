@@ -20,6 +20,6 @@ pub use builder::{check_value, SceneBuilder, IOR};
 pub use error::SceneError;
 pub use hull::{EyeHull, HULL_EDGES, NO_HULL};
 pub use model::{
-    axis_normal, Camera, CameraDesc, Composite, Culled, EyeWindow, ShadowWindow, Light, Material, Object, Parts, Scene, EYE_MARGIN, VIEW_MARGIN, MAX_COMPOSITES, MAX_LIGHTS,
+    axis_normal, lowest_terms, Camera, CameraDesc, FieldOfView, DEFAULT_FRAME, Composite, Culled, EyeWindow, ShadowWindow, Light, Material, Object, Parts, Scene, EYE_MARGIN, VIEW_MARGIN, MAX_COMPOSITES, MAX_LIGHTS,
     MAX_MATERIALS, NO_COMPOSITE, WHOLE_PLANE,
 };

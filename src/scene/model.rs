@@ -56,7 +56,54 @@ pub enum Light<R> {
     },
 }
 
-/// The camera as given in a scene (eye, look-at, up, field of view in degrees).
+/// A scene's field of view, in degrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FieldOfView {
+    /// The angle across the frame; the angle down follows from the frame's shape (square
+    /// pixels).
+    Across(f64),
+    /// A view of at least this angle across and this angle down: the frame shows all of it,
+    /// with square pixels, and more along the axis where its shape is wider than the view's
+    /// (`fov 40 25`, the paper's 160x100 window, on a 128x64 panel shows 47.9 x 25 degrees).
+    Within(f64, f64),
+}
+
+impl FieldOfView {
+    /// The paper's view: 40 x 25 degrees.
+    pub const PAPER: FieldOfView = FieldOfView::Within(40.0, 25.0);
+
+    /// The tangents of half the angle across and down for a frame of `w x h` pixels (both at
+    /// least 1): square pixels, and a [`FieldOfView::Within`] view fully inside.
+    pub fn half_tangents(self, [w, h]: [u32; 2]) -> (f64, f64) {
+        let aspect = f64::from(w.max(1)) / f64::from(h.max(1));
+        let tan = |deg: f64| libm::tan(deg * core::f64::consts::PI / 180.0 / 2.0);
+        match self {
+            FieldOfView::Across(a) => (tan(a), tan(a) / aspect),
+            FieldOfView::Within(a, d) => {
+                let (tx, ty) = (tan(a), tan(d));
+                if tx < ty * aspect {
+                    (ty * aspect, ty)
+                } else {
+                    (tx, tx / aspect)
+                }
+            }
+        }
+    }
+
+    /// The angles given, in degrees (one or two).
+    pub fn angles(self) -> ([f64; 2], usize) {
+        match self {
+            FieldOfView::Across(a) => ([a, a], 1),
+            FieldOfView::Within(a, d) => ([a, d], 2),
+        }
+    }
+}
+
+/// The frame shape a camera is fitted to unless told otherwise: the boards' 128x64 panel.
+pub const DEFAULT_FRAME: [u32; 2] = [128, 64];
+
+/// The camera as given in a scene (eye, look-at, up, field of view in degrees), and the shape of
+/// the frame it is fitted to.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraDesc {
     /// Viewpoint `V`.
@@ -65,8 +112,12 @@ pub struct CameraDesc {
     pub look: Vec3<f64>,
     /// Up direction.
     pub up: Vec3<f64>,
-    /// Horizontal and vertical field of view in degrees (the paper: 40 x 25).
-    pub fov: (f64, f64),
+    /// The field of view (the paper's: 40 x 25 degrees).
+    pub fov: FieldOfView,
+    /// Width and height of the frame the view is fitted to, in pixels (any multiple of them
+    /// renders the same view): pixels are square, and the render refuses a frame of another
+    /// shape ([`crate::render::RenderError::FrameShape`]).
+    pub frame: [u32; 2],
 }
 
 impl CameraDesc {
@@ -93,7 +144,8 @@ impl Default for CameraDesc {
             eye: Vec3::new(0.0, 0.0, -10.0),
             look: Vec3::zero(),
             up: Vec3::new(0.0, 1.0, 0.0),
-            fov: (40.0, 25.0),
+            fov: FieldOfView::PAPER,
+            frame: DEFAULT_FRAME,
         }
     }
 }
@@ -113,6 +165,20 @@ pub struct Camera<R> {
     /// pixels at least [`VIEW_MARGIN`] units of the scalar's last place apart (computed at
     /// set-up, so the render checks a frame against it with integers).
     pub resolves: [u32; 2],
+    /// The frame shape the view was fitted to, in lowest terms (`[2, 1]` for 128x64).
+    pub shape: [u32; 2],
+}
+
+/// `[w, h]` divided by their greatest common divisor (`[0, 0]` stays).
+pub fn lowest_terms([w, h]: [u32; 2]) -> [u32; 2] {
+    let (mut a, mut b) = (w, h);
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    match (w.checked_div(a), h.checked_div(a)) {
+        (Some(w), Some(h)) => [w, h],
+        _ => [w, h],
+    }
 }
 
 /// How many times the scalar's resolution the angle between neighbouring pixels must be: an

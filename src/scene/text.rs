@@ -7,7 +7,7 @@
 
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
-use super::{check_value, CameraDesc, Light, Material, Object, Parts, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
+use super::{check_value, CameraDesc, FieldOfView, Light, Material, Object, Parts, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
 use crate::shape::Shape;
 use crate::trace::MAX_DEPTH;
 use core::fmt;
@@ -330,6 +330,31 @@ impl<'t> Words<'t> {
         Ok(self.number_at()?.0)
     }
 
+    /// An angle of a field of view: above 0 and below 180 degrees (an error points at it).
+    fn view_angle(&mut self) -> Result<f64, ParseError<'t>> {
+        let (v, col, tok) = self.number_at()?;
+        if !(v > 0.0 && v < 180.0) {
+            return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::BadFieldOfView)));
+        }
+        Ok(v)
+    }
+
+    /// `A [D]`: the angle across, and the angle down if a number follows.
+    fn field_of_view(&mut self) -> Result<FieldOfView, ParseError<'t>> {
+        let across = self.view_angle()?;
+        let save = self.pos;
+        match self.next() {
+            Some((_, tok)) if parse_number(tok).is_some() => {
+                self.pos = save;
+                Ok(FieldOfView::Within(across, self.view_angle()?))
+            }
+            _ => {
+                self.pos = save;
+                Ok(FieldOfView::Across(across))
+            }
+        }
+    }
+
     /// A coordinate or length: below the scalar's coordinate limit.
     fn coord(&mut self) -> Result<f64, ParseError<'t>> {
         let (v, col, tok) = self.number_at()?;
@@ -502,7 +527,7 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
         Ok(v)
     }
 
-    /// `camera eye X Y Z look X Y Z up X Y Z fov H V`
+    /// `camera eye X Y Z look X Y Z up X Y Z fov A [D]`
     fn camera(&mut self, st: &mut Statement<'t>) -> Result<(), ParseError<'t>> {
         self.camera_at = (st.lineno, st.kcol, st.key);
         let c = &mut self.b.camera;
@@ -511,7 +536,7 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
                 "eye" => c.eye = st.w.point()?,
                 "look" => c.look = st.w.point()?,
                 "up" => c.up = st.w.vec3()?,
-                "fov" => c.fov = (st.w.number()?, st.w.number()?),
+                "fov" => c.fov = st.w.field_of_view()?,
                 _ => return Err(st.unknown(col, attr)),
             }
         }

@@ -3,7 +3,7 @@
 
 use lattice_rt::scene::Object;
 use lattice_rt::{
-    parse, render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, HeapStorage, Lattice, LatticeConfig,
+    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, HeapStorage, Lattice, LatticeConfig,
     NoHooks, Real, Scene, Sizes, Stats, Tracer,
 };
 
@@ -44,13 +44,18 @@ pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, 
     (pbm, stats)
 }
 
-/// Calls `f` with scene `name` (from `scenes/`), parsed in `R`, and its lattice built with the
-/// default configuration.
-pub fn with_lattice<R: Real, T>(name: &str, f: impl FnOnce(&Scene<'_, R>, &Lattice<'_, R>) -> T) -> T {
+/// Parses `text` in `R` with its view fitted to frames of `shape` (width and height).
+pub fn parse_for<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>], parts: &'a mut lattice_rt::Parts<R>, shape: [u32; 2]) -> Result<Scene<'a, R>, lattice_rt::ParseError<'t>> {
+    lattice_rt::scene::text::parse_with::<R>(text, storage, parts, |c| c.frame = shape)
+}
+
+/// Calls `f` with scene `name` (from `scenes/`), parsed in `R` with its view fitted to frames
+/// of `shape`, and its lattice built with the default configuration.
+pub fn with_lattice<R: Real, T>(name: &str, shape: [u32; 2], f: impl FnOnce(&Scene<'_, R>, &Lattice<'_, R>) -> T) -> T {
     let text = scene_text(name);
     let mut storage = vec![Object::<R>::default(); 64];
     let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<R>(&text, &mut storage, &mut parts).unwrap();
+    let scene = parse_for::<R>(&text, &mut storage, &mut parts, shape).unwrap();
     let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     f(&scene, &lat)
@@ -60,7 +65,7 @@ pub fn with_lattice<R: Real, T>(name: &str, f: impl FnOnce(&Scene<'_, R>, &Latti
 pub fn render_text<R: Real>(text: &str, accel: Accel, frame: &Frame) -> (Vec<u8>, Stats) {
     let mut storage = vec![Object::<R>::default(); text.lines().count()];
     let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{e}"));
+    let scene = parse_for::<R>(text, &mut storage, &mut parts, frame.size()).unwrap_or_else(|e| panic!("{e}"));
     let mut st = lattice_storage(&scene, &LatticeConfig::default());
     let lat = build_lattice(&scene, &LatticeConfig::default(), &mut st);
     let a: &dyn Accelerator<R> = match accel {

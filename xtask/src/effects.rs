@@ -53,7 +53,7 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
         bar.inc(1);
         let text = read(path)?;
         let mut storage = object_storage::<f64>(&text)?;
-        let fx = Effects::of(&parse_scene::<f64>(path, &text, &mut storage)?);
+        let fx = Effects::of(&parse_scene::<f64>(path, &text, &mut storage, &Frame::new(128, 64))?);
         let (mut td, mut ta) = (Vec::new(), Vec::new());
         let (mut d, mut a) = (None, None);
         for _ in 0..runs.max(1) {

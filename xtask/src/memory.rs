@@ -270,7 +270,7 @@ pub fn memory_cmd(a: &MemoryArgs) -> Result<()> {
         let t0 = Instant::now();
         let summary = match &s.source {
             Source::File(path, text) => {
-                let scene = parse_scene::<f64>(path, text, &mut s.objects)?;
+                let scene = parse_scene::<f64>(path, text, &mut s.objects, &lattice_rt::Frame::new(RAYS.0 as u16, RAYS.1 as u16))?;
                 sweep(&scene, &s.name, runs, &mut sections)?
             }
             Source::Generated(n, clustered) => {

@@ -112,7 +112,7 @@ fn shoot(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Result<Shot> {
 
 /// Gray levels (0..=64, as reals) of `n x n` f64 rays per pixel, averaged.
 pub fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f64>> {
-    host_sim::run::with_tracer::<f64, _>(path, text, |_| {}, |tracer| {
+    host_sim::run::with_tracer::<f64, _>(path, text, &Frame::new(w, h), |_| {}, |tracer| {
         let scene = tracer.scene();
         let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(scene)];
         let mut q = lattice_rt::Query::new(&mut mb);
