@@ -164,9 +164,13 @@ pub struct RenderArgs {
     /// Display theme of the PNG.
     #[arg(long, value_enum, default_value_t = output::Theme::OledWhite)]
     pub theme: output::Theme,
-    /// PNG pixel scale (1 to 64; the PNG may have at most 2^26 pixels).
+    /// PNG pixel scale (1 to 64; at 1 the PNG has the frame's own size; the PNG may have at
+    /// most 2^26 pixels).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub scale: u32,
+    /// Draw a one-pixel grid between the PNG's pixels, as a panel looks close up.
+    #[arg(long)]
+    pub grid: bool,
     /// Also write the gray levels (0..=64) as PGM.
     #[arg(long)]
     pub gray: Option<PathBuf>,

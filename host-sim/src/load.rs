@@ -95,7 +95,7 @@ pub fn lattice_storage<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Re
 pub fn build_lattice<'a, R: Real>(storage: &'a mut HeapStorage<R>, scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Lattice<'a, R>> {
     let (lattice, _) = storage.view().split().1.lattice(scene, cfg).map_err(|e| {
         if e.capacity == "budget" {
-            anyhow!("no lattice fits --budget {}: the smallest takes {} bytes; give more, or use --accel bbox (no lattice)", e.available, e.needed)
+            anyhow!("no lattice fits --budget {}: the smallest takes {} bytes; give at least that", e.available, e.needed)
         } else {
             anyhow!("{e}")
         }

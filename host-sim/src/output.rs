@@ -3,9 +3,8 @@
 
 use anyhow::{Context, Result};
 use embedded_graphics::geometry::Size;
-use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::prelude::*;
-use embedded_graphics_simulator::{BinaryColorTheme, OutputSettingsBuilder, SimulatorDisplay};
+use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
 use lattice_rt::BitFrame;
 use std::path::Path;
 
@@ -23,26 +22,30 @@ pub fn check_png_size(width: u32, height: u32, scale: u32) -> Result<()> {
     Ok(())
 }
 
-/// Display themes offered on the command line.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+/// Display themes offered on the command line. Every theme shows the picture as it is: what
+/// the tracer lit is the bright colour, so no theme draws a negative.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Theme {
-    /// Black on white, like the paper's print-out.
+    /// Black ink on white paper, like the paper's print-outs: lit pixels are the white paper,
+    /// the rest black ink (and the grid, if asked for, is paper too).
     Paper,
-    /// White OLED pixels on black.
+    /// A white OLED: lit pixels white, the rest the dark of a panel that is off.
     OledWhite,
-    /// Blue OLED pixels on black.
+    /// A blue OLED: lit pixels light blue, the rest dark blue.
     OledBlue,
-    /// White LCD.
+    /// A reflective white LCD (a Sharp memory display): lit pixels the light of the glass, the
+    /// rest dark gray segments.
     LcdWhite,
 }
 
 impl Theme {
-    fn sim(self) -> BinaryColorTheme {
+    /// The colours of a lit pixel, an unlit pixel and the grid between pixels.
+    pub fn colours(self) -> [[u8; 3]; 3] {
         match self {
-            Theme::Paper => BinaryColorTheme::Default,
-            Theme::OledWhite => BinaryColorTheme::OledWhite,
-            Theme::OledBlue => BinaryColorTheme::OledBlue,
-            Theme::LcdWhite => BinaryColorTheme::LcdWhite,
+            Theme::Paper => [[255; 3], [0; 3], [255; 3]],
+            Theme::OledWhite => [[255; 3], [20; 3], [0; 3]],
+            Theme::OledBlue => [[0, 210, 255], [0, 20, 40], [0, 10, 20]],
+            Theme::LcdWhite => [[245; 3], [32; 3], [245; 3]],
         }
     }
 }
@@ -55,24 +58,74 @@ fn create_parent(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes a 1-bit frame as PNG with a display theme and pixel scale.
-pub fn write_png(frame: &BitFrame<'_>, path: &Path, theme: Theme, scale: u32) -> Result<()> {
+/// How a 1-bit frame becomes a PNG: its theme, pixel scale and whether a one-pixel grid
+/// separates the pixels (as on a panel seen close up).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PngLook {
+    /// Colours.
+    pub theme: Theme,
+    /// Each frame pixel as `scale x scale` PNG pixels.
+    pub scale: u32,
+    /// A one-pixel line of the theme's grid colour between neighbouring pixels.
+    pub grid: bool,
+}
+
+impl PngLook {
+    /// The PNG's width and height for a `w x h` frame: the frame's own size at scale 1
+    /// without a grid.
+    pub fn size(&self, w: u32, h: u32) -> (u32, u32) {
+        let gap = u32::from(self.grid);
+        let side = |n: u32| n * self.scale.max(1) + n.saturating_sub(1) * gap;
+        (side(w), side(h))
+    }
+}
+
+/// The RGB bytes (row-major) of a 1-bit frame drawn with `look`, and their width and height.
+pub fn rgb_pixels(frame: &BitFrame<'_>, look: PngLook) -> (u32, u32, Vec<u8>) {
     let size = frame.size();
-    check_png_size(size.width, size.height, scale)?;
-    let mut display = SimulatorDisplay::<BinaryColor>::new(Size::new(size.width, size.height));
-    for y in 0..size.height {
-        for x in 0..size.width {
-            // Pixels on are lit (white on an OLED); the paper theme inverts to black ink.
-            let c = BinaryColor::from(frame.get(x, y));
-            Pixel(Point::new(x as i32, y as i32), c).draw(&mut display)?;
+    let (w, h) = look.size(size.width, size.height);
+    let [lit, unlit, grid] = look.theme.colours();
+    let (scale, pitch) = (look.scale.max(1), look.scale.max(1) + u32::from(look.grid));
+    let mut out = Vec::with_capacity(w as usize * h as usize * 3);
+    for y in 0..h {
+        for x in 0..w {
+            let (fx, fy) = (x / pitch, y / pitch);
+            let colour = if x % pitch >= scale || y % pitch >= scale {
+                grid
+            } else if frame.get(fx, fy) {
+                lit
+            } else {
+                unlit
+            };
+            out.extend_from_slice(&colour);
         }
     }
-    let settings = OutputSettingsBuilder::new().theme(theme.sim()).scale(scale.max(1)).build();
-    create_parent(path)?;
-    let mut staged = Staged::default();
-    let tmp = staged.stage(path)?;
-    display.to_rgb_output_image(&settings).save_png(&tmp).with_context(|| format!("cannot write {}", path.display()))?;
-    staged.commit()
+    (w, h, out)
+}
+
+/// Writes a 1-bit frame as PNG with a display theme and pixel scale (no grid).
+pub fn write_png(frame: &BitFrame<'_>, path: &Path, theme: Theme, scale: u32) -> Result<()> {
+    write_png_look(frame, path, PngLook { theme, scale, grid: false })
+}
+
+/// Writes a 1-bit frame as PNG drawn with `look`.
+pub fn write_png_look(frame: &BitFrame<'_>, path: &Path, look: PngLook) -> Result<()> {
+    write_atomic(path, &png_bytes(frame, look)?)
+}
+
+/// The bytes of a PNG of a 1-bit frame drawn with `look`.
+pub fn png_bytes(frame: &BitFrame<'_>, look: PngLook) -> Result<Vec<u8>> {
+    let size = frame.size();
+    check_png_size(size.width, size.height, look.scale)?;
+    let (w, h, rgb) = rgb_pixels(frame, look);
+    let mut bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut bytes, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().context("PNG header")?;
+    writer.write_image_data(&rgb).context("PNG data")?;
+    writer.finish().context("PNG end")?;
+    Ok(bytes)
 }
 
 /// Writes a 1-bit frame as binary PBM (`P4`; 1 = black, so lit pixels are written as 0).
@@ -184,5 +237,53 @@ mod tests {
     fn a_write_to_an_impossible_place_names_the_path() {
         let err = write_atomic(Path::new("/proc/no-such-dir/x.pov"), b"x").unwrap_err();
         assert!(format!("{err:#}").contains("/proc/no-such-dir"), "{err:#}");
+    }
+}
+
+#[cfg(test)]
+mod png_tests {
+    use super::*;
+    use embedded_graphics::pixelcolor::BinaryColor;
+
+    /// A 4x2 frame with its left half lit.
+    fn half_lit(bits: &mut [u8]) -> BitFrame<'_> {
+        let mut f = BitFrame::new(4, 2, bits).unwrap();
+        for y in 0..2 {
+            for x in 0..2 {
+                Pixel(Point::new(x, y), BinaryColor::On).draw(&mut f).unwrap();
+            }
+        }
+        f
+    }
+
+    #[test]
+    fn at_scale_one_a_png_has_the_frames_size_and_the_grid_is_an_option() {
+        let mut bits = vec![0u8; BitFrame::bytes(4, 2)];
+        let f = half_lit(&mut bits);
+        for theme in [Theme::Paper, Theme::OledWhite, Theme::OledBlue, Theme::LcdWhite] {
+            assert_eq!(rgb_pixels(&f, PngLook { theme, scale: 1, grid: false }).0, 4);
+            let (w, h, _) = rgb_pixels(&f, PngLook { theme, scale: 3, grid: false });
+            assert_eq!((w, h), (12, 6));
+            let (w, h, _) = rgb_pixels(&f, PngLook { theme, scale: 3, grid: true });
+            assert_eq!((w, h), (4 * 3 + 3, 2 * 3 + 1));
+        }
+        let png = png_bytes(&f, PngLook { theme: Theme::Paper, scale: 1, grid: false }).unwrap();
+        let reader = png::Decoder::new(std::io::Cursor::new(png)).read_info().unwrap();
+        assert_eq!((reader.info().width, reader.info().height), (4, 2));
+    }
+
+    #[test]
+    fn no_theme_draws_a_negative() {
+        // What the tracer lit is brighter than what it left dark, in every theme; paper is
+        // black ink on white (its lit pixels and its grid are white), an LCD's glass is light.
+        let mut bits = vec![0u8; BitFrame::bytes(4, 2)];
+        let f = half_lit(&mut bits);
+        let luma = |c: &[u8]| c.iter().map(|&v| u32::from(v)).sum::<u32>();
+        for theme in [Theme::Paper, Theme::OledWhite, Theme::OledBlue, Theme::LcdWhite] {
+            let (_, _, rgb) = rgb_pixels(&f, PngLook { theme, scale: 1, grid: false });
+            assert!(luma(&rgb[0..3]) > luma(&rgb[9..12]), "{theme:?}: the lit pixel is darker than the unlit one");
+        }
+        assert_eq!(Theme::Paper.colours(), [[255; 3], [0; 3], [255; 3]]);
+        assert!(luma(&Theme::LcdWhite.colours()[0]) > 600);
     }
 }
