@@ -3,7 +3,7 @@
 // in headless Chromium (puppeteer-core) and requires
 //   - the first panel within 1 s of the page's load (the time is printed);
 //   - each scene's panel, read back from the canvas, bit-identical to `host-sim render` with the
-//     same settings (the Pico's: fixed point, adaptive sampling, Floyd-Steinberg, lines; and one
+//     same settings (the Pico's: fixed point, coarse sampling, Floyd-Steinberg, lines; and one
 //     other set of switches);
 //   - a scene typed with a mistake on line 3 to show the error at line 3, column 15;
 //   - the exact Pico image, run in the page, to show a first frame bit-identical to host-sim's.

@@ -47,6 +47,9 @@ pub enum RayKind {
 pub struct Stats {
     /// Rays traced, by [`RayKind`].
     pub rays: [u64; 4],
+    /// Of those, the rays that hit an object, by [`RayKind`] (a shadow ray that hits is
+    /// blocked: its light is hidden).
+    pub hits: [u64; 4],
     /// Ray-object intersection tests.
     pub object_tests: u64,
     /// Bounding-box inside tests (the paper's baseline).
@@ -62,6 +65,9 @@ impl Stats {
     /// Adds another set of counts.
     pub fn add(&mut self, o: &Stats) {
         for (a, b) in self.rays.iter_mut().zip(o.rays.iter()) {
+            *a += b;
+        }
+        for (a, b) in self.hits.iter_mut().zip(o.hits.iter()) {
             *a += b;
         }
         self.object_tests += o.object_tests;

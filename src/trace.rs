@@ -127,10 +127,15 @@ impl core::ops::Sub for Effects {
 }
 
 impl Effects {
+    /// The names of the effects in the set (`shadows`, `reflection`, ...).
+    pub fn names(self) -> impl Iterator<Item = &'static str> + Clone {
+        Self::NAMES.iter().enumerate().filter(move |(i, _)| self.0 & (1 << i) != 0).map(|(_, n)| *n)
+    }
+
     /// The pieces [`Display`](core::fmt::Display) and `defmt` write: the effects' names
     /// separated by ", ", or "diffuse only".
     fn words(self) -> impl Iterator<Item = &'static str> {
-        let names = Self::NAMES.iter().enumerate().filter(move |(i, _)| self.0 & (1 << i) != 0).map(|(_, n)| *n);
+        let names = self.names();
         let none = names.clone().next().is_none().then_some("diffuse only");
         names.enumerate().flat_map(|(k, n)| [if k == 0 { "" } else { ", " }, n]).chain(none)
     }
@@ -500,7 +505,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     pub fn eye_hit(&self, eye: Ray<R>, q: &mut Query<'_>) -> (u32, R) {
         q.stats.rays[RayKind::Primary as usize] += 1;
         let uv = q.eye_ray();
-        self.nearest(&eye, uv, q).map_or((NO_OBJECT, R::MAX), |hit| (hit.object, hit.t))
+        let found = self.nearest(&eye, uv, q);
+        q.stats.hits[RayKind::Primary as usize] += u64::from(found.is_some());
+        found.map_or((NO_OBJECT, R::MAX), |hit| (hit.object, hit.t))
     }
 
     /// Whether rays the windows do not serve test every object instead of asking the
@@ -590,6 +597,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 total += node.weight.weigh(scene.background);
                 continue;
             };
+            q.stats.hits[node.kind as usize] += 1;
             if node.depth == 0 {
                 first = hit.object;
                 depth = hit.t;
@@ -697,6 +705,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                     }
                 };
                 if hit.is_some() {
+                    q.stats.hits[RayKind::Shadow as usize] += 1;
                     return R::ZERO;
                 }
             }
@@ -726,6 +735,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             };
             q.set_tried(None);
             if hidden {
+                q.stats.hits[RayKind::Shadow as usize] += 1;
                 return R::ZERO;
             }
         }

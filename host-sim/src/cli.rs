@@ -141,9 +141,11 @@ pub fn lattice_config(cells: Option<[u16; 3]>, budget: Option<usize>) -> lattice
 /// Options of `render`.
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
-    /// Scene file.
+    /// Scene file (`-`: read it from standard input).
     pub scene: PathBuf,
-    /// PNG to write.
+    /// File to write; its extension names the format: .png (the 1-bit frame in --theme), .pbm
+    /// (the 1-bit frame), .pgm (gray levels 0..=64). `-` writes the PNG to standard output (the
+    /// messages then go to standard error).
     #[arg(short, long, default_value = "out/render.png")]
     pub output: PathBuf,
     /// Image size.
@@ -171,10 +173,10 @@ pub struct RenderArgs {
     /// Draw a one-pixel grid between the PNG's pixels, as a panel looks close up.
     #[arg(long)]
     pub grid: bool,
-    /// Also write the gray levels (0..=64) as PGM.
+    /// Also write the gray levels (0..=64): FILE.pgm, or FILE.png as a gray PNG.
     #[arg(long)]
     pub gray: Option<PathBuf>,
-    /// Also write the 1-bit frame as PBM.
+    /// Also write the 1-bit frame as PBM (FILE.pbm).
     #[arg(long)]
     pub pbm: Option<PathBuf>,
     /// Tile side in pixels.
@@ -201,12 +203,47 @@ pub struct RenderArgs {
     /// 14). Without it every branch is traced.
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u8).range(1..=14))]
     pub cutoff: Option<u8>,
+    /// Print the statistics as JSON on standard output instead of text (fields: docs/json.md).
+    #[arg(long)]
+    pub json: bool,
+    /// Exactly the frame this board's default image shows: 128x64, its scalar (the Pico fixed
+    /// point, the Pico 2 f32), coarse sampling, 16x16 tiles, Floyd-Steinberg with lines and
+    /// cutoff 7 (the frame options above cannot be given with it).
+    #[arg(long, value_enum, conflicts_with_all = ["size", "dither", "sampling", "scalar", "tile", "no_outline", "gamma", "cutoff"])]
+    pub board: Option<crate::uf2::Board>,
+}
+
+impl RenderArgs {
+    /// The scalar the render runs in: the board's, or `--scalar`.
+    pub fn scalar(&self) -> Scalar {
+        match self.board {
+            Some(crate::uf2::Board::Pico) => Scalar::Fixed,
+            Some(crate::uf2::Board::Pico2) => Scalar::F32,
+            None => self.scalar,
+        }
+    }
+
+    /// The frame the options describe (the board's own with `--board`).
+    pub fn frame(&self) -> lattice_rt::Frame {
+        if self.board.is_some() {
+            return board_records::frame::rendered(board_records::frame::PICO);
+        }
+        lattice_rt::Frame {
+            tile: self.tile,
+            dither: self.dither.mode(),
+            sampling: self.sampling.mode(),
+            outline: !self.no_outline,
+            tone: lattice_rt::Tone { gamma_tenths: self.gamma },
+            cutoff: self.cutoff,
+            ..lattice_rt::Frame::new(self.size.0, self.size.1)
+        }
+    }
 }
 
 /// Options of `stats`.
 #[derive(clap::Args, Debug)]
 pub struct StatsArgs {
-    /// Scene file.
+    /// Scene file (`-`: read it from standard input).
     pub scene: PathBuf,
     /// Image size used to count work per ray.
     #[arg(long, default_value = "160x100", value_parser = parse_size)]
@@ -224,6 +261,9 @@ pub struct StatsArgs {
     /// (docs/memory.md); too small for one cell, the lattice method is refused.
     #[arg(long, value_name = "BYTES")]
     pub budget: Option<usize>,
+    /// Print the statistics as JSON instead of text (fields: docs/json.md).
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// The scenes given, or the paper's four and the Whitted showcase.

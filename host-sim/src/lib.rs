@@ -8,6 +8,7 @@ pub mod orbit;
 pub mod output;
 pub mod pov;
 pub mod progress;
+pub mod report;
 pub mod run;
 pub mod shared;
 pub mod uf2;

@@ -17,13 +17,17 @@ pub const MAX_SCENE_BYTES: u64 = 32 << 20;
 pub const MAX_OBJECT_BYTES: usize = 128 << 20;
 
 /// Reads a scene file: at most [`MAX_SCENE_BYTES`], UTF-8 (an error says the line and column
-/// of the first byte that is not).
+/// of the first byte that is not). `-` reads standard input.
 pub fn read(path: &Path) -> Result<String> {
-    let file = std::fs::File::open(path).with_context(|| format!("cannot read scene file {}", path.display()))?;
     let mut bytes = Vec::new();
-    file.take(MAX_SCENE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .with_context(|| format!("cannot read scene file {}", path.display()))?;
+    if path == Path::new("-") {
+        std::io::stdin().take(MAX_SCENE_BYTES + 1).read_to_end(&mut bytes).context("cannot read the scene from standard input")?;
+    } else {
+        let file = std::fs::File::open(path).with_context(|| format!("cannot read scene file {}", path.display()))?;
+        file.take(MAX_SCENE_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .with_context(|| format!("cannot read scene file {}", path.display()))?;
+    }
     if bytes.len() as u64 > MAX_SCENE_BYTES {
         bail!("{}: the scene file is larger than {} MiB, the most host-sim reads", path.display(), MAX_SCENE_BYTES >> 20);
     }

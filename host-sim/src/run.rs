@@ -1,10 +1,11 @@
 //! The commands: render, stats and the default gallery job.
 
-use crate::shared::{median, PAPER_SCENES};
+use crate::shared::median;
 use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
-use crate::output::{write_gray_png, write_pbm, write_pgm, write_png, Theme};
+use crate::output::{write_gray_png, write_pbm, write_pgm};
 use crate::cli::{Accel, RenderArgs, StatsArgs};
-use anyhow::{anyhow, Context, Result};
+use crate::report::{print_json, LatticeSize, MethodRender, MethodWork, RenderReport, StatsReport, Work};
+use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::{Effects, EyeRays};
 use lattice_rt::{
@@ -206,9 +207,10 @@ pub fn render_accel<R: Real>(
     }
 }
 
-fn print_stats(label: &str, s: &Stats, elapsed: Duration) {
-    println!(
-        "{label}: {:.1} ms, rays {} (primary {}, shadow {}, reflection {}, refraction {}), object tests {} ({:.2}/ray), inside tests {}, cells {}",
+/// One line of what a render counted.
+fn stats_line(label: &str, s: &Stats, elapsed: Duration) -> String {
+    format!(
+        "{label}: {:.1} ms, rays {} (primary {}, shadow {}, reflection {}, refraction {}), object tests {} ({:.2}/ray), inside tests {}, cells walked {}",
         elapsed.as_secs_f64() * 1e3,
         s.total_rays(),
         s.rays[0],
@@ -219,22 +221,15 @@ fn print_stats(label: &str, s: &Stats, elapsed: Duration) {
         s.object_tests as f64 / s.total_rays().max(1) as f64,
         s.inside_tests,
         s.cells_visited,
-    );
+    )
 }
 
 /// `host-sim render`.
 pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     crate::output::check_png_size(a.size.0 as u32, a.size.1 as u32, a.scale)?;
+    outputs(a)?;
     let text = read(&a.scene)?;
-    let frame = Frame {
-        tile: a.tile,
-        dither: a.dither.mode(),
-        sampling: a.sampling.mode(),
-        outline: !a.no_outline,
-        tone: lattice_rt::Tone { gamma_tenths: a.gamma },
-        cutoff: a.cutoff,
-        ..Frame::new(a.size.0, a.size.1)
-    };
+    let frame = a.frame();
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage, &frame)?;
     let mut out = render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true).map_err(|e| {
@@ -246,24 +241,118 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
         }
     })?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
+    let look = crate::output::PngLook { theme: a.theme, scale: a.scale, grid: a.grid };
+    let (w, h) = (frame.width as u32, frame.height as u32);
     // Every output under a temporary name first: if one cannot be written, none is left.
     let mut staged = crate::output::Staged::default();
-    crate::output::write_png_look(&frame_bits, &staged.stage(&a.output)?, crate::output::PngLook { theme: a.theme, scale: a.scale, grid: a.grid }).with_context(|| format!("cannot write {}", a.output.display()))?;
-    if let Some(p) = &a.pbm {
-        write_pbm(&frame_bits, &staged.stage(p)?).with_context(|| format!("cannot write {}", p.display()))?;
-    }
-    if let Some(p) = &a.gray {
-        write_pgm(frame.width as u32, frame.height as u32, &out.gray, &staged.stage(p)?).with_context(|| format!("cannot write {}", p.display()))?;
+    let mut stdout = None;
+    for (path, kind) in outputs(a)? {
+        if path == Path::new("-") {
+            stdout = Some(crate::output::png_bytes(&frame_bits, look)?);
+            continue;
+        }
+        let tmp = staged.stage(path)?;
+        match kind {
+            Output::Png => crate::output::write_png_look(&frame_bits, &tmp, look),
+            Output::Pbm => write_pbm(&frame_bits, &tmp),
+            Output::Pgm => write_pgm(w, h, &out.gray, &tmp),
+            Output::GrayPng => write_gray_png(w, h, &out.gray, &tmp, a.scale),
+        }
+        .with_context(|| format!("cannot write {}", path.display()))?;
     }
     staged.commit()?;
-    for p in [Some(&a.output), a.pbm.as_ref(), a.gray.as_ref()].into_iter().flatten() {
-        println!("wrote {}", p.display());
+    if let Some(png) = stdout {
+        use std::io::Write;
+        std::io::stdout().write_all(&png).context("cannot write the PNG to standard output")?;
     }
-    print_stats(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel.name()), &out.stats, out.elapsed);
+    // With the picture or JSON on standard output, the messages go to standard error.
+    let quiet = a.output == Path::new("-") || a.json;
+    for (p, _) in outputs(a)?.into_iter().filter(|(p, _)| *p != Path::new("-")) {
+        if quiet {
+            eprintln!("wrote {}", p.display());
+        } else {
+            println!("wrote {}", p.display());
+        }
+    }
+    if a.json {
+        let lattice = match a.accel {
+            Accel::Lattice => {
+                let cfg = crate::cli::lattice_config(a.cells, a.budget);
+                let mut bufs = lattice_storage(&scene, &cfg)?;
+                Some(LatticeSize::of(&build_lattice(&mut bufs, &scene, &cfg)?))
+            }
+            _ => None,
+        };
+        let report = RenderReport {
+            scene: a.scene.display().to_string(),
+            scalar: R::NAME,
+            accel: a.accel.name(),
+            width: frame.width,
+            height: frame.height,
+            lattice,
+            work: Work::of(&out.stats, out.elapsed),
+        };
+        return print_json(&report);
+    }
+    let line = stats_line(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel.name()), &out.stats, out.elapsed);
+    if quiet {
+        eprintln!("{line}");
+    } else {
+        println!("{line}");
+    }
     Ok(())
 }
 
+/// What a file written by `render` holds, by the option and the file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Output {
+    /// The 1-bit frame in the PNG's theme.
+    Png,
+    /// The 1-bit frame as binary PBM.
+    Pbm,
+    /// The gray levels (0..=64) as PGM.
+    Pgm,
+    /// The gray levels as a gray PNG.
+    GrayPng,
+}
 
+/// The files `render` writes with what each holds: the extension names the format, and one
+/// that is not the option's is refused before anything is rendered (`-o -`: PNG to standard
+/// output).
+fn outputs(a: &RenderArgs) -> Result<Vec<(&Path, Output)>> {
+    let ext = |p: &Path| p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    let mut out = Vec::new();
+    out.push((
+        a.output.as_path(),
+        match ext(&a.output).as_str() {
+            _ if a.output == Path::new("-") => Output::Png,
+            "png" => Output::Png,
+            "pbm" => Output::Pbm,
+            "pgm" => Output::Pgm,
+            _ => bail!("-o {}: the extension names the format: .png (the frame in --theme), .pbm (the 1-bit frame) or .pgm (gray levels); - writes a PNG to standard output", a.output.display()),
+        },
+    ));
+    if let Some(p) = &a.pbm {
+        if ext(p) != "pbm" {
+            bail!("--pbm {}: writes a PBM file, so its name must end in .pbm (-o FILE.png writes a PNG)", p.display());
+        }
+        out.push((p.as_path(), Output::Pbm));
+    }
+    if let Some(p) = &a.gray {
+        out.push((
+            p.as_path(),
+            match ext(p).as_str() {
+                "pgm" => Output::Pgm,
+                "png" => Output::GrayPng,
+                _ => bail!("--gray {}: writes the gray levels as .pgm or as a gray .png; give a name ending in one of them", p.display()),
+            },
+        ));
+    }
+    if a.json && a.output == Path::new("-") {
+        bail!("--json and -o - both write to standard output: write the PNG to a file");
+    }
+    Ok(out)
+}
 
 /// `host-sim stats`.
 pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
@@ -277,69 +366,108 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
     let build = t0.elapsed();
     let fx = Effects::of(&scene);
-    println!("scene {} ({})", a.scene.display(), R::NAME);
-    println!(
-        "  objects {}, composites {}, materials {}, lights {}, depth {}",
-        scene.objects().len(),
-        scene.composites().len(),
-        scene.materials().len(),
-        scene.lights().len(),
-        scene.max_depth()
-    );
+    let (per_eye_ray, full_render, identical) = per_accelerator(&scene, &cfg, frame, a.runs)?;
+    let report = StatsReport {
+        scene: a.scene.display().to_string(),
+        scalar: R::NAME,
+        width: frame.width,
+        height: frame.height,
+        objects: scene.objects().len(),
+        composites: scene.composites().len(),
+        materials: scene.materials().len(),
+        lights: scene.lights().len(),
+        depth: scene.max_depth(),
+        effects: fx.names().collect(),
+        lattice: LatticeSize::of(&lattice),
+        build_ms: build.as_secs_f64() * 1e3,
+        per_eye_ray,
+        full_render,
+        identical,
+    };
+    if a.json {
+        return print_json(&report);
+    }
+    let r = &report;
+    println!("scene {} ({})", r.scene, r.scalar);
+    println!("  objects {}, composites {}, materials {}, lights {}, depth {}", r.objects, r.composites, r.materials, r.lights, r.depth);
     println!("  effects: {fx}");
-    for (i, g) in lattice.lattices().iter().enumerate() {
+    for (i, n) in r.lattice.lattices.iter().enumerate() {
         let name = if i == 0 { "world lattice".to_string() } else { format!("sub-lattice {}", i - 1) };
-        println!("  {name}: {} x {} x {} cells", g.n[0], g.n[1], g.n[2]);
+        println!("  {name}: {} x {} x {} cells", n[0], n[1], n[2]);
     }
     if cfg.budget.is_some() {
         println!("  within {} bytes: {}", a.budget.unwrap_or(0), Lattice::choose(&scene, &cfg));
     }
+    println!("  lattice: {} cells, {} references, {} bytes, built in {:.3} ms", r.lattice.cells, r.lattice.references, r.lattice.bytes, r.build_ms);
+    println!("  per eye ray at {}x{}, each method answering every eye ray as in the paper's Table 1:", r.width, r.height);
+    for m in &r.per_eye_ray {
+        if m.method == "default" {
+            let how = match Tracer::new(&scene, &BruteForce).eye_rays() {
+                EyeRays::Windows => "every object's window on the image (its box projected through the eye) is tested and only the objects whose window holds the ray are intersected: no cell is walked, whichever method is chosen",
+                EyeRays::Accelerator => "the lattice is walked, skipping objects whose window on the image misses the ray",
+                EyeRays::Plain => "the method chosen answers them",
+            };
+            println!("    tracer's default: object tests {:6.3}, cells visited {:6.2}: {how}", m.object_tests_per_eye_ray, m.cells_per_eye_ray);
+        } else {
+            println!(
+                "    {:8} object tests {:6.3}, bounding-box (inside) tests {:6.2}, cells visited {:6.2}",
+                m.method, m.object_tests_per_eye_ray, m.inside_tests_per_eye_ray, m.cells_per_eye_ray
+            );
+        }
+    }
     println!(
-        "  lattice: {} cells, {} references, {} bytes, built in {:.3} ms",
-        lattice.cell_count(),
-        lattice.ref_count(),
-        lattice.bytes(),
-        build.as_secs_f64() * 1e3
+        "  full render at {}x{} with the tracer's defaults (eye rays, and shadow rays towards a directional first light, answered by windows where the scene allows: the methods differ only in the rays left to them), median of {} interleaved runs:",
+        r.width,
+        r.height,
+        a.runs.max(1)
     );
-    per_accelerator(&scene, &cfg, frame, a.runs)
+    for m in &r.full_render {
+        let w = &m.work;
+        println!(
+            "    {:8} {:9.2} ms  rays {:7}  object tests {:9}  ({:.2}/ray)",
+            m.method,
+            m.median_ms,
+            w.rays.total,
+            w.object_tests,
+            w.object_tests as f64 / w.rays.total.max(1) as f64
+        );
+    }
+    let (bbox, lat) = (r.full_render[1].median_ms, r.full_render[2].median_ms);
+    println!(
+        "  lattice/bbox time ratio {:.3} (lattice {:.2}x faster); images identical across accelerators: {}",
+        lat / bbox,
+        bbox / lat,
+        r.identical
+    );
+    Ok(())
 }
 
-
-/// Work per primary ray and full-render time of each accelerator on `scene`, printed.
-fn per_accelerator<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, frame: Frame, runs: usize) -> Result<()> {
+/// Work per eye ray of each accelerator (answering every eye ray, then the tracer's default),
+/// each accelerator's full render (median time of `runs` interleaved), and whether their
+/// frames are identical.
+fn per_accelerator<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, frame: Frame, runs: usize) -> Result<(Vec<MethodWork>, Vec<MethodRender>, bool)> {
     let pixels = frame.width as f64 * frame.height as f64;
     // Primary rays only: the paper's per-ray figures.
     let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>| {
         t.set_max_depth(0).expect("depth 0 is always valid");
         t.set_effects(Effects::NONE);
     };
-    println!("  per eye ray at {}x{}, each method answering every eye ray as in the paper's Table 1:", frame.width, frame.height);
+    let per = |method: &'static str, s: &Stats| MethodWork {
+        method,
+        object_tests_per_eye_ray: s.object_tests as f64 / pixels,
+        inside_tests_per_eye_ray: s.inside_tests as f64 / pixels,
+        cells_per_eye_ray: s.cells_visited as f64 / pixels,
+    };
     let accels = [Accel::Brute, Accel::Bbox, Accel::Lattice];
+    let mut per_eye_ray = Vec::new();
     for acc in accels {
         let plain = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>| {
             primary_only(t);
             t.set_eye_rays(EyeRays::Plain);
         };
-        let r = render_accel(scene, acc, cfg, &frame, plain, false, false)?;
-        println!(
-            "    {:8} object tests {:6.3}, bounding-box (inside) tests {:6.2}, cells visited {:6.2}",
-            acc.name(),
-            r.stats.object_tests as f64 / pixels,
-            r.stats.inside_tests as f64 / pixels,
-            r.stats.cells_visited as f64 / pixels
-        );
+        per_eye_ray.push(per(acc.name(), &render_accel(scene, acc, cfg, &frame, plain, false, false)?.stats));
     }
-    let defaults = render_accel(scene, Accel::Lattice, cfg, &frame, primary_only, false, false)?;
-    let how = match Tracer::new(scene, &BruteForce).eye_rays() {
-        EyeRays::Windows => "every object's window on the image (its box projected through the eye) is tested and only the objects whose window holds the ray are intersected: no cell is walked, whichever method is chosen",
-        EyeRays::Accelerator => "the lattice is walked, skipping objects whose window on the image misses the ray",
-        EyeRays::Plain => "the method chosen answers them",
-    };
-    println!(
-        "    tracer's default: object tests {:6.3}, cells visited {:6.2}: {how}",
-        defaults.stats.object_tests as f64 / pixels,
-        defaults.stats.cells_visited as f64 / pixels,
-    );
+    per_eye_ray.push(per("default", &render_accel(scene, Accel::Lattice, cfg, &frame, primary_only, false, false)?.stats));
     // Full renders, interleaved so drift on a shared machine hits all methods alike.
     let mut times: Vec<Vec<Duration>> = vec![Vec::new(); accels.len()];
     let mut last = Vec::new();
@@ -351,52 +479,51 @@ fn per_accelerator<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, frame: Fr
             last.push(r);
         }
     }
-    let med: Vec<Duration> = times.into_iter().map(median).collect();
-    println!(
-        "  full render at {}x{} with the tracer's defaults (eye rays, and shadow rays towards a directional first light, answered by windows where the scene allows: the methods differ only in the rays left to them), median of {} interleaved runs:",
-        frame.width,
-        frame.height,
-        runs.max(1)
-    );
-    for (i, acc) in accels.iter().enumerate() {
-        let s = &last[i].stats;
-        println!(
-            "    {:8} {:9.2} ms  rays {:7}  object tests {:9}  ({:.2}/ray)",
-            acc.name(),
-            med[i].as_secs_f64() * 1e3,
-            s.total_rays(),
-            s.object_tests,
-            s.object_tests as f64 / s.total_rays().max(1) as f64
-        );
-    }
-    let same = last.windows(2).all(|w| w[0].bits == w[1].bits);
-    println!(
-        "  lattice/bbox time ratio {:.3} (lattice {:.2}x faster); images identical across accelerators: {same}",
-        med[2].as_secs_f64() / med[1].as_secs_f64(),
-        med[1].as_secs_f64() / med[2].as_secs_f64()
-    );
-    Ok(())
+    let identical = last.windows(2).all(|w| w[0].bits == w[1].bits);
+    let full = accels
+        .iter()
+        .zip(times)
+        .zip(&last)
+        .map(|((acc, t), r)| MethodRender { method: acc.name(), median_ms: median(t).as_secs_f64() * 1e3, work: Work::of(&r.stats, r.elapsed) })
+        .collect();
+    Ok((per_eye_ray, full, identical))
 }
 
-/// The default job: the paper's scenes at 160x100 and 128x64.
+/// `render`'s options alone, parsed from a command line (what the gallery runs).
+#[derive(clap::Parser, Debug)]
+struct RenderLine {
+    #[command(flatten)]
+    args: RenderArgs,
+}
+
+/// The sizes the gallery renders: `render`'s default (the panel's 128x64) and the paper's 160x100.
+pub const GALLERY_SIZES: [&str; 2] = ["128x64", "160x100"];
+
+/// The default job and `gallery`: every scene file in `scenes` (sorted by name) rendered by
+/// `render` with its default settings at each of [`GALLERY_SIZES`], into `out` as
+/// `NAME-WxH.png`, `.pbm` and `-gray.png`; the command that draws each is printed.
 pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
-    for name in PAPER_SCENES {
-        let path = scenes.join(format!("{name}.scene"));
-        let text = read(&path)?;
-        for (w, h) in [(160u16, 100u16), (128, 64)] {
-            let frame = Frame::new(w, h);
-            let mut storage = object_storage::<f64>(&text)?;
-            let scene = parse_scene::<f64>(&path, &text, &mut storage, &frame)?;
-            let mut r = render_accel(&scene, Accel::Lattice, &LatticeConfig::default(), &frame, |_| {}, true, true)?;
-            let f = BitFrame::wrap(w as u32, h as u32, &mut r.bits).expect("sized by render");
-            let png = out.join(format!("{name}-{w}x{h}.png"));
-            write_png(&f, &png, Theme::Paper, 3)?;
-            write_pbm(&f, &out.join(format!("{name}-{w}x{h}.pbm")))?;
-            write_gray_png(w as u32, h as u32, &r.gray, &out.join(format!("{name}-{w}x{h}-gray.png")), 2)?;
-            print_stats(&format!("{}", png.display()), &r.stats, r.elapsed);
+    let mut files: Vec<_> = std::fs::read_dir(scenes)
+        .with_context(|| format!("cannot read the scene folder {}", scenes.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "scene"))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        bail!("{}: no .scene files to render", scenes.display());
+    }
+    for path in &files {
+        let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
+        for size in GALLERY_SIZES {
+            let at = |suffix: &str| out.join(format!("{name}-{size}{suffix}")).display().to_string();
+            let line = ["render".to_string(), path.display().to_string(), "--size".into(), size.into(), "-o".into(), at(".png"), "--pbm".into(), at(".pbm"), "--gray".into(), at("-gray.png")];
+            println!("host-sim {}", line[..].join(" "));
+            let RenderLine { args } = <RenderLine as clap::Parser>::try_parse_from(&line)?;
+            render_cmd::<f64>(&args)?;
         }
     }
-    println!("wrote the paper's four scenes to {}/", out.display());
+    println!("wrote {} scenes to {}/ (each as `render` draws it by default)", files.len(), out.display());
     Ok(())
 }
 

@@ -45,7 +45,8 @@ pub struct Settings {
     pub lines: bool,
     /// Tone curve exponent in tenths (5..=20; 10 leaves levels unchanged).
     pub gamma: u8,
-    /// `adaptive` (the boards') or `one` (one ray per pixel).
+    /// Eye rays by host-sim's names (`render --sampling`): `coarse` (adaptive in two levels,
+    /// the Pico's), `adaptive` (in one level) or `one` (one ray per pixel).
     pub sampling: String,
     /// The camera's turn around the scene (0..1), as `host-sim orbit` turns it.
     pub turn: f64,
@@ -69,12 +70,11 @@ fn dither_name(d: Dither) -> &'static str {
     DITHERS.iter().find(|(_, x)| *x == d).map_or("fs", |(n, _)| n)
 }
 
+/// The sampling modes the page offers, by host-sim's names.
+const SAMPLINGS: [(&str, Sampling); 3] = [("coarse", board_frame::PANEL_SAMPLING), ("adaptive", board_frame::SAMPLING), ("one", Sampling::Center)];
+
 fn sampling_name(s: Sampling) -> &'static str {
-    if s == board_frame::PANEL_SAMPLING {
-        "adaptive"
-    } else {
-        "one"
-    }
+    SAMPLINGS.iter().find(|(_, x)| *x == s).map_or("one", |(n, _)| n)
 }
 
 impl Settings {
@@ -85,11 +85,11 @@ impl Settings {
             .find(|(n, _)| *n == self.dither)
             .map(|(_, d)| *d)
             .ok_or_else(|| format!("unknown dither `{}` (one of {})", self.dither, DITHERS.map(|d| d.0).join(", ")))?;
-        let sampling = match self.sampling.as_str() {
-            "adaptive" => board_frame::PANEL_SAMPLING,
-            "one" => Sampling::Center,
-            other => return Err(format!("unknown sampling `{other}` (adaptive or one)")),
-        };
+        let sampling = SAMPLINGS
+            .iter()
+            .find(|(n, _)| *n == self.sampling)
+            .map(|(_, s)| *s)
+            .ok_or_else(|| format!("unknown sampling `{}` (one of {})", self.sampling, SAMPLINGS.map(|s| s.0).join(", ")))?;
         if !Tone::RANGE.contains(&self.gamma) {
             return Err(format!("gamma {} is outside 5..=20 tenths", self.gamma));
         }
