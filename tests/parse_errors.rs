@@ -23,8 +23,25 @@ fn unknown_statement() {
 
 #[test]
 fn unknown_attribute() {
-    check("sphere radius 1 colour red", "line 1, column 17 at `colour`: not an attribute of this statement");
-    check("box radius 1", "line 1, column 5 at `radius`: not an attribute of this statement");
+    check("sphere radius 1 colour red", "line 1, column 17 at `colour`: not an attribute of this statement; it takes center, radius, material, translate, rotate, scale or shear");
+    check("box radius 1", "line 1, column 5 at `radius`: not an attribute of this statement; it takes min, max, material, translate, rotate, scale or shear");
+    // A word one or two letters off a valid one is named.
+    check("sphere raduis 1", "line 1, column 8 at `raduis`: not an attribute of this statement (did you mean `radius`?); it takes center, radius, material, translate, rotate, scale or shear");
+    check("camera eyes 0 0 -5\nsphere", "line 1, column 8 at `eyes`: not an attribute of this statement (did you mean `eye`?); it takes eye, look, up or fov");
+    check("light point dir 0 1 0\nsphere", "line 1, column 13 at `dir`: not an attribute of this statement; it takes pos or intensity");
+    check("ambient 0.2 0.3\nsphere", "line 1, column 13 at `0.3`: not an attribute of this statement; it takes nothing after its value");
+}
+
+#[test]
+fn repeated_attribute() {
+    check("sphere radius 1 radius 2", "line 1, column 17 at `radius`: attribute given twice in this statement");
+    check("camera fov 40 fov 50\nsphere", "line 1, column 15 at `fov`: attribute given twice in this statement");
+    check("material m ka 0.1 kd 0.5 ka 0.2\nsphere", "line 1, column 26 at `ka`: attribute given twice in this statement");
+    check("light directional dir 0 -1 0 intensity 1 intensity 2\nsphere", "line 1, column 42 at `intensity`: attribute given twice in this statement");
+    // Transforms compose: they may repeat.
+    let mut storage = vec![lattice_rt::scene::Object::<f64>::default(); 2];
+    let mut parts = lattice_rt::Parts::default();
+    assert!(lattice_rt::parse::<f64>("sphere rotate y 10 rotate y 20 translate 1 0 0 translate 0 1 0", &mut storage, &mut parts).is_ok());
 }
 
 #[test]
@@ -171,4 +188,24 @@ fn fixed_point_refuses_an_object_too_small_for_the_scene_and_names_its_line() {
     let mut storage = vec![Object::<f32>::default(); 4];
     let mut parts = lattice_rt::Parts::default();
     assert!(parse::<f32>(text, &mut storage, &mut parts).is_ok());
+}
+
+#[test]
+fn rotation_about_a_point_is_the_translated_rotation() {
+    // `rotate A D about P` is `translate -P rotate A D translate P`, and leaves P in place.
+    let bounds = |text: &str| {
+        let mut storage = vec![lattice_rt::scene::Object::<f64>::default(); 2];
+        let mut parts = lattice_rt::Parts::default();
+        let scene = lattice_rt::parse::<f64>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{e}"));
+        let b = scene.objects()[0].bounds();
+        [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z]
+    };
+    let about = bounds("box min 0 0 0 max 1 2 1 rotate z 90 about 1 0 0");
+    let spelled = bounds("box min 0 0 0 max 1 2 1 translate -1 0 0 rotate z 90 translate 1 0 0");
+    assert_eq!(about, spelled);
+    assert_ne!(about, bounds("box min 0 0 0 max 1 2 1 rotate z 90"));
+    // A sphere turned about its centre stays where it was (to the rounding of the turn).
+    let (turned, still) = (bounds("sphere center 2 0 0 rotate y 70 about 2 0 0"), bounds("sphere center 2 0 0"));
+    assert!(turned.iter().zip(&still).all(|(a, b)| (a - b).abs() < 1e-12), "{turned:?} {still:?}");
+    check("sphere rotate y 30 about 1 2\n", "line 1, column 29: a value is missing at the end of the line");
 }

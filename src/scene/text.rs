@@ -20,7 +20,15 @@ pub enum ParseErrorKind {
     /// The first word of a line is not a statement.
     UnknownStatement,
     /// A word that is not an attribute of this statement.
-    UnknownAttribute,
+    UnknownAttribute {
+        /// The attributes the statement takes.
+        valid: &'static [&'static str],
+        /// The valid attribute nearest the word, when one is near (one or two letters off).
+        near: Option<&'static str>,
+    },
+    /// An attribute given twice in one statement (`sphere radius 1 radius 2`); transforms
+    /// compose and may repeat.
+    RepeatedAttribute,
     /// A number was expected.
     ExpectedNumber,
     /// The line ended where a value was expected.
@@ -70,7 +78,24 @@ impl fmt::Display for ParseErrorKind {
                 "unknown statement (expected camera, ambient, background, depth, light, material, \
                  sphere, cylinder, cone, box, group or end)"
             ),
-            ParseErrorKind::UnknownAttribute => write!(f, "not an attribute of this statement"),
+            ParseErrorKind::UnknownAttribute { valid, near } => {
+                write!(f, "not an attribute of this statement")?;
+                if let Some(n) = near {
+                    write!(f, " (did you mean `{n}`?)")?;
+                }
+                match valid {
+                    [] => write!(f, "; it takes nothing after its value"),
+                    _ => {
+                        write!(f, "; it takes ")?;
+                        for (i, v) in valid.iter().enumerate() {
+                            let sep = if i == 0 { "" } else if i + 1 == valid.len() { " or " } else { ", " };
+                            write!(f, "{sep}{v}")?;
+                        }
+                        Ok(())
+                    }
+                }
+            }
+            ParseErrorKind::RepeatedAttribute => write!(f, "attribute given twice in this statement"),
             ParseErrorKind::ExpectedNumber => write!(f, "expected a number"),
             ParseErrorKind::MissingValue => write!(f, "a value is missing at the end of the line"),
             ParseErrorKind::UnknownMaterial => write!(f, "material not defined before this line"),
@@ -409,7 +434,19 @@ impl<'t> Words<'t> {
             "translate" => Affine::translate(self.point()?),
             "rotate" => {
                 let a = self.axis()?;
-                Affine::rotate(a, self.number()?)
+                let turn = Affine::rotate(a, self.number()?);
+                // `about X Y Z`: about the line through that point (not the origin).
+                let save = self.pos;
+                match self.next() {
+                    Some((_, "about")) => {
+                        let p = self.point()?;
+                        Affine::translate(p).after(&turn.after(&Affine::translate(-p)))
+                    }
+                    _ => {
+                        self.pos = save;
+                        turn
+                    }
+                }
             }
             "scale" => {
                 let x = self.number()?;
@@ -482,6 +519,10 @@ struct Statement<'t> {
     kcol: u32,
     key: &'t str,
     w: Words<'t>,
+    /// The attributes (not transforms) read so far, to refuse one given twice.
+    seen: Vec<&'t str, 8>,
+    /// The attributes the statement takes (for an error naming them).
+    valid: &'static [&'static str],
 }
 
 impl<'t> Statement<'t> {
@@ -490,10 +531,62 @@ impl<'t> Statement<'t> {
         ParseError { line: self.lineno, col: self.kcol, token: self.key, kind: ParseErrorKind::Scene(e) }
     }
 
-    /// An attribute the statement does not take.
+    /// An attribute the statement does not take: the error lists those it takes, and the
+    /// nearest of them if the word is one or two letters off it.
     fn unknown(&self, col: u32, attr: &'t str) -> ParseError<'t> {
-        self.w.err(col, attr, ParseErrorKind::UnknownAttribute)
+        let near = self.valid.iter().map(|v| (edit_distance(attr, v), *v)).filter(|(d, _)| *d <= 2 && *d < attr.len()).min_by_key(|(d, _)| *d).map(|(_, v)| v);
+        self.w.err(col, attr, ParseErrorKind::UnknownAttribute { valid: self.valid, near })
     }
+
+    /// Refuses an attribute the statement has already read.
+    fn once(&mut self, col: u32, attr: &'t str) -> Result<(), ParseError<'t>> {
+        if self.seen.contains(&attr) {
+            return Err(self.w.err(col, attr, ParseErrorKind::RepeatedAttribute));
+        }
+        // More distinct attributes than any statement takes cannot be pushed: nothing to check.
+        let _ = self.seen.push(attr);
+        Ok(())
+    }
+}
+
+/// The attributes each statement takes (by its keyword, and a light by its kind).
+fn attributes(key: &str, light: Option<&str>) -> &'static [&'static str] {
+    const TRANSFORMS: [&str; 4] = ["translate", "rotate", "scale", "shear"];
+    match (key, light) {
+        ("camera", _) => &["eye", "look", "up", "fov"],
+        ("light", Some("directional")) => &["dir", "intensity"],
+        ("light", Some("point")) => &["pos", "intensity"],
+        ("material", _) => &["ka", "kd", "ks", "kt", "ior"],
+        ("sphere", _) => &["center", "radius", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
+        ("cylinder", _) => &["base", "radius", "height", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
+        ("cone", _) => &["base", "radius", "height", "top", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
+        ("box", _) => &["min", "max", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
+        ("group", _) => &TRANSFORMS,
+        _ => &[],
+    }
+}
+
+/// Levenshtein distance of two short words (at most 16 bytes of `b` counted; longer words are
+/// never near).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if b.len() > 16 || a.len() > 32 {
+        return usize::MAX;
+    }
+    let mut row = [0usize; 17];
+    for (j, r) in row.iter_mut().enumerate().take(b.len() + 1) {
+        *r = j;
+    }
+    for (i, &ca) in a.iter().enumerate() {
+        let mut diag = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let next = (diag + usize::from(ca != cb)).min(row[j] + 1).min(row[j + 1] + 1);
+            diag = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
 }
 
 /// The parser's state between statements: the builder, material names, and where the
@@ -532,6 +625,7 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
         self.camera_at = (st.lineno, st.kcol, st.key);
         let c = &mut self.b.camera;
         while let Some((col, attr)) = st.w.next() {
+            st.once(col, attr)?;
             match attr {
                 "eye" => c.eye = st.w.point()?,
                 "look" => c.look = st.w.point()?,
@@ -563,7 +657,9 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
             "point" => "pos",
             _ => return Err(st.w.err(col, kind, ParseErrorKind::UnknownLightKind)),
         };
+        st.valid = attributes("light", Some(kind));
         while let Some((col, attr)) = st.w.next() {
+            st.once(col, attr)?;
             match attr {
                 "dir" if want == "dir" => v = st.w.vec3()?,
                 "pos" if want == "pos" => v = st.w.point()?,
@@ -587,6 +683,7 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
         }
         let mut m = Material::DEFAULT;
         while let Some((col, attr)) = st.w.next() {
+            st.once(col, attr)?;
             let (slot, what) = match attr {
                 "ka" => (&mut m.ka, "coefficient"),
                 "kd" => (&mut m.kd, "coefficient"),
@@ -616,6 +713,9 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
         let mut material = 0u8;
         let mut t = Affine::identity();
         while let Some((col, attr)) = st.w.next() {
+            if !matches!(attr, "translate" | "rotate" | "scale" | "shear") {
+                st.once(col, attr)?;
+            }
             let w = &mut st.w;
             match (key, attr) {
                 ("sphere", "center") | ("cylinder" | "cone", "base") => pos = w.point()?,
@@ -755,7 +855,7 @@ pub fn parse_with<'a, 't, R: Real>(
         last_line = lineno;
         let mut w = Words::for_scalar::<R>(line, lineno);
         let Some((kcol, key)) = w.next() else { continue };
-        p.statement(&mut Statement { lineno, kcol, key, w })?;
+        p.statement(&mut Statement { lineno, kcol, key, w, seen: Vec::new(), valid: attributes(key, None) })?;
     }
     camera(&mut p.b.camera);
     p.finish(last_line)
