@@ -37,6 +37,11 @@ fn main() {
         let kib: u32 = kib.trim().parse().unwrap_or_else(|_| panic!("FIRMWARE_FLASH_KIB is not a number of KiB: {kib:?}"));
         map = map.replace("LENGTH = 16K", &format!("LENGTH = {kib}K"));
     }
+    // The slot image keeps its code below the scene slot (`board_records::slot::ADDRESS`).
+    if has("slot") {
+        let below = board_records::slot::ADDRESS - 0x1000_0000;
+        map = map.replace("LENGTH = 1536K - 0x100", &format!("LENGTH = {}K - 0x100", below / 1024));
+    }
     fs::write(out.join("memory.x"), map).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
     for map in ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x", "microbit/memory.x", "tiny/memory.x"] {
@@ -86,6 +91,8 @@ fn main() {
     // then a baked build gives its tracer brute force in place of the lattice, which it never
     // asks (`windows_only`). The ladder's rungs walk the lattice on purpose.
     let mut windows_only = baked && !has("ladder");
+    // The slot image embeds no scene: it reads one from flash at run time.
+    let names = if has("slot") { String::new() } else { names };
     let scenes: Vec<(&str, PathBuf, String)> = names
         .split(',')
         .map(str::trim)
@@ -118,6 +125,13 @@ fn main() {
     }
     let count = list.lines().count();
     if has("effects-all") {
+        effects = lattice_rt::Effects::ALL.bits();
+    }
+    if has("slot") {
+        // Room for any scene within the slot's: its rows are the frame's (any scene's), every
+        // effect compiled in (the tracer still simulates only those the scene calls for).
+        let (any, ..) = plan_in_scalar(std::path::Path::new("slot"), "sphere\n", None);
+        sizes = any.max(board_records::slot::ROOM);
         effects = lattice_rt::Effects::ALL.bits();
     }
     let code = format!(

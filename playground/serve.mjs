@@ -7,13 +7,28 @@ import { readFile } from 'node:fs/promises';
 import { extname, join, normalize, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
-const TYPES = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript', '.css': 'text/css', '.json': 'application/json', '.wasm': 'application/wasm', '.png': 'image/png' };
+const TYPES = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript', '.css': 'text/css', '.json': 'application/json', '.wasm': 'application/wasm', '.png': 'image/png', '.svg': 'image/svg+xml', '.uf2': 'application/octet-stream' };
 
 /** Serves `dir` at `host:port` (port 0: any free one); resolves to the server once it listens. */
 export function serve(dir, host = '127.0.0.1', port = 8080) {
   const root = resolve(dir);
   const server = createServer(async (req, res) => {
-    const path = normalize(decodeURIComponent(new URL(req.url, 'http://x').pathname));
+    // Whatever a browser or a neighbour on the network sends, the server answers and goes on:
+    // a path that does not decode (`/%E0%A4%A`) or holds a NUL byte is a bad request.
+    let path;
+    try {
+      path = normalize(decodeURIComponent(new URL(req.url, 'http://x').pathname));
+    } catch {
+      path = null;
+    }
+    if (path === null || path.includes('\0')) {
+      res.writeHead(400, { 'content-type': 'text/plain' }).end('bad request: the path does not decode\n');
+      return;
+    }
+    if (req.method !== 'GET' && req.method !== 'HEAD') {
+      res.writeHead(405, { 'content-type': 'text/plain', allow: 'GET, HEAD' }).end('only GET and HEAD\n');
+      return;
+    }
     const file = join(root, path.endsWith('/') ? join(path, 'index.html') : path);
     if (!file.startsWith(root)) {
       res.writeHead(403).end();

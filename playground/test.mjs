@@ -6,10 +6,15 @@
 //     same settings (the Pico's: fixed point, coarse sampling, Floyd-Steinberg, lines; and one
 //     other set of switches);
 //   - a scene typed with a mistake on line 3 to show the error at line 3, column 15;
-//   - the exact Pico image, run in the page, to show a first frame bit-identical to host-sim's.
+//   - the exact Pico image, run in the page, to show a first frame bit-identical to host-sim's;
+//   - an edited scene run in the slot image on the emulated Pico ("run my scene"), its frame
+//     host-sim's;
+//   - edits kept across a reload, a shared link that carries the scene, the panel marked stale
+//     while a mistake shows, a question before a built-in replaces edits, no failed request;
+//   - the server answering a malformed request with 400 and going on.
 // Usage: node playground/test.mjs --dist DIR --host-sim BIN [--chromium BIN] [--screenshot PNG]
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync, renameSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, renameSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -46,9 +51,9 @@ function args() {
 }
 
 /** host-sim's 1-bit frame of `scene` with `flags`, packed as the page packs it (1 lit). */
-function hostFrame(hostSim, scene, flags, work) {
+function hostFrame(hostSim, scene, flags, work, file = join(ROOT, `scenes/${scene}.scene`)) {
   const pbm = join(work, `${scene}.pbm`);
-  execFileSync(hostSim, ['render', join(ROOT, `scenes/${scene}.scene`), '-o', join(work, `${scene}.png`), '--pbm', pbm, ...flags], { stdio: ['ignore', 'ignore', 'inherit'] });
+  execFileSync(hostSim, ['render', file, '-o', join(work, `${scene}.png`), '--pbm', pbm, ...flags], { stdio: ['ignore', 'ignore', 'inherit'] });
   const bytes = readFileSync(pbm);
   const header = '128 64\n';
   const start = bytes.indexOf(header) + header.length;
@@ -85,6 +90,21 @@ async function main() {
     await page.setViewport({ width: 1500, height: 1180 });
     const problems = [];
     page.on('pageerror', (e) => problems.push(String(e)));
+    // Every request the page makes must succeed (no 404 in the console).
+    const failed = [];
+    const watch = (p) => p.on('response', (r) => r.status() >= 400 && failed.push(`${r.status()} ${r.url()}`));
+    watch(page);
+    let dialogs = 0;
+    page.on('dialog', (d) => {
+      dialogs++;
+      d.accept();
+    });
+
+    // The server: a malformed escape is a bad request, and the server goes on.
+    const bad = await fetch(`${url}%E0%A4%A`);
+    const post = await fetch(url, { method: 'POST', body: 'x' });
+    const after = await fetch(url);
+    check(bad.status === 400 && post.status === 405 && after.status === 200, `the server answers /%E0%A4%A with ${bad.status}, a POST with ${post.status}, and goes on (${after.status})`);
     await page.goto(url, { waitUntil: 'load' });
     await page.waitForFunction(() => window.playground?.firstPanelMs !== null && window.playground?.firstPanelMs !== undefined, { timeout: 30000 });
     const firstPanel = await page.evaluate(() => window.playground.firstPanelMs);
@@ -128,8 +148,13 @@ async function main() {
     const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
     const at = await page.evaluate(() => window.playground.error && [window.playground.error.line, window.playground.error.col]);
     check(shown.startsWith('line 3, column 15') && shown.includes('size must be positive') && at?.join(':') === '3:15', `a typed mistake shows where: "${shown}"`);
+    const stale = await page.evaluate(() => document.getElementById('panel').classList.contains('stale') && !document.getElementById('stale').hidden);
+    check(stale, 'while the mistake shows, the panel is marked stale');
+    // Loading a built-in over edits asks first (the test accepts).
+    const asked = dialogs;
     await page.select('#scene', 'chair');
     await page.waitForFunction(() => window.playground.error === null);
+    check(dialogs === asked + 1, `loading a built-in over edits asked first (${dialogs - asked} question)`);
 
     // The Pico image's first frame (the chair, the Pico's settings).
     await page.waitForFunction(() => window.playground.board.frames.length > 0 || window.playground.board.ended, { timeout: BOARD_TIMEOUT_MS, polling: 500 });
@@ -143,6 +168,24 @@ async function main() {
       check(f.scene === 'chair' && differing(f.pixels, want) === 0, `the Pico image's first frame (${f.scene}, ${(f.cycles / 1e6).toFixed(1)} M cycles, shown after ${secs} s in the page) equals host-sim's (${differing(f.pixels, want)} pixels differ)`);
       check(differing(f.canvas, f.pixels) === 0, `the board canvas showed the frame the emulated panel showed (${differing(f.canvas, f.pixels)} pixels differ)`);
     }
+
+    // The editor's own scene in the slot image on the emulated Pico: its frame is host-sim's.
+    const mine = 'camera eye 2 2.2 -6 look 0 0.7 0 fov 45\nlight directional dir -0.4 -1 0.6\nsphere center -0.8 0.8 0 radius 0.8\ncone base 1 0 0.2 radius 0.6 height 1.4\nbox min -4 -0.1 -3 max 4 0 5\n';
+    await page.$eval('#text', (t, v) => { t.value = v; t.dispatchEvent(new Event('input')); }, mine);
+    await page.waitForFunction(() => window.playground.error === null);
+    const mineStart = Date.now();
+    await page.click('#run-mine');
+    await page.waitForFunction(() => window.playground.board.frames.length > 0 || window.playground.board.ended, { timeout: BOARD_TIMEOUT_MS, polling: 500 });
+    const slot = await page.evaluate(() => window.playground.board);
+    const mineFile = join(work, 'mine.scene');
+    writeFileSync(mineFile, mine);
+    if (slot.frames.length === 0) {
+      check(false, `my scene on the emulated Pico showed no frame: ${slot.status}`);
+    } else {
+      const wantMine = hostFrame(o.hostSim, 'mine', pico, work, mineFile);
+      const f = slot.frames[0];
+      check(differing(f.pixels, wantMine) === 0, `my scene in the slot image on the emulated Pico (${(f.cycles / 1e6).toFixed(1)} M cycles, after ${((Date.now() - mineStart) / 1000).toFixed(0)} s) equals host-sim's (${differing(f.pixels, wantMine)} pixels differ)`);
+    }
     check(problems.length === 0, `no uncaught errors in the page${problems.length ? ': ' + problems.join('; ') : ''}`);
     if (o.screenshot) {
       const tmp = `${o.screenshot}.partial.png`;
@@ -150,6 +193,27 @@ async function main() {
       renameSync(tmp, o.screenshot);
       console.log(`wrote ${o.screenshot}`);
     }
+
+    // The last edit (the slot's scene) is kept: a reload brings it back.
+    await page.reload({ waitUntil: 'load' });
+    await page.waitForFunction(() => window.playground?.source !== undefined && window.playground?.firstPanelMs !== null, { timeout: 30000 });
+    const kept = await page.evaluate(() => [document.getElementById('text').value, window.playground.source]);
+    check(kept[0] === mine && kept[1] === 'kept', `the edited scene survives a reload (${kept[1]})`);
+
+    // A shared link carries the scene: opened in a new page, the editor holds it.
+    const sharedText = 'camera eye 0 1.5 -5 look 0 0.5 0 fov 50\nlight directional dir -1 -1 1\nsphere center 0 0.8 0 radius 0.8\nbox min -3 -0.1 -3 max 3 0 3\n';
+    await page.$eval('#text', (t, v) => { t.value = v; t.dispatchEvent(new Event('input')); }, sharedText);
+    await page.click('#share');
+    await page.waitForFunction(() => Boolean(window.playground.sharedUrl));
+    const link = await page.evaluate(() => window.playground.sharedUrl);
+    const second = await browser.newPage();
+    watch(second);
+    await second.goto(link, { waitUntil: 'load' });
+    await second.waitForFunction(() => window.playground?.source !== undefined && window.playground?.firstPanelMs !== null, { timeout: 30000 });
+    const got = await second.evaluate(() => [document.getElementById('text').value, window.playground.source]);
+    check(got[0] === sharedText && got[1] === 'link', `a shared link opens with its scene (${got[1]}, ${link.length} characters)`);
+    await second.close();
+    check(failed.length === 0, `no request failed${failed.length ? ': ' + failed.join(', ') : ''}`);
   } finally {
     await browser.close();
     server.close();

@@ -169,7 +169,7 @@ mod writer {
     }
     impl<R: Literal> Literal for Camera<R> {
         fn literal(&self, out: &mut String) {
-            record(out, "Camera", &[("eye", &self.eye), ("forward", &self.forward), ("right", &self.right), ("up", &self.up), ("resolves", &self.resolves)]);
+            record(out, "Camera", &[("eye", &self.eye), ("forward", &self.forward), ("right", &self.right), ("up", &self.up), ("resolves", &self.resolves), ("shape", &self.shape)]);
         }
     }
     impl<R: Literal> Literal for SubLattice<R> {

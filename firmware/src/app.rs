@@ -130,6 +130,7 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Render(RenderError::BadShare) => defmt::write!(f, "bad tile share"),
             AppError::Render(RenderError::NotProgressive) => defmt::write!(f, "frame cannot be rendered progressively"),
             AppError::Render(RenderError::ViewTooNarrow { most, .. }) => defmt::write!(f, "view too narrow for the scalar: at most {}x{} pixels", most[0], most[1]),
+            AppError::Render(RenderError::FrameShape { fitted, frame }) => defmt::write!(f, "the view was fitted to {}:{}, not {}x{}", fitted[0], fitted[1], frame[0], frame[1]),
             AppError::Render(RenderError::ScratchTooSmall { needed }) => {
                 defmt::write!(f, "scratch storage too small: {} entries needed", needed)
             }

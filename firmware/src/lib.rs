@@ -19,4 +19,6 @@ pub mod app;
 /// and check it against Rust's own slice copies.
 #[cfg(feature = "compact")]
 pub mod builtins;
+#[cfg(feature = "slot")]
+pub mod slot;
 pub mod stack;

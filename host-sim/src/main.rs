@@ -72,7 +72,9 @@ enum Command {
     },
     /// Build the Pico (or Pico 2) image and write it as a UF2 file, for flashing without a
     /// probe: hold BOOTSEL while plugging the board in and copy the file onto the drive it
-    /// shows (RPI-RP2 for the Pico, RP2350 for the Pico 2).
+    /// shows (RPI-RP2 for the Pico, RP2350 for the Pico 2). With --scene, no build: the scene
+    /// is written into the scene slot of a prebuilt slot image (`--features slot`, built once,
+    /// or downloaded from the playground), which parses and shows it on the Pico.
     Uf2 {
         /// The board: pico (RP2040, fixed point) or pico2 (RP2350, f32).
         #[arg(long, value_enum, default_value = "pico")]
@@ -81,9 +83,17 @@ enum Command {
         /// module, `i2c-1mhz`, `orbit`, `progressive`, `no-outline`, ...
         #[arg(long, value_name = "LIST")]
         features: Option<String>,
-        /// UF2 file to write [default: out/lattice-rt-<board>.uf2].
+        /// UF2 file to write [default: out/lattice-rt-<board>.uf2; with --features,
+        /// out/lattice-rt-<board>-<features>.uf2; with --scene, out/lattice-rt-pico-<scene>.uf2].
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// A scene file (or `-`) to write into the slot image's scene slot: checked as the Pico
+        /// will read it (fixed point, 128x64, the slot's storage), no compiler involved.
+        #[arg(long, conflicts_with = "features")]
+        scene: Option<PathBuf>,
+        /// The slot image's UF2 file the scene is written beside.
+        #[arg(long, default_value = "out/lattice-rt-pico-slot.uf2", requires = "scene")]
+        image: PathBuf,
     },
 }
 
@@ -128,7 +138,10 @@ fn real_main() -> Result<()> {
             Ok(())
         }
         Some(Command::Orbit { scene, output, frames }) => orbit::orbit_cmd(&scene, &output, frames),
-        Some(Command::Uf2 { board, features, output }) => uf2::uf2_cmd(&std::env::current_dir()?, board, features.as_deref(), output.as_deref()),
+        Some(Command::Uf2 { board, features, output, scene, image }) => match scene {
+            Some(scene) => uf2::scene_cmd(board, &scene, &image, output.as_deref()),
+            None => uf2::uf2_cmd(&std::env::current_dir()?, board, features.as_deref(), output.as_deref()),
+        },
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),
             Scalar::F32 => run::stats_cmd::<f32>(&a),

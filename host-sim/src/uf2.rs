@@ -146,12 +146,36 @@ pub fn write_uf2(elf: &Path, out: &Path) -> Result<()> {
 }
 
 /// The command `host-sim uf2`: the image with the firmware's `features` (comma-separated, such
-/// as `spi`), if any; `out` defaults to `out/lattice-rt-<board>.uf2`.
+/// as `spi`), if any; `out` defaults to `out/lattice-rt-<board>[-<features>].uf2`.
 pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, out: Option<&Path>) -> Result<()> {
     let elf = build_board(root, board, features)?;
-    let out = out.map_or_else(|| PathBuf::from(format!("out/lattice-rt-{}.uf2", board.name())), Path::to_path_buf);
+    let named = match features {
+        Some(f) => format!("out/lattice-rt-{}-{}.uf2", board.name(), f.replace(',', "-")),
+        None => format!("out/lattice-rt-{}.uf2", board.name()),
+    };
+    let out = out.map_or_else(|| PathBuf::from(named), Path::to_path_buf);
     board.write_uf2(&elf, &out)?;
     println!("wrote {}: hold BOOTSEL while plugging the board in, then copy this file onto the {} drive", out.display(), board.drive());
     Ok(())
 }
 
+
+/// The command `host-sim uf2 --scene FILE`: `image` (the slot image's UF2 file) with the scene
+/// in its slot, written to `out` (default `out/lattice-rt-pico-<scene>.uf2`). The scene is
+/// checked first as the Pico will read it; nothing is built.
+pub fn scene_cmd(board: Board, scene: &Path, image: &Path, out: Option<&Path>) -> Result<()> {
+    if board != Board::Pico {
+        bail!("the scene slot is the Pico's (RP2040) for now: --board pico");
+    }
+    let text = crate::load::read(scene)?;
+    let base = std::fs::read(image).with_context(|| {
+        format!("cannot read the slot image {}: build it once with `host-sim uf2 --features slot` (needs the Rust toolchain), or download it from the playground's page", image.display())
+    })?;
+    board_records::slot::check_scene(&text).map_err(|e| anyhow::anyhow!("{}: {e}", scene.display()))?;
+    let bytes = board_records::slot::with::scene(&base, &text).map_err(|e| anyhow::anyhow!("{}: {e}", image.display()))?;
+    let stem = scene.file_stem().map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().to_string());
+    let out = out.map_or_else(|| PathBuf::from(format!("out/lattice-rt-pico-{stem}.uf2")), Path::to_path_buf);
+    crate::output::write_atomic(&out, &bytes)?;
+    println!("wrote {}: the slot image with {} in its scene slot ({} bytes); hold BOOTSEL while plugging the Pico in, then copy this file onto the RPI-RP2 drive", out.display(), scene.display(), text.len());
+    Ok(())
+}

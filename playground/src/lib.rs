@@ -240,6 +240,13 @@ pub fn panel(text: &str, scalar: &str, dither: &str, lines: bool, gamma: u8, sam
     render_panel(text, &settings).map(Panel).map_err(ScriptError)
 }
 
+/// The slot image's UF2 file `image` with scene `text` in its scene slot: what `host-sim uf2
+/// --scene` writes (the scene checked as the Pico reads it; an error says where and why).
+#[wasm_bindgen]
+pub fn slot_uf2(image: &[u8], text: &str) -> Result<Vec<u8>, String> {
+    board_records::slot::with::scene(image, text)
+}
+
 /// The names of the scenes the page starts from, comma-separated.
 #[wasm_bindgen]
 pub fn scene_names() -> String {

@@ -1,7 +1,7 @@
 // The playground page: the scene editor, the panel the core renders (WebAssembly, built from
 // playground/src/lib.rs) and the exact Pico image on an emulated RP2040 (board-worker.js).
 // `window.playground` holds what the browser test (playground/test.mjs) reads.
-import init, { panel, scene_names, scene_text, default_settings } from './pkg/playground.js';
+import init, { panel, scene_names, scene_text, default_settings, slot_uf2 } from './pkg/playground.js';
 
 const W = 128;
 const H = 64;
@@ -92,6 +92,9 @@ function showReport(r, ms, cost) {
 
 function showError(e) {
   const box = $('error');
+  // While a mistake shows, the panel still shows the last scene that had none: marked stale.
+  $('panel').classList.toggle('stale', Boolean(e));
+  $('stale').hidden = !e;
   if (!e) {
     box.hidden = true;
     box.textContent = '';
@@ -135,18 +138,31 @@ function rerender(cost) {
   if (state.firstPanelMs === null && state.bits) state.firstPanelMs = performance.now();
 }
 
-function startBoard(info) {
+/** The bytes of file `f` of the page. */
+const fetchBytes = (f) => fetch(f).then((r) => {
+  if (!r.ok) throw new Error(`${f}: ${r.status}`);
+  return r.arrayBuffer();
+});
+
+/** The slot image's UF2 file with the editor's scene in its slot (throws the scene's mistake). */
+async function mySlotUf2(info) {
+  const image = new Uint8Array(await fetchBytes(info.slotUf2));
+  return slot_uf2(image, $('text').value);
+}
+
+/** Runs the UF2 file `uf2` (or `info.uf2`, fetched) on the emulated board for `names` frames. */
+function startBoard(info, uf2 = null, names = info.scenes) {
   const status = $('board-status');
-  $('run-board').disabled = true;
+  // One board at a time: a new run stops the one before.
+  state.worker?.terminate();
   state.board = { frames: [], status: 'loading' };
   const worker = new Worker('board-worker.js');
-  Promise.all([info.uf2, info.bootrom].map((f) => fetch(f).then((r) => {
-    if (!r.ok) throw new Error(`${f}: ${r.status}`);
-    return r.arrayBuffer();
-  }))).then(([uf2, bootrom]) => {
-    worker.postMessage({ uf2, bootrom, frames: info.scenes.length });
+  state.worker = worker;
+  Promise.all([uf2 ? Promise.resolve(uf2) : fetchBytes(info.uf2), fetchBytes(info.bootrom)]).then(([uf2, bootrom]) => {
+    worker.postMessage({ uf2, bootrom, frames: names.length });
   }, (e) => {
     state.board.status = `cannot load the image: ${e.message}`;
+    state.board.ended = true;
     status.textContent = state.board.status;
   });
   const t0 = performance.now();
@@ -156,7 +172,7 @@ function startBoard(info) {
       if (m.pixels) draw($('board-panel'), m.pixels);
       state.board.status = `running: ${fmt(m.cycles)} cycles, ${m.ms.toFixed(1)} ms of board time (${secs} s in this page), ${m.frames} frames shown`;
     } else if (m.kind === 'frame') {
-      const scene = info.scenes[m.index] ?? `frame ${m.index}`;
+      const scene = names[m.index] ?? `frame ${m.index}`;
       draw($('board-panel'), m.pixels);
       // What the canvas showed when the frame was done (the board goes straight on to the next).
       state.board.frames.push({ scene, pixels: Array.from(m.pixels), cycles: m.cycles, canvas: readBits($('board-panel')) });
@@ -164,11 +180,33 @@ function startBoard(info) {
     } else if (m.kind === 'end') {
       state.board.status = `${m.ok ? 'done' : 'stopped'}: ${m.reason}`;
       state.board.ended = true;
-      $('run-board').disabled = false;
       worker.terminate();
     }
     status.textContent = state.board.status + (state.board.last ? ` — last frame ${state.board.last}` : '');
   };
+}
+
+/** Where the page keeps the editor's text between visits. */
+const KEPT_TEXT = 'lattice-rt.scene';
+
+/** Scene text as URL-safe base64 of its UTF-8 bytes. */
+function encodeScene(text) {
+  const bytes = new TextEncoder().encode(text);
+  let bin = '';
+  for (const b of bytes) bin += String.fromCharCode(b);
+  return btoa(bin).replace(/\+/g, '-').replace(/\//g, '_').replace(/=+$/, '');
+}
+
+/** The scene a shared link carries (`#scene=...`), or null. */
+function sharedScene() {
+  const m = /^#scene=([A-Za-z0-9_-]*)$/.exec(location.hash);
+  if (!m) return null;
+  try {
+    const bin = atob(m[1].replace(/-/g, '+').replace(/_/g, '/'));
+    return new TextDecoder('utf-8', { fatal: true }).decode(Uint8Array.from(bin, (c) => c.charCodeAt(0)));
+  } catch {
+    return null;
+  }
 }
 
 async function main() {
@@ -181,7 +219,14 @@ async function main() {
   for (const d of defaults.dithers.split(',')) $('dither').append(new Option(d, d));
   for (const n of scene_names().split(',')) $('scene').append(new Option(n, n));
   applySettings(defaults);
-  $('text').value = scene_text($('scene').value);
+  // The scene: from the address (a shared link), else the edits kept in this browser, else the
+  // first built-in.
+  const shared = sharedScene();
+  const kept = localStorage.getItem(KEPT_TEXT);
+  $('text').value = shared ?? kept ?? scene_text($('scene').value);
+  state.source = shared !== null ? 'link' : kept !== null ? 'kept' : 'built-in';
+  // What the editor held when a built-in was loaded last: anything else is the user's edit.
+  let loaded = shared === null && kept === null ? $('text').value : null;
   $('board-scenes').textContent = info.scenes.join(', ');
   const go = () => rerender(cost);
   // Redraw as the user types, once per animation frame at most.
@@ -194,11 +239,56 @@ async function main() {
       go();
     });
   };
-  $('text').addEventListener('input', soon);
+  $('text').addEventListener('input', () => {
+    localStorage.setItem(KEPT_TEXT, $('text').value);
+    soon();
+  });
   for (const id of ['dither', 'lines', 'gamma', 'scalar', 'sampling', 'orbit']) $(id).addEventListener('input', soon);
+  let shown = $('scene').value;
   $('scene').addEventListener('change', () => {
-    $('text').value = scene_text($('scene').value);
+    const edited = loaded === null ? $('text').value.trim() !== '' : $('text').value !== loaded;
+    if (edited && !confirm(`Replace your scene in the editor with the built-in ${$('scene').value}? Your edits are lost.`)) {
+      $('scene').value = shown;
+      return;
+    }
+    shown = $('scene').value;
+    $('text').value = loaded = scene_text(shown);
+    localStorage.removeItem(KEPT_TEXT);
     go();
+  });
+  $('share').addEventListener('click', async () => {
+    history.replaceState(null, '', `#scene=${encodeScene($('text').value)}`);
+    state.sharedUrl = location.href;
+    try {
+      await navigator.clipboard.writeText(location.href);
+      $('share').textContent = 'Link copied';
+    } catch {
+      $('share').textContent = 'Link in the address bar';
+    }
+  });
+  $('run-mine').addEventListener('click', async () => {
+    // The board's state is the new run's from the click on.
+    state.worker?.terminate();
+    state.board = { frames: [], status: 'writing your scene beside the slot image' };
+    try {
+      startBoard(info, await mySlotUf2(info), ['your scene']);
+    } catch (e) {
+      state.board = { frames: [], status: `your scene cannot go on the Pico: ${e.message ?? e}`, ended: true };
+      $('board-status').textContent = state.board.status;
+    }
+  });
+  $('download-mine').addEventListener('click', async () => {
+    try {
+      const bytes = await mySlotUf2(info);
+      const a = document.createElement('a');
+      a.href = URL.createObjectURL(new Blob([bytes], { type: 'application/octet-stream' }));
+      a.download = 'lattice-rt-pico-scene.uf2';
+      a.click();
+      setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
+      $('board-status').textContent = `downloaded lattice-rt-pico-scene.uf2 (${fmt(bytes.length)} bytes)`;
+    } catch (e) {
+      $('board-status').textContent = `your scene cannot go on the Pico: ${e.message ?? e}`;
+    }
   });
   $('pico-settings').addEventListener('click', () => {
     applySettings(defaults);

@@ -4,8 +4,12 @@
 //! as text. The defmt log stays for people; records are for `cargo xtask board`.
 #![no_std]
 #![deny(missing_docs)]
+#[cfg(feature = "alloc")]
+extern crate alloc;
 
 pub mod frame;
+pub mod message;
 mod record;
+pub mod slot;
 
 pub use record::{Channel, FrameDone, Record, CHANNEL_BYTES, CHANNEL_MAGIC};

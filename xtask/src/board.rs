@@ -11,6 +11,8 @@
 //! `host-sim uf2` is the first half alone: the UF2 file to drag onto a Pico (or, with
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
 
+mod slot;
+
 use crate::firmware::{board_frame, elf_sizes, host_frame};
 use host_sim::uf2::{build_image, build_pico, kept_image, pico_built, pico_elf, write_uf2, Scenes};
 use board_frame::{Build, LADDER, ORBIT_FRAMES, PICO};
@@ -458,6 +460,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let progressive = s.progressive_rows(&prun, &rows)?;
     let plain_run = s.variant("no-outline", false, 1, &[])?;
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
+    let slot_rows = s.slot_runs()?;
 
     let spi_byte = levers.iter().find(|(feature, ..)| *feature == "spi").map_or(0, |(_, _, f, _)| f.bus_cycles / f.bus_bytes.max(1));
     let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period, spi_byte };
@@ -471,6 +474,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     if let (Some((f, rays, same)), Some((lined, ..))) = (outline_row, &alone) {
         md.push_str(&outline_report(f, rays, same, lined, run.clk_sys_hz)?);
     }
+    md.push_str(&slot::slot_report(&slot_rows)?);
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     let Checks { passed, failures } = s.checks;

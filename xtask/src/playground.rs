@@ -100,12 +100,15 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     )?;
     let elf = if no_build { host_sim::uf2::pico_elf(root) } else { host_sim::uf2::build_pico(root)? };
     host_sim::uf2::write_uf2(&elf, &staging.join("pico.uf2"))?;
+    // The slot image, which the page writes the editor's scene beside (`host-sim uf2 --scene`).
+    let slot = if no_build { host_sim::uf2::kept_image(root, "pico-slot") } else { host_sim::uf2::build_board(root, host_sim::uf2::Board::Pico, Some("slot"))? };
+    host_sim::uf2::write_uf2(&slot, &staging.join("pico-slot.uf2"))?;
     copy(&bootrom, &staging.join("bootrom-b1.bin"))?;
     let scenes: Vec<String> = host_sim::shared::default_scene_paths()
         .iter()
         .map(|p| p.file_stem().expect("scenes/<name>.scene").to_string_lossy().into_owned())
         .collect();
-    let board = serde_json::json!({ "uf2": "pico.uf2", "bootrom": "bootrom-b1.bin", "scenes": scenes });
+    let board = serde_json::json!({ "uf2": "pico.uf2", "slotUf2": "pico-slot.uf2", "bootrom": "bootrom-b1.bin", "scenes": scenes });
     std::fs::write(staging.join("board.json"), board.to_string()).context("cannot write board.json")?;
     let cost = cost_fit(root)?;
     std::fs::write(staging.join("cost.json"), cost.to_string()).context("cannot write cost.json")?;

@@ -63,6 +63,12 @@ pub static PICOTOOL_ENTRIES: [hal::binary_info::EntryAddr; 4] = [
     hal::binary_info::rp_cargo_homepage_url!(),
 ];
 
+/// What tells the slot image's UF2 file from another's (`board_records::slot::IMAGE_MARK`),
+/// which `host-sim uf2 --scene` looks for before writing a scene beside it.
+#[cfg(feature = "slot")]
+#[used]
+pub static SLOT_IMAGE: [u8; 16] = board_records::slot::IMAGE_MARK;
+
 /// The board's name in the log.
 #[cfg(feature = "pico")]
 const BOARD: &str = "Pico (RP2040)";

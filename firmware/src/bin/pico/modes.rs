@@ -7,9 +7,9 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_hal::digital::OutputPin;
 use firmware::app::{render_embedded_at, AppError, Board, Embedded, Report, SceneMemory, ShareMemory, Shot};
-#[cfg(not(feature = "ladder"))]
+#[cfg(not(any(feature = "ladder", feature = "slot")))]
 use firmware::app::EMBEDDED;
-#[cfg(not(feature = "ladder"))]
+#[cfg(not(any(feature = "ladder", feature = "slot")))]
 use firmware::stack;
 use display_interface::DisplayError;
 use lattice_rt::render::RenderError;
@@ -93,14 +93,69 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         })
     }
 
+    /// Shows `text` on the panel in place of a picture (`board_records::message`, as the host
+    /// draws it), with the LED lit until it is on the panel, as for a frame.
+    #[cfg(feature = "slot")]
+    pub fn message(&mut self, text: &str) -> Result<(), DisplayError> {
+        use embedded_graphics_core::geometry::{Point, Size};
+        use embedded_graphics_core::primitives::Rectangle;
+        use firmware::app::{HEIGHT, WIDTH};
+        use lattice_rt::BitFrame;
+        const BYTES: usize = BitFrame::bytes(WIDTH as u32, HEIGHT as u32);
+        let (w, h) = (WIDTH as u32, HEIGHT as u32);
+        let _ = self.led.set_high();
+        let mut bits = [0u8; BYTES];
+        let Some(mut frame) = BitFrame::new(w, h, &mut bits) else { return Err(DisplayError::OutOfBoundsError) };
+        let Ok(()) = board_records::message::draw(&mut frame, w, h, text);
+        // Sent in bands of tiles, as a frame is (the display takes page-aligned bands).
+        let band = u32::from(firmware::app::RENDERED.tile);
+        for y0 in (0..h).step_by(band as usize) {
+            let rows = band.min(h - y0);
+            let colors = (y0..y0 + rows).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| BinaryColor::from(frame.get(x, y)));
+            self.target.fill_contiguous(&Rectangle::new(Point::new(0, y0 as i32), Size::new(w, rows)), colors)?;
+        }
+        let sent = crate::display::flush();
+        let _ = self.led.set_low();
+        sent.map_err(|_| DisplayError::BusWriteError)
+    }
+
     /// Sleeps between scenes.
     pub fn pause(&mut self) {
         sleep_ms(&mut self.alarm, PAUSE_MS);
     }
 }
 
+/// The scene in the slot (`firmware::slot`), again and again: its frame, or a message on the
+/// panel that says why there is none (the slot empty or corrupt, the scene refused at its line
+/// and column or too big for the image's storage), also logged.
+#[cfg(feature = "slot")]
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+    use firmware::slot::Message;
+    loop {
+        let failed = match firmware::slot::text() {
+            Ok(text) => match panel.show(text, &Shot::default()) {
+                Ok((r, micros)) => {
+                    report(Record::Frame(frame_done(0, &r, micros)));
+                    defmt::info!("slot: {} ms, rays {}, object tests {}", micros.0 / 1000, r.stats.total_rays(), r.stats.object_tests);
+                    None
+                }
+                Err(e) => Some(Message::of(e)),
+            },
+            Err(e) => Some(Message::of(e)),
+        };
+        if let Some(m) = failed {
+            report(Record::Failed { scene: 0 });
+            defmt::error!("slot: {}", m.as_str());
+            if panel.message(m.as_str()).is_err() {
+                defmt::error!("the display did not take the message");
+            }
+        }
+        panel.pause();
+    }
+}
+
 /// The embedded scenes in turn, each frame's time and statistics logged.
-#[cfg(not(any(feature = "orbit", feature = "ladder")))]
+#[cfg(not(any(feature = "orbit", feature = "ladder", feature = "slot")))]
 pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
     loop {
         for (i, (name, scene)) in EMBEDDED.iter().copied().enumerate() {
