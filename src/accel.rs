@@ -48,7 +48,8 @@ pub struct Stats {
     /// Rays traced, by [`RayKind`].
     pub rays: [u64; 4],
     /// Of those, the rays that hit an object, by [`RayKind`] (a shadow ray that hits is
-    /// blocked: its light is hidden).
+    /// blocked: its light is hidden); with the `hit-counts` feature (a default one).
+    #[cfg(feature = "hit-counts")]
     pub hits: [u64; 4],
     /// Ray-object intersection tests.
     pub object_tests: u64,
@@ -67,6 +68,7 @@ impl Stats {
         for (a, b) in self.rays.iter_mut().zip(o.rays.iter()) {
             *a += b;
         }
+        #[cfg(feature = "hit-counts")]
         for (a, b) in self.hits.iter_mut().zip(o.hits.iter()) {
             *a += b;
         }
@@ -74,6 +76,16 @@ impl Stats {
         self.inside_tests += o.inside_tests;
         self.cells_visited += o.cells_visited;
         self.culled += o.culled;
+    }
+    /// Counts a ray of `kind` that hit (`hit`), with the `hit-counts` feature.
+    #[inline(always)]
+    pub fn hit(&mut self, kind: RayKind, hit: bool) {
+        #[cfg(feature = "hit-counts")]
+        {
+            self.hits[kind as usize] += u64::from(hit);
+        }
+        #[cfg(not(feature = "hit-counts"))]
+        let _ = (kind, hit);
     }
     /// All rays of every kind.
     pub fn total_rays(&self) -> u64 {

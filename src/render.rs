@@ -875,7 +875,11 @@ fn check<E>(frame: &Frame, share: Share, dithered: bool) -> Result<(), RenderErr
 /// neighbouring pixels of `frame` through `camera`.
 fn resolves<R: Real, E>(camera: &Camera<R>, frame: &Frame) -> Result<(), RenderError<E>> {
     let size = [u32::from(frame.width), u32::from(frame.height)];
-    if crate::scene::lowest_terms(size) != camera.shape {
+    // The same shape: the frame's sides in the ratio of the camera's (in lowest terms, so a
+    // frame of that shape has sides of at most 65,535 times them: the products fit in u32).
+    let [a, b] = camera.shape;
+    let same = a <= 0xFFFF && b <= 0xFFFF && size[0] * b == size[1] * a;
+    if !same {
         return Err(RenderError::FrameShape { fitted: camera.shape, frame: size });
     }
     let [w, h] = camera.resolves;

@@ -506,7 +506,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         q.stats.rays[RayKind::Primary as usize] += 1;
         let uv = q.eye_ray();
         let found = self.nearest(&eye, uv, q);
-        q.stats.hits[RayKind::Primary as usize] += u64::from(found.is_some());
+        q.stats.hit(RayKind::Primary, found.is_some());
         found.map_or((NO_OBJECT, R::MAX), |hit| (hit.object, hit.t))
     }
 
@@ -597,7 +597,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 total += node.weight.weigh(scene.background);
                 continue;
             };
-            q.stats.hits[node.kind as usize] += 1;
+            q.stats.hit(node.kind, true);
             if node.depth == 0 {
                 first = hit.object;
                 depth = hit.t;
@@ -705,7 +705,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                     }
                 };
                 if hit.is_some() {
-                    q.stats.hits[RayKind::Shadow as usize] += 1;
+                    q.stats.hit(RayKind::Shadow, true);
                     return R::ZERO;
                 }
             }
@@ -735,7 +735,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             };
             q.set_tried(None);
             if hidden {
-                q.stats.hits[RayKind::Shadow as usize] += 1;
+                q.stats.hit(RayKind::Shadow, true);
                 return R::ZERO;
             }
         }
