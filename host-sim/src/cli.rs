@@ -148,7 +148,7 @@ pub struct RenderArgs {
     /// messages then go to standard error).
     #[arg(short, long, default_value = "out/render.png")]
     pub output: PathBuf,
-    /// Image size.
+    /// Image size (the scene's view is fitted to its shape: pixels are square).
     #[arg(long, default_value = "128x64", value_parser = parse_size)]
     pub size: (u16, u16),
     /// Dithering mode (the default scores best in `host-sim display`, docs/display.md).
