@@ -94,7 +94,7 @@ fn levers(c: &mut Criterion) {
         b.iter(|| {
             let mut carry = lattice_rt::dither::Carry::new(&mut carries, 16).unwrap();
             carry.next_band();
-            carry.tile(lattice_rt::Dither::FloydSteinberg, 0, 16, 16, black_box(&levels), &mut out);
+            carry.tile(lattice_rt::Dither::FloydSteinberg, (0, 0), 16, 16, black_box(&levels), &mut out);
         })
     });
 }
