@@ -874,7 +874,7 @@ fn check<E>(frame: &Frame, share: Share, dithered: bool) -> Result<(), RenderErr
 /// Whether `frame` has the shape `camera` was fitted to, and `R` resolves the angle between
 /// neighbouring pixels of `frame` through `camera`.
 fn resolves<R: Real, E>(camera: &Camera<R>, frame: &Frame) -> Result<(), RenderError<E>> {
-    let size = [u32::from(frame.width), u32::from(frame.height)];
+    let size = frame.size();
     // The same shape: the frame's sides in the ratio of the camera's (in lowest terms, so a
     // frame of that shape has sides of at most 65,535 times them: the products fit in u32).
     let [a, b] = camera.shape;

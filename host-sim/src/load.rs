@@ -95,11 +95,29 @@ pub fn lattice_storage<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Re
     Ok(HeapStorage::new(sizes))
 }
 
+/// No lattice fits the byte budget asked for (`--budget`): an error its callers can tell apart
+/// (render adds what it can do instead).
+#[derive(Debug)]
+pub struct BudgetTooSmall {
+    /// Bytes the budget gives.
+    pub available: usize,
+    /// Bytes the smallest lattice takes.
+    pub needed: usize,
+}
+
+impl std::fmt::Display for BudgetTooSmall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "no lattice fits --budget {}: the smallest takes {} bytes; give at least that", self.available, self.needed)
+    }
+}
+
+impl std::error::Error for BudgetTooSmall {}
+
 /// Builds the lattice of `scene` with `cfg` in `storage` (from [`lattice_storage`]).
 pub fn build_lattice<'a, R: Real>(storage: &'a mut HeapStorage<R>, scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Lattice<'a, R>> {
     let (lattice, _) = storage.view().split().1.lattice(scene, cfg).map_err(|e| {
         if e.capacity == "budget" {
-            anyhow!("no lattice fits --budget {}: the smallest takes {} bytes; give at least that", e.available, e.needed)
+            anyhow::Error::new(BudgetTooSmall { available: e.available, needed: e.needed })
         } else {
             anyhow!("{e}")
         }

@@ -25,6 +25,8 @@ pub struct Rendered {
     pub stats: Stats,
     /// Wall time of the render.
     pub elapsed: Duration,
+    /// The size of the lattice it traced with, when [`render_accel`] built one.
+    pub lattice: Option<LatticeSize>,
 }
 
 /// Collects gray tiles into a full image and shows progress on long renders.
@@ -83,7 +85,7 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
         })
         .collect();
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let mut out = Rendered { bits: vec![0; BitFrame::bytes(w as u32, h as u32)], gray: vec![0; w * h], stats: Stats::default(), elapsed: Duration::ZERO };
+    let mut out = Rendered { bits: vec![0; BitFrame::bytes(w as u32, h as u32)], gray: vec![0; w * h], stats: Stats::default(), elapsed: Duration::ZERO, lattice: None };
     for band in bands {
         let band = band?;
         out.bits.iter_mut().zip(&band.bits).for_each(|(a, b)| *a |= b);
@@ -108,7 +110,7 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
         other => anyhow!("{other}"),
     })?;
     let elapsed = start.elapsed();
-    Ok(Rendered { bits, gray: hooks.gray, stats, elapsed })
+    Ok(Rendered { bits, gray: hooks.gray, stats, elapsed, lattice: None })
 }
 
 
@@ -189,10 +191,12 @@ pub fn render_accel<R: Real>(
 ) -> Result<Rendered> {
     let mut bufs;
     let lattice;
+    let mut size = None;
     let a: &(dyn Accelerator<R> + Sync) = match accel {
         Accel::Lattice => {
             bufs = lattice_storage(scene, cfg)?;
             lattice = build_lattice(&mut bufs, scene, cfg)?;
+            size = Some(LatticeSize::of(&lattice));
             &lattice
         }
         Accel::Bbox => &BoundingBox,
@@ -200,11 +204,9 @@ pub fn render_accel<R: Real>(
     };
     let mut tracer = Tracer::new(scene, a);
     tune(&mut tracer);
-    if parallel {
-        render_with(&tracer, frame, progress)
-    } else {
-        render_band(&tracer, frame, progress)
-    }
+    let mut out = if parallel { render_with(&tracer, frame, progress) } else { render_band(&tracer, frame, progress) }?;
+    out.lattice = size;
+    Ok(out)
 }
 
 /// One line of what a render counted.
@@ -227,17 +229,16 @@ fn stats_line(label: &str, s: &Stats, elapsed: Duration) -> String {
 /// `host-sim render`.
 pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     crate::output::check_png_size(a.size.0 as u32, a.size.1 as u32, a.scale)?;
-    outputs(a)?;
+    let files = outputs(a)?;
     let text = read(&a.scene)?;
     let frame = a.frame();
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage, &frame)?;
     let mut out = render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true).map_err(|e| {
         // Only render chooses its method: say how to trace without a lattice.
-        if a.budget.is_some() && e.to_string().starts_with("no lattice fits") {
-            anyhow!("{e}, or render with --accel bbox (no lattice)")
-        } else {
-            e
+        match e.downcast_ref::<crate::load::BudgetTooSmall>() {
+            Some(b) => anyhow!("{b}, or render with --accel bbox (no lattice)"),
+            None => e,
         }
     })?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
@@ -246,7 +247,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     // Every output under a temporary name first: if one cannot be written, none is left.
     let mut staged = crate::output::Staged::default();
     let mut stdout = None;
-    for (path, kind) in outputs(a)? {
+    for &(path, kind) in &files {
         if path == Path::new("-") {
             stdout = Some(crate::output::png_bytes(&frame_bits, look)?);
             continue;
@@ -267,39 +268,23 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     }
     // With the picture or JSON on standard output, the messages go to standard error.
     let quiet = a.output == Path::new("-") || a.json;
-    for (p, _) in outputs(a)?.into_iter().filter(|(p, _)| *p != Path::new("-")) {
-        if quiet {
-            eprintln!("wrote {}", p.display());
-        } else {
-            println!("wrote {}", p.display());
-        }
+    let say = |line: String| if quiet { eprintln!("{line}") } else { println!("{line}") };
+    for (p, _) in files.iter().filter(|(p, _)| *p != Path::new("-")) {
+        say(format!("wrote {}", p.display()));
     }
     if a.json {
-        let lattice = match a.accel {
-            Accel::Lattice => {
-                let cfg = crate::cli::lattice_config(a.cells, a.budget);
-                let mut bufs = lattice_storage(&scene, &cfg)?;
-                Some(LatticeSize::of(&build_lattice(&mut bufs, &scene, &cfg)?))
-            }
-            _ => None,
-        };
         let report = RenderReport {
             scene: a.scene.display().to_string(),
             scalar: R::NAME,
             accel: a.accel.name(),
             width: frame.width,
             height: frame.height,
-            lattice,
+            lattice: out.lattice,
             work: Work::of(&out.stats, out.elapsed),
         };
         return print_json(&report);
     }
-    let line = stats_line(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel.name()), &out.stats, out.elapsed);
-    if quiet {
-        eprintln!("{line}");
-    } else {
-        println!("{line}");
-    }
+    say(stats_line(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel.name()), &out.stats, out.elapsed));
     Ok(())
 }
 

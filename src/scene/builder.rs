@@ -271,7 +271,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let c = self.camera;
         check_range::<R>(c.eye)?;
         check_range::<R>(c.look)?;
-        let (angles, _) = c.fov.angles();
+        let angles = c.fov.angles();
         check_finite(&[c.up.x, c.up.y, c.up.z, angles[0], angles[1]])?;
         check_value::<R>("ambient", self.ambient)?;
         check_value::<R>("background", self.background)?;

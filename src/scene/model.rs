@@ -90,11 +90,11 @@ impl FieldOfView {
         }
     }
 
-    /// The angles given, in degrees (one or two).
-    pub fn angles(self) -> ([f64; 2], usize) {
+    /// The angles given, in degrees (the angle across twice for [`FieldOfView::Across`]).
+    pub fn angles(self) -> [f64; 2] {
         match self {
-            FieldOfView::Across(a) => ([a, a], 1),
-            FieldOfView::Within(a, d) => ([a, d], 2),
+            FieldOfView::Across(a) => [a, a],
+            FieldOfView::Within(a, d) => [a, d],
         }
     }
 }

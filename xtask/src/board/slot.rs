@@ -68,20 +68,6 @@ fn message_frame(message: &str) -> Vec<u8> {
     bits
 }
 
-/// The slot's blocks for `text`, numbered after `image`'s, with no check of the text (the
-/// cases the host refuses, to see the board refuse them too).
-fn unchecked(image: &[u8], text: &str) -> Vec<u8> {
-    use slot::uf2;
-    let mut blocks: Vec<[u8; uf2::BLOCK]> = image.chunks(uf2::BLOCK).map(|b| b.try_into().expect("whole blocks")).collect();
-    let first = blocks.len();
-    let count = (first + uf2::slot_blocks(text.as_bytes())) as u32;
-    for k in 0..uf2::slot_blocks(text.as_bytes()) {
-        blocks.push(uf2::slot_block(text.as_bytes(), k, (first + k) as u32, count));
-    }
-    blocks.iter_mut().enumerate().for_each(|(i, b)| uf2::renumber(b, i as u32, count));
-    blocks.concat()
-}
-
 impl Session<'_> {
     /// Builds the slot image (unless `no_build`), writes each case's UF2 file and runs it for
     /// one frame, checking the panel and the log.
@@ -106,8 +92,8 @@ impl Session<'_> {
             Case { name: "user", what: "a scene of the user's (`host-sim uf2 --scene`)", uf2: user, expect: Expect::Frame(USER_SCENE) },
             Case { name: "empty", what: "the slot image alone (nothing in its slot)", uf2: image.clone(), expect: Expect::Message(SlotError::Empty.to_string()) },
             Case { name: "corrupt", what: "the user's file with a byte of its scene changed", uf2: corrupt, expect: Expect::Message(SlotError::Corrupt { stored, computed: slot::checksum(&damaged) }.to_string()) },
-            Case { name: "too-big", what: "70 spheres (room for 64), written past the host's check", uf2: unchecked(&image, &too_big), expect: Expect::Message(refused(&too_big)) },
-            Case { name: "mistake", what: "a misspelt attribute, written past the host's check", uf2: unchecked(&image, mistake), expect: Expect::Message(refused(mistake)) },
+            Case { name: "too-big", what: "70 spheres (room for 64), written past the host's check", uf2: slot::with::unchecked(&image, &too_big).map_err(anyhow::Error::msg)?, expect: Expect::Message(refused(&too_big)) },
+            Case { name: "mistake", what: "a misspelt attribute, written past the host's check", uf2: slot::with::unchecked(&image, mistake).map_err(anyhow::Error::msg)?, expect: Expect::Message(refused(mistake)) },
         ];
         let mut rows = Vec::new();
         for case in cases {
