@@ -9,14 +9,13 @@
 //! capacities are the exact maximum the chosen scenes need (written to `capacities.rs`).
 use lattice_rt::bake::Literal;
 use lattice_rt::lattice::{LatticeConfig, LatticeStorage, SubLattice};
-use lattice_rt::Lattice;
 use lattice_rt::scene::Object;
+use lattice_rt::Lattice;
 use lattice_rt::{Real, Sizes};
 
 use board_records::frame;
 use std::fmt::Write as _;
 use std::{env, fs, path::PathBuf};
-
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
@@ -34,7 +33,8 @@ fn main() {
     let mut map = fs::read_to_string(src).expect("memory.x");
     println!("cargo:rerun-if-env-changed=FIRMWARE_FLASH_KIB");
     if let (true, Ok(kib)) = (tiny, env::var("FIRMWARE_FLASH_KIB")) {
-        let kib: u32 = kib.trim().parse().unwrap_or_else(|_| panic!("FIRMWARE_FLASH_KIB is not a number of KiB: {kib:?}"));
+        let kib: u32 =
+            kib.trim().parse().unwrap_or_else(|_| panic!("FIRMWARE_FLASH_KIB is not a number of KiB: {kib:?}"));
         map = map.replace("LENGTH = 16K", &format!("LENGTH = {kib}K"));
     }
     // The slot image keeps its code below the scene slot (`board_records::slot::ADDRESS`).
@@ -44,11 +44,19 @@ fn main() {
     }
     fs::write(out.join("memory.x"), map).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
-    for map in ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x", "microbit/memory.x", "tiny/memory.x"] {
+    for map in
+        ["../memory.x", "pico2/memory.x", "qemu-an505/memory.x", "qemu/memory.x", "microbit/memory.x", "tiny/memory.x"]
+    {
         println!("cargo:rerun-if-changed={map}");
     }
     // The core's name in the firmware's reports.
-    let core = if m33 { "m33" } else if target.starts_with("thumbv7em") { "m4f" } else { "m0" };
+    let core = if m33 {
+        "m33"
+    } else if target.starts_with("thumbv7em") {
+        "m4f"
+    } else {
+        "m0"
+    };
     println!("cargo:rustc-env=FIRMWARE_CORE={core}");
     println!("cargo:rerun-if-env-changed=FIRMWARE_SCENES");
     // The Pico's hot code runs from SRAM (pico/ram-code.x), unless `code-in-flash` keeps it in
@@ -74,7 +82,8 @@ fn main() {
     }
 
     println!("cargo:rerun-if-changed=default-scenes.txt");
-    let names = env::var("FIRMWARE_SCENES").unwrap_or_else(|_| fs::read_to_string("default-scenes.txt").expect("default-scenes.txt"));
+    let names = env::var("FIRMWARE_SCENES")
+        .unwrap_or_else(|_| fs::read_to_string("default-scenes.txt").expect("default-scenes.txt"));
     let mut list = String::new();
     let mut sizes = Sizes { objects: 1, lattices: 1, coords: 1, words: 1, rows: 0 };
     let mut effects = 0u8;
@@ -148,7 +157,13 @@ fn main() {
     fs::write(out.join("capacities.rs"), code).unwrap();
     if baked {
         let names: Vec<String> = scenes.iter().map(|(n, ..)| format!("({n:?}, &{})", table_name(n))).collect();
-        writeln!(tables, "/// The baked scenes, by name.\npub static BAKED: [(&str, &Baked<S>); {}] = [{}];", names.len(), names.join(", ")).unwrap();
+        writeln!(
+            tables,
+            "/// The baked scenes, by name.\npub static BAKED: [(&str, &Baked<S>); {}] = [{}];",
+            names.len(),
+            names.join(", ")
+        )
+        .unwrap();
         fs::write(out.join("baked.rs"), tables).unwrap();
     }
 }
@@ -179,10 +194,15 @@ fn plan_in_scalar(path: &std::path::Path, text: &str, bake: Option<(&str, bool, 
 /// Storage and effects of one scene in the firmware's scalar, and whether its windows serve
 /// every ray; with `bake`, its tables too (the scene as parsed and, if asked for, its lattice
 /// as built in that scalar, as the firmware would).
-fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&str, bool, &mut String)>) -> (Sizes, u8, bool) {
+fn plan<R: Real + Literal>(
+    path: &std::path::Path,
+    text: &str,
+    bake: Option<(&str, bool, &mut String)>,
+) -> (Sizes, u8, bool) {
     let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
     let mut parts = lattice_rt::Parts::default();
-    let scene = lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let scene =
+        lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     // build.rs's own lattice-rt has every shape: the firmware's may not.
     for (i, o) in scene.objects().iter().enumerate() {
         let Some(feature) = o.shape().feature() else { continue };
@@ -196,10 +216,16 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<(&st
     let sizes = Sizes::of(&scene, Some(&cfg), &frame::rendered(frame::Build::of(has)));
     if let Some((name, with_lattice, out)) = bake {
         let s = Lattice::plan(&scene, &cfg);
-        let (mut lattices, mut coords, mut words) = (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);
+        let (mut lattices, mut coords, mut words) =
+            (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);
         let storage = LatticeStorage { lattices: &mut lattices, coords: &mut coords, words: &mut words };
         let lattice = Lattice::build(&scene, &cfg, storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        out.push_str(&lattice_rt::bake::source(&table_name(name), "S", &scene, Some(&lattice).filter(|_| with_lattice)));
+        out.push_str(&lattice_rt::bake::source(
+            &table_name(name),
+            "S",
+            &scene,
+            Some(&lattice).filter(|_| with_lattice),
+        ));
     }
     (sizes, effects, lattice_rt::EyeRays::serve_every_ray(&scene))
 }

@@ -136,7 +136,21 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0, eye_on: false, eye_uv: 0, first_light: None, axis_normal: None, last_hit: u32::MAX, box_tests: true, skip: [u32::MAX; 2], occluders: [u32::MAX; MAX_LIGHTS], eye_candidates: u64::MAX, eye_list: None }
+        Query {
+            stats: Stats::default(),
+            mailbox,
+            ray_id: 0,
+            eye_on: false,
+            eye_uv: 0,
+            first_light: None,
+            axis_normal: None,
+            last_hit: u32::MAX,
+            box_tests: true,
+            skip: [u32::MAX; 2],
+            occluders: [u32::MAX; MAX_LIGHTS],
+            eye_candidates: u64::MAX,
+            eye_list: None,
+        }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {

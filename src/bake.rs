@@ -149,7 +149,11 @@ mod writer {
     }
     impl<R: Literal> Literal for Material<R> {
         fn literal(&self, out: &mut String) {
-            record(out, "Material", &[("ka", &self.ka), ("kd", &self.kd), ("ks", &self.ks), ("kt", &self.kt), ("ior", &self.ior)]);
+            record(
+                out,
+                "Material",
+                &[("ka", &self.ka), ("kd", &self.kd), ("ks", &self.ks), ("kt", &self.kt), ("ior", &self.ior)],
+            );
         }
     }
     impl<R: Literal> Literal for Light<R> {
@@ -158,7 +162,9 @@ mod writer {
                 Light::Directional { to_light, intensity } => {
                     record(out, "Light::Directional", &[("to_light", to_light), ("intensity", intensity)])
                 }
-                Light::Point { pos, intensity } => record(out, "Light::Point", &[("pos", pos), ("intensity", intensity)]),
+                Light::Point { pos, intensity } => {
+                    record(out, "Light::Point", &[("pos", pos), ("intensity", intensity)])
+                }
             }
         }
     }
@@ -169,12 +175,33 @@ mod writer {
     }
     impl<R: Literal> Literal for Camera<R> {
         fn literal(&self, out: &mut String) {
-            record(out, "Camera", &[("eye", &self.eye), ("forward", &self.forward), ("right", &self.right), ("up", &self.up), ("resolves", &self.resolves), ("shape", &self.shape)]);
+            record(
+                out,
+                "Camera",
+                &[
+                    ("eye", &self.eye),
+                    ("forward", &self.forward),
+                    ("right", &self.right),
+                    ("up", &self.up),
+                    ("resolves", &self.resolves),
+                    ("shape", &self.shape),
+                ],
+            );
         }
     }
     impl<R: Literal> Literal for SubLattice<R> {
         fn literal(&self, out: &mut String) {
-            record(out, "SubLattice", &[("bounds", &self.bounds), ("n", &self.n), ("coord_start", &self.coord_start), ("cell_start", &self.cell_start), ("dense_cell", &self.dense_cell)])
+            record(
+                out,
+                "SubLattice",
+                &[
+                    ("bounds", &self.bounds),
+                    ("n", &self.n),
+                    ("coord_start", &self.coord_start),
+                    ("cell_start", &self.cell_start),
+                    ("dense_cell", &self.dense_cell),
+                ],
+            )
         }
     }
     impl<R: Literal> Literal for Object<R> {
@@ -231,7 +258,12 @@ mod writer {
     /// the windows, [`EyeRays::serve_every_ray`](crate::EyeRays::serve_every_ray)). The code
     /// that includes it must have the types of [`prelude`](super::prelude) and the scalar
     /// `scalar` in scope.
-    pub fn source<R: Real + Literal>(name: &str, scalar: &str, scene: &Scene<'_, R>, lattice: Option<&Lattice<'_, R>>) -> String {
+    pub fn source<R: Real + Literal>(
+        name: &str,
+        scalar: &str,
+        scene: &Scene<'_, R>,
+        lattice: Option<&Lattice<'_, R>>,
+    ) -> String {
         let mut out = String::new();
         let _ = write!(out, "/// The scene `{name}`, baked.\npub static {name}: Baked<{scalar}> = Baked {{\n    scene: Scene::from_tables(\n        &");
         list(scene.objects, &mut out);
@@ -287,11 +319,11 @@ mod writer {
 pub mod prelude {
     pub use super::Baked;
     pub use crate::lattice::{Lattice, SubLattice};
-    pub use crate::scene::Scene;
     pub use crate::math::{Aabb, Affine, Linear, Vec3};
+    pub use crate::scalar::Pow2;
+    pub use crate::scene::Scene;
     pub use crate::scene::{Camera, Composite, Light, Material, Object};
     pub use crate::shape::Shape;
-    pub use crate::scalar::Pow2;
     pub use crate::{F32Micro, F32MicroNewton, Fx};
 }
 
@@ -316,7 +348,8 @@ mod tests {
         let cfg = LatticeConfig::default();
         let s = Lattice::plan(&scene, &cfg);
         let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![Fx(0); s.coords], vec![0; s.words()]);
-        let lattice = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
+        let lattice =
+            Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
         let (l, co, words, entries, narrow) = lattice.tables();
         let copy = Lattice::from_tables(l, co, words, entries, narrow, scene.objects.len());
         let tables = Scene::from_tables(
@@ -349,7 +382,8 @@ mod tests {
         #[cfg(feature = "bake")]
         {
             let src = source("TEST", "Fx", &scene, Some(&lattice));
-            assert!(source("TEST", "Fx", &scene, None).contains("lattice: Lattice::from_tables(\n        &[],\n        &[],"));
+            assert!(source("TEST", "Fx", &scene, None)
+                .contains("lattice: Lattice::from_tables(\n        &[],\n        &[],"));
             assert_eq!(src.matches("Object::from_tables(").count(), scene.objects.len());
             assert!(src.starts_with("/// The scene `TEST`, baked.\npub static TEST: Baked<Fx> = Baked {"));
             let mut f = std::string::String::new();

@@ -4,12 +4,12 @@
 //! binary PBM (`P4`) file, so tests, host-sim and the emulated firmware can all emit the same
 //! bytes. The renderer never needs it; it is one possible [`DrawTarget`].
 
+use crate::bounds::{at_mut, span_mut};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::{PointsIter, Rectangle};
 use embedded_graphics_core::Pixel;
-use crate::bounds::{at_mut, span_mut};
 
 /// A 1-bit frame; `On` pixels are stored as 1 (PBM black).
 #[derive(Debug)]
@@ -115,10 +115,17 @@ impl DrawTarget for BitFrame<'_> {
 
     /// A whole rectangle inside the frame (a tile) goes row by row with no per-pixel bounds
     /// checks; one reaching outside goes pixel by pixel through [`DrawTarget::draw_iter`].
-    fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Self::Error> {
+    fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(
+        &mut self,
+        area: &Rectangle,
+        colors: I,
+    ) -> Result<(), Self::Error> {
         let (x0, y0) = (area.top_left.x, area.top_left.y);
         let (w, h) = (area.size.width, area.size.height);
-        let inside = x0 >= 0 && y0 >= 0 && (x0 as u32).checked_add(w).is_some_and(|x1| x1 <= self.width) && (y0 as u32).checked_add(h).is_some_and(|y1| y1 <= self.height);
+        let inside = x0 >= 0
+            && y0 >= 0
+            && (x0 as u32).checked_add(w).is_some_and(|x1| x1 <= self.width)
+            && (y0 as u32).checked_add(h).is_some_and(|y1| y1 <= self.height);
         if !inside {
             return self.draw_iter(area.points().zip(colors).map(|(p, c)| Pixel(p, c)));
         }
@@ -172,7 +179,18 @@ mod tests {
     /// its pixels one by one sets.
     #[test]
     fn fill_contiguous_is_draw_iter() {
-        for (x, y, w, h) in [(0, 0, 8, 8), (8, 16, 8, 8), (3, 5, 7, 3), (20, 10, 8, 8), (-3, -2, 6, 5), (0, 0, 21, 13), (0, 0, 0, 4), (8, 1, 13, 4), (16, 0, 5, 2), (5, 3, 16, 2)] {
+        for (x, y, w, h) in [
+            (0, 0, 8, 8),
+            (8, 16, 8, 8),
+            (3, 5, 7, 3),
+            (20, 10, 8, 8),
+            (-3, -2, 6, 5),
+            (0, 0, 21, 13),
+            (0, 0, 0, 4),
+            (8, 1, 13, 4),
+            (16, 0, 5, 2),
+            (5, 3, 16, 2),
+        ] {
             let area = Rectangle::new(Point::new(x, y), Size::new(w, h));
             let colors = (0..w * h).map(|i| BinaryColor::from((i * 7 + i / 3) % 5 < 2));
             let (mut a, mut b) = ([0x5au8; 3 * 13], [0x5au8; 3 * 13]);
@@ -193,7 +211,10 @@ mod tests {
             let colors = (0..n).map(|i| BinaryColor::from(i % 3 == 0));
             let (mut a, mut b) = ([0x5au8; 3 * 13], [0x5au8; 3 * 13]);
             BitFrame::wrap(21, 13, &mut a).unwrap().fill_contiguous(&area, colors.clone()).unwrap();
-            BitFrame::wrap(21, 13, &mut b).unwrap().draw_iter(area.points().zip(colors).map(|(p, c)| Pixel(p, c))).unwrap();
+            BitFrame::wrap(21, 13, &mut b)
+                .unwrap()
+                .draw_iter(area.points().zip(colors).map(|(p, c)| Pixel(p, c)))
+                .unwrap();
             assert_eq!(a, b, "{n} colors");
         }
     }

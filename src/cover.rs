@@ -7,15 +7,20 @@
 //! candidate mask ([`crate::scene::Scene::eye_candidates`]) does the same; the lists serve the
 //! larger ones, in one pass over the objects instead of one per tile.
 
-use crate::scene::{Camera, EyeWindow, Scene};
-use core::ops::Range;
 use crate::bounds::{at_mut, span_mut};
 use crate::scalar::Real;
+use crate::scene::{Camera, EyeWindow, Scene};
+use core::ops::Range;
 
 /// A tile's rectangle on the window (2^-16 units, inclusive, as [`Camera::window_uv`] gives):
 /// its pixels `x0..x0 + tw` by `y0..y0 + th`, widened by `margin` pixels on each side, on an
 /// image of `(w4, h4)` quarter pixels. Returns the `u` and the `v` range.
-pub(crate) fn tile_window<R: Real>(x: (usize, usize), y: (usize, usize), margin: usize, (w4, h4): (i32, i32)) -> ([i32; 2], [i32; 2]) {
+pub(crate) fn tile_window<R: Real>(
+    x: (usize, usize),
+    y: (usize, usize),
+    margin: usize,
+    (w4, h4): (i32, i32),
+) -> ([i32; 2], [i32; 2]) {
     let m = 4 * margin as i32;
     let (sx, sy) = ([4 * x.0 as i32 - m, 4 * (x.0 + x.1) as i32 + m], [4 * y.0 as i32 - m, 4 * (y.0 + y.1) as i32 + m]);
     let (lo, hi) = (Camera::<R>::window_uv(sx[0], sy[1], w4, h4), Camera::<R>::window_uv(sx[1], sy[0], w4, h4));
@@ -65,7 +70,10 @@ impl Tiling {
         let (w, m) = (self.size.0, 4 * self.margin as i32);
         let x0 = tx * self.t;
         let w4 = 4 * w as i32;
-        [Camera::<R>::window_u(4 * x0 as i32 - m, w4), Camera::<R>::window_u(4 * (x0 + self.t.min(w - x0)) as i32 + m, w4)]
+        [
+            Camera::<R>::window_u(4 * x0 as i32 - m, w4),
+            Camera::<R>::window_u(4 * (x0 + self.t.min(w - x0)) as i32 + m, w4),
+        ]
     }
 
     /// The `v` range of tile row `ty`'s window (widened by the margin; `v` points up).
@@ -73,7 +81,10 @@ impl Tiling {
         let (h, m) = (self.size.1, 4 * self.margin as i32);
         let y0 = ty * self.t;
         let h4 = 4 * h as i32;
-        [Camera::<R>::window_v(4 * (y0 + self.t.min(h - y0)) as i32 + m, h4), Camera::<R>::window_v(4 * y0 as i32 - m, h4)]
+        [
+            Camera::<R>::window_v(4 * (y0 + self.t.min(h - y0)) as i32 + m, h4),
+            Camera::<R>::window_v(4 * y0 as i32 - m, h4),
+        ]
     }
 
     /// Counts into `cover`'s first entries (one per tile, row by row; saturating) how many of
@@ -162,13 +173,19 @@ mod tests {
             // Each tile's ranges are the rectangle a tile's candidate mask is taken over.
             for (tx, ty) in (0..nx).flat_map(|tx| (0..ny).map(move |ty| (tx, ty))) {
                 let (x0, y0) = (tx * t, ty * t);
-                let whole = tile_window::<f64>((x0, t.min(size.0 - x0)), (y0, t.min(size.1 - y0)), margin, (4 * size.0 as i32, 4 * size.1 as i32));
+                let whole = tile_window::<f64>(
+                    (x0, t.min(size.0 - x0)),
+                    (y0, t.min(size.1 - y0)),
+                    margin,
+                    (4 * size.0 as i32, 4 * size.1 as i32),
+                );
                 assert_eq!(tiling.ranges::<f64>(tx, ty), whole, "{size:?} tile ({tx}, {ty})");
             }
             for k in 0..400 {
                 let r = if k % 4 == 0 { 1 << 18 } else { 1 << 16 };
                 let (a, b, c, d) = (next(r), next(r), next(r), next(r));
-                let mut window = if k == 0 { crate::scene::WHOLE_PLANE } else { [a.min(b), a.max(b), c.min(d), c.max(d)] };
+                let mut window =
+                    if k == 0 { crate::scene::WHOLE_PLANE } else { [a.min(b), a.max(b), c.min(d), c.max(d)] };
                 if k % 4 == 1 {
                     // Edges exactly on tiles' edges: touching counts as meeting.
                     let (tx, ty) = (a.unsigned_abs() as usize % nx, c.unsigned_abs() as usize % ny);
@@ -186,7 +203,11 @@ mod tests {
                     for tx in 0..nx {
                         let (u, v) = tiling.ranges::<f64>(tx, ty);
                         let meets = window[0] <= u[1] && u[0] <= window[1] && window[2] <= v[1] && v[0] <= window[3];
-                        assert_eq!(cols.contains(&tx) && rows.contains(&ty), meets, "{size:?} tile ({tx}, {ty}) window {window:?}");
+                        assert_eq!(
+                            cols.contains(&tx) && rows.contains(&ty),
+                            meets,
+                            "{size:?} tile ({tx}, {ty}) window {window:?}"
+                        );
                         some += usize::from(meets);
                     }
                 }

@@ -253,7 +253,15 @@ impl<'c> Carry<'c> {
     /// Never inlined: its accumulators then take stack only while a tile is dithered, not for
     /// the whole of its caller's render loop (the deepest stack is the tracer's, below it).
     #[inline(never)]
-    pub fn tile(&mut self, mode: Dither, (x0, y0): (usize, usize), w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
+    pub fn tile(
+        &mut self,
+        mode: Dither,
+        (x0, y0): (usize, usize),
+        w: usize,
+        h: usize,
+        levels: &[u8],
+        out: &mut [BinaryColor],
+    ) {
         // Each kernel inlined as a constant: its weights unrolled and its divisor a shift, not
         // a division call per neighbour (a Cortex-M0+ has no divide instruction).
         if mode == Dither::Atkinson {
@@ -274,7 +282,15 @@ impl<'c> Carry<'c> {
     /// [`EDGE_PAD`] columns beyond it too, as pixels that are not drawn; at the left edge each
     /// row starts with its [`row_seed`].
     #[inline(always)]
-    fn diffuse(&mut self, kernel: impl Fn(&mut Acc, usize, &[u8], &mut [BinaryColor]), (x0, y0): (usize, usize), w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
+    fn diffuse(
+        &mut self,
+        kernel: impl Fn(&mut Acc, usize, &[u8], &mut [BinaryColor]),
+        (x0, y0): (usize, usize),
+        w: usize,
+        h: usize,
+        levels: &[u8],
+        out: &mut [BinaryColor],
+    ) {
         // No tile is larger (the render's tiles are at most MAX_TILE on a side); saying so lets
         // the kernel's indices go unchecked.
         let (w, h) = (w.min(MAX_TILE), h.min(MAX_TILE));
@@ -425,7 +441,9 @@ mod tests {
     use super::*;
 
     fn art(w: usize, px: &[BinaryColor]) -> std::string::String {
-        px.chunks(w).map(|r| r.iter().map(|c| if c.is_on() { '#' } else { '.' }).collect::<std::string::String>() + "\n").collect()
+        px.chunks(w)
+            .map(|r| r.iter().map(|c| if c.is_on() { '#' } else { '.' }).collect::<std::string::String>() + "\n")
+            .collect()
     }
 
     #[test]
@@ -438,7 +456,11 @@ mod tests {
             let mut out = [BinaryColor::Off; MAX_TILE * MAX_TILE];
             d.tile(x0, y0, w, h, &levels, &mut out);
             for (i, &l) in levels.iter().enumerate() {
-                assert_eq!(out[i], blue_noise(l, (x0 + i % w) as u32, (y0 + i / w) as u32), "tile at ({x0}, {y0}), pixel {i}");
+                assert_eq!(
+                    out[i],
+                    blue_noise(l, (x0 + i % w) as u32, (y0 + i / w) as u32),
+                    "tile at ({x0}, {y0}), pixel {i}"
+                );
             }
         }
     }

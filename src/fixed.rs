@@ -290,7 +290,11 @@ impl Real for Fx {
         if lead > 30 {
             return Fx::MAX;
         }
-        let raw = if lead >= 11 { (1 << lead) | (mantissa << (lead - 11)) } else { (1 << lead) + mantissa.div_ceil(1 << (11 - lead)) };
+        let raw = if lead >= 11 {
+            (1 << lead) | (mantissa << (lead - 11))
+        } else {
+            (1 << lead) + mantissa.div_ceil(1 << (11 - lead))
+        };
         Fx(raw as i32)
     }
     #[inline]
@@ -436,7 +440,8 @@ mod tests {
         // Every path of `product` (a factor below 1, both below 128, the rest) against the
         // 64-bit product, on magnitudes of every size and at the paths' edges.
         let want = |a: u32, b: u32| ((u64::from(a) * u64::from(b) + 0x8000) >> 16).min(i32::MAX as u64) as i32;
-        let edges = [0u32, 1, 0xFFFF, 0x1_0000, 0x1_0001, 0x7F_FFFF, 0x80_0000, 0x80_0001, 0xFF_FFFF, 0x7FFF_FFFF, 0x8000_0000];
+        let edges =
+            [0u32, 1, 0xFFFF, 0x1_0000, 0x1_0001, 0x7F_FFFF, 0x80_0000, 0x80_0001, 0xFF_FFFF, 0x7FFF_FFFF, 0x8000_0000];
         for &a in &edges {
             for &b in &edges {
                 if a >> 16 != 0 || b >> 16 != 0 {
@@ -459,10 +464,30 @@ mod tests {
         // Every path of `Fx * Fx` against the 64-bit product: |a| |b| rounded half away from
         // zero, saturated, then signed.
         let want = |a: i32, b: i32| {
-            let m = ((u64::from(a.unsigned_abs()) * u64::from(b.unsigned_abs()) + 0x8000) >> 16).min(i32::MAX as u64) as i32;
-            if (a ^ b) < 0 { -m } else { m }
+            let m = ((u64::from(a.unsigned_abs()) * u64::from(b.unsigned_abs()) + 0x8000) >> 16).min(i32::MAX as u64)
+                as i32;
+            if (a ^ b) < 0 {
+                -m
+            } else {
+                m
+            }
         };
-        let edges = [0, 1, -1, 0x7FFF, 0x8000, -0x8000, 46_340, -46_341, 0xFFFF, -0xFFFF, 0x1_0000, -0x1_0000, i32::MAX, -i32::MAX];
+        let edges = [
+            0,
+            1,
+            -1,
+            0x7FFF,
+            0x8000,
+            -0x8000,
+            46_340,
+            -46_341,
+            0xFFFF,
+            -0xFFFF,
+            0x1_0000,
+            -0x1_0000,
+            i32::MAX,
+            -i32::MAX,
+        ];
         for &a in &edges {
             for &b in &edges {
                 assert_eq!((Fx(a) * Fx(b)).0, want(a, b), "{a} * {b}");
@@ -471,7 +496,10 @@ mod tests {
         let mut x = 0x0123_4567_89AB_CDEFu64;
         for _ in 0..200_000 {
             xorshift(&mut x);
-            let (a, b) = (((x as i32) >> (x % 31) as i32).max(-i32::MAX), (((x >> 32) as i32) >> ((x >> 8) % 31) as i32).max(-i32::MAX));
+            let (a, b) = (
+                ((x as i32) >> (x % 31) as i32).max(-i32::MAX),
+                (((x >> 32) as i32) >> ((x >> 8) % 31) as i32).max(-i32::MAX),
+            );
             assert_eq!((Fx(a) * Fx(b)).0, want(a, b), "{a} * {b}");
         }
     }
@@ -557,7 +585,21 @@ mod tests {
             check(small, small >> (x % 5));
         }
         // Around the products that just fit and just saturate, and the halves' extremes.
-        let edges: [i32; 13] = [0, 1, 0x7FFF, 0x8000, 0xFFFF, 0x1_0000, 0x1_FFFF, 0x00B5_04F3, 0x00B5_0500, 0x7FFF_0000, 0x7FFF_FFFF, 0x00FF_FFFF, 0x0100_0000];
+        let edges: [i32; 13] = [
+            0,
+            1,
+            0x7FFF,
+            0x8000,
+            0xFFFF,
+            0x1_0000,
+            0x1_FFFF,
+            0x00B5_04F3,
+            0x00B5_0500,
+            0x7FFF_0000,
+            0x7FFF_FFFF,
+            0x00FF_FFFF,
+            0x0100_0000,
+        ];
         for &a in &edges {
             for &b in &edges {
                 for (da, db) in [(0, 0), (-1, 1), (1, -1), (2, 3)] {
@@ -597,7 +639,8 @@ mod tests {
             let b = ((x as i32) >> (x % 31) as i32).max(-i32::MAX);
             assert_eq!(Fx(b).recip(), Fx::ONE / Fx(b), "1 / {b}");
         }
-        for b in (-70_000..=70_000).chain([i32::MAX, -i32::MAX, i32::MAX - 1, 1 << 30, -(1 << 30), 3 << 20, 65_537 * 3]) {
+        for b in (-70_000..=70_000).chain([i32::MAX, -i32::MAX, i32::MAX - 1, 1 << 30, -(1 << 30), 3 << 20, 65_537 * 3])
+        {
             assert_eq!(Fx(b).recip(), Fx::ONE / Fx(b), "1 / {b}");
         }
     }
@@ -622,7 +665,9 @@ mod tests {
     #[test]
     fn divide_by_large_powers_of_two_matches_the_wide_quotient() {
         for k in 23..31 {
-            for a in [0, 1, 3, 0x7f, 0x80, 0x81, 0xffff, 0x1_0000, 0x12_3456, 0x7fff_ffff, -1, -0x80, -0x81, -0x7fff_ffff] {
+            for a in
+                [0, 1, 3, 0x7f, 0x80, 0x81, 0xffff, 0x1_0000, 0x12_3456, 0x7fff_ffff, -1, -0x80, -0x81, -0x7fff_ffff]
+            {
                 for b in [1i32 << k, -(1i32 << k)] {
                     let (n, d) = ((a as i64).abs() << 16, (b as i64).abs());
                     let q = if (n % d) * 2 >= d { n / d + 1 } else { n / d };
@@ -646,7 +691,11 @@ mod tests {
             while (r + 1) * (r + 1) <= n {
                 r += 1;
             }
-            if n - r * r > r { r + 1 } else { r }
+            if n - r * r > r {
+                r + 1
+            } else {
+                r
+            }
         };
         let mut x = 0x9E37_79B9u32;
         let edges = [0u32, 1, 2, 3, 4, 255, 256, 65535, 65536, 65537, i32::MAX as u32 - 1, i32::MAX as u32];

@@ -6,10 +6,10 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 #![deny(trivial_casts, trivial_numeric_casts, unused_qualifications, missing_copy_implementations)]
 
-#[cfg(test)]
-extern crate std;
 #[cfg(feature = "alloc")]
 extern crate alloc;
+#[cfg(test)]
+extern crate std;
 
 // In the order the data flows: numbers, geometry, the scene (text in, validated scene out),
 // the lattice over it, the storage that holds both and the loading that fills it, then tracing, sampling, dithering and the
@@ -26,14 +26,14 @@ pub use shape::{Shape, ShapeHit};
 pub mod scene;
 pub use scene::text::{parse, ParseError};
 pub use scene::{Parts, Scene, SceneBuilder, SceneError};
+pub mod accel;
 #[cfg(any(test, feature = "generate"))]
 pub mod generate;
-pub mod accel;
 pub use accel::{Accelerator, BoundingBox, BruteForce, Hit, Query, Stats};
 pub mod lattice;
 pub use lattice::{Lattice, LatticeConfig, LatticeStorage};
-pub mod storage;
 pub mod load;
+pub mod storage;
 pub use load::{LoadError, Loaded};
 pub mod bake;
 pub use bake::Baked;
@@ -41,13 +41,16 @@ pub use storage::{Buffers, Sizes, Storage, StorageView};
 #[cfg(feature = "alloc")]
 pub use storage::{HeapScratch, HeapStorage};
 pub mod trace;
-pub use trace::{EyeRays, Effects, Tracer};
-pub mod sample;
+pub use trace::{Effects, EyeRays, Tracer};
 pub mod dither;
+pub mod sample;
 pub use dither::{Dither, Tone};
+mod cover;
 pub mod outline;
 pub mod render;
-mod cover;
-pub use render::{dither_band, dither_tiles, render, render_pass, render_share, trace_pass, trace_share, Frame, Hooks, KeptTile, NoHooks, Sampling, Scratch, Share, Traced};
+pub use render::{
+    dither_band, dither_tiles, render, render_pass, render_share, trace_pass, trace_share, Frame, Hooks, KeptTile,
+    NoHooks, Sampling, Scratch, Share, Traced,
+};
 pub mod bitframe;
 pub use bitframe::BitFrame;

@@ -45,11 +45,7 @@ impl core::error::Error for LoadError<'_> {}
 impl<'a, R: Real> StorageView<'a, R> {
     /// Parses `text` into the object storage and builds its lattice with `cfg` in the rest;
     /// what is left becomes the render's scratch.
-    pub fn load<'t>(
-        self,
-        text: &'t str,
-        cfg: &LatticeConfig,
-    ) -> Result<Loaded<'a, R>, LoadError<'t>> {
+    pub fn load<'t>(self, text: &'t str, cfg: &LatticeConfig) -> Result<Loaded<'a, R>, LoadError<'t>> {
         self.load_with(text, cfg, |_| {})
     }
 
@@ -64,10 +60,6 @@ impl<'a, R: Real> StorageView<'a, R> {
         let ((objects, parts), rest) = self.split();
         let scene = parse_with::<R>(text, objects, parts, camera).map_err(LoadError::Parse)?;
         let (lattice, scratch) = rest.lattice(&scene, cfg).map_err(LoadError::Lattice)?;
-        Ok(Loaded {
-            scene,
-            lattice,
-            scratch,
-        })
+        Ok(Loaded { scene, lattice, scratch })
     }
 }

@@ -43,11 +43,7 @@ impl<R: Real> Vec3<R> {
     }
     /// Cross product.
     pub fn cross(self, o: Self) -> Self {
-        Vec3::new(
-            self.y * o.z - self.z * o.y,
-            self.z * o.x - self.x * o.z,
-            self.x * o.y - self.y * o.x,
-        )
+        Vec3::new(self.y * o.z - self.z * o.y, self.z * o.x - self.x * o.z, self.x * o.y - self.y * o.x)
     }
     /// Euclidean length.
     pub fn length(self) -> R {
@@ -214,7 +210,8 @@ impl<R: Real> Aabb<R> {
     /// The box grown (in `f64`) by the padding [`Aabb::cast_padded`] gives it in `S`.
     pub fn padded_for<S: Real>(&self) -> Aabb<f64> {
         let pad = self.pad_for::<S>();
-        let grow = |v: Vec3<R>, s: f64| Vec3::new(v.x.to_f64() + s * pad, v.y.to_f64() + s * pad, v.z.to_f64() + s * pad);
+        let grow =
+            |v: Vec3<R>, s: f64| Vec3::new(v.x.to_f64() + s * pad, v.y.to_f64() + s * pad, v.z.to_f64() + s * pad);
         Aabb { min: grow(self.min, -1.0), max: grow(self.max, 1.0) }
     }
 }

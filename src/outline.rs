@@ -39,7 +39,14 @@ pub fn apron(tw: usize, th: usize, left: &[(u16, u16)], top: &[(u16, u16)], apro
 }
 
 /// [`apron`] with the tile's left column's and top row's hits as `left(y)` and `top(x)`.
-fn borders(tw: usize, th: usize, left: impl Fn(usize) -> Option<(u16, u16)>, top: impl Fn(usize) -> Option<(u16, u16)>, apron: Apron<'_>, levels: &mut [u8]) {
+fn borders(
+    tw: usize,
+    th: usize,
+    left: impl Fn(usize) -> Option<(u16, u16)>,
+    top: impl Fn(usize) -> Option<(u16, u16)>,
+    apron: Apron<'_>,
+    levels: &mut [u8],
+) {
     if let Some(column) = apron.left {
         for (y, &n) in column.iter().enumerate().take(th) {
             if left(y).is_some_and(|here| differ(n, here)) {
@@ -110,7 +117,10 @@ mod tests {
     }
 
     fn art(levels: &[u8], w: usize) -> std::string::String {
-        levels.chunks(w).map(|r| r.iter().map(|&l| if l == 0 { '#' } else { '.' }).collect::<std::string::String>() + "\n").collect()
+        levels
+            .chunks(w)
+            .map(|r| r.iter().map(|&l| if l == 0 { '#' } else { '.' }).collect::<std::string::String>() + "\n")
+            .collect()
     }
 
     const NO_APRON: Apron<'static> = Apron { left: None, up: None };
@@ -144,7 +154,9 @@ mod tests {
         let (mut a, mut b) = ([40u8; 12], [40u8; 12]);
         tile(3, 4, &split(0), NO_APRON, &mut a);
         tile(3, 4, &split(3), Apron { left: Some(&left), up: None }, &mut b);
-        let whole: std::vec::Vec<u8> = (0..4).flat_map(|y| a[y * 3..y * 3 + 3].iter().chain(&b[y * 3..y * 3 + 3]).copied().collect::<std::vec::Vec<_>>()).collect();
+        let whole: std::vec::Vec<u8> = (0..4)
+            .flat_map(|y| a[y * 3..y * 3 + 3].iter().chain(&b[y * 3..y * 3 + 3]).copied().collect::<std::vec::Vec<_>>())
+            .collect();
         let mut levels = [40u8; 24];
         tile(6, 4, &hits, NO_APRON, &mut levels);
         assert_eq!(art(&whole, 6), art(&levels, 6));

@@ -11,11 +11,11 @@
 
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
-use crate::outline::Apron;
 use crate::math::{Ray, Vec3};
-use crate::scalar::Real;
-pub use crate::sample::{level, Hits, Sampling, Shot};
+use crate::outline::Apron;
 use crate::sample::Sampler;
+pub use crate::sample::{level, Hits, Sampling, Shot};
+use crate::scalar::Real;
 use crate::scene::{Camera, Scene};
 use crate::trace::Tracer;
 use core::fmt;
@@ -143,7 +143,12 @@ impl Frame {
 
     /// Entries of [`Scratch::with_cover`] a render of this frame uses (a few per tile).
     pub fn cover_len(&self) -> usize {
-        crate::cover::Tiling { t: self.tile.max(1) as usize, size: (self.width as usize, self.height as usize), margin: 0 }.len()
+        crate::cover::Tiling {
+            t: self.tile.max(1) as usize,
+            size: (self.width as usize, self.height as usize),
+            margin: 0,
+        }
+        .len()
     }
 
     /// Entries of `i16` scratch storage [`trace_share`] needs: [`Frame::scratch_len`] without
@@ -349,7 +354,13 @@ pub struct KeptTile {
 
 impl KeptTile {
     /// Nothing kept yet.
-    pub const EMPTY: KeptTile = KeptTile { levels: [0; MAX_TILE * MAX_TILE], left: [(0, 0); MAX_TILE], top: [(0, 0); MAX_TILE], right: [(0, 0); MAX_TILE], bottom: [(0, 0); MAX_TILE] };
+    pub const EMPTY: KeptTile = KeptTile {
+        levels: [0; MAX_TILE * MAX_TILE],
+        left: [(0, 0); MAX_TILE],
+        top: [(0, 0); MAX_TILE],
+        right: [(0, 0); MAX_TILE],
+        bottom: [(0, 0); MAX_TILE],
+    };
 }
 
 impl Default for KeptTile {
@@ -408,7 +419,15 @@ pub fn trace_pass<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     if kept.len() < frame.tiles_len(share) {
         return Err(RenderError::ScratchTooSmall { needed: frame.tiles_len(share) });
     }
-    render_tiles::<_, _, Nowhere, E>(tracer, frame, share, Some(Pass { n: pass, traced, whole_share: false }), Out::Keep(kept), scratch, hooks)
+    render_tiles::<_, _, Nowhere, E>(
+        tracer,
+        frame,
+        share,
+        Some(Pass { n: pass, traced, whole_share: false }),
+        Out::Keep(kept),
+        scratch,
+        hooks,
+    )
 }
 
 /// The second half of trace, then dither ([`trace_share`]): dithers tile row `ty` of `frame`
@@ -521,7 +540,10 @@ impl embedded_graphics_core::geometry::OriginDimensions for Nowhere {
 impl DrawTarget for Nowhere {
     type Color = BinaryColor;
     type Error = core::convert::Infallible;
-    fn draw_iter<I: IntoIterator<Item = embedded_graphics_core::Pixel<BinaryColor>>>(&mut self, _: I) -> Result<(), Self::Error> {
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics_core::Pixel<BinaryColor>>>(
+        &mut self,
+        _: I,
+    ) -> Result<(), Self::Error> {
         Ok(())
     }
 }
@@ -559,7 +581,15 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
     if !frame.progressive() || ![8, 4, 2, 1].contains(&pass) || traced.len() < frame.traced_len(share) {
         return Err(RenderError::NotProgressive);
     }
-    render_tiles(tracer, frame, share, Some(Pass { n: pass, traced, whole_share: true }), Out::Draw(target), scratch, hooks)
+    render_tiles(
+        tracer,
+        frame,
+        share,
+        Some(Pass { n: pass, traced, whole_share: true }),
+        Out::Draw(target),
+        scratch,
+        hooks,
+    )
 }
 
 /// Whether the pixels of a tile at `(x0, y0)` between columns `xs` and rows `ys` (inclusive),
@@ -569,7 +599,15 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
 /// ([`crate::scene::hull::behind`]), and the object neither mirrors nor refracts (in the
 /// effects simulated). A tile with more than 64 objects' candidates is never filled so.
 #[allow(clippy::too_many_arguments)]
-fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '_, R, A, E>, candidates: u64, (x0, y0): (usize, usize), (xs, ys): ([usize; 2], [usize; 2]), id: u16, far: u16, size: (i32, i32)) -> bool {
+fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
+    tracer: &Tracer<'_, '_, R, A, E>,
+    candidates: u64,
+    (x0, y0): (usize, usize),
+    (xs, ys): ([usize; 2], [usize; 2]),
+    id: u16,
+    far: u16,
+    size: (i32, i32),
+) -> bool {
     let scene = tracer.scene();
     // A scene of more than 64 objects gives every tile this mask (`Scene::eye_candidates`).
     if candidates == u64::MAX {
@@ -588,7 +626,10 @@ fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(tracer: &Tracer<'_, '
     // corner's centre to the last's (window `v` runs up the image).
     let (w4, h4) = size;
     let centre = |p: usize| 4 * p as i32 + 2;
-    let (lo, hi) = (Camera::<R>::window_uv(centre(x0 + xs[0]), centre(y0 + ys[1]), w4, h4), Camera::<R>::window_uv(centre(x0 + xs[1]), centre(y0 + ys[0]), w4, h4));
+    let (lo, hi) = (
+        Camera::<R>::window_uv(centre(x0 + xs[0]), centre(y0 + ys[1]), w4, h4),
+        Camera::<R>::window_uv(centre(x0 + xs[1]), centre(y0 + ys[0]), w4, h4),
+    );
     let (u, v) = ([lo[0], hi[0]], [lo[1], hi[1]]);
     if !scene.eye_region_among_meets(others, u, v) {
         return true;
@@ -685,7 +726,9 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 q.set_eye_candidates(c);
                 c
             };
-            let mut alone = |xs: [usize; 2], ys: [usize; 2], id: u16, far: u16| alone(tracer, candidates, (x0, y0), (xs, ys), id, far, (w4, h4));
+            let mut alone = |xs: [usize; 2], ys: [usize; 2], id: u16, far: u16| {
+                alone(tracer, candidates, (x0, y0), (xs, ys), id, far, (w4, h4))
+            };
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 let ray = eye(&mut q, sx, sy);
                 let (v, id, depth) = tracer.eye_sample(ray, &mut q);
@@ -697,7 +740,16 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 None => sampler.tile(x0, y0, tw, th, &mut shoot, &mut alone, &mut levels, &mut hits),
                 Some(Pass { n, traced, whole_share }) => {
                     let k = if *whole_share { skipped } else { 0 } + done as usize;
-                    pass_tile(*n, &mut sampler, at, &mut traced[k * per_tile..(k + 1) * per_tile], &mut shoot, &mut alone, &mut levels, &mut hits);
+                    pass_tile(
+                        *n,
+                        &mut sampler,
+                        at,
+                        &mut traced[k * per_tile..(k + 1) * per_tile],
+                        &mut shoot,
+                        &mut alone,
+                        &mut levels,
+                        &mut hits,
+                    );
                 }
             }
             hooks.gray_tile(x0 as u16, y0 as u16, tw as u16, th as u16, &levels[..tw * th]);
@@ -718,7 +770,13 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                     // sides kept here: no apron rays (2x2 grids and pattern blocks alone trace
                     // their right column's and bottom row's pixels again, through the centres).
                     let hit = |x: usize, y: usize| (hits.object[y * tw + x], hits.depth[y * tw + x]);
-                    let mut exact = |x: usize, y: usize| if sampler.exact(x, y, tw, th, &hits) { hit(x, y) } else { probe(x0 + x, y0 + y) };
+                    let mut exact = |x: usize, y: usize| {
+                        if sampler.exact(x, y, tw, th, &hits) {
+                            hit(x, y)
+                        } else {
+                            probe(x0 + x, y0 + y)
+                        }
+                    };
                     (0..th).for_each(|y| sides.left[y] = hit(0, y));
                     (0..tw).for_each(|x| sides.top[x] = hit(x, 0));
                     sampler.side(th, |y| exact(tw - 1, y), &mut sides.right);
@@ -799,7 +857,12 @@ fn column_of<R: Real>(_: &Camera<R>, part: ColumnPart<R>) -> Vec3<R> {
 impl<'c, R: Real> Window<'c, R> {
     fn new(camera: &'c Camera<R>, w4: i32, h4: i32) -> Self {
         let none = column_part(camera, R::ZERO);
-        Window { camera, size: (w4, h4), cols: [(-1, 0, none); MAX_TILE], row: (-1, 0, Vec3::new(R::ZERO, R::ZERO, R::ZERO)) }
+        Window {
+            camera,
+            size: (w4, h4),
+            cols: [(-1, 0, none); MAX_TILE],
+            row: (-1, 0, Vec3::new(R::ZERO, R::ZERO, R::ZERO)),
+        }
     }
 
     /// Window position (2^-16 units) and the eye ray through `(sx, sy)`.
@@ -893,7 +956,13 @@ fn resolves<R: Real, E>(camera: &Camera<R>, frame: &Frame) -> Result<(), RenderE
 /// Silhouette lines on a tile's `levels`: its own `hits`, and its apron: the right column of
 /// the tile left of it and the bottom row of the tile above, as those tiles keep their sides
 /// ([`Sampler::side`]), from what `probe` answers (the eye ray through a pixel's centre).
-fn outline_tile(at: Block, sampler: &Sampler<'_>, probe: &mut impl FnMut(usize, usize) -> (u16, u16), hits: &Hits, levels: &mut [u8]) {
+fn outline_tile(
+    at: Block,
+    sampler: &Sampler<'_>,
+    probe: &mut impl FnMut(usize, usize) -> (u16, u16),
+    hits: &Hits,
+    levels: &mut [u8],
+) {
     let Block { x0, y0, tw, th, .. } = at;
     let (mut left, mut up) = ([(0u16, 0u16); MAX_TILE], [(0u16, 0u16); MAX_TILE]);
     if x0 > 0 {

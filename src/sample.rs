@@ -150,7 +150,8 @@ impl<'r> Sampler<'r> {
         for by in (0..th).step_by(block) {
             for bx in (0..tw).step_by(block) {
                 let (cx, cy) = (4 * (x0 + bx) + 2 * block, 4 * (y0 + by) + 2 * block);
-                let (v, id, depth) = if self.mode == Sampling::Grid2x2 && block == 1 { grid2x2(shoot, cx, cy) } else { shoot(cx, cy) };
+                let (v, id, depth) =
+                    if self.mode == Sampling::Grid2x2 && block == 1 { grid2x2(shoot, cx, cy) } else { shoot(cx, cy) };
                 let l = level(v);
                 for y in by..(by + block).min(th) {
                     for x in bx..(bx + block).min(tw) {
@@ -178,7 +179,11 @@ impl<'r> Sampler<'r> {
                 if first_pass(coarse, x, tw) && first_pass(coarse, y, th) {
                     return true;
                 }
-                let (xs, ys) = if traced(x, tw) && traced(y, th) { (between(x, tw), between(y, th)) } else { around(x, y, tw, th) };
+                let (xs, ys) = if traced(x, tw) && traced(y, th) {
+                    (between(x, tw), between(y, th))
+                } else {
+                    around(x, y, tw, th)
+                };
                 let id = |(nx, ny): (usize, usize)| hits.object[ny * tw + nx];
                 let first = id((xs[0], ys[0]));
                 (0..4).any(|i| id((xs[i % 2], ys[i / 2])) != first)
@@ -385,9 +390,19 @@ fn adaptive<R: Real>(
                 let i = y * tw + x;
                 // Two neighbours on a coarse line, else the four corners.
                 let filled = if xs[0] == xs[1] || ys[0] == ys[1] {
-                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id, far| alone(xs, ys, id, far))
+                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id, far| {
+                        alone(xs, ys, id, far)
+                    })
                 } else {
-                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[0] * tw + xs[1], ys[1] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id, far| alone(xs, ys, id, far))
+                    fill(
+                        levels,
+                        ids,
+                        depths,
+                        i,
+                        [ys[0] * tw + xs[0], ys[0] * tw + xs[1], ys[1] * tw + xs[0], ys[1] * tw + xs[1]],
+                        contrast,
+                        |id, far| alone(xs, ys, id, far),
+                    )
                 };
                 if !filled {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
@@ -424,7 +439,9 @@ fn adaptive<R: Real>(
                 let filled = if traced(x, tw) {
                     fill(levels, ids, depths, i, [i - tw, i + tw], contrast, |_, _| true)
                 } else {
-                    fill(levels, ids, depths, i, [i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], contrast, |_, _| true)
+                    fill(levels, ids, depths, i, [i - tw - 1, i - tw + 1, i + tw - 1, i + tw + 1], contrast, |_, _| {
+                        true
+                    })
                 };
                 if !filled {
                     shoot_at(shoot, levels, ids, depths, i, centre(x, y));
@@ -447,7 +464,15 @@ fn at(i: usize) -> usize {
 /// nearest depth, if `allowed(object, farthest depth)` too. Returns whether it did; else the
 /// pixel is traced.
 #[inline]
-fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, ns: [usize; N], contrast: u8, allowed: impl FnOnce(u16, u16) -> bool) -> bool {
+fn fill<const N: usize>(
+    levels: &mut [u8; MAX_TILE * MAX_TILE],
+    ids: &mut [u16; MAX_TILE * MAX_TILE],
+    depths: &mut [u16; MAX_TILE * MAX_TILE],
+    i: usize,
+    ns: [usize; N],
+    contrast: u8,
+    allowed: impl FnOnce(u16, u16) -> bool,
+) -> bool {
     let first = ids[at(ns[0])];
     let (mut lo, mut hi, mut sum, mut same, mut near) = (u8::MAX, 0u8, 0u32, true, u16::MAX);
     for k in ns.iter().map(|&k| at(k)) {
@@ -472,7 +497,14 @@ fn fill<const N: usize>(levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; 
 /// later passes call it from several places, and `shoot` (the tracer, inlined into it) is
 /// large.
 #[inline(never)]
-fn shoot_at<R: Real>(shoot: &mut impl FnMut(usize, usize) -> Shot<R>, levels: &mut [u8; MAX_TILE * MAX_TILE], ids: &mut [u16; MAX_TILE * MAX_TILE], depths: &mut [u16; MAX_TILE * MAX_TILE], i: usize, (cx, cy): (usize, usize)) {
+fn shoot_at<R: Real>(
+    shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+    levels: &mut [u8; MAX_TILE * MAX_TILE],
+    ids: &mut [u16; MAX_TILE * MAX_TILE],
+    depths: &mut [u16; MAX_TILE * MAX_TILE],
+    i: usize,
+    (cx, cy): (usize, usize),
+) {
     let (v, id, depth) = shoot(cx, cy);
     let i = at(i);
     (levels[i], ids[i], depths[i]) = (level(v), id, depth);
@@ -501,7 +533,13 @@ mod tests {
     #[test]
     fn level_is_the_product_with_64_rounded() {
         fn check<R: Real>(v: R) {
-            assert_eq!(level(v), (v * R::from_i32(LEVELS as i32) + R::HALF).floor_clamped(LEVELS), "{} {}", R::NAME, v.to_f64());
+            assert_eq!(
+                level(v),
+                (v * R::from_i32(LEVELS as i32) + R::HALF).floor_clamped(LEVELS),
+                "{} {}",
+                R::NAME,
+                v.to_f64()
+            );
         }
         let mut x = 0x2545_f491_4f6c_dd1du64;
         for _ in 0..20_000 {
@@ -548,7 +586,13 @@ mod tests {
     /// a gradient and a shadow, crossed by thin diagonal stripes of a third.
     fn picture(sx: usize, sy: usize) -> Shot<f64> {
         let (x, y) = (sx / 4, sy / 4);
-        let id = if (x * 7 + y * 3) % 23 < 2 { 3 } else if x < 20 { 1 } else { 2 };
+        let id = if (x * 7 + y * 3) % 23 < 2 {
+            3
+        } else if x < 20 {
+            1
+        } else {
+            2
+        };
         let v = match id {
             1 => ((x + y) % 64) as f64 / 64.0,
             2 if (x / 3 + y / 5) % 7 == 0 => 0.2,
@@ -559,12 +603,21 @@ mod tests {
 
     /// Samples one tile of [`picture`] at `(x0, y0)` with `mode`, `alone` answering the coarse
     /// level; returns the levels, the hits and the eye rays traced.
-    fn sample(mode: Sampling, at: (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
+    fn sample(
+        mode: Sampling,
+        at: (usize, usize, usize, usize),
+        alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool,
+    ) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
         sample_of(picture, mode, at, alone)
     }
 
     /// [`sample`] of another picture.
-    fn sample_of(picture: fn(usize, usize) -> Shot<f64>, mode: Sampling, (x0, y0, tw, th): (usize, usize, usize, usize), alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
+    fn sample_of(
+        picture: fn(usize, usize) -> Shot<f64>,
+        mode: Sampling,
+        (x0, y0, tw, th): (usize, usize, usize, usize),
+        alone: &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool,
+    ) -> ([u8; MAX_TILE * MAX_TILE], Hits, usize) {
         let mut sampler = Sampler::new(mode, 1, 64, &mut []).unwrap();
         let (mut levels, mut hits, mut rays) = ([0; MAX_TILE * MAX_TILE], Hits::new(), 0);
         let mut shoot = |sx: usize, sy: usize| {
@@ -605,25 +658,37 @@ mod tests {
         for tw in 1..=MAX_TILE {
             for th in 1..=MAX_TILE {
                 let at = (3 * tw, 5 * th, tw, th);
-                let alones: [&mut Alone<'_>; 3] = [&mut |_, _, _, _| true, &mut |_, _, _, _| false, &mut |_, _, _, _| {
-                    coin ^= coin << 13;
-                    coin ^= coin >> 17;
-                    coin ^= coin << 5;
-                    coin & 1 == 0
-                }];
+                let alones: [&mut Alone<'_>; 3] =
+                    [&mut |_, _, _, _| true, &mut |_, _, _, _| false, &mut |_, _, _, _| {
+                        coin ^= coin << 13;
+                        coin ^= coin >> 17;
+                        coin ^= coin << 5;
+                        coin & 1 == 0
+                    }];
                 for (k, alone) in alones.into_iter().enumerate() {
                     for mode in [ONE_LEVEL, TWO_LEVELS] {
                         let (_, hits, _) = sample(mode, at, &mut |xs, ys, id, far| alone(xs, ys, id, far));
                         let sampler = Sampler::new(mode, 1, 64, &mut []).unwrap();
-                        for (x, y) in (0..th).flat_map(|y| (0..tw).map(move |x| (x, y))).filter(|&(x, y)| sampler.exact(x, y, tw, th, &hits)) {
+                        for (x, y) in (0..th)
+                            .flat_map(|y| (0..tw).map(move |x| (x, y)))
+                            .filter(|&(x, y)| sampler.exact(x, y, tw, th, &hits))
+                        {
                             let (_, id, depth) = picture(4 * (at.0 + x) + 2, 4 * (at.1 + y) + 2);
-                            assert_eq!((hits.object[y * tw + x], hits.depth[y * tw + x]), (id, depth), "{tw}x{th} {mode:?} alone #{k}: pixel ({x}, {y})");
+                            assert_eq!(
+                                (hits.object[y * tw + x], hits.depth[y * tw + x]),
+                                (id, depth),
+                                "{tw}x{th} {mode:?} alone #{k}: pixel ({x}, {y})"
+                            );
                         }
                     }
                 }
                 let (one, one_hits, one_rays) = sample(ONE_LEVEL, at, &mut |_, _, _, _| true);
                 let (two, two_hits, two_rays) = sample(TWO_LEVELS, at, &mut |_, _, _, _| false);
-                assert_eq!((one, one_hits.object, one_hits.depth, one_rays), (two, two_hits.object, two_hits.depth, two_rays), "{tw}x{th}");
+                assert_eq!(
+                    (one, one_hits.object, one_hits.depth, one_rays),
+                    (two, two_hits.object, two_hits.depth, two_rays),
+                    "{tw}x{th}"
+                );
             }
         }
     }

@@ -400,7 +400,8 @@ mod tests {
     }
 
     fn depth_keys_keep_order<R: Real>() {
-        let mut values: std::vec::Vec<f64> = (0..2000).map(|i| 1.013f64.powi(i) * 1e-3).filter(|v| *v < R::LIMIT).collect();
+        let mut values: std::vec::Vec<f64> =
+            (0..2000).map(|i| 1.013f64.powi(i) * 1e-3).filter(|v| *v < R::LIMIT).collect();
         values.extend([0.0, -1.0]);
         values.sort_by(f64::total_cmp);
         let keys: std::vec::Vec<u16> = values.iter().map(|&v| R::from_f64(v).depth_key()).collect();
@@ -413,7 +414,12 @@ mod tests {
         for &v in &values {
             let key = R::from_f64(v).depth_key();
             let bound = R::key_bound(key);
-            assert!(bound > R::from_f64(v) && bound.depth_key() > key, "{}: {v} has key {key}, bound {}", R::NAME, bound.to_f64());
+            assert!(
+                bound > R::from_f64(v) && bound.depth_key() > key,
+                "{}: {v} has key {key}, bound {}",
+                R::NAME,
+                bound.to_f64()
+            );
         }
     }
 

@@ -162,11 +162,8 @@ fn unit_slab<R: Real>(o: R, d: R, below: bool, t0: R, t1: R) -> Option<(R, R)> {
     }
     let inv = d.recip();
     let m = o * inv;
-    let (ta, tb) = if m.abs() < R::MAX {
-        (if below { -m - inv } else { -m }, inv - m)
-    } else {
-        sides_apart(o, inv, lo)
-    };
+    let (ta, tb) =
+        if m.abs() < R::MAX { (if below { -m - inv } else { -m }, inv - m) } else { sides_apart(o, inv, lo) };
     crate::math::cut(ta, tb, t0, t1)
 }
 
@@ -294,7 +291,13 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
 /// the first of entry and exit after `tmin`, with the normal of the face it crosses.
 #[cfg_attr(target_arch = "x86_64", inline(always))]
 fn unit_box<R: Real>(r: &Ray<R>, tmin: R, t0: R, t1: R) -> Option<ShapeHit<R>> {
-    let t = if t0 > tmin { t0 } else if t1 > tmin { t1 } else { return None };
+    let t = if t0 > tmin {
+        t0
+    } else if t1 > tmin {
+        t1
+    } else {
+        return None;
+    };
     // The face is the one the point lies on: the axis whose coordinate is nearest 0 or 1.
     let p = r.at(t);
     let (mut axis, mut dist, mut sign) = (0, R::MAX, R::ZERO);

@@ -10,7 +10,7 @@
 //! left of the pool and the `i16` rows (the render's [`Scratch`]).
 
 use crate::accel::Query;
-use crate::lattice::{SubLattice, Lattice, LatticeConfig, LatticeError, LatticeStorage};
+use crate::lattice::{Lattice, LatticeConfig, LatticeError, LatticeStorage, SubLattice};
 use crate::render::{Frame, Scratch};
 use crate::scalar::Real;
 use crate::scene::{Object, Parts, Scene};
@@ -165,18 +165,12 @@ impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, co
 
     /// The capacities as [`Sizes`].
     pub const fn sizes() -> Sizes {
-        Sizes {
-            objects: O,
-            lattices: G,
-            coords: C,
-            words: W,
-            rows: S,
-        }
+        Sizes { objects: O, lattices: G, coords: C, words: W, rows: S }
     }
 }
 
-impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, const S: usize>
-    Default for Storage<R, O, G, C, W, S>
+impl<R: Real, const O: usize, const G: usize, const C: usize, const W: usize, const S: usize> Default
+    for Storage<R, O, G, C, W, S>
 {
     fn default() -> Self {
         Self::new()
@@ -228,16 +222,7 @@ impl<'a, R: Real> StorageView<'a, R> {
         words: &'a mut [u32],
         rows: &'a mut [i16],
     ) -> Self {
-        StorageView {
-            objects,
-            parts,
-            rest: FrameStorage {
-                lattices,
-                coords,
-                words,
-                rows,
-            },
-        }
+        StorageView { objects, parts, rest: FrameStorage { lattices, coords, words, rows } }
     }
 
     /// The scene's storage (objects and parts, for a [`crate::SceneBuilder`]) and the rest.
@@ -255,11 +240,7 @@ impl<'a, R: Real> FrameStorage<'a, R> {
         scene: &Scene<'_, R>,
         cfg: &LatticeConfig,
     ) -> Result<(Lattice<'a, R>, Scratch<'a>), LatticeError> {
-        let storage = LatticeStorage {
-            lattices: self.lattices,
-            coords: self.coords,
-            words: self.words,
-        };
+        let storage = LatticeStorage { lattices: self.lattices, coords: self.coords, words: self.words };
         let (lattice, mailbox) = Lattice::build_leaving(scene, cfg, storage)?;
         Ok((lattice, Scratch::new(mailbox, self.rows)))
     }

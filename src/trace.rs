@@ -311,7 +311,8 @@ impl EyeRays {
             [_] => scene.shadow_basis.is_some(),
             _ => false,
         };
-        Self::for_scene(scene) == EyeRays::Windows && (scene.objects.len() <= Self::EVERY_OBJECT_UP_TO || !secondary && lights)
+        Self::for_scene(scene) == EyeRays::Windows
+            && (scene.objects.len() <= Self::EVERY_OBJECT_UP_TO || !secondary && lights)
     }
 }
 
@@ -583,7 +584,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             } else if let Some(top) = stack.len().checked_sub(1) {
                 let at = &stack[top];
                 popped = Ray::new(at.ray.origin, at.ray.dir);
-                let meta = Meta { weight: at.meta.weight, depth: at.meta.depth, kind: at.meta.kind, leaving: at.meta.leaving };
+                let meta =
+                    Meta { weight: at.meta.weight, depth: at.meta.depth, kind: at.meta.kind, leaving: at.meta.leaving };
                 stack.truncate(top);
                 (&popped, meta)
             } else {
@@ -631,7 +633,10 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             if !children {
                 continue;
             }
-            let child = |ray, w: R, kind, leaving| Node { ray, meta: Meta { weight: node.weight * w, depth: node.depth + 1, kind, leaving } };
+            let child = |ray, w: R, kind, leaving| Node {
+                ray,
+                meta: Meta { weight: node.weight * w, depth: node.depth + 1, kind, leaving },
+            };
             let cos_i = -d.dot(n);
             let mirror = d + n * (cos_i + cos_i);
             let mut reflect_w = if reflects { m.ks } else { R::ZERO };

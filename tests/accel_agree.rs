@@ -5,12 +5,20 @@ mod common;
 use common::{build_lattice, lattice_storage};
 use lattice_rt::generate::{random_scene, RandomScene, Rng};
 use lattice_rt::scene::Object;
-use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, Query, Ray, Real, Scene, SceneBuilder, Vec3};
+use lattice_rt::{
+    Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, Query, Ray, Real, Scene, SceneBuilder, Vec3,
+};
 use proptest::prelude::*;
 
 /// Rays aimed to hurt: random, axis-aligned with +0.0/-0.0 components, starting on lattice
 /// planes, through lattice corners, and from outside the world, up to `far` times 60 units away.
-fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &mut Rng, n: usize, far: f64) -> Vec<Ray<R>> {
+fn adversarial_rays<R: Real>(
+    lat: &Lattice<'_, R>,
+    scene: &Scene<'_, R>,
+    rng: &mut Rng,
+    n: usize,
+    far: f64,
+) -> Vec<Ray<R>> {
     let w = scene.world();
     let pick = |rng: &mut Rng, a: usize| {
         let c = lat.coordinate_list(0, a);
@@ -21,7 +29,11 @@ fn adversarial_rays<R: Real>(lat: &Lattice<'_, R>, scene: &Scene<'_, R>, rng: &m
     for i in 0..n {
         let kind = i % 5;
         let mut o = Vec3::new(inside(rng, 0), inside(rng, 1), inside(rng, 2));
-        let mut d = Vec3::new(R::from_f64(rng.range(-1.0, 1.0)), R::from_f64(rng.range(-1.0, 1.0)), R::from_f64(rng.range(-1.0, 1.0)));
+        let mut d = Vec3::new(
+            R::from_f64(rng.range(-1.0, 1.0)),
+            R::from_f64(rng.range(-1.0, 1.0)),
+            R::from_f64(rng.range(-1.0, 1.0)),
+        );
         match kind {
             // Axis-aligned with signed zeros, from a point on cell planes.
             1 => {
@@ -95,17 +107,34 @@ fn fixed_point_rays_from_two_thousand_units_out_agree() {
     use lattice_rt::lattice::Resolution;
     for (seed, n, res) in [(4192288894521944035u64, 12usize, 5u16), (11663554660185185422, 10, 3)] {
         let p = RandomScene { objects: n, composite_size: 4, spread: 0.0, seed };
-        let cfg = LatticeConfig { top: Resolution::Uniform([res, res + 1, res.saturating_sub(1).max(1)]), sub: Resolution::Uniform([res; 3]), ..LatticeConfig::default() };
+        let cfg = LatticeConfig {
+            top: Resolution::Uniform([res, res + 1, res.saturating_sub(1).max(1)]),
+            sub: Resolution::Uniform([res; 3]),
+            ..LatticeConfig::default()
+        };
         check_far::<lattice_rt::Fx>(&p, &cfg, 200, lattice_rt::Fx::LIMIT / 240.0).unwrap();
     }
 }
 
-fn check_scene<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, seed: u64, nrays: usize, far: f64) -> Result<(), TestCaseError> {
+fn check_scene<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    seed: u64,
+    nrays: usize,
+    far: f64,
+) -> Result<(), TestCaseError> {
     check_rays(scene, cfg, seed, nrays, far, |r| r)
 }
 
 /// [`check_scene`] with each ray first passed through `shape`.
-fn check_rays<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, seed: u64, nrays: usize, far: f64, shape: impl Fn(Ray<R>) -> Ray<R>) -> Result<(), TestCaseError> {
+fn check_rays<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    seed: u64,
+    nrays: usize,
+    far: f64,
+    shape: impl Fn(Ray<R>) -> Ray<R>,
+) -> Result<(), TestCaseError> {
     let mut bufs = lattice_storage(scene, cfg);
     let lat = build_lattice(scene, cfg, &mut bufs);
     let mut rng = Rng::new(seed ^ 0xABCD);
@@ -229,8 +258,13 @@ fn check_crowded<R: Real>(seed: u64, n: usize, group: usize, cfg: &LatticeConfig
         b.add_object(s, t, 0).unwrap();
     };
     // A floor under them all, too large to move: it stays in every dense cell's world list.
-    b.add_object(lattice_rt::Shape::Box, lattice_rt::Affine::translate(Vec3::new(-0.5, -0.5, -0.5)).after(&lattice_rt::Affine::scale(Vec3::new(4.0, 0.6, 4.0))), 0)
-        .unwrap();
+    b.add_object(
+        lattice_rt::Shape::Box,
+        lattice_rt::Affine::translate(Vec3::new(-0.5, -0.5, -0.5))
+            .after(&lattice_rt::Affine::scale(Vec3::new(4.0, 0.6, 4.0))),
+        0,
+    )
+    .unwrap();
     for _ in 0..n {
         place(&mut b, &mut rng);
     }
@@ -286,7 +320,8 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
     let lat = build_lattice(&scene, &cfg, &mut bufs);
     let mut mb = vec![0; Query::mailbox_len(&scene)];
     let mut q = Query::new(&mut mb);
-    let picks: Vec<usize> = [0, members / 2, members - 1].into_iter().chain((0..20).map(|_| rng.below(members as u64) as usize)).collect();
+    let picks: Vec<usize> =
+        [0, members / 2, members - 1].into_iter().chain((0..20).map(|_| rng.below(members as u64) as usize)).collect();
     let mut hits = 0;
     for k in picks {
         // Aimed at a random point of the member's box: most such rays hit it.
@@ -297,8 +332,22 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
         let ray = Ray::new(o, target - o);
         let want = BruteForce.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q);
         hits += usize::from(want.is_some());
-        prop_assert_eq!(want, lat.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q), "lattice, lead {} members {} ray {:?}", lead, members, ray);
-        prop_assert_eq!(want, BoundingBox.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q), "bbox, lead {} members {} ray {:?}", lead, members, ray);
+        prop_assert_eq!(
+            want,
+            lat.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q),
+            "lattice, lead {} members {} ray {:?}",
+            lead,
+            members,
+            ray
+        );
+        prop_assert_eq!(
+            want,
+            BoundingBox.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q),
+            "bbox, lead {} members {} ray {:?}",
+            lead,
+            members,
+            ray
+        );
     }
     prop_assert!(hits > 0, "no ray hit the group: the test aims badly");
     Ok(())

@@ -29,7 +29,8 @@ fn accepted<R: Real>(text: &str) -> bool {
 fn gray<R: Real>(text: &str, frame: &Frame) -> Vec<u8> {
     let mut storage = vec![Object::<R>::default(); 16];
     let mut parts = lattice_rt::Parts::default();
-    let scene = parse_for::<R>(text, &mut storage, &mut parts, frame.size()).unwrap_or_else(|e| panic!("{}: {e}", R::NAME));
+    let scene =
+        parse_for::<R>(text, &mut storage, &mut parts, frame.size()).unwrap_or_else(|e| panic!("{}: {e}", R::NAME));
     let cfg = LatticeConfig::default();
     let mut bufs = lattice_storage(&scene, &cfg);
     let lat = build_lattice(&scene, &cfg, &mut bufs);
@@ -116,7 +117,10 @@ fn an_object_whose_padded_box_leaves_the_range_is_blamed_on_its_own_line() {
 
 #[test]
 fn a_singular_group_transform_is_blamed_on_the_group() {
-    assert_eq!(err::<f64>("sphere\ngroup g scale 1 0 1\nsphere\nend\n"), "line 2, column 1 at `group`: transform is singular (zero or near-zero scale)");
+    assert_eq!(
+        err::<f64>("sphere\ngroup g scale 1 0 1\nsphere\nend\n"),
+        "line 2, column 1 at `group`: transform is singular (zero or near-zero scale)"
+    );
     assert_eq!(
         err::<f64>("group g\nsphere\nend\ngroup h rotate y 30 scale 0 1 1 translate 1 2 3\nbox\nend\n"),
         "line 4, column 1 at `group`: transform is singular (zero or near-zero scale)"
@@ -125,18 +129,28 @@ fn a_singular_group_transform_is_blamed_on_the_group() {
 
 #[test]
 fn an_object_scaled_to_nothing_is_refused_in_every_scalar() {
-    for text in ["sphere\nsphere scale 1e-300\n", "sphere\nbox scale 1 1e-250 1\n", "sphere\ngroup g scale 1e-80\ncone scale 1e-80\nend\n"] {
+    for text in [
+        "sphere\nsphere scale 1e-300\n",
+        "sphere\nbox scale 1 1e-250 1\n",
+        "sphere\ngroup g scale 1e-80\ncone scale 1e-80\nend\n",
+    ] {
         for msg in [err::<f64>(text), err::<f32>(text), err::<Fx>(text)] {
             let line = if text.contains("group") { "line 3, column 1 at `cone`" } else { "line 2, column 1 at" };
             // Refused on its own line: singular where the determinant underflows to zero.
-            assert!(msg.starts_with(line) && (msg.contains("object 1 is too") || msg.contains("singular")), "{text:?}: {msg}");
+            assert!(
+                msg.starts_with(line) && (msg.contains("object 1 is too") || msg.contains("singular")),
+                "{text:?}: {msg}"
+            );
         }
     }
 }
 
 #[test]
 fn directions_too_short_to_normalise_are_refused() {
-    assert_eq!(err::<f64>("light directional dir 1e-320 0 0\nsphere"), "line 1, column 1 at `light`: light direction is zero");
+    assert_eq!(
+        err::<f64>("light directional dir 1e-320 0 0\nsphere"),
+        "line 1, column 1 at `light`: light direction is zero"
+    );
     assert_eq!(
         err::<f64>("camera eye 0 0 0 look 1e-320 0 1e-320\nsphere"),
         "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector"
@@ -161,18 +175,17 @@ fn invalid_utf8_is_reported_at_its_line_and_column() {
 #[test]
 fn a_byte_order_mark_and_every_line_ending_parse_alike() {
     let plain = "camera eye 0 0 -10\nsphere\nbox min 1 1 1 max 2 2 2\n";
-    for text in [
-        format!("\u{feff}{plain}"),
-        plain.replace('\n', "\r\n"),
-        plain.replace('\n', "\r"),
-    ] {
+    for text in [format!("\u{feff}{plain}"), plain.replace('\n', "\r\n"), plain.replace('\n', "\r")] {
         let mut storage = vec![Object::<f64>::default(); 4];
         let mut parts = lattice_rt::Parts::default();
         let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{text:?}: {e}"));
         assert_eq!(scene.objects().len(), 2);
     }
     // Line numbers count CR-only lines too.
-    assert_eq!(err::<f64>("sphere\rsphere\rcone material gold"), "line 3, column 15 at `gold`: material not defined before this line");
+    assert_eq!(
+        err::<f64>("sphere\rsphere\rcone material gold"),
+        "line 3, column 15 at `gold`: material not defined before this line"
+    );
 }
 
 #[test]
@@ -183,7 +196,10 @@ fn zero_is_zero_whatever_its_exponent() {
         let mut parts = lattice_rt::Parts::default();
         let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{zero}: {e}"));
         let mut parts = lattice_rt::Parts::default();
-        let expected = parse::<f64>("sphere center 0 0 0", &mut vec![Object::<f64>::default(); 1], &mut parts).unwrap().objects()[0].origin();
+        let expected = parse::<f64>("sphere center 0 0 0", &mut vec![Object::<f64>::default(); 1], &mut parts)
+            .unwrap()
+            .objects()[0]
+            .origin();
         assert_eq!(scene.objects()[0].origin(), expected, "{zero}");
     }
     // Tiny non-zero numbers underflow to zero as f64 itself rounds them.
@@ -192,8 +208,14 @@ fn zero_is_zero_whatever_its_exponent() {
 
 #[test]
 fn numbers_and_transforms_beyond_f64_say_out_of_range() {
-    assert_eq!(err::<f64>("sphere center 1e999 0 0"), "line 1, column 15 at `1e999`: number out of range: beyond the largest f64 (about 1.8e308)");
-    assert_eq!(err::<f64>("ambient -1e400\nsphere"), "line 1, column 9 at `-1e400`: number out of range: beyond the largest f64 (about 1.8e308)");
+    assert_eq!(
+        err::<f64>("sphere center 1e999 0 0"),
+        "line 1, column 15 at `1e999`: number out of range: beyond the largest f64 (about 1.8e308)"
+    );
+    assert_eq!(
+        err::<f64>("ambient -1e400\nsphere"),
+        "line 1, column 9 at `-1e400`: number out of range: beyond the largest f64 (about 1.8e308)"
+    );
     assert_eq!(
         err::<f64>("sphere scale 1e200 scale 1e200"),
         "line 1, column 20 at `scale`: transform out of range: composed, its entries overflow (more than 1e308)"
@@ -207,7 +229,10 @@ fn a_large_exact_shear_is_not_singular() {
     // too thin for f64 (too small in f32), out of range for fixed point; never "singular".
     let text = "camera eye 0 0 -10\nbox shear x y 1e12\n";
     let msg = err::<f64>(text);
-    assert!(msg.starts_with("line 2, column 1 at `box`: object 0 is too thin") && msg.contains("1e-12 across"), "{msg}");
+    assert!(
+        msg.starts_with("line 2, column 1 at `box`: object 0 is too thin") && msg.contains("1e-12 across"),
+        "{msg}"
+    );
     let msg = err::<f32>(text);
     assert!(msg.starts_with("line 2, column 1 at `box`: object 0 is too small for this scene in f32"), "{msg}");
     let msg = err::<Fx>(text);

@@ -20,14 +20,20 @@ const TWO: &str = "sphere\nbox min 2 0 0 max 3 1 1\n";
 fn shadows_need_a_light_and_two_objects() {
     assert!(effects_of(&format!("{LIGHT}{TWO}")).contains(Effects::SHADOWS));
     assert!(!effects_of(TWO).contains(Effects::SHADOWS), "no light");
-    assert!(!effects_of(&format!("{LIGHT}sphere\n")).contains(Effects::SHADOWS), "a lone convex object cannot shadow itself");
+    assert!(
+        !effects_of(&format!("{LIGHT}sphere\n")).contains(Effects::SHADOWS),
+        "a lone convex object cannot shadow itself"
+    );
 }
 
 #[test]
 fn reflection_needs_a_mirror_material_in_use() {
     assert!(effects_of(&format!("material m ks 0.5\nsphere material m\n{TWO}")).contains(Effects::REFLECTION));
     // Objects without a material get the first one defined, so the mirror comes second here.
-    assert!(!effects_of(&format!("material plain\nmaterial m ks 0.5\n{TWO}")).contains(Effects::REFLECTION), "defined but unused");
+    assert!(
+        !effects_of(&format!("material plain\nmaterial m ks 0.5\n{TWO}")).contains(Effects::REFLECTION),
+        "defined but unused"
+    );
     assert!(!effects_of(TWO).contains(Effects::REFLECTION));
 }
 

@@ -9,7 +9,9 @@ mod common;
 use common::{build_lattice, lattice_storage, scene_text, ACCELS};
 use lattice_rt::generate::{random_scene, RandomScene};
 use lattice_rt::scene::{Camera, Object};
-use lattice_rt::{parse, Accelerator, BoundingBox, BruteForce, EyeRays, Fx, LatticeConfig, Query, Real, Scene, SceneBuilder, Tracer};
+use lattice_rt::{
+    parse, Accelerator, BoundingBox, BruteForce, EyeRays, Fx, LatticeConfig, Query, Real, Scene, SceneBuilder, Tracer,
+};
 
 /// Traces every eye ray of a `w x h` frame (pixel centres and a quarter-pixel offset) with and
 /// without its window position; returns how many object tests the windows skipped.
@@ -74,12 +76,25 @@ fn the_paper_scenes_render_the_same_with_windows_in_every_scalar() {
 
 /// A random scene of 40 objects (4 per composite) seen from `eye` towards `look` (the view
 /// fitted to frames of 48x32), or `None` if the camera is refused.
-fn generated<'a>(storage: &'a mut [Object<f64>], parts: &'a mut lattice_rt::Parts<f64>, seed: u64, eye: (f64, f64, f64), look: (f64, f64, f64)) -> Option<Scene<'a, f64>> {
+fn generated<'a>(
+    storage: &'a mut [Object<f64>],
+    parts: &'a mut lattice_rt::Parts<f64>,
+    seed: u64,
+    eye: (f64, f64, f64),
+    look: (f64, f64, f64),
+) -> Option<Scene<'a, f64>> {
     generated_for(storage, parts, seed, eye, look, [48, 32])
 }
 
 /// [`generated`] with the view fitted to frames of `shape`.
-fn generated_for<'a>(storage: &'a mut [Object<f64>], parts: &'a mut lattice_rt::Parts<f64>, seed: u64, eye: (f64, f64, f64), look: (f64, f64, f64), shape: [u32; 2]) -> Option<Scene<'a, f64>> {
+fn generated_for<'a>(
+    storage: &'a mut [Object<f64>],
+    parts: &'a mut lattice_rt::Parts<f64>,
+    seed: u64,
+    eye: (f64, f64, f64),
+    look: (f64, f64, f64),
+    shape: [u32; 2],
+) -> Option<Scene<'a, f64>> {
     let mut b = SceneBuilder::new(storage, parts);
     random_scene(&mut b, &RandomScene { objects: 40, composite_size: 4, spread: 0.0, seed }).unwrap();
     b.camera.eye = lattice_rt::Vec3::new(eye.0, eye.1, eye.2);
@@ -95,7 +110,11 @@ fn generated_for<'a>(storage: &'a mut [Object<f64>], parts: &'a mut lattice_rt::
 fn over_generated(mut each: impl FnMut(&Scene<'_, f64>, &str) -> u64) -> (u32, u64) {
     let (mut built, mut counted) = (0, 0);
     for seed in 0..6u64 {
-        for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0)), ((3.0, 0.0, 0.0), (-3.0, 0.5, 0.0))] {
+        for (eye, look) in [
+            ((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)),
+            ((0.1, 0.2, 0.3), (5.0, 1.0, 2.0)),
+            ((3.0, 0.0, 0.0), (-3.0, 0.5, 0.0)),
+        ] {
             let (mut storage, mut parts) = (vec![Object::<f64>::default(); 40], lattice_rt::Parts::default());
             let Some(scene) = generated(&mut storage, &mut parts, seed, eye, look) else { continue };
             built += 1;
@@ -127,7 +146,8 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
             let (w4, h4) = (4 * 48, 4 * 32);
             for (tx, ty) in (0..6).flat_map(|tx| (0..4).map(move |ty| (tx, ty))) {
                 let (sx, sy) = ([32 * tx, 32 * tx + 32], [32 * ty, 32 * ty + 32]);
-                let (lo, hi) = (Camera::<f64>::window_uv(sx[0], sy[1], w4, h4), Camera::<f64>::window_uv(sx[1], sy[0], w4, h4));
+                let (lo, hi) =
+                    (Camera::<f64>::window_uv(sx[0], sy[1], w4, h4), Camera::<f64>::window_uv(sx[1], sy[0], w4, h4));
                 let mask = scene.eye_candidates([lo[0], hi[0]], [lo[1], hi[1]]);
                 for (i, o) in scene.objects().iter().enumerate().filter(|&(i, _)| mask & (1 << i) == 0) {
                     left_out += 1;
@@ -140,14 +160,32 @@ fn tile_candidates_leave_out_only_objects_no_eye_ray_of_the_tile_can_hit() {
                     }
                 }
             }
-            for frame in [lattice_rt::Frame::new(48, 32), lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false }, ..lattice_rt::Frame::new(37, 21) }, lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: true }, ..lattice_rt::Frame::new(37, 21) }] {
+            for frame in [
+                lattice_rt::Frame::new(48, 32),
+                lattice_rt::Frame {
+                    sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false },
+                    ..lattice_rt::Frame::new(37, 21)
+                },
+                lattice_rt::Frame {
+                    sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: true },
+                    ..lattice_rt::Frame::new(37, 21)
+                },
+            ] {
                 let (mut storage, mut parts) = (vec![Object::<f64>::default(); 40], lattice_rt::Parts::default());
-                let Some(scene) = generated_for(&mut storage, &mut parts, seed, eye, look, frame.size()) else { continue };
+                let Some(scene) = generated_for(&mut storage, &mut parts, seed, eye, look, frame.size()) else {
+                    continue;
+                };
                 let mut by_tiles = Tracer::new(&scene, &BruteForce);
                 by_tiles.set_eye_rays(EyeRays::Windows);
                 let mut by_rays = Tracer::new(&scene, &BruteForce);
                 by_rays.set_eye_rays(EyeRays::Accelerator);
-                assert_eq!(common::render_tracer(&by_tiles, &frame).0, common::render_tracer(&by_rays, &frame).0, "seed {seed}, eye {eye:?}, {}x{}", frame.width, frame.height);
+                assert_eq!(
+                    common::render_tracer(&by_tiles, &frame).0,
+                    common::render_tracer(&by_rays, &frame).0,
+                    "seed {seed}, eye {eye:?}, {}x{}",
+                    frame.width,
+                    frame.height
+                );
                 checked += 1;
             }
         }
@@ -173,7 +211,11 @@ fn eye_rays_that_hit_an_object_pass_inside_its_eye_hull() {
                     culled += u64::from(o.eye_window_meets([uv[0]; 2], [uv[1]; 2]) && !inside);
                     if o.intersect(&ray, R::ZERO, R::MAX).is_some() {
                         hits += 1;
-                        assert!(inside, "{what}, {}: the eye ray ({sx}, {sy}) of ({w4}, {h4}) hits object {i} outside its eye hull", R::NAME);
+                        assert!(
+                            inside,
+                            "{what}, {}: the eye ray ({sx}, {sy}) of ({w4}, {h4}) hits object {i} outside its eye hull",
+                            R::NAME
+                        );
                     }
                 }
             }
@@ -209,17 +251,28 @@ fn first_light_rays_meet_objects_as_any_ray_does() {
             let mut storage = vec![Object::<R>::default(); 64];
             let mut parts = lattice_rt::Parts::default();
             let scene = parse::<R>(&scene_text(name), &mut storage, &mut parts).unwrap();
-            let Some(lattice_rt::scene::Light::Directional { to_light, .. }) = scene.lights().first().copied() else { panic!("{name}: no directional light") };
+            let Some(lattice_rt::scene::Light::Directional { to_light, .. }) = scene.lights().first().copied() else {
+                panic!("{name}: no directional light")
+            };
             let w = scene.world();
             for i in 0..=20 {
                 for j in 0..=20 {
                     let f = |lo: R, hi: R, k: i32| lo + (hi - lo) * R::from_i32(k) / R::from_i32(20);
-                    let p = lattice_rt::Vec3::new(f(w.min.x, w.max.x, i), f(w.min.y, w.max.y, j), f(w.min.z, w.max.z, (i * 7 + j * 3) % 21));
+                    let p = lattice_rt::Vec3::new(
+                        f(w.min.x, w.max.x, i),
+                        f(w.min.y, w.max.y, j),
+                        f(w.min.z, w.max.z, (i * 7 + j * 3) % 21),
+                    );
                     let ray = lattice_rt::Ray::new(p, to_light);
                     for o in scene.objects() {
                         let want = o.intersect(&ray, R::ZERO, R::MAX);
                         hits += usize::from(want.is_some());
-                        assert_eq!(o.intersect_first_light_ray(&ray, R::ZERO, R::MAX), want, "{name}, {}, from {p:?}", R::NAME);
+                        assert_eq!(
+                            o.intersect_first_light_ray(&ray, R::ZERO, R::MAX),
+                            want,
+                            "{name}, {}, from {p:?}",
+                            R::NAME
+                        );
                     }
                 }
             }
@@ -243,7 +296,8 @@ fn kept_axis_normals_are_the_objects_own() {
         let mut q = Query::new(&mut mb);
         let (o, z, h) = (R::ONE, R::ZERO, R::HALF);
         let v = lattice_rt::Vec3::new;
-        let normals = [v(o, z, z), v(-o, z, z), v(z, o, z), v(z, -o, z), v(z, z, o), v(z, z, -o), v(h, o, z), v(z, z, h)];
+        let normals =
+            [v(o, z, z), v(-o, z, z), v(z, o, z), v(z, -o, z), v(z, z, o), v(z, z, -o), v(h, o, z), v(z, z, h)];
         let n = scene.objects().len() as u32;
         let mut x = 7u32;
         for _ in 0..4000 {
@@ -263,7 +317,11 @@ fn kept_axis_normals_are_the_objects_own() {
 
 /// Renders `frame` of `scene` with the tracer's defaults over its lattice, with the scratch's
 /// tile lists (`Scratch::with_cover`) or without; returns the PBM bytes and the gray levels.
-fn render_cover<R: Real>(scene: &Scene<'_, R>, frame: &lattice_rt::Frame, cover: bool) -> (Vec<u8>, Vec<u8>, lattice_rt::Stats) {
+fn render_cover<R: Real>(
+    scene: &Scene<'_, R>,
+    frame: &lattice_rt::Frame,
+    cover: bool,
+) -> (Vec<u8>, Vec<u8>, lattice_rt::Stats) {
     struct Gray(Vec<u8>, usize);
     impl lattice_rt::Hooks for Gray {
         fn gray_tile(&mut self, x0: u16, y0: u16, w: u16, h: u16, levels: &[u8]) {
@@ -297,12 +355,30 @@ fn tile_lists_change_no_pixel() {
     fn check<R: Real>() -> (usize, usize) {
         let (mut checked, mut fewer_walks) = (0, 0);
         for (seed, composite_size, spread) in [(1u64, 0, 0.0), (2, 0, 40.0), (3, 25, 0.0), (4, 0, 6.0)] {
-            for (eye, look) in [((0.0, 8.0, -60.0), (0.0, 0.0, 0.0)), ((0.3, 0.2, 0.1), (5.0, 1.0, 2.0)), ((40.0, 3.0, 5.0), (0.0, 0.0, 0.0))] {
+            for (eye, look) in [
+                ((0.0, 8.0, -60.0), (0.0, 0.0, 0.0)),
+                ((0.3, 0.2, 0.1), (5.0, 1.0, 2.0)),
+                ((40.0, 3.0, 5.0), (0.0, 0.0, 0.0)),
+            ] {
                 let frames = [
                     lattice_rt::Frame::new(64, 40),
-                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false }, outline: true, dither: lattice_rt::Dither::FloydSteinberg, ..lattice_rt::Frame::new(53, 35) },
-                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: true }, outline: true, tile: 16, ..lattice_rt::Frame::new(53, 35) },
-                    lattice_rt::Frame { sampling: lattice_rt::Sampling::Edges { contrast: 8 }, rows: (1, 3), ..lattice_rt::Frame::new(48, 40) },
+                    lattice_rt::Frame {
+                        sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: false },
+                        outline: true,
+                        dither: lattice_rt::Dither::FloydSteinberg,
+                        ..lattice_rt::Frame::new(53, 35)
+                    },
+                    lattice_rt::Frame {
+                        sampling: lattice_rt::Sampling::Adaptive { contrast: 4, coarse: true },
+                        outline: true,
+                        tile: 16,
+                        ..lattice_rt::Frame::new(53, 35)
+                    },
+                    lattice_rt::Frame {
+                        sampling: lattice_rt::Sampling::Edges { contrast: 8 },
+                        rows: (1, 3),
+                        ..lattice_rt::Frame::new(48, 40)
+                    },
                 ];
                 for frame in &frames {
                     let mut storage = vec![Object::<R>::default(); 150];

@@ -63,7 +63,15 @@ fn near_scene(rng: &mut Rng) -> String {
         let material = ["matte", "mirror", "glass"][rng.below(3) as usize];
         let line = match rng.below(4) {
             0 => format!("sphere center {x} {size} {z} radius {size}"),
-            1 => format!("box min {} 0 {} max {} {} {} rotate y {}", x - size, z - size, x + size, 1.5 * size, z + size, uniform(rng, 0.0, 90.0)),
+            1 => format!(
+                "box min {} 0 {} max {} {} {} rotate y {}",
+                x - size,
+                z - size,
+                x + size,
+                1.5 * size,
+                z + size,
+                uniform(rng, 0.0, 90.0)
+            ),
             2 => format!("cylinder base {x} 0 {z} radius {} height {}", size * 0.6, 2.0 * size),
             _ => format!("cone base {x} 0 {z} radius {} height {} top {}", size * 0.7, 2.0 * size, size * 0.2),
         };
@@ -134,9 +142,15 @@ fn far_object_changes_nothing<R: Real>() {
         let near = format!("{}{near}", camera(az, el, d));
         let dist = log_uniform(&mut rng, lo, hi);
         let far = far_object(&mut rng, dist);
-        let (alone, dull) = (gray::<R>(&near, Accel::Lattice, &frame), gray::<f64>(&matte(&near), Accel::Lattice, &frame));
+        let (alone, dull) =
+            (gray::<R>(&near, Accel::Lattice, &frame), gray::<f64>(&matte(&near), Accel::Lattice, &frame));
         let off = share_off(&alone, &gray::<f64>(&near, Accel::Lattice, &frame));
-        assert!(off <= bound_with_glass::<R>(), "seed {seed}, {}: {:.2} % of pixels more than one level off f64\n{near}", R::NAME, off * 100.0);
+        assert!(
+            off <= bound_with_glass::<R>(),
+            "seed {seed}, {}: {:.2} % of pixels more than one level off f64\n{near}",
+            R::NAME,
+            off * 100.0
+        );
         for accel in ACCELS {
             let with_far = format!("{near}{far}");
             let off = share_off(&gray::<R>(&with_far, accel, &frame), &alone);
@@ -167,7 +181,6 @@ fn a_far_object_changes_nothing_in_f32() {
 fn a_far_object_changes_nothing_in_fixed_point() {
     far_object_changes_nothing::<Fx>();
 }
-
 
 /// The far camera's distance in `R`, for a view about 7 units across at 128x64: up to where
 /// neighbouring pixels stay [`lattice_rt::scene::VIEW_MARGIN`] units of the last place apart
@@ -233,7 +246,8 @@ fn a_far_camera_draws_the_scene_in_f32() {
 // 0.5 %), from its shading arithmetic rather than from the offset or the view's resolution.
 
 /// The paper's floor and a sphere near the origin.
-const FLOOR_AND_SPHERE: &str = "light directional dir -0.6 -1 0.5\nmaterial floor ka 0.3 kd 0.6\nmaterial matte ka 0.3 kd 0.7\n\
+const FLOOR_AND_SPHERE: &str =
+    "light directional dir -0.6 -1 0.5\nmaterial floor ka 0.3 kd 0.6\nmaterial matte ka 0.3 kd 0.7\n\
     box min -6 -0.1 -4 max 6 0 6 material floor\nsphere center 0 0.8 0.3 radius 0.8 material matte\n";
 
 /// The cases that were refused because something else was far away (the floor called too thin).
@@ -243,7 +257,8 @@ fn the_cases_once_refused_render_as_without_the_far_part() {
     let near = format!("camera eye 0 1.8 -5.5 look 0 0.7 0 fov 40 25\n{FLOOR_AND_SPHERE}");
     let reference = gray::<f64>(&near, Accel::Lattice, &frame);
     // One more sphere 40,000 away, in f32 and f64; one at 1e15 in f64.
-    for (far, scalars) in [("sphere center 40000 -40000 0 radius 1\n", 2), ("sphere center 1e15 -1e15 0 radius 1\n", 1)] {
+    for (far, scalars) in [("sphere center 40000 -40000 0 radius 1\n", 2), ("sphere center 1e15 -1e15 0 radius 1\n", 1)]
+    {
         let text = format!("{near}{far}");
         assert_eq!(share_off(&gray::<f64>(&text, Accel::Lattice, &frame), &reference), 0.0, "f64: {far}");
         if scalars == 2 {
@@ -254,9 +269,15 @@ fn the_cases_once_refused_render_as_without_the_far_part() {
     // is 1/120 of a pixel), against the view from 1e6.
     let view = |d: f64| {
         let fov = 2.0 * libm::atan(120.0 / d).to_degrees();
-        format!("camera eye 0 {:e} {:e} look 0 0.5 0 fov {fov:e} {:e}\n{FLOOR_AND_SPHERE}", 0.5 + 0.3 * d, -d, fov * 0.625)
+        format!(
+            "camera eye 0 {:e} {:e} look 0 0.5 0 fov {fov:e} {:e}\n{FLOOR_AND_SPHERE}",
+            0.5 + 0.3 * d,
+            -d,
+            fov * 0.625
+        )
     };
-    let off = share_off(&gray::<f64>(&view(1e14), Accel::Lattice, &frame), &gray::<f64>(&view(1e6), Accel::Lattice, &frame));
+    let off =
+        share_off(&gray::<f64>(&view(1e14), Accel::Lattice, &frame), &gray::<f64>(&view(1e6), Accel::Lattice, &frame));
     assert!(off <= bound::<f32>(), "camera 1e14 away: {:.2} % of pixels off the view from 1e6", off * 100.0);
 }
 

@@ -65,12 +65,21 @@ fn error_diffusion_in_tiles_keeps_the_mean_gray() {
 /// Atkinson's kernel.
 #[test]
 fn error_diffused_frames_match_golden_images() {
-    let panel = Frame { dither: Dither::FloydSteinberg, sampling: lattice_rt::render::Sampling::Adaptive { contrast: 4, coarse: true }, outline: true, cutoff: Some(7), ..Frame::new(128, 64) };
+    let panel = Frame {
+        dither: Dither::FloydSteinberg,
+        sampling: lattice_rt::render::Sampling::Adaptive { contrast: 4, coarse: true },
+        outline: true,
+        cutoff: Some(7),
+        ..Frame::new(128, 64)
+    };
     for s in SCENES {
         let (pbm, _) = render_text::<lattice_rt::Fx>(&scene_text(s), Accel::Lattice, &panel);
         assert_golden(&format!("{s}-panel-fixed"), &pbm);
     }
-    for (s, frame) in [("chair", Frame { width: 100, height: 60, cutoff: None, ..panel }), ("whitted", Frame { dither: Dither::Atkinson, width: 100, height: 60, cutoff: None, ..panel })] {
+    for (s, frame) in [
+        ("chair", Frame { width: 100, height: 60, cutoff: None, ..panel }),
+        ("whitted", Frame { dither: Dither::Atkinson, width: 100, height: 60, cutoff: None, ..panel }),
+    ] {
         let (pbm, _) = render_text::<f64>(&scene_text(s), Accel::Lattice, &frame);
         assert_golden(&format!("{s}-100x60-{:?}-f64", frame.dither).to_lowercase(), &pbm);
     }

@@ -9,8 +9,8 @@ use lattice_rt::scene::Object;
 use lattice_rt::shape::{Shape, ShapeHit};
 use lattice_rt::trace::{facing, refract};
 use lattice_rt::{
-    parse, Accelerator, BoundingBox, BruteForce, Effects, Frame, Fx, LatticeConfig, Query, Ray,
-    Real, Scene, Tracer, Vec3,
+    parse, Accelerator, BoundingBox, BruteForce, Effects, Frame, Fx, LatticeConfig, Query, Ray, Real, Scene, Tracer,
+    Vec3,
 };
 
 /// Runs a generic case body in every scalar.
@@ -30,7 +30,11 @@ fn scene_in<'a, R: Real>(text: &str, st: &'a mut (Vec<Object<R>>, lattice_rt::Pa
 }
 
 /// [`scene_in`] with the view fitted to frames of `shape`.
-fn scene_for<'a, R: Real>(text: &str, (storage, parts): &'a mut (Vec<Object<R>>, lattice_rt::Parts<R>), shape: [u32; 2]) -> Scene<'a, R> {
+fn scene_for<'a, R: Real>(
+    text: &str,
+    (storage, parts): &'a mut (Vec<Object<R>>, lattice_rt::Parts<R>),
+    shape: [u32; 2],
+) -> Scene<'a, R> {
     *storage = vec![Object::default(); text.lines().count().max(1)];
     parse_for::<R>(text, storage, parts, shape).unwrap_or_else(|e| panic!("{} : {e}", R::NAME))
 }
@@ -89,7 +93,8 @@ fn leaving_rays_miss_their_object<R: Real>() {
     let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
     let cam = scene.camera();
-    let dirs = [(1.0, 1.0, -1.0), (-0.6, 1.0, 0.5), (0.0, 1.0, 0.0), (0.3, 0.2, -1.0), (1.0, 0.05, 0.0), (-1.0, 0.3, 0.7)];
+    let dirs =
+        [(1.0, 1.0, -1.0), (-0.6, 1.0, 0.5), (0.0, 1.0, 0.0), (0.3, 0.2, -1.0), (1.0, 0.05, 0.0), (-1.0, 0.3, 0.7)];
     let mut checked = 0;
     for (i, o) in scene.objects().iter().enumerate() {
         for y in 0..48 {
@@ -101,11 +106,20 @@ fn leaving_rays_miss_their_object<R: Real>() {
                     let p = o.surface_point(hit.point, hit.normal);
                     let from = p + n * R::offset(p.max_abs(), o.size());
                     let mirror = eye.dir.normalize() + n * (-(eye.dir.normalize().dot(n)) * R::from_f64(2.0));
-                    for d in dirs.iter().map(|&(a, b, c)| Vec3::new(R::from_f64(a), R::from_f64(b), R::from_f64(c)).normalize()).chain([mirror]) {
+                    for d in dirs
+                        .iter()
+                        .map(|&(a, b, c)| Vec3::new(R::from_f64(a), R::from_f64(b), R::from_f64(c)).normalize())
+                        .chain([mirror])
+                    {
                         if d.dot(n) > R::ZERO {
                             checked += 1;
                             let again = o.intersect(&Ray::new(from, d), R::ZERO, R::MAX);
-                            assert!(again.is_none(), "{}: object {i}, pixel ({x}, {y}), direction {d:?}: hit again at {:?}", R::NAME, again.map(|h| h.t));
+                            assert!(
+                                again.is_none(),
+                                "{}: object {i}, pixel ({x}, {y}), direction {d:?}: hit again at {:?}",
+                                R::NAME,
+                                again.map(|h| h.t)
+                            );
                         }
                     }
                 }
@@ -142,7 +156,9 @@ fn translate_scene(text: &str, d: f64) -> String {
         let mut line_out = Vec::new();
         while i < words.len() {
             line_out.push(words[i].to_string());
-            if matches!(words[i], "eye" | "look" | "center" | "min" | "max" | "base" | "pos") && words[0] != "light" || words[i] == "pos" {
+            if matches!(words[i], "eye" | "look" | "center" | "min" | "max" | "base" | "pos") && words[0] != "light"
+                || words[i] == "pos"
+            {
                 for k in 1..=3 {
                     let x: f64 = words[i + k].parse().unwrap();
                     line_out.push(format!("{}", x + d));
@@ -205,7 +221,10 @@ fn tangent_rays<R: Real>() {
         for k in -8i32..=8 {
             // A ray along x at height `top` in z: grazes the side of each shape at z = radius.
             let z = (if let Shape::Cone { .. } = shape { 0.5 } else { 1.0 }) + k as f64 * step;
-            let r = Ray::new(v::<R>(-5.0, if let Shape::Sphere = shape { 0.0 } else { 1.0 - top }, z), v::<R>(1.0, 0.0, 0.0));
+            let r = Ray::new(
+                v::<R>(-5.0, if let Shape::Sphere = shape { 0.0 } else { 1.0 - top }, z),
+                v::<R>(1.0, 0.0, 0.0),
+            );
             let hit = shape.intersect(&r, R::ZERO, R::MAX);
             if let Some(ShapeHit { t, normal: n, .. }) = hit {
                 assert!(t.is_finite() && n.x.is_finite() && n.y.is_finite() && n.z.is_finite(), "{}: NaN", R::NAME);
@@ -215,7 +234,16 @@ fn tangent_rays<R: Real>() {
             }
         }
         assert!(missed, "{} {shape:?}: the sweep never misses", R::NAME);
-        assert!(shape.intersect(&Ray::new(v::<R>(-5.0, if let Shape::Sphere = shape { 0.0 } else { 1.0 - top }, 0.0), v::<R>(1.0, 0.0, 0.0)), R::ZERO, R::MAX).is_some());
+        assert!(shape
+            .intersect(
+                &Ray::new(
+                    v::<R>(-5.0, if let Shape::Sphere = shape { 0.0 } else { 1.0 - top }, 0.0),
+                    v::<R>(1.0, 0.0, 0.0)
+                ),
+                R::ZERO,
+                R::MAX
+            )
+            .is_some());
     }
 }
 
@@ -267,7 +295,13 @@ fn signed_zero_parallel_rays<R: Real>() {
                 answers.push(a.nearest(&scene, &r, R::ZERO, R::MAX, &mut q));
             }
             assert!(answers.windows(2).all(|w| w[0] == w[1]), "{} {name}: +0 and -0 differ at {x},{y}", R::NAME);
-            let want = BruteForce.nearest(&scene, &Ray::new(v::<R>(x, y, -10.0), v::<R>(0.0, 0.0, 1.0)), R::ZERO, R::MAX, &mut q);
+            let want = BruteForce.nearest(
+                &scene,
+                &Ray::new(v::<R>(x, y, -10.0), v::<R>(0.0, 0.0, 1.0)),
+                R::ZERO,
+                R::MAX,
+                &mut q,
+            );
             assert_eq!(answers[0], want, "{} {name}", R::NAME);
         }
     });
@@ -280,16 +314,20 @@ fn corners_faces_and_sub_lattices<R: Real>() {
     let text = "camera eye -4 -4 -4 look 0 0 0\nbox min 0 0 0 max 1 1 1\nsphere center 2 2 2 radius 0.5\ngroup g\n  box min 3 0 0 max 4 1 1\n  sphere center 3.5 2 0.5 radius 0.5\nend\n";
     let mut st = Default::default();
     let scene = scene_in::<R>(text, &mut st);
-    let cfg = LatticeConfig { top: Resolution::Uniform([4, 4, 4]), sub: Resolution::Uniform([2, 2, 2]), ..LatticeConfig::default() };
+    let cfg = LatticeConfig {
+        top: Resolution::Uniform([4, 4, 4]),
+        sub: Resolution::Uniform([2, 2, 2]),
+        ..LatticeConfig::default()
+    };
     let w = scene.world();
     let g = scene.composites()[0].bounds;
     let rays = [
-        Ray::new(w.min, w.max - w.min),                                         // corner to corner
-        Ray::new(Vec3::new(w.min.x, w.min.y, w.min.z), v::<R>(1.0, 1.0, 0.0)),   // along a face edge
+        Ray::new(w.min, w.max - w.min),                                        // corner to corner
+        Ray::new(Vec3::new(w.min.x, w.min.y, w.min.z), v::<R>(1.0, 1.0, 0.0)), // along a face edge
         Ray::new(Vec3::new(w.min.x - R::ONE, w.min.y, R::ZERO), v::<R>(1.0, 0.0, 0.0)), // in a face plane, from outside
-        Ray::new(Vec3::new(w.max.x, R::HALF, R::HALF), v::<R>(-1.0, 0.0, 0.0)),  // starting on the far face
-        Ray::new((g.min + g.max) * R::HALF, v::<R>(0.3, 1.0, 0.2)),               // inside the sub-lattice
-        Ray::new(g.min - v::<R>(1.0, 1.0, 1.0), v::<R>(1.0, 1.0, 1.0)),           // into the sub-lattice's corner
+        Ray::new(Vec3::new(w.max.x, R::HALF, R::HALF), v::<R>(-1.0, 0.0, 0.0)), // starting on the far face
+        Ray::new((g.min + g.max) * R::HALF, v::<R>(0.3, 1.0, 0.2)),            // inside the sub-lattice
+        Ray::new(g.min - v::<R>(1.0, 1.0, 1.0), v::<R>(1.0, 1.0, 1.0)),        // into the sub-lattice's corner
     ];
     let mut mb = vec![0; 16];
     let mut q = Query::new(&mut mb);
@@ -316,7 +354,10 @@ fn long_walk_does_not_drift<R: Real>() {
     let mut walked = Vec::new();
     lat.walk_cells(&ray, R::ZERO, R::MAX, |c, _, _| walked.push((c[0], c[1])));
     // The exact walk over the same planes, in f64 on the scalar's own coordinates.
-    let (xs, ys) = (lat.coordinate_list(0, 0).iter().map(|v| v.to_f64()).collect::<Vec<_>>(), lat.coordinate_list(0, 1).iter().map(|v| v.to_f64()).collect::<Vec<_>>());
+    let (xs, ys) = (
+        lat.coordinate_list(0, 0).iter().map(|v| v.to_f64()).collect::<Vec<_>>(),
+        lat.coordinate_list(0, 1).iter().map(|v| v.to_f64()).collect::<Vec<_>>(),
+    );
     let (o, d) = ([ray.origin.x.to_f64(), ray.origin.y.to_f64()], [ray.dir.x.to_f64(), ray.dir.y.to_f64()]);
     let start = |c: &[f64], x: f64| c.iter().rposition(|&p| p <= x).unwrap_or(0).min(c.len() - 2);
     let (mut i, mut j) = (start(&xs, o[0]), start(&ys, o[1]));
@@ -324,7 +365,11 @@ fn long_walk_does_not_drift<R: Real>() {
     loop {
         let tx = (xs[i + 1] - o[0]) / d[0];
         let ty = (ys[j + 1] - o[1]) / d[1];
-        if tx <= ty { i += 1 } else { j += 1 }
+        if tx <= ty {
+            i += 1
+        } else {
+            j += 1
+        }
         if i + 1 >= xs.len() || j + 1 >= ys.len() {
             break;
         }
@@ -335,7 +380,13 @@ fn long_walk_does_not_drift<R: Real>() {
         let (i, j) = exact[k - 1];
         let tx = (xs[i + 1] - o[0]) / d[0];
         let ty = (ys[j + 1] - o[1]) / d[1];
-        eprintln!("{}: first difference at step {k}: walked {:?}, exact {:?}, |tx - ty| = {:e}", R::NAME, walked[k], exact[k], (tx - ty).abs());
+        eprintln!(
+            "{}: first difference at step {k}: walked {:?}, exact {:?}, |tx - ty| = {:e}",
+            R::NAME,
+            walked[k],
+            exact[k],
+            (tx - ty).abs()
+        );
     }
     assert_eq!(walked, exact, "{}: the walk drifted", R::NAME);
 }
@@ -350,10 +401,17 @@ fn large_object_and_mailbox<R: Real>() {
     with_accels(&scene, &cfg, |name, a| {
         let mut mb = vec![0; 4];
         let mut q = Query::new(&mut mb);
-        let hit = a.nearest(&scene, &Ray::new(v::<R>(0.0, 0.5, -1.0), v::<R>(0.0, 0.0, 1.0)), R::ZERO, R::MAX, &mut q).unwrap();
+        let hit = a
+            .nearest(&scene, &Ray::new(v::<R>(0.0, 0.5, -1.0), v::<R>(0.0, 0.0, 1.0)), R::ZERO, R::MAX, &mut q)
+            .unwrap();
         assert_eq!(hit.object, 1, "{} {name}: the sphere is nearer", R::NAME);
         if name != "bbox" {
-            assert!(q.stats.object_tests <= 2, "{} {name}: {} object tests for 2 objects", R::NAME, q.stats.object_tests);
+            assert!(
+                q.stats.object_tests <= 2,
+                "{} {name}: {} object tests for 2 objects",
+                R::NAME,
+                q.stats.object_tests
+            );
         }
     });
 }
@@ -362,11 +420,16 @@ fn large_object_and_mailbox<R: Real>() {
 fn cylinder_and_cone_special_rays<R: Real>() {
     let cyl = Shape::<R>::Cylinder;
     // Parallel to the axis, inside the radius: hits the bottom cap.
-    let ShapeHit { t, normal: n, .. } = cyl.intersect(&Ray::new(v(0.3, -2.0, 0.2), v(0.0, 1.0, 0.0)), R::ZERO, R::MAX).unwrap();
+    let ShapeHit { t, normal: n, .. } =
+        cyl.intersect(&Ray::new(v(0.3, -2.0, 0.2), v(0.0, 1.0, 0.0)), R::ZERO, R::MAX).unwrap();
     assert_eq!((t, n), (R::from_f64(2.0), v(0.0, -1.0, 0.0)), "{}", R::NAME);
     // Down onto the cap rim and just inside/outside it: no crack between cap and side.
     for x in [0.999, 1.0] {
-        assert!(cyl.intersect(&Ray::new(v(x, 3.0, 0.0), v(0.0, -1.0, 0.0)), R::ZERO, R::MAX).is_some(), "{} rim {x}", R::NAME);
+        assert!(
+            cyl.intersect(&Ray::new(v(x, 3.0, 0.0), v(0.0, -1.0, 0.0)), R::ZERO, R::MAX).is_some(),
+            "{} rim {x}",
+            R::NAME
+        );
     }
     // Diagonally through the rim edge from outside: hits, never falls between cap and side.
     for k in -3..=3 {
@@ -385,13 +448,22 @@ fn cylinder_and_cone_special_rays<R: Real>() {
     }
     // The mirror cone above the apex is never hit.
     for y in [1.2, 1.5, 2.0] {
-        assert!(cone.intersect(&Ray::new(v(-5.0, y, 0.0), v(1.0, 0.0, 0.0)), R::ZERO, R::MAX).is_none(), "{} mirror cone at {y}", R::NAME);
+        assert!(
+            cone.intersect(&Ray::new(v(-5.0, y, 0.0), v(1.0, 0.0, 0.0)), R::ZERO, R::MAX).is_none(),
+            "{} mirror cone at {y}",
+            R::NAME
+        );
     }
 }
 
 // 12. Boxes under extreme transforms: hits and normals as in f64, or refused.
 fn boxes_under_extreme_transforms<R: Real>() {
-    for (name, tr) in [("scale 1000", "scale 1000"), ("scale 0.001", "scale 0.001"), ("shear", "shear x y 3 rotate z 20"), ("mixed", "scale 1000 1 0.01")] {
+    for (name, tr) in [
+        ("scale 1000", "scale 1000"),
+        ("scale 0.001", "scale 0.001"),
+        ("shear", "shear x y 3 rotate z 20"),
+        ("mixed", "scale 1000 1 0.01"),
+    ] {
         let text = format!("camera eye 0.3 0.2 -20\nbox min -0.5 -0.5 -0.5 max 0.5 0.5 0.5 {tr}\n");
         let mut st = vec![Object::<R>::default(); 2];
         let mut parts = lattice_rt::Parts::default();
@@ -419,12 +491,17 @@ fn boxes_under_extreme_transforms<R: Real>() {
                     let rel = (a.t.to_f64() - b.t).abs() / b.t;
                     assert!(rel < 1e-3, "{} {name}: t {} vs {}", R::NAME, a.t.to_f64(), b.t);
                     let (na, nb) = (scene.objects()[0].world_normal(a.normal), s64.objects()[0].world_normal(b.normal));
-                    assert!(na.x.to_f64() * nb.x + na.y.to_f64() * nb.y + na.z.to_f64() * nb.z > 0.99, "{} {name}: normal", R::NAME);
+                    assert!(
+                        na.x.to_f64() * nb.x + na.y.to_f64() * nb.y + na.z.to_f64() * nb.z > 0.99,
+                        "{} {name}: normal",
+                        R::NAME
+                    );
                 }
                 (None, None) => {}
                 (a, b) => {
                     // Disagreement only for rays grazing an edge: the f64 hit is near the box's silhouette.
-                    let grazing = b.is_none_or(|b| s64.objects()[0].world_normal(b.normal).dot(r64.dir.normalize()).abs() < 0.05);
+                    let grazing =
+                        b.is_none_or(|b| s64.objects()[0].world_normal(b.normal).dot(r64.dir.normalize()).abs() < 0.05);
                     assert!(grazing, "{} {name}: hit {:?} vs {:?}", R::NAME, a.map(|h| h.t), b.map(|h| h.t));
                 }
             }
@@ -443,7 +520,8 @@ fn fixed_point_far_spheres_are_right_and_tiny_ones_refused() {
     let (fx, f) = (parse::<Fx>(text, &mut a, &mut pa).unwrap(), parse::<f64>(text, &mut b, &mut pb).unwrap());
     let mut mb = vec![0; 2];
     let mut q = Query::new(&mut mb);
-    let h = BruteForce.nearest(&fx, &Ray::new(fx.camera().eye, fx.camera().forward), Fx::ZERO, Fx::MAX, &mut q).unwrap();
+    let h =
+        BruteForce.nearest(&fx, &Ray::new(fx.camera().eye, fx.camera().forward), Fx::ZERO, Fx::MAX, &mut q).unwrap();
     let h64 = BruteForce.nearest(&f, &Ray::new(f.camera().eye, f.camera().forward), 0.0, f64::MAX, &mut q).unwrap();
     // Right to 1e-4 of the distance (the saturating, unshifted quadratic would be off by far more).
     assert!((h.t.to_f64() - h64.t).abs() < 1e-4 * h64.t, "{} vs {}", h.t.to_f64(), h64.t);
@@ -459,7 +537,13 @@ fn fixed_point_far_spheres_are_right_and_tiny_ones_refused() {
 // of two leaves the floating-point image bit-identical.
 fn mirror_and_scale<R: Real>() {
     let base = scene_text("chair");
-    let mirrored = format!("{}\n", base.replace("group chair rotate y 20", "group chair rotate y 20 scale -1 1 1").replace("box min -4 -0.1 -4 max 4 0 4", "box min -4 -0.1 -4 max 4 0 4 scale -1 1 1").replace("camera eye 3 2.6", "camera eye -3 2.6").replace("dir -0.5 -1 0.6", "dir 0.5 -1 0.6"));
+    let mirrored = format!(
+        "{}\n",
+        base.replace("group chair rotate y 20", "group chair rotate y 20 scale -1 1 1")
+            .replace("box min -4 -0.1 -4 max 4 0 4", "box min -4 -0.1 -4 max 4 0 4 scale -1 1 1")
+            .replace("camera eye 3 2.6", "camera eye -3 2.6")
+            .replace("dir -0.5 -1 0.6", "dir 0.5 -1 0.6")
+    );
     let frame = Frame::new(96, 48);
     let (mut s1, mut s2) = Default::default();
     let (a, b) = (scene_in::<R>(&base, &mut s1), scene_in::<R>(&mirrored, &mut s2));

@@ -28,20 +28,37 @@ fn unknown_attribute() {
     // A word one or two letters off a valid one is named.
     check("sphere raduis 1", "line 1, column 8 at `raduis`: not an attribute of this statement (did you mean `radius`?); it takes center, radius, material, translate, rotate, scale or shear");
     check("camera eyes 0 0 -5\nsphere", "line 1, column 8 at `eyes`: not an attribute of this statement (did you mean `eye`?); it takes eye, look, up or fov");
-    check("light point dir 0 1 0\nsphere", "line 1, column 13 at `dir`: not an attribute of this statement; it takes pos or intensity");
-    check("ambient 0.2 0.3\nsphere", "line 1, column 13 at `0.3`: not an attribute of this statement; it takes nothing after its value");
+    check(
+        "light point dir 0 1 0\nsphere",
+        "line 1, column 13 at `dir`: not an attribute of this statement; it takes pos or intensity",
+    );
+    check(
+        "ambient 0.2 0.3\nsphere",
+        "line 1, column 13 at `0.3`: not an attribute of this statement; it takes nothing after its value",
+    );
 }
 
 #[test]
 fn repeated_attribute() {
     check("sphere radius 1 radius 2", "line 1, column 17 at `radius`: attribute given twice in this statement");
     check("camera fov 40 fov 50\nsphere", "line 1, column 15 at `fov`: attribute given twice in this statement");
-    check("material m ka 0.1 kd 0.5 ka 0.2\nsphere", "line 1, column 26 at `ka`: attribute given twice in this statement");
-    check("light directional dir 0 -1 0 intensity 1 intensity 2\nsphere", "line 1, column 42 at `intensity`: attribute given twice in this statement");
+    check(
+        "material m ka 0.1 kd 0.5 ka 0.2\nsphere",
+        "line 1, column 26 at `ka`: attribute given twice in this statement",
+    );
+    check(
+        "light directional dir 0 -1 0 intensity 1 intensity 2\nsphere",
+        "line 1, column 42 at `intensity`: attribute given twice in this statement",
+    );
     // Transforms compose: they may repeat.
     let mut storage = vec![lattice_rt::scene::Object::<f64>::default(); 2];
     let mut parts = lattice_rt::Parts::default();
-    assert!(lattice_rt::parse::<f64>("sphere rotate y 10 rotate y 20 translate 1 0 0 translate 0 1 0", &mut storage, &mut parts).is_ok());
+    assert!(lattice_rt::parse::<f64>(
+        "sphere rotate y 10 rotate y 20 translate 1 0 0 translate 0 1 0",
+        &mut storage,
+        &mut parts
+    )
+    .is_ok());
 }
 
 #[test]
@@ -101,14 +118,26 @@ fn zero_scale_is_a_singular_transform() {
 
 #[test]
 fn bad_coefficients() {
-    check("material m kd -0.5", "line 1, column 15 at `-0.5`: coefficients must be >= 0 and the index of refraction >= 1");
-    check("material m ior 0.5", "line 1, column 16 at `0.5`: coefficients must be >= 0 and the index of refraction >= 1");
+    check(
+        "material m kd -0.5",
+        "line 1, column 15 at `-0.5`: coefficients must be >= 0 and the index of refraction >= 1",
+    );
+    check(
+        "material m ior 0.5",
+        "line 1, column 16 at `0.5`: coefficients must be >= 0 and the index of refraction >= 1",
+    );
 }
 
 #[test]
 fn camera_looking_along_its_up_vector() {
-    check("camera eye 0 5 0 look 0 0 0 up 0 1 0\nsphere", "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector");
-    check("camera eye 0 0 0 look 0 0 0\nsphere", "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector");
+    check(
+        "camera eye 0 5 0 look 0 0 0 up 0 1 0\nsphere",
+        "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector",
+    );
+    check(
+        "camera eye 0 0 0 look 0 0 0\nsphere",
+        "line 1, column 1 at `camera`: camera looks nowhere or straight along its up vector",
+    );
 }
 
 #[test]

@@ -8,7 +8,10 @@ mod common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;
-use lattice_rt::{parse, render_pass, render_share, BitFrame, Dither, Frame, Fx, HeapScratch, NoHooks, Real, Sampling, Share, Tone, Traced, Tracer};
+use lattice_rt::{
+    parse, render_pass, render_share, BitFrame, Dither, Frame, Fx, HeapScratch, NoHooks, Real, Sampling, Share, Tone,
+    Traced, Tracer,
+};
 
 /// The frames of each pass (shares rendered one after the other into one bitmap), the eye rays
 /// of all passes, and the plain frame with its eye rays.
@@ -17,34 +20,44 @@ fn passes<R: Real>(name: &str, frame: Frame, of: u8) -> (Vec<Vec<u8>>, u64, Vec<
         let tracer = Tracer::new(scene, lat);
         let (w, h) = (frame.width as u32, frame.height as u32);
         let shares: Vec<Share> = (0..of).map(|index| Share { index, of }).collect();
-        let mut traced: Vec<Vec<Traced>> = shares.iter().map(|s| vec![Traced::default(); frame.traced_len(*s)]).collect();
+        let mut traced: Vec<Vec<Traced>> =
+            shares.iter().map(|s| vec![Traced::default(); frame.traced_len(*s)]).collect();
         let (mut frames, mut rays) = (Vec::new(), 0);
         for pass in [8u8, 4, 2, 1] {
             let mut bits = vec![0u8; BitFrame::bytes(w, h)];
             let mut target = BitFrame::new(w, h, &mut bits).unwrap();
             for (s, kept) in shares.iter().zip(traced.iter_mut()) {
                 let mut scratch = HeapScratch::new(scene, &frame);
-                rays += render_pass(&tracer, &frame, *s, pass, kept, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap().rays[0];
+                rays += render_pass(&tracer, &frame, *s, pass, kept, &mut target, &mut scratch.scratch(), &mut NoHooks)
+                    .unwrap()
+                    .rays[0];
             }
             frames.push(bits);
         }
         let mut plain = vec![0u8; BitFrame::bytes(w, h)];
         let mut target = BitFrame::new(w, h, &mut plain).unwrap();
         let mut scratch = HeapScratch::new(scene, &frame);
-        let stats = render_share(&tracer, &frame, Share::ALL, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
+        let stats =
+            render_share(&tracer, &frame, Share::ALL, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
         (frames, rays, plain, stats.rays[0])
     })
 }
 
 #[test]
 fn the_last_pass_is_the_plain_frame_and_no_eye_ray_is_traced_twice() {
-    let samplings = [Sampling::Center, Sampling::Adaptive { contrast: 4, coarse: false }, Sampling::Adaptive { contrast: 4, coarse: true }, Sampling::Edges { contrast: 16 }];
+    let samplings = [
+        Sampling::Center,
+        Sampling::Adaptive { contrast: 4, coarse: false },
+        Sampling::Adaptive { contrast: 4, coarse: true },
+        Sampling::Edges { contrast: 16 },
+    ];
     for name in ["chair", "whitted", "desk"] {
         for sampling in samplings {
             for dither in [Dither::Bayer, Dither::BlueNoise, Dither::FloydSteinberg] {
                 for outline in [false, true] {
                     // 100x60: partial tiles at the right and bottom.
-                    let frame = Frame { sampling, dither, outline, tone: Tone { gamma_tenths: 8 }, ..Frame::new(100, 60) };
+                    let frame =
+                        Frame { sampling, dither, outline, tone: Tone { gamma_tenths: 8 }, ..Frame::new(100, 60) };
                     let of = if frame.bands_independent() { 2 } else { 1 };
                     let (frames, rays, plain, plain_rays) = passes::<Fx>(name, frame, of);
                     let what = format!("{name} {sampling:?} {dither:?} outline {outline}");
@@ -52,9 +65,17 @@ fn the_last_pass_is_the_plain_frame_and_no_eye_ray_is_traced_twice() {
                     if sampling == (Sampling::Adaptive { contrast: 4, coarse: true }) {
                         // The previews trace every second pixel of every second line, which the
                         // plain frame's coarse level partly fills: at most those rays more.
-                        let halves = |n: u16| (0..n).step_by(frame.tile as usize).map(|a| u64::from((n - a).min(u16::from(frame.tile))).div_ceil(2)).sum::<u64>();
+                        let halves = |n: u16| {
+                            (0..n)
+                                .step_by(frame.tile as usize)
+                                .map(|a| u64::from((n - a).min(u16::from(frame.tile))).div_ceil(2))
+                                .sum::<u64>()
+                        };
                         let previews = halves(frame.width) * halves(frame.height);
-                        assert!(plain_rays < rays && rays <= plain_rays + previews, "{what}: {rays} rays, plain {plain_rays}, previews {previews}");
+                        assert!(
+                            plain_rays < rays && rays <= plain_rays + previews,
+                            "{what}: {rays} rays, plain {plain_rays}, previews {previews}"
+                        );
                     } else {
                         assert_eq!(rays, plain_rays, "{what}");
                     }
@@ -103,7 +124,16 @@ fn frames_that_cannot_be_progressive_are_refused() {
         let n = if room { frame.traced_len(Share::ALL) } else { frame.traced_len(Share::ALL) - 1 };
         let mut traced = vec![Traced::default(); n];
         let mut scratch = HeapScratch::new(&scene, &frame);
-        let r = render_pass(&tracer, &frame, Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut NoHooks);
+        let r = render_pass(
+            &tracer,
+            &frame,
+            Share::ALL,
+            pass,
+            &mut traced,
+            &mut target,
+            &mut scratch.scratch(),
+            &mut NoHooks,
+        );
         assert!(matches!(r, Err(RenderError::NotProgressive)), "{frame:?} pass {pass}");
     }
 }

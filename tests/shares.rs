@@ -6,7 +6,10 @@ mod common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;
-use lattice_rt::{dither_band, parse, render_pass, trace_pass, KeptTile, render, render_share, trace_share, BitFrame, Traced, Dither, Frame, Fx, HeapScratch, NoHooks, Real, Sampling, Share, Stats, Tracer};
+use lattice_rt::{
+    dither_band, parse, render, render_pass, render_share, trace_pass, trace_share, BitFrame, Dither, Frame, Fx,
+    HeapScratch, KeptTile, NoHooks, Real, Sampling, Share, Stats, Traced, Tracer,
+};
 
 /// Renders `name` into a fresh 1-bit frame for each frame in `frames`, all into one bitmap.
 fn render_into<R: Real>(name: &str, frames: &[(Frame, Share)], coherence: bool) -> (Vec<u8>, Stats) {
@@ -34,7 +37,11 @@ fn shares_of(frame: Frame, of: u8) -> Vec<(Frame, Share)> {
 #[test]
 fn shares_rendered_apart_give_the_whole_frame() {
     for name in ["chair", "spheres", "whitted"] {
-        for sampling in [Sampling::Center, Sampling::Adaptive { contrast: 4, coarse: false }, Sampling::Adaptive { contrast: 4, coarse: true }] {
+        for sampling in [
+            Sampling::Center,
+            Sampling::Adaptive { contrast: 4, coarse: false },
+            Sampling::Adaptive { contrast: 4, coarse: true },
+        ] {
             // Silhouette lines too: each tile traces its own apron, so they split like the rest.
             for outline in [false, true] {
                 // 100x60: the last tile column and row are partial.
@@ -46,8 +53,13 @@ fn shares_rendered_apart_give_the_whole_frame() {
                     assert_eq!(ws.rays[0], ss.rays[0], "{name}, {sampling:?}: every eye ray traced once");
                 }
                 // And bands of tile rows.
-                let bands: Vec<(Frame, Share)> = [(0, 3), (3, 5), (5, 8)].map(|rows| (Frame { rows, ..frame }, Share::ALL)).to_vec();
-                assert_eq!(whole, render_into::<Fx>(name, &bands, true).0, "{name}, {sampling:?}, outline {outline}, bands");
+                let bands: Vec<(Frame, Share)> =
+                    [(0, 3), (3, 5), (5, 8)].map(|rows| (Frame { rows, ..frame }, Share::ALL)).to_vec();
+                assert_eq!(
+                    whole,
+                    render_into::<Fx>(name, &bands, true).0,
+                    "{name}, {sampling:?}, outline {outline}, bands"
+                );
             }
         }
     }
@@ -97,7 +109,12 @@ fn shadow_coherence_changes_work_not_pixels() {
         let (with, ws) = render_into::<f64>(name, &[(frame, Share::ALL)], true);
         let (without, wo) = render_into::<f64>(name, &[(frame, Share::ALL)], false);
         assert_eq!(with, without, "{name}");
-        assert!(ws.object_tests <= wo.object_tests, "{name}: {} tests with coherence, {} without", ws.object_tests, wo.object_tests);
+        assert!(
+            ws.object_tests <= wo.object_tests,
+            "{name}: {} tests with coherence, {} without",
+            ws.object_tests,
+            wo.object_tests
+        );
     }
 }
 
@@ -107,8 +124,15 @@ fn shares_count_their_tiles_as_the_checkerboard_holds_them() {
         for index in 0..of {
             let share = Share { index, of };
             for (tiles_x, rows) in [(16, (0, 8)), (5, (2, 7)), (1, (0, 1)), (7, (3, 3))] {
-                let counted = (rows.0..rows.1).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).filter(|&(tx, ty)| share.holds(tx, ty)).count();
-                assert_eq!(share.tiles_in(tiles_x, rows), counted, "share {index} of {of}, {tiles_x} tiles wide, rows {rows:?}");
+                let counted = (rows.0..rows.1)
+                    .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
+                    .filter(|&(tx, ty)| share.holds(tx, ty))
+                    .count();
+                assert_eq!(
+                    share.tiles_in(tiles_x, rows),
+                    counted,
+                    "share {index} of {of}, {tiles_x} tiles wide, rows {rows:?}"
+                );
             }
         }
     }
@@ -149,12 +173,24 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8, part: Option<
             // Share s holds the tiles tx = s - ty (mod of) of this row: tile tx is its (tx / of)-th.
             let tile = |tx: usize| kept[(tx + ty as usize) % of as usize].get(tx / of as usize);
             match part {
-                None => dither_band(&frame, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap(),
+                None => {
+                    dither_band(&frame, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target)
+                        .unwrap()
+                }
                 Some(part) => {
-                    let (tiles, mut from, mut left) = ((w as usize).div_ceil(frame.tile as usize), 0, [(0, 0); lattice_rt::dither::MAX_TILE]);
+                    let (tiles, mut from, mut left) =
+                        ((w as usize).div_ceil(frame.tile as usize), 0, [(0, 0); lattice_rt::dither::MAX_TILE]);
                     while from < tiles {
                         let upto = |tx: usize| if tx < from + part { tile(tx) } else { None };
-                        let next = lattice_rt::dither_tiles(&frame, (ty as usize, from), upto, (&mut above, &mut band_bits, &mut left), &mut ditherer, &mut target).unwrap();
+                        let next = lattice_rt::dither_tiles(
+                            &frame,
+                            (ty as usize, from),
+                            upto,
+                            (&mut above, &mut band_bits, &mut left),
+                            &mut ditherer,
+                            &mut target,
+                        )
+                        .unwrap();
                         assert_eq!(next, (from + part).min(tiles), "a part ends where its tiles end");
                         from = next;
                     }
@@ -169,15 +205,21 @@ fn traced_then_dithered<R: Real>(name: &str, frame: Frame, of: u8, part: Option<
 fn traced_shares_dithered_in_order_give_the_whole_frame() {
     for name in ["chair", "desk", "whitted"] {
         let samplings = [Sampling::Adaptive { contrast: 4, coarse: true }, Sampling::Center, Sampling::Grid2x2];
-        for (dither, sampling) in [Dither::FloydSteinberg, Dither::Atkinson, Dither::BlueNoise].into_iter().zip(samplings) {
-            for (width, height, outline, tile) in [(128, 64, true, 8), (100, 60, true, 8), (100, 60, false, 8), (128, 64, true, 16), (100, 60, true, 16)] {
+        for (dither, sampling) in
+            [Dither::FloydSteinberg, Dither::Atkinson, Dither::BlueNoise].into_iter().zip(samplings)
+        {
+            for (width, height, outline, tile) in
+                [(128, 64, true, 8), (100, 60, true, 8), (100, 60, false, 8), (128, 64, true, 16), (100, 60, true, 16)]
+            {
                 let frame = Frame { dither, outline, sampling, tile, ..Frame::new(width, height) };
                 let (whole, _) = render_into::<Fx>(name, &[(frame, Share::ALL)], true);
                 // 1 to 3 shares, and one tile at a time (`Share::single`: as many shares as tiles
                 // across), each band dithered whole; one tile at a time, dithered in parts of
                 // one and of three tiles.
                 let across = (width as usize).div_ceil(tile as usize) as u8;
-                for (of, part) in [(1, None), (2, None), (3, None), (across, None), (across, Some(1)), (across, Some(3))] {
+                for (of, part) in
+                    [(1, None), (2, None), (3, None), (across, None), (across, Some(1)), (across, Some(3))]
+                {
                     assert_eq!(whole, traced_then_dithered::<Fx>(name, frame, of, part), "{name}, {dither:?}, {sampling:?}, {width}x{height}, {tile}x{tile} tiles, lines {outline}, {of} shares, parts of {part:?} tiles");
                 }
                 assert_eq!(Share::single(5, 3, 16), Share { index: 8, of: 16 });
@@ -185,7 +227,11 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
         }
     }
     let frame = Frame { dither: Dither::FloydSteinberg, outline: true, ..Frame::new(128, 64) };
-    assert_eq!(render_into::<f32>("spheres", &[(frame, Share::ALL)], true).0, traced_then_dithered::<f32>("spheres", frame, 2, None), "f32");
+    assert_eq!(
+        render_into::<f32>("spheres", &[(frame, Share::ALL)], true).0,
+        traced_then_dithered::<f32>("spheres", frame, 2, None),
+        "f32"
+    );
     // Lines need the row above: too short a row is refused, not drawn without them.
     let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, 128)];
     let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, 128, &mut carries).unwrap();
@@ -193,9 +239,18 @@ fn traced_shares_dithered_in_order_give_the_whole_frame() {
     let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
     let kept = KeptTile::EMPTY;
     let mut band_bits = [embedded_graphics::pixelcolor::BinaryColor::Off; 128 * 8];
-    let err = dither_band(&frame, 1, |_| Some(&kept), (&mut [(0, 0); 100], &mut band_bits), &mut ditherer, &mut target).unwrap_err();
+    let err = dither_band(&frame, 1, |_| Some(&kept), (&mut [(0, 0); 100], &mut band_bits), &mut ditherer, &mut target)
+        .unwrap_err();
     assert_eq!(err, RenderError::ScratchTooSmall { needed: 128 });
-    let err = dither_band(&frame, 1, |_| Some(&kept), (&mut [(0, 0); 128], &mut band_bits[..1000]), &mut ditherer, &mut target).unwrap_err();
+    let err = dither_band(
+        &frame,
+        1,
+        |_| Some(&kept),
+        (&mut [(0, 0); 128], &mut band_bits[..1000]),
+        &mut ditherer,
+        &mut target,
+    )
+    .unwrap_err();
     assert_eq!(err, RenderError::ScratchTooSmall { needed: 1024 });
 }
 
@@ -208,7 +263,12 @@ fn traced_passes_dithered_in_order_give_every_pass() {
     for name in ["chair", "whitted"] {
         with_lattice::<Fx, _>(name, [128, 64], |scene, lat| {
             let tracer = Tracer::new(scene, lat);
-            let frame = Frame { dither: Dither::BlueNoise, outline: true, sampling: Sampling::Adaptive { contrast: 4, coarse: true }, ..Frame::new(128, 64) };
+            let frame = Frame {
+                dither: Dither::BlueNoise,
+                outline: true,
+                sampling: Sampling::Adaptive { contrast: 4, coarse: true },
+                ..Frame::new(128, 64)
+            };
             let (w, h) = (128u32, 64u32);
             // What render_pass draws, pass by pass.
             let mut want = Vec::new();
@@ -217,7 +277,17 @@ fn traced_passes_dithered_in_order_give_every_pass() {
             for pass in [8, 4, 2, 1] {
                 let mut target = BitFrame::new(w, h, &mut bits).unwrap();
                 let mut scratch = HeapScratch::new(scene, &frame);
-                render_pass(&tracer, &frame, Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                render_pass(
+                    &tracer,
+                    &frame,
+                    Share::ALL,
+                    pass,
+                    &mut traced,
+                    &mut target,
+                    &mut scratch.scratch(),
+                    &mut NoHooks,
+                )
+                .unwrap();
                 want.push(bits.clone());
             }
             {
@@ -228,7 +298,8 @@ fn traced_passes_dithered_in_order_give_every_pass() {
                     let mut target = BitFrame::new(w, h, &mut bits).unwrap();
                     let shown = Frame { outline: frame.outline && pass == 1, ..frame };
                     let mut carries = vec![0i16; lattice_rt::dither::Ditherer::rows_len(frame.dither, w as usize)];
-                    let mut ditherer = lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
+                    let mut ditherer =
+                        lattice_rt::dither::Ditherer::new(frame.dither, w as usize, &mut carries).unwrap();
                     let mut above = vec![(0u16, 0u16); w as usize];
                     let mut band_bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; w as usize * 8];
                     for ty in 0..(h / 8) as u16 {
@@ -241,12 +312,30 @@ fn traced_passes_dithered_in_order_give_every_pass() {
                                 let mut kept = [KeptTile::EMPTY];
                                 let mut scratch = HeapScratch::new(scene, &band);
                                 let rays = &mut traced[ty as usize * tiles_x + tx];
-                                trace_pass(&tracer, &band, share, pass, rays, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap();
+                                trace_pass(
+                                    &tracer,
+                                    &band,
+                                    share,
+                                    pass,
+                                    rays,
+                                    &mut kept,
+                                    &mut scratch.scratch(),
+                                    &mut NoHooks,
+                                )
+                                .unwrap();
                                 kept[0]
                             })
                             .collect();
                         let tile = |tx: usize| kept.get(tx);
-                        dither_band(&shown, ty as usize, tile, (&mut above, &mut band_bits), &mut ditherer, &mut target).unwrap();
+                        dither_band(
+                            &shown,
+                            ty as usize,
+                            tile,
+                            (&mut above, &mut band_bits),
+                            &mut ditherer,
+                            &mut target,
+                        )
+                        .unwrap();
                     }
                     assert_eq!(bits, want[k], "{name}, pass {pass}");
                 }
@@ -254,7 +343,17 @@ fn traced_passes_dithered_in_order_give_every_pass() {
             // A frame that cannot be progressive, or a pass that is not one, is refused.
             let mut kept = vec![KeptTile::EMPTY; frame.tiles_len(Share::ALL)];
             let mut scratch = HeapScratch::new(scene, &frame);
-            let err = trace_pass(&tracer, &frame, Share::ALL, 3, &mut traced, &mut kept, &mut scratch.scratch(), &mut NoHooks).unwrap_err();
+            let err = trace_pass(
+                &tracer,
+                &frame,
+                Share::ALL,
+                3,
+                &mut traced,
+                &mut kept,
+                &mut scratch.scratch(),
+                &mut NoHooks,
+            )
+            .unwrap_err();
             assert_eq!(err, RenderError::NotProgressive);
         });
     }

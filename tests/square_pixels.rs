@@ -30,7 +30,10 @@ fn a_sphere_is_round_at_every_frame_shape() {
         for (w, h) in [(128, 64), (200, 200), (160, 100), (400, 240), (72, 40), (64, 128)] {
             let aspect = sphere_aspect(fov, w, h);
             // Within a pixel on either side of a sphere at least 10 pixels across.
-            assert!((aspect - 1.0).abs() < 0.1, "fov {fov} at {w}x{h}: the sphere is {aspect:.3} times wider than tall");
+            assert!(
+                (aspect - 1.0).abs() < 0.1,
+                "fov {fov} at {w}x{h}: the sphere is {aspect:.3} times wider than tall"
+            );
         }
     }
 }
@@ -48,12 +51,26 @@ fn a_frame_of_another_shape_is_refused_not_stretched() {
     let mut bits = vec![0u8; lattice_rt::BitFrame::bytes(200, 200)];
     let mut target = lattice_rt::BitFrame::new(200, 200, &mut bits).unwrap();
     let mut scratch = lattice_rt::HeapScratch::new(&scene, &frame);
-    let err = lattice_rt::render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut scratch.scratch(), &mut lattice_rt::NoHooks).unwrap_err();
+    let err = lattice_rt::render(
+        &Tracer::new(&scene, &lat),
+        &frame,
+        &mut target,
+        &mut scratch.scratch(),
+        &mut lattice_rt::NoHooks,
+    )
+    .unwrap_err();
     assert_eq!(err.to_string(), "the scene's view was fitted to frames of shape 2:1, not 200x200 (pixels would not be square): load the scene for this frame");
     // The same shape at another size renders.
     let half = Frame::new(64, 32);
     let mut bits = vec![0u8; lattice_rt::BitFrame::bytes(64, 32)];
     let mut target = lattice_rt::BitFrame::new(64, 32, &mut bits).unwrap();
     let mut scratch = lattice_rt::HeapScratch::new(&scene, &half);
-    assert!(lattice_rt::render(&Tracer::new(&scene, &lat), &half, &mut target, &mut scratch.scratch(), &mut lattice_rt::NoHooks).is_ok());
+    assert!(lattice_rt::render(
+        &Tracer::new(&scene, &lat),
+        &half,
+        &mut target,
+        &mut scratch.scratch(),
+        &mut lattice_rt::NoHooks
+    )
+    .is_ok());
 }

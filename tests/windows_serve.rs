@@ -35,7 +35,13 @@ impl<R: Real> Accelerator<R> for Counting<'_, R> {
 /// lines: hit-only apron rays too) and one ray per pixel with four at edges.
 fn frames() -> [Frame; 2] {
     [
-        Frame { tile: 16, sampling: Sampling::Adaptive { contrast: 4, coarse: true }, dither: Dither::FloydSteinberg, outline: true, ..Frame::new(128, 64) },
+        Frame {
+            tile: 16,
+            sampling: Sampling::Adaptive { contrast: 4, coarse: true },
+            dither: Dither::FloydSteinberg,
+            outline: true,
+            ..Frame::new(128, 64)
+        },
         Frame { sampling: Sampling::Edges { contrast: 16 }, ..Frame::new(96, 60) },
     ]
 }
@@ -67,7 +73,9 @@ fn scenes_the_windows_serve_never_ask_the_accelerator() {
     // The matte paper scenes qualify (one directional light, no mirror); spheres has a mirror
     // but three objects, which its mirror rays test without the walk; the Whitted scene has 38
     // objects, mirrors and glass.
-    for (name, expected) in [("chair", true), ("desk", true), ("polyhedron", true), ("spheres", true), ("whitted", false)] {
+    for (name, expected) in
+        [("chair", true), ("desk", true), ("polyhedron", true), ("spheres", true), ("whitted", false)]
+    {
         let text = scene_text(name);
         for (scalar, (serves, runs)) in [("f64", check::<f64>(&text)), ("fixed", check::<Fx>(&text))] {
             assert_eq!(serves, expected, "{name} ({scalar})");
@@ -76,7 +84,10 @@ fn scenes_the_windows_serve_never_ask_the_accelerator() {
                     assert_eq!(asked, 0, "{name} ({scalar}), frame {i}: the lattice was asked about {asked} rays");
                     assert!(same, "{name} ({scalar}), frame {i}: brute force drew another frame");
                 } else {
-                    assert!(asked > 0, "{name} ({scalar}), frame {i}: a scene with secondary rays asks its accelerator");
+                    assert!(
+                        asked > 0,
+                        "{name} ({scalar}), frame {i}: a scene with secondary rays asks its accelerator"
+                    );
                 }
             }
         }
@@ -92,6 +103,9 @@ fn a_second_light_or_a_point_light_needs_the_accelerator() {
     for text in [second, point] {
         let (serves, runs) = check::<f64>(&text);
         assert!(!serves);
-        assert!(runs.iter().all(|&(asked, _)| asked > 0), "shadow rays towards a second or point light walk the lattice");
+        assert!(
+            runs.iter().all(|&(asked, _)| asked > 0),
+            "shadow rays towards a second or point light walk the lattice"
+        );
     }
 }

@@ -3,16 +3,19 @@
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::BinaryColor;
+use lattice_rt::dither::{Carry, Ditherer};
 #[cfg(not(baked_scenes))]
 use lattice_rt::lattice::LatticeError;
 #[cfg(not(baked_scenes))]
-use lattice_rt::scene::text::ParseError;
+use lattice_rt::load::{LoadError, Loaded};
 use lattice_rt::render::{Hooks, RenderError};
 #[cfg(not(baked_scenes))]
-use lattice_rt::load::{LoadError, Loaded};
+use lattice_rt::scene::text::ParseError;
 use lattice_rt::trace::MissingEffects;
-use lattice_rt::dither::{Carry, Ditherer};
-use lattice_rt::{dither_tiles, Accelerator, KeptTile, render_pass, render_share, trace_pass, trace_share, Effects, Frame, Real, Share, Stats, Traced, Tracer};
+use lattice_rt::{
+    dither_tiles, render_pass, render_share, trace_pass, trace_share, Accelerator, Effects, Frame, KeptTile, Real,
+    Share, Stats, Traced, Tracer,
+};
 
 pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
 
@@ -129,8 +132,12 @@ impl<E: fmt::Debug> defmt::Format for AppError<'_, E> {
             AppError::Render(RenderError::DiffusionNotCompiled) => defmt::write!(f, "error diffusion not compiled in"),
             AppError::Render(RenderError::BadShare) => defmt::write!(f, "bad tile share"),
             AppError::Render(RenderError::NotProgressive) => defmt::write!(f, "frame cannot be rendered progressively"),
-            AppError::Render(RenderError::ViewTooNarrow { most, .. }) => defmt::write!(f, "view too narrow for the scalar: at most {}x{} pixels", most[0], most[1]),
-            AppError::Render(RenderError::FrameShape { fitted, frame }) => defmt::write!(f, "the view was fitted to {}:{}, not {}x{}", fitted[0], fitted[1], frame[0], frame[1]),
+            AppError::Render(RenderError::ViewTooNarrow { most, .. }) => {
+                defmt::write!(f, "view too narrow for the scalar: at most {}x{} pixels", most[0], most[1])
+            }
+            AppError::Render(RenderError::FrameShape { fitted, frame }) => {
+                defmt::write!(f, "the view was fitted to {}:{}, not {}x{}", fitted[0], fitted[1], frame[0], frame[1])
+            }
             AppError::Render(RenderError::ScratchTooSmall { needed }) => {
                 defmt::write!(f, "scratch storage too small: {} entries needed", needed)
             }
@@ -164,8 +171,13 @@ pub const PASSES: &[u8] = if cfg!(feature = "progressive") { &[8, 4, 2, 1] } els
 /// (`render_pass`; none without the `progressive` feature, and none on a two-core board, whose
 /// tiles each keep their own: [`TILE_RAYS`]).
 pub const TRACED: usize = if cfg!(feature = "progressive") && !SECOND_CORE {
-    let (a, b) = (RENDERED.traced_len(Share { index: 0, of: SHARES }), RENDERED.traced_len(Share { index: 1, of: SHARES }));
-    if a > b { a } else { b }
+    let (a, b) =
+        (RENDERED.traced_len(Share { index: 0, of: SHARES }), RENDERED.traced_len(Share { index: 1, of: SHARES }));
+    if a > b {
+        a
+    } else {
+        b
+    }
 } else {
     0
 };
@@ -253,7 +265,11 @@ const TRACE_THEN_DITHER: bool = SECOND_CORE || cfg!(feature = "panel-frame");
 /// Rays each tile keeps between the passes of a progressive frame on a two-core board (the
 /// cores take tiles one at a time, so each has its own: one per pixel of its 2x2 grid); none
 /// otherwise.
-const TILE_RAYS: usize = if cfg!(feature = "progressive") && SECOND_CORE { (RENDERED.tile as usize / 2) * (RENDERED.tile as usize / 2) } else { 0 };
+const TILE_RAYS: usize = if cfg!(feature = "progressive") && SECOND_CORE {
+    (RENDERED.tile as usize / 2) * (RENDERED.tile as usize / 2)
+} else {
+    0
+};
 /// Entries of [`ShareMemory`]'s arrays when [`TRACE_THEN_DITHER`] (else none).
 const fn dithered(n: usize) -> usize {
     if TRACE_THEN_DITHER {
@@ -411,7 +427,12 @@ pub fn render_embedded_at<D: DrawTarget<Color = BinaryColor, Error: Send> + Send
 
 /// The frame of a scene loaded or baked: its tracer (over `accel`, with `lattice_bytes` of
 /// lattice), then every pass of both tile shares.
-fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+fn render_loaded<
+    't,
+    R: Real,
+    A: Accelerator<R> + Sync + ?Sized,
+    D: DrawTarget<Color = BinaryColor, Error: Send> + Send,
+>(
     scene: &lattice_rt::Scene<'_, R>,
     (accel, lattice_bytes): (&A, usize),
     mut scratch: lattice_rt::Scratch<'_>,
@@ -444,16 +465,35 @@ fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<C
     let tiles_at = now();
     if TRACE_THEN_DITHER {
         let memory = DitherMemory { mailbox, rows, kept, rays, above, band, carries };
-        let (s, [there, mine]) = trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown), target)?;
-        return Ok(Report { stats: s, objects: scene.objects().len(), lattice_bytes, share_us: [mine, there], tiles_at });
+        let (s, [there, mine]) =
+            trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown), target)?;
+        return Ok(Report {
+            stats: s,
+            objects: scene.objects().len(),
+            lattice_bytes,
+            share_us: [mine, there],
+            tiles_at,
+        });
     }
     for &pass in PASSES {
         // One core: both shares straight to the display, one after the other.
         let [there_us, here_us] = &mut times;
         let t0 = now();
-        stats.add(&draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks).map_err(AppError::Render)?);
+        stats.add(
+            &draw(tracer, pick(&tuned), first, pass, &mut traced_here[..], target, &mut scratch, hooks)
+                .map_err(AppError::Render)?,
+        );
         let t1 = now();
-        let more = draw(tracer, pick(&tuned), other, pass, &mut traced_there[..], target, &mut scratch, &mut lattice_rt::NoHooks);
+        let more = draw(
+            tracer,
+            pick(&tuned),
+            other,
+            pass,
+            &mut traced_there[..],
+            target,
+            &mut scratch,
+            &mut lattice_rt::NoHooks,
+        );
         stats.add(&more.map_err(AppError::Render)?);
         (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
         shown(pass);
@@ -525,7 +565,15 @@ enum Take<T> {
 
 /// Traces one tile of a frame: pass `PASSES[p]`, the band it is in, the share that holds it
 /// alone, what it keeps, and the rays it keeps between progressive passes.
-type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, usize, Frame, Share, &mut [KeptTile], &mut [Traced]) -> Result<Stats, RenderError<core::convert::Infallible>> + 'a;
+type TraceTile<'a> = dyn FnMut(
+        &mut lattice_rt::Scratch<'_>,
+        usize,
+        Frame,
+        Share,
+        &mut [KeptTile],
+        &mut [Traced],
+    ) -> Result<Stats, RenderError<core::convert::Infallible>>
+    + 'a;
 
 /// A frame on two cores, trace then dither: the cores take the frame's tiles one at a time as
 /// they come free (`Share::single`), in raster order, and trace each into its levels
@@ -540,12 +588,22 @@ type TraceTile<'a> = dyn FnMut(&mut lattice_rt::Scratch<'_>, usize, Frame, Share
 /// the render's hooks, the board's clock and what to do once each pass is on the display.
 /// Returns both cores' statistics and their times, core 1's first.
 #[allow(clippy::type_complexity)]
-fn trace_then_dither<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+fn trace_then_dither<
+    't,
+    R: Real,
+    A: Accelerator<R> + Sync + ?Sized,
+    D: DrawTarget<Color = BinaryColor, Error: Send> + Send,
+>(
     tracer: &Tracer<'_, '_, R, A, EFFECTS>,
     frame: &Frame,
     cores: &mut impl Cores,
     memory: DitherMemory<'_>,
-    (scratch, hooks, now, shown): (&mut lattice_rt::Scratch<'_>, &mut impl Hooks, &(dyn Fn() -> u64 + Sync), &mut dyn FnMut(u8)),
+    (scratch, hooks, now, shown): (
+        &mut lattice_rt::Scratch<'_>,
+        &mut impl Hooks,
+        &(dyn Fn() -> u64 + Sync),
+        &mut dyn FnMut(u8),
+    ),
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
     let DitherMemory { mailbox, rows, kept, rays, above, band: band_bits, carries } = memory;
@@ -592,7 +650,14 @@ fn trace_then_dither<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarg
         &mut || {
             let t0 = now();
             let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, p: usize, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, &mut lattice_rt::NoHooks);
+            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>,
+                             p: usize,
+                             band: Frame,
+                             share: Share,
+                             l: &mut [KeptTile],
+                             r: &mut [Traced]| {
+                trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, &mut lattice_rt::NoHooks)
+            };
             loop {
                 match take(&mut scratch, &mut trace) {
                     Take::Tile(Ok(s)) => there.0.add(&s),
@@ -605,13 +670,20 @@ fn trace_then_dither<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarg
         },
         &mut || {
             let t0 = now();
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>, p: usize, band: Frame, share: Share, l: &mut [KeptTile], r: &mut [Traced]| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, hooks);
+            let mut trace =
+                |scratch: &mut lattice_rt::Scratch<'_>,
+                 p: usize,
+                 band: Frame,
+                 share: Share,
+                 l: &mut [KeptTile],
+                 r: &mut [Traced]| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, hooks);
             let bands = tiles.div_ceil(tiles_x);
             here.1 = (|| {
                 for &pass in PASSES {
                     // Only a finished frame (a progressive one's last pass) has silhouette lines.
                     let shows = Frame { outline: frame.outline && pass <= 1, ..*frame };
-                    let mut ditherer = Ditherer::new(frame.dither, w, &mut *carries).ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
+                    let mut ditherer = Ditherer::new(frame.dither, w, &mut *carries)
+                        .ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
                     let (mut band, mut from) = (0, 0);
                     // The right column's hits of the last tile dithered (`dither_tiles`).
                     let mut left = [(0, 0); lattice_rt::dither::MAX_TILE];
@@ -635,8 +707,17 @@ fn trace_then_dither<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarg
                             Some(out)
                         });
                         if let Some(mut part) = ready {
-                            let tile = |tx: usize| part.get(tx.wrapping_sub(from)).and_then(|l| l.as_ref()).map(|l| &*l.kept);
-                            let next = dither_tiles(&shows, (band, from), tile, (&mut *above, &mut *band_bits, &mut left), &mut ditherer, target).map_err(AppError::Render)?;
+                            let tile =
+                                |tx: usize| part.get(tx.wrapping_sub(from)).and_then(|l| l.as_ref()).map(|l| &*l.kept);
+                            let next = dither_tiles(
+                                &shows,
+                                (band, from),
+                                tile,
+                                (&mut *above, &mut *band_bits, &mut left),
+                                &mut ditherer,
+                                target,
+                            )
+                            .map_err(AppError::Render)?;
                             critical_section::with(|cs| {
                                 let mut b = board.borrow(cs).borrow_mut();
                                 for (tx, slot) in part.iter_mut().enumerate() {

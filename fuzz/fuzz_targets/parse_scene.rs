@@ -22,8 +22,10 @@ fn check<R: Real>(text: &str) {
             if sizes.words() > 1 << 20 {
                 return;
             }
-            let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; sizes.lattices], vec![R::ZERO; sizes.coords], vec![0; sizes.words()]);
-            let lat = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
+            let (mut g, mut c, mut w) =
+                (vec![SubLattice::EMPTY; sizes.lattices], vec![R::ZERO; sizes.coords], vec![0; sizes.words()]);
+            let lat = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w })
+                .unwrap();
             let mut mb = vec![0; Query::mailbox_len(&scene)];
             let mut q = Query::new(&mut mb);
             for (x, y) in [(1, 1), (7, 3), (15, 9)] {

@@ -122,7 +122,8 @@ pub fn parse_size(s: &str) -> Result<(u16, u16), String> {
 
 /// Parses `NXxNYxNZ` into a manual lattice resolution.
 pub fn parse_cells(s: &str) -> Result<[u16; 3], String> {
-    let v: Vec<Option<u16>> = s.split(['x', 'X']).map(|p| p.trim().parse::<u16>().ok().filter(|&n| (1..=1024).contains(&n))).collect();
+    let v: Vec<Option<u16>> =
+        s.split(['x', 'X']).map(|p| p.trim().parse::<u16>().ok().filter(|&n| (1..=1024).contains(&n))).collect();
     match v.as_slice() {
         [Some(x), Some(y), Some(z)] => Ok([*x, *y, *z]),
         _ => Err(format!("cells `{s}`: expected NXxNYxNZ with each from 1 to 1024")),
@@ -274,4 +275,3 @@ pub fn default_scenes(scenes: Vec<PathBuf>) -> Vec<PathBuf> {
         scenes
     }
 }
-

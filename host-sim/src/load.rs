@@ -3,9 +3,9 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::lattice::LatticeSizes;
+use lattice_rt::scene::text::parse_with;
 use lattice_rt::scene::text::{object_count, text_from_bytes};
 use lattice_rt::scene::Object;
-use lattice_rt::scene::text::parse_with;
 use lattice_rt::{Frame, HeapStorage, Lattice, LatticeConfig, Parts, Real, Scene, SceneBuilder, Sizes};
 use std::io::Read;
 use std::path::Path;
@@ -21,7 +21,10 @@ pub const MAX_OBJECT_BYTES: usize = 128 << 20;
 pub fn read(path: &Path) -> Result<String> {
     let mut bytes = Vec::new();
     if path == Path::new("-") {
-        std::io::stdin().take(MAX_SCENE_BYTES + 1).read_to_end(&mut bytes).context("cannot read the scene from standard input")?;
+        std::io::stdin()
+            .take(MAX_SCENE_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .context("cannot read the scene from standard input")?;
     } else {
         let file = std::fs::File::open(path).with_context(|| format!("cannot read scene file {}", path.display()))?;
         file.take(MAX_SCENE_BYTES + 1)
@@ -29,7 +32,11 @@ pub fn read(path: &Path) -> Result<String> {
             .with_context(|| format!("cannot read scene file {}", path.display()))?;
     }
     if bytes.len() as u64 > MAX_SCENE_BYTES {
-        bail!("{}: the scene file is larger than {} MiB, the most host-sim reads", path.display(), MAX_SCENE_BYTES >> 20);
+        bail!(
+            "{}: the scene file is larger than {} MiB, the most host-sim reads",
+            path.display(),
+            MAX_SCENE_BYTES >> 20
+        );
     }
     // Validated once; only a failure is located (line and column) by the core.
     String::from_utf8(bytes).map_err(|e| match text_from_bytes(e.as_bytes()) {
@@ -72,8 +79,14 @@ pub fn object_storage<R: Real>(text: &str) -> Result<SceneStore<R>> {
 
 /// Parses `text` into `storage` with its camera fitted to `frame`'s shape (square pixels),
 /// turning errors into messages that name the file.
-pub fn parse_scene<'a, R: Real>(path: &Path, text: &str, storage: &'a mut SceneStore<R>, frame: &Frame) -> Result<Scene<'a, R>> {
-    parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| c.frame = frame.size()).map_err(|e| anyhow!("{}: {e}", path.display()))
+pub fn parse_scene<'a, R: Real>(
+    path: &Path,
+    text: &str,
+    storage: &'a mut SceneStore<R>,
+    frame: &Frame,
+) -> Result<Scene<'a, R>> {
+    parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| c.frame = frame.size())
+        .map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 /// The most memory a lattice may take on the host (so that no flag makes host-sim allocate
@@ -107,14 +120,22 @@ pub struct BudgetTooSmall {
 
 impl std::fmt::Display for BudgetTooSmall {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "no lattice fits --budget {}: the smallest takes {} bytes; give at least that", self.available, self.needed)
+        write!(
+            f,
+            "no lattice fits --budget {}: the smallest takes {} bytes; give at least that",
+            self.available, self.needed
+        )
     }
 }
 
 impl std::error::Error for BudgetTooSmall {}
 
 /// Builds the lattice of `scene` with `cfg` in `storage` (from [`lattice_storage`]).
-pub fn build_lattice<'a, R: Real>(storage: &'a mut HeapStorage<R>, scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<Lattice<'a, R>> {
+pub fn build_lattice<'a, R: Real>(
+    storage: &'a mut HeapStorage<R>,
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+) -> Result<Lattice<'a, R>> {
     let (lattice, _) = storage.view().split().1.lattice(scene, cfg).map_err(|e| {
         if e.capacity == "budget" {
             anyhow::Error::new(BudgetTooSmall { available: e.available, needed: e.needed })
@@ -135,7 +156,8 @@ mod tests {
         let text = read(path).unwrap();
         let mut storage = object_storage::<f64>(&text).unwrap();
         let scene = parse_scene::<f64>(path, &text, &mut storage, &Frame::new(128, 64)).unwrap();
-        let err = lattice_storage(&scene, &crate::cli::lattice_config(Some([1024, 1024, 1024]), None)).expect_err("refused");
+        let err =
+            lattice_storage(&scene, &crate::cli::lattice_config(Some([1024, 1024, 1024]), None)).expect_err("refused");
         let msg = format!("{err:#}");
         assert!(msg.contains("--cells") && msg.contains(&MAX_LATTICE_BYTES.to_string()), "{msg}");
         assert!(lattice_storage(&scene, &crate::cli::lattice_config(Some([64, 64, 64]), None)).is_ok());

@@ -1,11 +1,11 @@
 //! `host-sim orbit`: the camera circles a scene and the 1-bit frames, as the display shows
 //! them, become an animated GIF.
 
-use board_records::frame as board_frame;
 use crate::load::{build_lattice, lattice_storage, object_storage, read};
 use crate::output::write_atomic;
 use crate::progress;
 use anyhow::{anyhow, bail, Context, Result};
+use board_records::frame as board_frame;
 use lattice_rt::scene::text::parse_with;
 use lattice_rt::{BitFrame, Frame, LatticeConfig, Real, Tracer};
 use std::borrow::Cow;
@@ -17,7 +17,12 @@ pub const FPS: u16 = 10;
 /// The frames of `frames` evenly spaced turns around the scene in scalar `R`, rendered with
 /// `frame` (1-bit packed rows as `bits`, gray levels as `gray`); frame 0 is the scene's own
 /// camera.
-pub fn orbit_renders<R: Real>(path: &Path, text: &str, frames: u32, frame: &Frame) -> Result<Vec<crate::run::Rendered>> {
+pub fn orbit_renders<R: Real>(
+    path: &Path,
+    text: &str,
+    frames: u32,
+    frame: &Frame,
+) -> Result<Vec<crate::run::Rendered>> {
     let mut storage = object_storage::<R>(text)?;
     let bar = progress::bar(frames as usize, "orbit frames");
     let mut out = Vec::new();
@@ -49,8 +54,17 @@ pub fn gif_bytes(frames: &[Vec<u8>], w: u16, h: u16) -> Result<Vec<u8>> {
         for bits in frames {
             let mut raster = bits.clone();
             let view = BitFrame::wrap(w as u32, h as u32, &mut raster).context("frame size")?;
-            let pixels: Vec<u8> = (0..h as u32).flat_map(|y| (0..w as u32).map(move |x| (x, y))).map(|(x, y)| view.get(x, y) as u8).collect();
-            let f = gif::Frame { width: w, height: h, delay: 100 / FPS, buffer: Cow::Owned(pixels), ..gif::Frame::default() };
+            let pixels: Vec<u8> = (0..h as u32)
+                .flat_map(|y| (0..w as u32).map(move |x| (x, y)))
+                .map(|(x, y)| view.get(x, y) as u8)
+                .collect();
+            let f = gif::Frame {
+                width: w,
+                height: h,
+                delay: 100 / FPS,
+                buffer: Cow::Owned(pixels),
+                ..gif::Frame::default()
+            };
             enc.write_frame(&f).context("GIF frame")?;
         }
     }
@@ -67,7 +81,12 @@ pub fn orbit_cmd(scene: &Path, out: &Path, frames: u32) -> Result<()> {
     let frame = board_frame::rendered(board_frame::Build { orbit: true, ..board_frame::PICO });
     let bits = orbit_frames::<lattice_rt::Fx>(scene, &text, frames, &frame)?;
     write_atomic(out, &gif_bytes(&bits, frame.width, frame.height)?)?;
-    println!("wrote {} ({frames} frames at {FPS} fps, {}x{}, as the Pico renders them)", out.display(), frame.width, frame.height);
+    println!(
+        "wrote {} ({frames} frames at {FPS} fps, {}x{}, as the Pico renders them)",
+        out.display(),
+        frame.width,
+        frame.height
+    );
     Ok(())
 }
 

@@ -1,8 +1,8 @@
 //! POV-Ray export and the cross-check against it. See docs/povray.md for the mapping.
 
-use anyhow::{bail, Result};
 #[cfg(test)]
 use anyhow::Context;
+use anyhow::{bail, Result};
 use lattice_rt::scene::Light;
 use lattice_rt::shape::Shape;
 use lattice_rt::{Affine, Scene, Vec3};
@@ -85,7 +85,14 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
     writeln!(s, "global_settings {{ assumed_gamma 1.0 max_trace_level {trace} ambient_light rgb {ambient} }}")?;
     writeln!(s, "background {{ rgb {} }}", if mode == PovMode::Full { scene.background() } else { 0.0 })?;
     // The same image plane: direction, and right/up spanning twice tan(fov/2).
-    writeln!(s, "camera {{ perspective location {} direction {} right {} up {} }}", v(c.eye), v(c.forward), v(c.right * 2.0), v(c.up * 2.0))?;
+    writeln!(
+        s,
+        "camera {{ perspective location {} direction {} right {} up {} }}",
+        v(c.eye),
+        v(c.forward),
+        v(c.right * 2.0),
+        v(c.up * 2.0)
+    )?;
     if mode == PovMode::Full {
         for l in scene.lights().iter() {
             match *l {
@@ -138,8 +145,18 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
         // Shortest round-trip scientific notation: every f64 exactly, however small or large.
         let matrix = format!(
             "matrix <{:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}>",
-            m.m[0][0], m.m[1][0], m.m[2][0], m.m[0][1], m.m[1][1], m.m[2][1], m.m[0][2], m.m[1][2], m.m[2][2],
-            m.m[0][3] + o.origin().x, m.m[1][3] + o.origin().y, m.m[2][3] + o.origin().z
+            m.m[0][0],
+            m.m[1][0],
+            m.m[2][0],
+            m.m[0][1],
+            m.m[1][1],
+            m.m[2][1],
+            m.m[0][2],
+            m.m[1][2],
+            m.m[2][2],
+            m.m[0][3] + o.origin().x,
+            m.m[1][3] + o.origin().y,
+            m.m[2][3] + o.origin().z
         );
         if mode == PovMode::Full && mat.kt > 0.0 {
             // Whitted's shadow rays stop at glass; POV-Ray would let filtered light through.
@@ -169,7 +186,15 @@ pub fn render_povray_rgb(pov: &str, w: u32, h: u32, work: &Path, name: &str) -> 
     let out = Command::new("povray")
         .arg(format!("+I{}", src.display()))
         .arg(format!("+O{}", png.display()))
-        .args([format!("+W{w}"), format!("+H{h}"), "-D".into(), "+FN".into(), "-V".into(), "-A".into(), "File_Gamma=1.0".into()])
+        .args([
+            format!("+W{w}"),
+            format!("+H{h}"),
+            "-D".into(),
+            "+FN".into(),
+            "-V".into(),
+            "-A".into(),
+            "File_Gamma=1.0".into(),
+        ])
         .env("HOME", work)
         .output()
         .context("cannot run povray (Debian package povray)")?;
@@ -195,7 +220,7 @@ fn image_rgb(path: &Path) -> Result<Vec<[u8; 3]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
+    use crate::load::{build_lattice, lattice_storage, object_storage, parse_scene, read};
     use crate::run::render_with;
     use lattice_rt::generate::{random_scene, RandomScene};
     use lattice_rt::scene::Object;
@@ -208,7 +233,10 @@ mod tests {
     fn have_povray() -> bool {
         let ok = Command::new("povray").arg("--version").output().is_ok();
         if !ok {
-            assert!(std::env::var("CI").is_err(), "POV-Ray is not installed: the cross-check cannot run (apt-get install povray)");
+            assert!(
+                std::env::var("CI").is_err(),
+                "POV-Ray is not installed: the cross-check cannot run (apt-get install povray)"
+            );
             eprintln!("POV-Ray is not installed: skipping the cross-check (apt-get install povray)");
         }
         ok
@@ -229,7 +257,8 @@ mod tests {
     /// the pixels whose object is opaque).
     fn compare(name: &str, scene: &Scene<'_, f64>) -> (f64, f64, f64) {
         let n = scene.objects().len();
-        let ids = render_povray_rgb(&export(scene, PovMode::Ids).unwrap(), W, H, &work(), &format!("{name}-ids")).unwrap();
+        let ids =
+            render_povray_rgb(&export(scene, PovMode::Ids).unwrap(), W, H, &work(), &format!("{name}-ids")).unwrap();
         let mut mb = vec![0; lattice_rt::Query::mailbox_len(scene)];
         let mut q = Query::new(&mut mb);
         let ours: Vec<Option<usize>> = (0..(W * H) as i32)
@@ -244,14 +273,26 @@ mod tests {
         let mut bufs = lattice_storage(scene, &cfg).expect("lattice fits");
         let lat = build_lattice(&mut bufs, scene, &cfg).unwrap();
         let mine = render_with(&Tracer::new(scene, &lat), &Frame::new(W as u16, H as u16), false).unwrap().gray;
-        let opaque: Vec<usize> = (0..mine.len()).filter(|&i| ours[i].is_none_or(|o| scene.materials()[scene.objects()[o].material() as usize].kt == 0.0)).collect();
+        let opaque: Vec<usize> = (0..mine.len())
+            .filter(|&i| ours[i].is_none_or(|o| scene.materials()[scene.objects()[o].material() as usize].kt == 0.0))
+            .collect();
         let diff: Vec<f64> = opaque.iter().map(|&i| (mine[i] as f64 - pov[i] as f64 * 64.0 / 255.0).abs()).collect();
         let mean = diff.iter().sum::<f64>() / diff.len().max(1) as f64;
         let far = diff.iter().filter(|&&d| d > 8.0).count() as f64 / diff.len().max(1) as f64;
         // Both images and a diff for a person to look at.
-        write_pgm(&work().join(format!("{name}-ours.pgm")), &mine.iter().map(|&l| (l as u32 * 255 / 64) as u8).collect::<Vec<_>>());
+        write_pgm(
+            &work().join(format!("{name}-ours.pgm")),
+            &mine.iter().map(|&l| (l as u32 * 255 / 64) as u8).collect::<Vec<_>>(),
+        );
         write_pgm(&work().join(format!("{name}-povray.pgm")), &pov);
-        write_pgm(&work().join(format!("{name}-diff.pgm")), &mine.iter().zip(&pov).map(|(&a, &b)| ((a as f64 * 255.0 / 64.0 - b as f64).abs() * 4.0).min(255.0) as u8).collect::<Vec<_>>());
+        write_pgm(
+            &work().join(format!("{name}-diff.pgm")),
+            &mine
+                .iter()
+                .zip(&pov)
+                .map(|(&a, &b)| ((a as f64 * 255.0 / 64.0 - b as f64).abs() * 4.0).min(255.0) as u8)
+                .collect::<Vec<_>>(),
+        );
         (agree, mean, far)
     }
 
@@ -262,7 +303,12 @@ mod tests {
         }
         let mut failures = Vec::new();
         let mut report = String::new();
-        let mut names: Vec<PathBuf> = std::fs::read_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes")).unwrap().flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|e| e == "scene")).collect();
+        let mut names: Vec<PathBuf> = std::fs::read_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|e| e == "scene"))
+            .collect();
         names.sort();
         for path in &names {
             let name = path.file_stem().unwrap().to_string_lossy().to_string();
@@ -270,7 +316,11 @@ mod tests {
             let mut storage = object_storage::<f64>(&text).unwrap();
             let scene = parse_scene::<f64>(path, &text, &mut storage, &Frame::new(W as u16, H as u16)).unwrap();
             let (agree, mean, far) = compare(&name, &scene);
-            report.push_str(&format!("{name}: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n", agree * 100.0, far * 100.0));
+            report.push_str(&format!(
+                "{name}: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n",
+                agree * 100.0,
+                far * 100.0
+            ));
             if agree < 0.995 || mean > 2.0 || far > 0.01 {
                 failures.push(name);
             }
@@ -283,12 +333,20 @@ mod tests {
         b.camera.frame = [W, H];
         let scene = b.finish().unwrap();
         let (agree, mean, far) = compare("random30", &scene);
-        report.push_str(&format!("random30: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n", agree * 100.0, far * 100.0));
+        report.push_str(&format!(
+            "random30: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n",
+            agree * 100.0,
+            far * 100.0
+        ));
         if agree < 0.995 || mean > 2.0 || far > 0.01 {
             failures.push("random30".into());
         }
         eprintln!("{report}images under {}", work().display());
         std::fs::write(work().join("report.txt"), &report).unwrap();
-        assert!(failures.is_empty(), "POV-Ray disagrees on {failures:?}:\n{report}images and diffs: {}", work().display());
+        assert!(
+            failures.is_empty(),
+            "POV-Ray disagrees on {failures:?}:\n{report}images and diffs: {}",
+            work().display()
+        );
     }
 }

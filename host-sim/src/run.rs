@@ -1,16 +1,16 @@
 //! The commands: render, stats and the default gallery job.
 
-use crate::shared::median;
-use crate::load::{object_storage, parse_scene, read, build_lattice, lattice_storage};
-use crate::output::{write_gray_png, write_pbm, write_pgm};
 use crate::cli::{Accel, RenderArgs, StatsArgs};
+use crate::load::{build_lattice, lattice_storage, object_storage, parse_scene, read};
+use crate::output::{write_gray_png, write_pbm, write_pgm};
 use crate::report::{print_json, LatticeSize, MethodRender, MethodWork, RenderReport, StatsReport, Work};
+use crate::shared::median;
 use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::{Effects, EyeRays};
 use lattice_rt::{
-    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, Lattice, LatticeConfig, Real, Scene, Stats,
-    Tracer,
+    render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, Lattice, LatticeConfig, Real, Scene,
+    Stats, Tracer,
 };
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -85,7 +85,13 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
         })
         .collect();
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let mut out = Rendered { bits: vec![0; BitFrame::bytes(w as u32, h as u32)], gray: vec![0; w * h], stats: Stats::default(), elapsed: Duration::ZERO, lattice: None };
+    let mut out = Rendered {
+        bits: vec![0; BitFrame::bytes(w as u32, h as u32)],
+        gray: vec![0; w * h],
+        stats: Stats::default(),
+        elapsed: Duration::ZERO,
+        lattice: None,
+    };
     for band in bands {
         let band = band?;
         out.bits.iter_mut().zip(&band.bits).for_each(|(a, b)| *a |= b);
@@ -98,7 +104,11 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
 
 /// Renders the frame's band of tile rows on this thread (pixels outside it stay 0).
 /// Timing measurements use this: one core, so methods and modes compare fairly.
-pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, R, A>, frame: &Frame, progress: bool) -> Result<Rendered> {
+pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(
+    tracer: &Tracer<'_, '_, R, A>,
+    frame: &Frame,
+    progress: bool,
+) -> Result<Rendered> {
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
     let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
@@ -112,7 +122,6 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(tracer: &Tracer<'_, '_, 
     let elapsed = start.elapsed();
     Ok(Rendered { bits, gray: hooks.gray, stats, elapsed, lattice: None })
 }
-
 
 /// Parses scene text, builds its default lattice and hands `work` a tracer on it, after `tune`
 /// has adjusted the tracer (depth, cutoff, effects, eye rays).
@@ -159,24 +168,39 @@ pub struct Pass {
 /// The passes of a progressive frame (8, 4, 2, 1; `render_pass`) of scene text with its default
 /// lattice, in scalar `R`.
 pub fn progressive_passes<R: Real>(path: &Path, text: &str, frame: &Frame) -> Result<Vec<Pass>> {
-    with_tracer::<R, _>(path, text, frame, |_| {}, |tracer| {
-        let (w, h) = (frame.width as u32, frame.height as u32);
-        let mut scratch = HeapScratch::new(tracer.scene(), frame);
-        let mut traced = vec![lattice_rt::Traced::default(); frame.traced_len(lattice_rt::Share::ALL)];
-        let mut out = Vec::new();
-        for pass in [8u8, 4, 2, 1] {
-            let mut bits = vec![0u8; BitFrame::bytes(w, h)];
-            let mut target = BitFrame::new(w, h, &mut bits).expect("sized");
-            let start = Instant::now();
-            let stats = lattice_rt::render_pass(tracer, frame, lattice_rt::Share::ALL, pass, &mut traced, &mut target, &mut scratch.scratch(), &mut lattice_rt::NoHooks)
+    with_tracer::<R, _>(
+        path,
+        text,
+        frame,
+        |_| {},
+        |tracer| {
+            let (w, h) = (frame.width as u32, frame.height as u32);
+            let mut scratch = HeapScratch::new(tracer.scene(), frame);
+            let mut traced = vec![lattice_rt::Traced::default(); frame.traced_len(lattice_rt::Share::ALL)];
+            let mut out = Vec::new();
+            for pass in [8u8, 4, 2, 1] {
+                let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+                let mut target = BitFrame::new(w, h, &mut bits).expect("sized");
+                let start = Instant::now();
+                let stats = lattice_rt::render_pass(
+                    tracer,
+                    frame,
+                    lattice_rt::Share::ALL,
+                    pass,
+                    &mut traced,
+                    &mut target,
+                    &mut scratch.scratch(),
+                    &mut lattice_rt::NoHooks,
+                )
                 .map_err(|e| match e {
                     RenderError::Draw(never) => match never {},
                     other => anyhow!("{other}"),
                 })?;
-            out.push(Pass { pass, bits, stats, elapsed: start.elapsed() });
-        }
-        Ok(out)
-    })
+                out.push(Pass { pass, bits, stats, elapsed: start.elapsed() });
+            }
+            Ok(out)
+        },
+    )
 }
 
 /// Renders with the accelerator chosen by `accel` (building the lattice when needed).
@@ -234,13 +258,15 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let frame = a.frame();
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage, &frame)?;
-    let mut out = render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true).map_err(|e| {
-        // Only render chooses its method: say how to trace without a lattice.
-        match e.downcast_ref::<crate::load::BudgetTooSmall>() {
-            Some(b) => anyhow!("{b}, or render with --accel bbox (no lattice)"),
-            None => e,
-        }
-    })?;
+    let mut out =
+        render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true)
+            .map_err(|e| {
+                // Only render chooses its method: say how to trace without a lattice.
+                match e.downcast_ref::<crate::load::BudgetTooSmall>() {
+                    Some(b) => anyhow!("{b}, or render with --accel bbox (no lattice)"),
+                    None => e,
+                }
+            })?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
     let look = crate::output::PngLook { theme: a.theme, scale: a.scale, grid: a.grid };
     let (w, h) = (frame.width as u32, frame.height as u32);
@@ -329,7 +355,10 @@ fn outputs(a: &RenderArgs) -> Result<Vec<(&Path, Output)>> {
             match ext(p).as_str() {
                 "pgm" => Output::Pgm,
                 "png" => Output::GrayPng,
-                _ => bail!("--gray {}: writes the gray levels as .pgm or as a gray .png; give a name ending in one of them", p.display()),
+                _ => bail!(
+                    "--gray {}: writes the gray levels as .pgm or as a gray .png; give a name ending in one of them",
+                    p.display()
+                ),
             },
         ));
     }
@@ -374,7 +403,10 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     }
     let r = &report;
     println!("scene {} ({})", r.scene, r.scalar);
-    println!("  objects {}, composites {}, materials {}, lights {}, depth {}", r.objects, r.composites, r.materials, r.lights, r.depth);
+    println!(
+        "  objects {}, composites {}, materials {}, lights {}, depth {}",
+        r.objects, r.composites, r.materials, r.lights, r.depth
+    );
     println!("  effects: {fx}");
     for (i, n) in r.lattice.lattices.iter().enumerate() {
         let name = if i == 0 { "world lattice".to_string() } else { format!("sub-lattice {}", i - 1) };
@@ -383,8 +415,14 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     if cfg.budget.is_some() {
         println!("  within {} bytes: {}", a.budget.unwrap_or(0), Lattice::choose(&scene, &cfg));
     }
-    println!("  lattice: {} cells, {} references, {} bytes, built in {:.3} ms", r.lattice.cells, r.lattice.references, r.lattice.bytes, r.build_ms);
-    println!("  per eye ray at {}x{}, each method answering every eye ray as in the paper's Table 1:", r.width, r.height);
+    println!(
+        "  lattice: {} cells, {} references, {} bytes, built in {:.3} ms",
+        r.lattice.cells, r.lattice.references, r.lattice.bytes, r.build_ms
+    );
+    println!(
+        "  per eye ray at {}x{}, each method answering every eye ray as in the paper's Table 1:",
+        r.width, r.height
+    );
     for m in &r.per_eye_ray {
         if m.method == "default" {
             let how = match Tracer::new(&scene, &BruteForce).eye_rays() {
@@ -392,7 +430,10 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
                 EyeRays::Accelerator => "the lattice is walked, skipping objects whose window on the image misses the ray",
                 EyeRays::Plain => "the method chosen answers them",
             };
-            println!("    tracer's default: object tests {:6.3}, cells visited {:6.2}: {how}", m.object_tests_per_eye_ray, m.cells_per_eye_ray);
+            println!(
+                "    tracer's default: object tests {:6.3}, cells visited {:6.2}: {how}",
+                m.object_tests_per_eye_ray, m.cells_per_eye_ray
+            );
         } else {
             println!(
                 "    {:8} object tests {:6.3}, bounding-box (inside) tests {:6.2}, cells visited {:6.2}",
@@ -430,7 +471,12 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
 /// Work per eye ray of each accelerator (answering every eye ray, then the tracer's default),
 /// each accelerator's full render (median time of `runs` interleaved), and whether their
 /// frames are identical.
-fn per_accelerator<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, frame: Frame, runs: usize) -> Result<(Vec<MethodWork>, Vec<MethodRender>, bool)> {
+fn per_accelerator<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    frame: Frame,
+    runs: usize,
+) -> Result<(Vec<MethodWork>, Vec<MethodRender>, bool)> {
     let pixels = frame.width as f64 * frame.height as f64;
     // Primary rays only: the paper's per-ray figures.
     let primary_only = |t: &mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>| {
@@ -452,7 +498,8 @@ fn per_accelerator<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, frame: Fr
         };
         per_eye_ray.push(per(acc.name(), &render_accel(scene, acc, cfg, &frame, plain, false, false)?.stats));
     }
-    per_eye_ray.push(per("default", &render_accel(scene, Accel::Lattice, cfg, &frame, primary_only, false, false)?.stats));
+    per_eye_ray
+        .push(per("default", &render_accel(scene, Accel::Lattice, cfg, &frame, primary_only, false, false)?.stats));
     // Full renders, interleaved so drift on a shared machine hits all methods alike.
     let mut times: Vec<Vec<Duration>> = vec![Vec::new(); accels.len()];
     let mut last = Vec::new();
@@ -469,7 +516,11 @@ fn per_accelerator<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, frame: Fr
         .iter()
         .zip(times)
         .zip(&last)
-        .map(|((acc, t), r)| MethodRender { method: acc.name(), median_ms: median(t).as_secs_f64() * 1e3, work: Work::of(&r.stats, r.elapsed) })
+        .map(|((acc, t), r)| MethodRender {
+            method: acc.name(),
+            median_ms: median(t).as_secs_f64() * 1e3,
+            work: Work::of(&r.stats, r.elapsed),
+        })
         .collect();
     Ok((per_eye_ray, full, identical))
 }
@@ -502,7 +553,18 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
         let name = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
         for size in GALLERY_SIZES {
             let at = |suffix: &str| out.join(format!("{name}-{size}{suffix}")).display().to_string();
-            let line = ["render".to_string(), path.display().to_string(), "--size".into(), size.into(), "-o".into(), at(".png"), "--pbm".into(), at(".pbm"), "--gray".into(), at("-gray.png")];
+            let line = [
+                "render".to_string(),
+                path.display().to_string(),
+                "--size".into(),
+                size.into(),
+                "-o".into(),
+                at(".png"),
+                "--pbm".into(),
+                at(".pbm"),
+                "--gray".into(),
+                at("-gray.png"),
+            ];
             println!("host-sim {}", line[..].join(" "));
             let RenderLine { args } = <RenderLine as clap::Parser>::try_parse_from(&line)?;
             render_cmd::<f64>(&args)?;

@@ -38,7 +38,8 @@ mod tests {
 
     #[test]
     fn the_default_scenes_start_with_the_papers_four() {
-        let names: Vec<String> = default_scene_paths().iter().map(|p| p.file_stem().unwrap().to_string_lossy().into_owned()).collect();
+        let names: Vec<String> =
+            default_scene_paths().iter().map(|p| p.file_stem().unwrap().to_string_lossy().into_owned()).collect();
         assert_eq!(names[..4], PAPER_SCENES.map(String::from));
     }
 

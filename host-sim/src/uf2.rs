@@ -58,8 +58,12 @@ impl Board {
         let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
         let mut bytes = Vec::new();
         let converted = match self {
-            Board::Pico => elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2040, elf2flash_core::NoProgress),
-            Board::Pico2 => elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2350, elf2flash_core::NoProgress),
+            Board::Pico => {
+                elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2040, elf2flash_core::NoProgress)
+            }
+            Board::Pico2 => {
+                elf2flash_core::elf2uf2(&data, &mut bytes, &elf2flash_core::boards::RP2350, elf2flash_core::NoProgress)
+            }
         };
         converted.map_err(|e| anyhow::anyhow!("cannot convert {} to UF2: {e}", elf.display()))?;
         crate::output::write_atomic(out, &bytes)
@@ -155,10 +159,13 @@ pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, out: Option<&P
     };
     let out = out.map_or_else(|| PathBuf::from(named), Path::to_path_buf);
     board.write_uf2(&elf, &out)?;
-    println!("wrote {}: hold BOOTSEL while plugging the board in, then copy this file onto the {} drive", out.display(), board.drive());
+    println!(
+        "wrote {}: hold BOOTSEL while plugging the board in, then copy this file onto the {} drive",
+        out.display(),
+        board.drive()
+    );
     Ok(())
 }
-
 
 /// The command `host-sim uf2 --scene FILE`: `image` (the slot image's UF2 file) with the scene
 /// in its slot, written to `out` (default `out/lattice-rt-pico-<scene>.uf2`). The scene is
@@ -172,7 +179,8 @@ pub fn scene_cmd(board: Board, scene: &Path, image: &Path, out: Option<&Path>) -
         format!("cannot read the slot image {}: build it once with `host-sim uf2 --features slot` (needs the Rust toolchain), or download it from the playground's page", image.display())
     })?;
     board_records::slot::check_scene(&text).map_err(|e| anyhow::anyhow!("{}: {e}", scene.display()))?;
-    let bytes = board_records::slot::with::scene(&base, &text).map_err(|e| anyhow::anyhow!("{}: {e}", image.display()))?;
+    let bytes =
+        board_records::slot::with::scene(&base, &text).map_err(|e| anyhow::anyhow!("{}: {e}", image.display()))?;
     let stem = scene.file_stem().map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().to_string());
     let out = out.map_or_else(|| PathBuf::from(format!("out/lattice-rt-pico-{stem}.uf2")), Path::to_path_buf);
     crate::output::write_atomic(&out, &bytes)?;

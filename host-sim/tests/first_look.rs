@@ -59,7 +59,9 @@ fn an_extension_names_the_format_and_a_wrong_one_is_refused_before_anything_is_w
     let dir = work("ext");
     let out = run_in(&dir, &["render", &scene("chair"), "-o", "a.png", "--gray", "g.txt"], b"");
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--gray g.txt: writes the gray levels as .pgm or as a gray .png"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--gray g.txt: writes the gray levels as .pgm or as a gray .png")
+    );
     assert!(!dir.join("a.png").exists(), "nothing is written");
     let out = run_in(&dir, &["render", &scene("chair"), "-o", "a.png", "--pbm", "b.png"], b"");
     assert!(String::from_utf8_lossy(&out.stderr).contains("--pbm b.png: writes a PBM file"));
@@ -88,7 +90,12 @@ fn stats_say_what_each_method_did_per_eye_ray() {
     let dir = work("stats");
     let (o, _) = ok(&run_in(&dir, &["stats", &scene("chair"), "--runs", "1", "--json"], b""));
     let v: serde_json::Value = serde_json::from_str(&o).unwrap();
-    let per: Vec<(String, f64)> = v["per_eye_ray"].as_array().unwrap().iter().map(|m| (m["method"].as_str().unwrap().to_string(), m["object_tests_per_eye_ray"].as_f64().unwrap())).collect();
+    let per: Vec<(String, f64)> = v["per_eye_ray"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| (m["method"].as_str().unwrap().to_string(), m["object_tests_per_eye_ray"].as_f64().unwrap()))
+        .collect();
     // Brute force tests every object for every eye ray; the others test fewer, each its own way.
     assert_eq!(per[0], ("brute".to_string(), 8.0));
     assert!(per[1].1 < 8.0 && per[2].1 < per[1].1 && per[3].0 == "default", "{per:?}");
@@ -105,7 +112,26 @@ fn stats_say_what_each_method_did_per_eye_ray() {
 fn render_board_pico_is_the_picos_frame() {
     let dir = work("board");
     ok(&run_in(&dir, &["render", &scene("desk"), "--board", "pico", "-o", "a.pbm"], b""));
-    ok(&run_in(&dir, &["render", &scene("desk"), "--scalar", "fixed", "--sampling", "coarse", "--dither", "fs", "--tile", "16", "--cutoff", "7", "-o", "b.pbm"], b""));
+    ok(&run_in(
+        &dir,
+        &[
+            "render",
+            &scene("desk"),
+            "--scalar",
+            "fixed",
+            "--sampling",
+            "coarse",
+            "--dither",
+            "fs",
+            "--tile",
+            "16",
+            "--cutoff",
+            "7",
+            "-o",
+            "b.pbm",
+        ],
+        b"",
+    ));
     assert_eq!(std::fs::read(dir.join("a.pbm")).unwrap(), std::fs::read(dir.join("b.pbm")).unwrap());
     let out = run_in(&dir, &["render", &scene("desk"), "--board", "pico", "--size", "64x64"], b"");
     assert_eq!(out.status.code(), Some(2), "--board fixes the frame: --size is refused with it");
@@ -124,7 +150,11 @@ fn a_gallery_picture_is_what_its_printed_command_draws() {
     assert_eq!(lines.len(), 4, "two scenes, two sizes, the Whitted scene among them:\n{o}");
     assert!(lines.iter().any(|l| l.contains("whitted.scene --size 160x100")));
     // The first command again, into another file: the same picture.
-    let args: Vec<String> = lines[0].split(' ').skip(1).map(|w| if w.ends_with(".png") && !w.ends_with("-gray.png") { "again.png".into() } else { w.into() }).collect();
+    let args: Vec<String> = lines[0]
+        .split(' ')
+        .skip(1)
+        .map(|w| if w.ends_with(".png") && !w.ends_with("-gray.png") { "again.png".into() } else { w.into() })
+        .collect();
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     ok(&run_in(&dir, &args, b""));
     let first = lines[0].split(' ').find(|w| w.ends_with(".png") && !w.ends_with("-gray.png")).unwrap();

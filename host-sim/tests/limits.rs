@@ -41,7 +41,11 @@ fn peak_child_rss() -> u64 {
 fn refused(args: &[&str], words: &[&str]) {
     let out = run(args);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(matches!(out.status.code(), Some(1) | Some(2)), "{args:?}: {:?} (a signal means abort or kill)\n{err}", out.status);
+    assert!(
+        matches!(out.status.code(), Some(1) | Some(2)),
+        "{args:?}: {:?} (a signal means abort or kill)\n{err}",
+        out.status
+    );
     assert!(!err.contains("panicked") && !err.contains("memory allocation"), "{args:?}: {err}");
     for w in words {
         assert!(err.contains(w), "{args:?}: the message lacks `{w}`:\n{err}");
@@ -96,7 +100,10 @@ fn a_100000_object_scene_renders_well_under_a_gibibyte() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(png.exists());
     let peak = peak_child_rss();
-    eprintln!("peak resident memory (largest child so far, 100,000 objects): {:.1} MiB", peak as f64 / (1 << 20) as f64);
+    eprintln!(
+        "peak resident memory (largest child so far, 100,000 objects): {:.1} MiB",
+        peak as f64 / (1 << 20) as f64
+    );
     assert!(peak < 1 << 30);
 }
 

@@ -21,7 +21,8 @@ mod tests {
         assert_eq!(Shape::<f64>::Cone { top: 0.5 }.left_out(), Some("cones"));
         let sphere = error(&format!("{FLOOR}sphere center 0 1 0 radius 0.5\n")).expect("a sphere is refused");
         assert!(sphere.starts_with("line 2, column 1") && sphere.contains("this build leaves out spheres"), "{sphere}");
-        let cone = error(&format!("{FLOOR}\n  cone base 0 0 0 height 1 radius 0.5 top 0.2\n")).expect("a cone is refused");
+        let cone =
+            error(&format!("{FLOOR}\n  cone base 0 0 0 height 1 radius 0.5 top 0.2\n")).expect("a cone is refused");
         assert!(cone.starts_with("line 3, column 3") && cone.contains("this build leaves out cones"), "{cone}");
     }
 

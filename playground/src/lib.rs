@@ -11,7 +11,9 @@ use lattice_rt::render::{RenderError, Sampling};
 use lattice_rt::scene::text::{object_count, parse_with};
 use lattice_rt::scene::Object;
 use lattice_rt::trace::Effects;
-use lattice_rt::{render, BitFrame, Dither, Frame, Fx, HeapScratch, HeapStorage, LatticeConfig, NoHooks, Real, Sizes, Tone, Tracer};
+use lattice_rt::{
+    render, BitFrame, Dither, Frame, Fx, HeapScratch, HeapStorage, LatticeConfig, NoHooks, Real, Sizes, Tone, Tracer,
+};
 use std::fmt::Write;
 use wasm_bindgen::prelude::*;
 
@@ -71,7 +73,8 @@ fn dither_name(d: Dither) -> &'static str {
 }
 
 /// The sampling modes the page offers, by host-sim's names.
-const SAMPLINGS: [(&str, Sampling); 3] = [("coarse", board_frame::PANEL_SAMPLING), ("adaptive", board_frame::SAMPLING), ("one", Sampling::Center)];
+const SAMPLINGS: [(&str, Sampling); 3] =
+    [("coarse", board_frame::PANEL_SAMPLING), ("adaptive", board_frame::SAMPLING), ("one", Sampling::Center)];
 
 fn sampling_name(s: Sampling) -> &'static str {
     SAMPLINGS.iter().find(|(_, x)| *x == s).map_or("one", |(n, _)| n)
@@ -80,16 +83,13 @@ fn sampling_name(s: Sampling) -> &'static str {
 impl Settings {
     /// The frame these settings render (128x64, 16x16 tiles, as the Pico's panel).
     pub fn frame(&self) -> Result<Frame, String> {
-        let dither = DITHERS
-            .iter()
-            .find(|(n, _)| *n == self.dither)
-            .map(|(_, d)| *d)
-            .ok_or_else(|| format!("unknown dither `{}` (one of {})", self.dither, DITHERS.map(|d| d.0).join(", ")))?;
-        let sampling = SAMPLINGS
-            .iter()
-            .find(|(n, _)| *n == self.sampling)
-            .map(|(_, s)| *s)
-            .ok_or_else(|| format!("unknown sampling `{}` (one of {})", self.sampling, SAMPLINGS.map(|s| s.0).join(", ")))?;
+        let dither =
+            DITHERS.iter().find(|(n, _)| *n == self.dither).map(|(_, d)| *d).ok_or_else(|| {
+                format!("unknown dither `{}` (one of {})", self.dither, DITHERS.map(|d| d.0).join(", "))
+            })?;
+        let sampling = SAMPLINGS.iter().find(|(n, _)| *n == self.sampling).map(|(_, s)| *s).ok_or_else(|| {
+            format!("unknown sampling `{}` (one of {})", self.sampling, SAMPLINGS.map(|s| s.0).join(", "))
+        })?;
         if !Tone::RANGE.contains(&self.gamma) {
             return Err(format!("gamma {} is outside 5..=20 tenths", self.gamma));
         }
@@ -144,12 +144,18 @@ fn render_in<R: Real>(text: &str, turn: f64, frame: &Frame) -> Result<Output, Mi
         return Err(unplaced(format!("the scene declares {n} objects; the playground takes at most {MAX_OBJECTS}")));
     }
     let (mut objects, mut parts) = (vec![Object::<R>::default(); n.max(1)], lattice_rt::Parts::new());
-    let scene = parse_with::<R>(text, &mut objects, &mut parts, |c| *c = c.orbit(turn))
-        .map_err(|e| Mistake { line: e.line, col: e.col, message: e.to_string() })?;
+    let scene = parse_with::<R>(text, &mut objects, &mut parts, |c| *c = c.orbit(turn)).map_err(|e| Mistake {
+        line: e.line,
+        col: e.col,
+        message: e.to_string(),
+    })?;
     let cfg = LatticeConfig::default();
     let sizes = Sizes { objects: 0, rows: 0, ..Sizes::of(&scene, Some(&cfg), &Frame::new(1, 1)) };
     if sizes.bytes::<R>() > MAX_LATTICE_BYTES {
-        return Err(unplaced(format!("the lattice would take {} bytes; the playground allows {MAX_LATTICE_BYTES}", sizes.bytes::<R>())));
+        return Err(unplaced(format!(
+            "the lattice would take {} bytes; the playground allows {MAX_LATTICE_BYTES}",
+            sizes.bytes::<R>()
+        )));
     }
     let mut storage = HeapStorage::<R>::new(sizes);
     let (lattice, _) = storage.view().split().1.lattice(&scene, &cfg).map_err(|e| unplaced(e.to_string()))?;
@@ -163,7 +169,8 @@ fn render_in<R: Real>(text: &str, turn: f64, frame: &Frame) -> Result<Output, Mi
         other => unplaced(other.to_string()),
     })?;
     let mut report = String::new();
-    let lattices: Vec<String> = lattice.lattices().iter().map(|g| format!("[{},{},{}]", g.n[0], g.n[1], g.n[2])).collect();
+    let lattices: Vec<String> =
+        lattice.lattices().iter().map(|g| format!("[{},{},{}]", g.n[0], g.n[1], g.n[2])).collect();
     write!(
         report,
         r#"{{"scalar":"{}","objects":{},"composites":{},"lights":{},"effects":"{}","lattices":[{}],"cells":{},"references":{},"bytes":{},"rays":[{},{},{},{}],"objectTests":{},"cellsVisited":{},"culled":{}}}"#,
@@ -235,8 +242,17 @@ impl ScriptError {
 
 /// Renders `text` for the page: [`render_panel`] with the settings given one by one.
 #[wasm_bindgen]
-pub fn panel(text: &str, scalar: &str, dither: &str, lines: bool, gamma: u8, sampling: &str, turn: f64) -> Result<Panel, ScriptError> {
-    let settings = Settings { scalar: scalar.into(), dither: dither.into(), lines, gamma, sampling: sampling.into(), turn };
+pub fn panel(
+    text: &str,
+    scalar: &str,
+    dither: &str,
+    lines: bool,
+    gamma: u8,
+    sampling: &str,
+    turn: f64,
+) -> Result<Panel, ScriptError> {
+    let settings =
+        Settings { scalar: scalar.into(), dither: dither.into(), lines, gamma, sampling: sampling.into(), turn };
     render_panel(text, &settings).map(Panel).map_err(ScriptError)
 }
 
@@ -283,9 +299,12 @@ mod tests {
     fn the_default_panel_is_the_pico_frame_host_sim_renders() {
         for (name, text) in SCENES {
             let out = render_panel(text, &Settings::default()).expect("a paper scene renders");
-            let want = host_sim::run::render_text::<Fx>(Path::new(name), text, &board_frame::rendered(PICO), |_| {}).unwrap();
+            let want =
+                host_sim::run::render_text::<Fx>(Path::new(name), text, &board_frame::rendered(PICO), |_| {}).unwrap();
             assert_eq!(out.bits, want.bits, "{name}");
-            assert!(out.report.contains(r#""objectTests":"#) && out.report.starts_with('{') && out.report.ends_with('}'));
+            assert!(
+                out.report.contains(r#""objectTests":"#) && out.report.starts_with('{') && out.report.ends_with('}')
+            );
         }
     }
 
@@ -304,8 +323,18 @@ mod tests {
             assert_ne!(out.bits, base.bits, "{s:?}");
         }
         let orbit = Settings { turn: 0.25, dither: "blue-noise".into(), ..Settings::default() };
-        let want = host_sim::orbit::orbit_frames::<Fx>(Path::new("chair"), chair, 4, &board_frame::rendered(Build { orbit: true, ..PICO })).unwrap();
-        assert_eq!(render_panel(chair, &orbit).unwrap().bits, want[1], "a quarter turn is host-sim orbit's frame 1 of 4");
+        let want = host_sim::orbit::orbit_frames::<Fx>(
+            Path::new("chair"),
+            chair,
+            4,
+            &board_frame::rendered(Build { orbit: true, ..PICO }),
+        )
+        .unwrap();
+        assert_eq!(
+            render_panel(chair, &orbit).unwrap().bits,
+            want[1],
+            "a quarter turn is host-sim orbit's frame 1 of 4"
+        );
     }
 
     #[test]

@@ -95,7 +95,13 @@ impl Build {
         } else {
             None
         };
-        Build { panel: has("rp") || has("panel-frame"), orbit: has("orbit"), progressive: has("progressive"), lines, exact_sampling: has("exact-sampling") }
+        Build {
+            panel: has("rp") || has("panel-frame"),
+            orbit: has("orbit"),
+            progressive: has("progressive"),
+            lines,
+            exact_sampling: has("exact-sampling"),
+        }
     }
 }
 
@@ -144,11 +150,41 @@ pub const TUNING: Tuning = Tuning { eye_rays: None, shadow_coherence: true, box_
 /// The ladder of the real-time work, from the paper's method to what the boards run, one lever
 /// added per rung (docs/board.md, written by `cargo xtask board` from the `ladder` image).
 pub const LADDER: [(&str, Tuning); 7] = [
-    ("the paper's nested lattice, one ray per pixel", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: false, box_tests: false, sampling: Sampling::Center }),
-    ("+ shadow rays try the last occluder first", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: false, sampling: Sampling::Center }),
-    ("+ the walk tests an object's box before the object", Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
-    ("+ eye windows: the walk skips objects whose window misses the eye ray", Tuning { eye_rays: Some(EyeRays::Accelerator), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
-    ("+ eye rays and first-light shadow rays by windows alone, no walk", Tuning { eye_rays: Some(EyeRays::Windows), shadow_coherence: true, box_tests: true, sampling: Sampling::Center }),
+    (
+        "the paper's nested lattice, one ray per pixel",
+        Tuning {
+            eye_rays: Some(EyeRays::Plain),
+            shadow_coherence: false,
+            box_tests: false,
+            sampling: Sampling::Center,
+        },
+    ),
+    (
+        "+ shadow rays try the last occluder first",
+        Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: false, sampling: Sampling::Center },
+    ),
+    (
+        "+ the walk tests an object's box before the object",
+        Tuning { eye_rays: Some(EyeRays::Plain), shadow_coherence: true, box_tests: true, sampling: Sampling::Center },
+    ),
+    (
+        "+ eye windows: the walk skips objects whose window misses the eye ray",
+        Tuning {
+            eye_rays: Some(EyeRays::Accelerator),
+            shadow_coherence: true,
+            box_tests: true,
+            sampling: Sampling::Center,
+        },
+    ),
+    (
+        "+ eye rays and first-light shadow rays by windows alone, no walk",
+        Tuning {
+            eye_rays: Some(EyeRays::Windows),
+            shadow_coherence: true,
+            box_tests: true,
+            sampling: Sampling::Center,
+        },
+    ),
     ("+ adaptive sub-sampling: every second pixel traced first", TUNING),
     ("+ in two levels: every fourth pixel first (the panels' default)", Tuning { sampling: PANEL_SAMPLING, ..TUNING }),
 ];

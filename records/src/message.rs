@@ -15,8 +15,16 @@ const LINE: i32 = 10;
 /// Draws `text` word-wrapped in 6x10 glyphs, lit on black, over a `width x height` target
 /// (every pixel of it is drawn: the message replaces the picture). Lines that do not fit are
 /// left out.
-pub fn draw<D: DrawTarget<Color = BinaryColor>>(target: &mut D, width: u32, height: u32, text: &str) -> Result<(), D::Error> {
-    target.fill_solid(&embedded_graphics::primitives::Rectangle::new(Point::zero(), Size::new(width, height)), BinaryColor::Off)?;
+pub fn draw<D: DrawTarget<Color = BinaryColor>>(
+    target: &mut D,
+    width: u32,
+    height: u32,
+    text: &str,
+) -> Result<(), D::Error> {
+    target.fill_solid(
+        &embedded_graphics::primitives::Rectangle::new(Point::zero(), Size::new(width, height)),
+        BinaryColor::Off,
+    )?;
     let style = MonoTextStyle::new(&FONT_6X10, BinaryColor::On);
     let columns = (width as usize / 6).clamp(1, COLUMNS);
     let mut y = 0;

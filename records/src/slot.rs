@@ -24,12 +24,23 @@ pub const MAX_TEXT: usize = SIZE - HEADER;
 
 /// The storage the `slot` image has for the scene it reads: a scene that needs more of any is
 /// refused (by `host-sim uf2 --scene` before it is written, and by the board with a message).
-pub const ROOM: lattice_rt::Sizes = lattice_rt::Sizes { objects: 64, lattices: 1 + lattice_rt::scene::MAX_COMPOSITES, coords: 1024, words: 8192, rows: 0 };
+pub const ROOM: lattice_rt::Sizes = lattice_rt::Sizes {
+    objects: 64,
+    lattices: 1 + lattice_rt::scene::MAX_COMPOSITES,
+    coords: 1024,
+    words: 8192,
+    rows: 0,
+};
 
 /// Whether a scene that needs `needs` fits [`ROOM`] (rows are the frame's, not the scene's).
 pub fn fits(needs: &lattice_rt::Sizes) -> Result<(), (&'static str, usize, usize)> {
     let room = ROOM;
-    for (what, need, have) in [("objects", needs.objects, room.objects), ("lattices", needs.lattices, room.lattices), ("lattice coordinates", needs.coords, room.coords), ("lattice words (cells, references, mailbox)", needs.words, room.words)] {
+    for (what, need, have) in [
+        ("objects", needs.objects, room.objects),
+        ("lattices", needs.lattices, room.lattices),
+        ("lattice coordinates", needs.coords, room.coords),
+        ("lattice words (cells, references, mailbox)", needs.words, room.words),
+    ] {
         if need > have {
             return Err((what, need, have));
         }
@@ -63,8 +74,12 @@ impl core::fmt::Display for SlotError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             SlotError::Empty => write!(f, "no scene in the slot: write one with host-sim uf2 --scene FILE"),
-            SlotError::TooLong { length } => write!(f, "scene slot corrupt: length {length} is more than the {MAX_TEXT} bytes a slot holds"),
-            SlotError::Corrupt { stored, computed } => write!(f, "scene slot corrupt: checksum {computed:08x}, written {stored:08x}"),
+            SlotError::TooLong { length } => {
+                write!(f, "scene slot corrupt: length {length} is more than the {MAX_TEXT} bytes a slot holds")
+            }
+            SlotError::Corrupt { stored, computed } => {
+                write!(f, "scene slot corrupt: checksum {computed:08x}, written {stored:08x}")
+            }
             SlotError::NotText => write!(f, "scene slot corrupt: not UTF-8 text"),
         }
     }
@@ -91,7 +106,10 @@ pub fn read(bytes: &[u8]) -> Result<&str, SlotError> {
     }
     let word = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
     let (length, stored) = (word(8), word(12));
-    let text = bytes.get(HEADER..HEADER + length as usize).filter(|_| length as usize <= MAX_TEXT).ok_or(SlotError::TooLong { length })?;
+    let text = bytes
+        .get(HEADER..HEADER + length as usize)
+        .filter(|_| length as usize <= MAX_TEXT)
+        .ok_or(SlotError::TooLong { length })?;
     let computed = checksum(text);
     if computed != stored {
         return Err(SlotError::Corrupt { stored, computed });
@@ -116,7 +134,8 @@ pub mod uf2 {
     /// `count`.
     pub fn block(address: u32, data: &[u8], index: u32, count: u32) -> [u8; BLOCK] {
         let mut b = [0u8; BLOCK];
-        let words = [MAGIC_START[0], MAGIC_START[1], FAMILY_PRESENT, address, PAYLOAD as u32, index, count, RP2040_FAMILY];
+        let words =
+            [MAGIC_START[0], MAGIC_START[1], FAMILY_PRESENT, address, PAYLOAD as u32, index, count, RP2040_FAMILY];
         for (i, w) in words.iter().enumerate() {
             b[4 * i..4 * i + 4].copy_from_slice(&w.to_le_bytes());
         }
@@ -179,9 +198,11 @@ pub fn check_scene(text: &str) -> Result<(), alloc::string::String> {
     let frame = crate::frame::rendered(crate::frame::PICO);
     let mut objects = alloc::vec![lattice_rt::scene::Object::<Fx>::default(); object_count(text).max(1)];
     let mut parts = lattice_rt::Parts::default();
-    let scene = parse_with::<Fx>(text, &mut objects, &mut parts, |c| c.frame = frame.size()).map_err(|e| format!("{e}"))?;
+    let scene =
+        parse_with::<Fx>(text, &mut objects, &mut parts, |c| c.frame = frame.size()).map_err(|e| format!("{e}"))?;
     let needs = Sizes::of(&scene, Some(&LatticeConfig::default()), &frame);
-    fits(&needs).map_err(|(what, need, have)| format!("the scene needs {need} {what}; the slot image has room for {have}"))
+    fits(&needs)
+        .map_err(|(what, need, have)| format!("the scene needs {need} {what}; the slot image has room for {have}"))
 }
 
 /// UF2 files with a scene: the blocks of a slot image's file, and the slot's.
@@ -213,7 +234,9 @@ pub mod with {
                 blocks.push(b);
             }
         }
-        let marked = blocks.iter().any(|b| b[32..32 + uf2::PAYLOAD].windows(super::IMAGE_MARK.len()).any(|w| w == super::IMAGE_MARK));
+        let marked = blocks
+            .iter()
+            .any(|b| b[32..32 + uf2::PAYLOAD].windows(super::IMAGE_MARK.len()).any(|w| w == super::IMAGE_MARK));
         if !marked {
             return Err(String::from("this UF2 file is not the slot image (build it with `host-sim uf2 --features slot`, or download it from the playground)"));
         }

@@ -189,7 +189,8 @@ mod tests {
             let c = Lattice::choose(&scene, &cfg);
             let s = Lattice::plan(&scene, &cfg);
             let (mut g, mut co, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![0.0; s.coords], vec![0; s.words()]);
-            let built = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut co, words: &mut w });
+            let built =
+                Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut co, words: &mut w });
             if c.fits {
                 let lat = built.unwrap();
                 assert!(c.bytes <= budget && lat.bytes() == c.bytes, "{budget}: {c}");
@@ -202,7 +203,10 @@ mod tests {
                 let e = built.unwrap_err();
                 assert_eq!((e.capacity, e.needed, e.available), ("budget", c.bytes, budget));
                 assert!(std::format!("{e}").contains("bytes needed"));
-                assert!(c.sizes.cells - 1 == c.sizes.lattices && c.bytes > budget, "fails only below one cell per lattice: {c}");
+                assert!(
+                    c.sizes.cells - 1 == c.sizes.lattices && c.bytes > budget,
+                    "fails only below one cell per lattice: {c}"
+                );
             }
         }
     }

@@ -49,7 +49,11 @@ impl fmt::Display for LatticeError {
 impl core::error::Error for LatticeError {}
 impl<'a, R: Real> Lattice<'a, R> {
     /// Builds the lattice into `storage`.
-    pub fn build(scene: &Scene<'_, R>, cfg: &LatticeConfig, storage: LatticeStorage<'a, R>) -> Result<Self, LatticeError> {
+    pub fn build(
+        scene: &Scene<'_, R>,
+        cfg: &LatticeConfig,
+        storage: LatticeStorage<'a, R>,
+    ) -> Result<Self, LatticeError> {
         Self::build_leaving(scene, cfg, storage).map(|(lattice, _)| lattice)
     }
 
@@ -70,7 +74,13 @@ impl<'a, R: Real> Lattice<'a, R> {
         // Coordinate lists and cell ranges: the world, the composites, then the dense cells.
         let (mut nc, mut ncells, mut nlattices, all_coords) = (0usize, 0usize, 0usize, coords.len());
         // `place(.., planes)` stores a lattice; `planes(axis, out)` writes its coordinate lists.
-        let mut place = |lattices: &mut [SubLattice<R>], coords: &mut [R], nc: &mut usize, b: Aabb<R>, n: [u16; 3], dense_cell: u32, planes: &dyn Fn(usize, &mut [R])| {
+        let mut place = |lattices: &mut [SubLattice<R>],
+                         coords: &mut [R],
+                         nc: &mut usize,
+                         b: Aabb<R>,
+                         n: [u16; 3],
+                         dense_cell: u32,
+                         planes: &dyn Fn(usize, &mut [R])| {
             let available = lattices.len();
             let slot = lattices.get_mut(nlattices).ok_or_else(|| short("lattices", available))?;
             let mut sub = SubLattice { bounds: b, n, coord_start: [0; 3], cell_start: ncells as u32, dense_cell };
@@ -150,8 +160,15 @@ impl<'a, R: Real> Lattice<'a, R> {
             set(cells, i, get(cells, i - 1));
         }
         set(cells, 0, 0);
-        let lattice =
-            Lattice { lattices, coords: &coords[..nc], cells, refs, entries: (ncells + 1, nrefs), narrow, objects: scene.objects.len() };
+        let lattice = Lattice {
+            lattices,
+            coords: &coords[..nc],
+            cells,
+            refs,
+            entries: (ncells + 1, nrefs),
+            narrow,
+            objects: scene.objects.len(),
+        };
         Ok((lattice, rest))
     }
 }
@@ -167,7 +184,13 @@ fn planes_of<'c, R: Real>(coords: &'c [R], sub: &SubLattice<R>) -> [&'c [R]; 3] 
 /// Calls `f(item, cell)` for every reference of every lattice, in storage order. A dense
 /// cell of the world holds its composites, its free objects too large to move
 /// ([`cluster::moves`]) and its own lattice instead of the others.
-fn for_each_ref<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, coords: &[R], lattices: &[SubLattice<R>], mut f: impl FnMut(u32, usize)) {
+fn for_each_ref<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    coords: &[R],
+    lattices: &[SubLattice<R>],
+    mut f: impl FnMut(u32, usize),
+) {
     let base = if cfg.nested { 1 + scene.composites.len() } else { 1 };
     let dense = &lattices[base..];
     let find = |c: usize| dense.binary_search_by_key(&(c as u32), |d| d.dense_cell).ok();

@@ -101,7 +101,12 @@ pub(super) fn possible<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> bo
 
 /// Calls `f` for every dense cell of the world lattice whose coordinate lists are `planes`, in
 /// cell order.
-pub(super) fn for_each_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Planes<R> + ?Sized), f: impl FnMut(&Dense<R>)) {
+pub(super) fn for_each_dense<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    planes: &(impl Planes<R> + ?Sized),
+    f: impl FnMut(&Dense<R>),
+) {
     if possible(scene, cfg) {
         scan(scene, cfg, planes, f);
     }
@@ -159,7 +164,9 @@ impl Occupied {
             return q;
         }
         let field = |w: u32, a: usize, k: usize| (w >> (10 * a + 5 * k)) & 31;
-        (0..3).fold(0, |w, a| w | (field(p, a, 0).min(field(q, a, 0)) | field(p, a, 1).max(field(q, a, 1)) << 5) << (10 * a))
+        (0..3).fold(0, |w, a| {
+            w | (field(p, a, 0).min(field(q, a, 0)) | field(p, a, 1).max(field(q, a, 1)) << 5) << (10 * a)
+        })
     }
 
     /// The packed box `p` in world coordinates inside `cell`, its inner planes moved outwards
@@ -176,7 +183,8 @@ impl Occupied {
                 }
             }
         };
-        let (first, last) = ([0, 1, 2].map(|a| (p >> (10 * a)) & 31), [0, 1, 2].map(|a| ((p >> (10 * a + 5)) & 31) + 1));
+        let (first, last) =
+            ([0, 1, 2].map(|a| (p >> (10 * a)) & 31), [0, 1, 2].map(|a| ((p >> (10 * a + 5)) & 31) + 1));
         let (down, up) = (-R::ONE, R::ONE);
         Aabb {
             min: Vec3::new(at(0, first[0], down), at(1, first[1], down), at(2, first[2], down)),
@@ -191,7 +199,12 @@ type Visit<'v, R> = dyn FnMut(usize, &Aabb<R>, &Aabb<R>) + 'v;
 /// [`for_each_dense`]'s work, out of line so that its counters are on the stack only when a
 /// scene can have a dense cell.
 #[inline(never)]
-fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Planes<R> + ?Sized), mut f: impl FnMut(&Dense<R>)) {
+fn scan<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    planes: &(impl Planes<R> + ?Sized),
+    mut f: impl FnMut(&Dense<R>),
+) {
     let split = cfg.split as usize;
     let n = [0, 1, 2].map(|a| planes.cells(a));
     let (slab, total) = (n[0] * n[1], n[0] * n[1] * n[2]);
@@ -200,7 +213,8 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Plane
         let bounds = Occupied::region(&cell_box(planes, c), occupied);
         Dense { cell: c, free, centred: 0, bounds, n: resolution(&bounds, free, cfg.sub, cfg.max_per_axis), refs: 0 }
     };
-    let (mut counts, mut centred, mut occupied, mut refs) = ([0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK]);
+    let (mut counts, mut centred, mut occupied, mut refs) =
+        ([0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK]);
     for base in (0..total).step_by(CHUNK) {
         let end = (base + CHUNK).min(total);
         let (z0, z1) = (base / slab, (end - 1) / slab);
@@ -239,7 +253,8 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Plane
             if counts[i] as usize > split {
                 occupied[i] = Occupied::union(occupied[i], Occupied::of(cell, b));
                 let centre = (b.min + b.max) * R::HALF;
-                centred[i] += u32::from((0..3).all(|a| centre.axis(a) >= cell.min.axis(a) && centre.axis(a) < cell.max.axis(a)));
+                centred[i] +=
+                    u32::from((0..3).all(|a| centre.axis(a) >= cell.min.axis(a) && centre.axis(a) < cell.max.axis(a)));
             }
         });
         each(&mut |i, _, b| {
@@ -250,7 +265,11 @@ fn scan<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, planes: &(impl Plane
         });
         for i in 0..end - base {
             if counts[i] as usize > split {
-                f(&Dense { centred: centred[i] as usize, refs: refs[i] as usize, ..dense(base + i, counts[i] as usize, occupied[i]) });
+                f(&Dense {
+                    centred: centred[i] as usize,
+                    refs: refs[i] as usize,
+                    ..dense(base + i, counts[i] as usize, occupied[i])
+                });
             }
         }
     }
@@ -267,7 +286,8 @@ mod tests {
         let mut rng = Rng::new(5);
         for _ in 0..300 {
             let lo = Vec3::new(rng.range(-50.0, 50.0), rng.range(-50.0, 50.0), rng.range(-50.0, 50.0));
-            let cell = Aabb { min: lo, max: lo + Vec3::new(rng.range(0.0, 9.0), rng.range(0.0, 9.0), rng.range(0.0, 9.0)) };
+            let cell =
+                Aabb { min: lo, max: lo + Vec3::new(rng.range(0.0, 9.0), rng.range(0.0, 9.0), rng.range(0.0, 9.0)) };
             let cell = Aabb { min: cell.min.cast::<R>(), max: cell.max.cast::<R>() };
             let boxes: std::vec::Vec<Aabb<R>> = (0..1 + rng.below(4))
                 .map(|_| {
@@ -283,11 +303,21 @@ mod tests {
             let packed = boxes.iter().fold(NOTHING, |w, b| Occupied::union(w, Occupied::of(&cell, b)));
             let r = Occupied::region(&cell, packed);
             for a in 0..3 {
-                assert!(r.min.axis(a) >= cell.min.axis(a) && r.max.axis(a) <= cell.max.axis(a), "{} outside the cell", R::NAME);
+                assert!(
+                    r.min.axis(a) >= cell.min.axis(a) && r.max.axis(a) <= cell.max.axis(a),
+                    "{} outside the cell",
+                    R::NAME
+                );
                 for b in &boxes {
                     let (l, h) = (b.min.axis(a).max(cell.min.axis(a)), b.max.axis(a).min(cell.max.axis(a)));
                     if l <= h {
-                        assert!(r.min.axis(a) <= l && r.max.axis(a) >= h, "{}: axis {a}: {:?} does not hold {:?}", R::NAME, r, b);
+                        assert!(
+                            r.min.axis(a) <= l && r.max.axis(a) >= h,
+                            "{}: axis {a}: {:?} does not hold {:?}",
+                            R::NAME,
+                            r,
+                            b
+                        );
                     }
                 }
             }

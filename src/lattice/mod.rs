@@ -169,10 +169,7 @@ impl<'a, R> Lattice<'a, R> {
 impl<'a, R: Real> Lattice<'a, R> {
     /// Bytes the built lattice occupies (lattices, coordinate lists, cells, references).
     pub fn bytes(&self) -> usize {
-        size_of_val(self.lattices)
-            + size_of_val(self.coords)
-            + size_of_val(self.cells)
-            + size_of_val(self.refs)
+        size_of_val(self.lattices) + size_of_val(self.coords) + size_of_val(self.cells) + size_of_val(self.refs)
     }
 
     /// The lattices: index 0 is the world, then one per composite.
@@ -242,8 +239,12 @@ mod tests {
         let scene = b.finish().unwrap();
         let s = Lattice::plan(&scene, &cfg);
         let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![0.0; s.coords], vec![0; s.words()]);
-        let lat = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
-        assert_eq!((lat.lattices.len(), lat.coords.len(), lat.cell_count() + 1, lat.ref_count()), (s.lattices, s.coords, s.cells, s.refs));
+        let lat =
+            Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap();
+        assert_eq!(
+            (lat.lattices.len(), lat.coords.len(), lat.cell_count() + 1, lat.ref_count()),
+            (s.lattices, s.coords, s.cells, s.refs)
+        );
         assert_eq!(lat.cells.len() + lat.refs.len(), s.words());
         assert_eq!(lat.bytes(), s.bytes::<f64>());
         f(&scene, &lat);
@@ -267,15 +268,21 @@ mod tests {
             let cfg = LatticeConfig { index16, ..LatticeConfig::default() };
             let s = Lattice::plan(&scene, &cfg);
             assert_eq!(s.narrow, index16);
-            let (mut g, mut c, mut w) = (vec![SubLattice::EMPTY; s.lattices], vec![0.0; s.coords], vec![0; s.words() - 1]);
-            let e = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w }).unwrap_err();
-            assert_eq!(e, LatticeError { capacity: "refs", needed: s.refs, available: s.refs.next_multiple_of(short) - short });
+            let (mut g, mut c, mut w) =
+                (vec![SubLattice::EMPTY; s.lattices], vec![0.0; s.coords], vec![0; s.words() - 1]);
+            let e = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g, coords: &mut c, words: &mut w })
+                .unwrap_err();
+            assert_eq!(
+                e,
+                LatticeError { capacity: "refs", needed: s.refs, available: s.refs.next_multiple_of(short) - short }
+            );
         }
         let cfg = LatticeConfig::default();
         let s = Lattice::plan(&scene, &cfg);
         let (mut c, mut w) = (vec![0.0; s.coords], vec![0; s.words()]);
         let mut g2 = vec![SubLattice::EMPTY; 1];
-        let e = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g2, coords: &mut c, words: &mut w }).unwrap_err();
+        let e = Lattice::build(&scene, &cfg, LatticeStorage { lattices: &mut g2, coords: &mut c, words: &mut w })
+            .unwrap_err();
         assert_eq!(e.capacity, "lattices");
         assert_eq!(std::format!("{e}"), "lattice capacity `lattices` too small: 5 entries needed, 1 available");
     }
@@ -325,7 +332,9 @@ mod tests {
             let z0 = lat.coordinate_list(0, 2)[0];
             let cells = |dx: f64, dy: f64| {
                 let mut v = Vec::new();
-                lat.walk_cells(&Ray::new(Vec3::new(x, y, z0), Vec3::new(dx, dy, 1.0)), 0.0, f64::MAX, |c, _, _| v.push(c));
+                lat.walk_cells(&Ray::new(Vec3::new(x, y, z0), Vec3::new(dx, dy, 1.0)), 0.0, f64::MAX, |c, _, _| {
+                    v.push(c)
+                });
                 v
             };
             let plus = cells(0.0, 0.0);

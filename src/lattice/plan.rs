@@ -104,7 +104,12 @@ impl LatticeSizes {
 }
 /// Cells per axis of lattice `g` over `b`. An automatic resolution with equal cells is then
 /// moved by one cell on an axis whose planes fall on the items' faces ([`off_the_faces`]).
-pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>) -> [u16; 3] {
+pub(super) fn lattice_resolution<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    g: usize,
+    b: &Aabb<R>,
+) -> [u16; 3] {
     let mut count = 0;
     for_each_item(scene, cfg, g, |_, _| count += 1);
     let res = if g == 0 { cfg.top } else { cfg.sub };
@@ -126,7 +131,14 @@ pub(super) fn lattice_resolution<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeCon
 /// that many empty cells. The world lattice keeps the items not centred in a dense cell, and one
 /// reference per dense cell; with no dense cell, `n` stands.
 #[inline(never)]
-fn past_the_clusters<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: &Aabb<R>, n: [u16; 3], items: usize, res: Resolution) -> [u16; 3] {
+fn past_the_clusters<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    b: &Aabb<R>,
+    n: [u16; 3],
+    items: usize,
+    res: Resolution,
+) -> [u16; 3] {
     let (centred, cells) = with_planes(scene, cfg, 0, b, n, |planes| {
         let (mut centred, mut cells) = (0, 0);
         cluster::for_each_dense(scene, cfg, planes, |d| {
@@ -147,7 +159,14 @@ fn past_the_clusters<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, b: &Aab
 /// cells the count whose cells an item overlaps least beyond what a random placement gives
 /// (`1 + extent / cell width`) is taken, when `n`'s excess is more than a quarter of a cell per
 /// item: a scene without such a coincidence keeps `n`.
-fn off_the_faces<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3], items: usize) -> [u16; 3] {
+fn off_the_faces<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    g: usize,
+    b: &Aabb<R>,
+    n: [u16; 3],
+    items: usize,
+) -> [u16; 3] {
     let max = cfg.max_per_axis.clamp(1, MAX_PER_AXIS);
     let cand = |a: usize, k: usize| (n[a] as i32 - 1 + k as i32).clamp(1, max as i32) as u16;
     let mut excess = [[0.0f64; 3]; 3];
@@ -222,8 +241,17 @@ pub(super) fn uniform_coord<R: Real>(lo: R, hi: R, n: u16, i: usize) -> R {
     } else {
         lo + (hi - lo) / R::from_i32(n as i32) * R::from_i32(i as i32)
     }
-}/// Writes the `n + 1` planes of axis `a` of lattice `g` (bounds `b`) into `out`.
-pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, b: &Aabb<R>, n: u16, out: &mut [R]) {
+}
+/// Writes the `n + 1` planes of axis `a` of lattice `g` (bounds `b`) into `out`.
+pub(super) fn axis_planes<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    g: usize,
+    a: usize,
+    b: &Aabb<R>,
+    n: u16,
+    out: &mut [R],
+) {
     let (lo, hi) = (b.min.axis(a), b.max.axis(a));
     match cfg.spacing {
         Spacing::Uniform => {
@@ -239,7 +267,16 @@ pub(super) fn axis_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g:
 /// 1024 bins (no allocation, no sorting). Out of line so its 4 KB histogram is only on the stack when used.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-fn adaptive_planes<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, a: usize, lo: R, hi: R, n: u16, out: &mut [R]) {
+fn adaptive_planes<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    g: usize,
+    a: usize,
+    lo: R,
+    hi: R,
+    n: u16,
+    out: &mut [R],
+) {
     const BINS: usize = 1024;
     let (l, h) = (lo.to_f64(), hi.to_f64());
     let width = (h - l).max(f64::MIN_POSITIVE);
@@ -290,7 +327,14 @@ fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &A
 /// [`axis_planes`] writes them: equal cells computed when asked, adaptive ones written into
 /// lists on the stack (12 KB in fixed point for [`MAX_PER_AXIS`] planes an axis, out of line
 /// so that only they pay it).
-fn with_planes<R: Real, T>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3], work: impl FnOnce(&dyn cluster::Planes<R>) -> T) -> T {
+fn with_planes<R: Real, T>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    g: usize,
+    b: &Aabb<R>,
+    n: [u16; 3],
+    work: impl FnOnce(&dyn cluster::Planes<R>) -> T,
+) -> T {
     match cfg.spacing {
         Spacing::Uniform => work(&cluster::Uniform { bounds: b, n }),
         Spacing::Adaptive => listed_planes(scene, cfg, g, b, n, work),
@@ -299,7 +343,14 @@ fn with_planes<R: Real, T>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, 
 
 /// [`with_planes`] for adaptive spacing.
 #[inline(never)]
-fn listed_planes<R: Real, T>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3], work: impl FnOnce(&dyn cluster::Planes<R>) -> T) -> T {
+fn listed_planes<R: Real, T>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    g: usize,
+    b: &Aabb<R>,
+    n: [u16; 3],
+    work: impl FnOnce(&dyn cluster::Planes<R>) -> T,
+) -> T {
     let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
     for (a, p) in planes.iter_mut().enumerate() {
         axis_planes(scene, cfg, g, a, b, n[a], p);
@@ -318,7 +369,11 @@ impl<R: Real> Lattice<'_, R> {
 
     /// Storage a scene needs with these resolutions (no budget); `each(g, bounds, cells per
     /// axis, references)` sees every lattice on the way.
-    pub(super) fn plan_exact(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut each: impl FnMut(usize, &Aabb<R>, [u16; 3], usize)) -> LatticeSizes {
+    pub(super) fn plan_exact(
+        scene: &Scene<'_, R>,
+        cfg: &LatticeConfig,
+        mut each: impl FnMut(usize, &Aabb<R>, [u16; 3], usize),
+    ) -> LatticeSizes {
         let mut s = LatticeSizes { cells: 1, ..Default::default() };
         plan_each(scene, cfg, |g, b, n, refs| {
             each(g, b, n, refs);
@@ -357,9 +412,17 @@ fn plan_each<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, mut f: impl FnM
 /// Calls `f(bounds, cells per axis, references, free objects of the world cell)` for
 /// the lattice of every dense world cell (module `cluster`) of the world lattice over `wb`.
 #[inline(never)]
-fn plan_dense<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, wb: &Aabb<R>, wn: [u16; 3], mut f: impl FnMut(&Aabb<R>, [u16; 3], usize, usize)) {
+fn plan_dense<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    wb: &Aabb<R>,
+    wn: [u16; 3],
+    mut f: impl FnMut(&Aabb<R>, [u16; 3], usize, usize),
+) {
     if !cluster::possible(scene, cfg) {
         return;
     }
-    with_planes(scene, cfg, 0, wb, wn, |planes| cluster::for_each_dense(scene, cfg, planes, |d| f(&d.bounds, d.n, d.refs, d.free)));
+    with_planes(scene, cfg, 0, wb, wn, |planes| {
+        cluster::for_each_dense(scene, cfg, planes, |d| f(&d.bounds, d.n, d.refs, d.free))
+    });
 }

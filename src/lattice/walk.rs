@@ -27,7 +27,15 @@ impl<R: Real> Lattice<'_, R> {
         }
     }
 
-    pub(super) fn run(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, any: bool, q: &mut Query<'_>) -> Option<Hit<R>> {
+    pub(super) fn run(
+        &self,
+        scene: &Scene<'_, R>,
+        ray: &Ray<R>,
+        tmin: R,
+        tmax: R,
+        any: bool,
+        q: &mut Query<'_>,
+    ) -> Option<Hit<R>> {
         let slack = slack(ray);
         let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
@@ -45,7 +53,11 @@ impl<R: Real> Lattice<'_, R> {
                 w.ref_i += 1;
                 match item {
                     Ok(i) => {
-                        if q.first_visit(i) && inv.may_meet(scene, i, tmin, reach(&best, tmax), q) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
+                        if q.first_visit(i)
+                            && inv.may_meet(scene, i, tmin, reach(&best, tmax), q)
+                            && offer(scene, i, ray, tmin, tmax, &mut best, q)
+                            && any
+                        {
                             return best;
                         }
                     }
@@ -74,7 +86,6 @@ impl<R: Real> Lattice<'_, R> {
         best
     }
 }
-
 
 /// What a walk keeps of a ray for its crossings: which axes it steps along (a zero
 /// component, +0.0 or -0.0, never steps), and per axis the factor a crossing uses.
@@ -111,7 +122,11 @@ impl<R: Real> Inverse<R> {
             factor: if R::WALK_BY_RECIPROCAL { inv } else { d },
             inv: Vec3::new(inv[0], inv[1], inv[2]),
             boxes,
-            grown: if boxes { (ray.origin + Vec3::new(slack, slack, slack), ray.origin - Vec3::new(slack, slack, slack)) } else { (ray.origin, ray.origin) },
+            grown: if boxes {
+                (ray.origin + Vec3::new(slack, slack, slack), ray.origin - Vec3::new(slack, slack, slack))
+            } else {
+                (ray.origin, ray.origin)
+            },
         }
     }
 
@@ -167,7 +182,15 @@ impl<R: Real> Walker<R> {
     /// A walker of lattice `sub` for `ray` on `[t0, t1]`, set up where it lies in `slot`: a
     /// walker returned by value is copied into the walk's stack whole (a `memcpy` call on a
     /// Cortex-M).
-    fn start_in<'s>(slot: &'s mut Option<Self>, l: &Lattice<'_, R>, sub: usize, ray: &Ray<R>, inv: &Inverse<R>, t0: R, t1: R) -> &'s mut Self {
+    fn start_in<'s>(
+        slot: &'s mut Option<Self>,
+        l: &Lattice<'_, R>,
+        sub: usize,
+        ray: &Ray<R>,
+        inv: &Inverse<R>,
+        t0: R,
+        t1: R,
+    ) -> &'s mut Self {
         let g = &l.lattices[sub];
         let p = ray.at(t0);
         let n = g.n.map(i32::from);

@@ -1,11 +1,14 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::model::{Camera, CameraDesc, EyeWindow, ShadowWindow, EYE_MARGIN, lowest_terms, resolvable_pixels, shadow_whole_plane, WHOLE_PLANE, Composite, Light, Material, Object, Parts, Scene, NO_COMPOSITE};
+use super::hull::Projection;
+use super::model::{
+    lowest_terms, resolvable_pixels, shadow_whole_plane, Camera, CameraDesc, Composite, EyeWindow, Light, Material,
+    Object, Parts, Scene, ShadowWindow, EYE_MARGIN, NO_COMPOSITE, WHOLE_PLANE,
+};
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
-use super::hull::Projection;
 
 /// Builds and validates a [`Scene`] into caller-provided object storage.
 #[derive(Debug)]
@@ -192,7 +195,9 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         // The canonical cone narrows from radius 1 at its base (the sides of its box lie at 1):
         // one wider at its top is the cone of the top's radius turned over onto it.
         let (shape, place, inv) = if top > 1.0 {
-            let over = Affine::translate(Vec3::new(0.0, 1.0, 0.0)).after(&Affine::rotate(0, 180.0)).after(&Affine::scale(Vec3::new(top, 1.0, top)));
+            let over = Affine::translate(Vec3::new(0.0, 1.0, 0.0))
+                .after(&Affine::rotate(0, 180.0))
+                .after(&Affine::scale(Vec3::new(top, 1.0, top)));
             let place = place.after(&over);
             (Shape::Cone { top: 1.0 / top }, place, checked_inverse(&place)?)
         } else {
@@ -222,12 +227,18 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         };
         // Largest stretch of a direction into object space, rounded up to a power of two.
         let m = &inv.m;
-        let stretch = (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(0.0, f64::max);
+        let stretch =
+            (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(0.0, f64::max);
         let largest = m.iter().flat_map(|r| r[..3].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
         // An object so small that its inverse transform leaves f64's comfortable range is too
         // small for any scene (its own coordinates would overflow).
         if !(stretch < 1e200 && largest > 1e-200) {
-            return Err(SceneError::ObjectOutOfRange { object: self.len, reach: f64::INFINITY, limit: R::LIMIT, scalar: R::NAME });
+            return Err(SceneError::ObjectOutOfRange {
+                object: self.len,
+                reach: f64::INFINITY,
+                limit: R::LIMIT,
+                scalar: R::NAME,
+            });
         }
         let dir_scale = 1.0 / pow2_at_least(stretch);
         let unscale = pow2_at_least(largest);
@@ -291,15 +302,14 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             return Err(SceneError::DegenerateCamera);
         }
         let (tx, ty) = c.fov.half_tangents(c.frame);
-        let camera =
-            Camera {
-                eye: c.eye.cast(),
-                forward: forward.cast(),
-                right: (right * tx).cast(),
-                up: (up * ty).cast(),
-                resolves: [resolvable_pixels::<R>(tx), resolvable_pixels::<R>(ty)],
-                shape: lowest_terms(c.frame),
-            };
+        let camera = Camera {
+            eye: c.eye.cast(),
+            forward: forward.cast(),
+            right: (right * tx).cast(),
+            up: (up * ty).cast(),
+            resolves: [resolvable_pixels::<R>(tx), resolvable_pixels::<R>(ty)],
+            shape: lowest_terms(c.frame),
+        };
         let mut world = Aabb { min: camera.eye, max: camera.eye };
         for o in &self.storage[..self.len] {
             world = world.union(&o.bounds);

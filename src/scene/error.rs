@@ -207,4 +207,3 @@ impl fmt::Display for Round {
         write!(f, "{}e{e}", (v + 0.5) as u64)
     }
 }
-

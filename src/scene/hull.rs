@@ -16,14 +16,14 @@
 //! pixels whose corners hit one object may be filled: which of the objects that can appear
 //! there that object hides all over the block.
 
-use super::model::{any_object, Camera, Scene};
-use crate::math::Aabb;
 #[cfg(feature = "eye-hulls")]
 use super::model::Object;
-#[cfg(feature = "eye-hulls")]
-use crate::shape::Shape;
+use super::model::{any_object, Camera, Scene};
+use crate::math::Aabb;
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
+#[cfg(feature = "eye-hulls")]
+use crate::shape::Shape;
 
 /// Edges an [`EyeHull`] keeps: the image of a box seen from outside has at most six.
 pub const HULL_EDGES: usize = 6;
@@ -85,7 +85,10 @@ pub fn behind<R: Real>(scene: &Scene<'_, R>, among: u64, front: usize, far: u16,
     let eye = scene.camera.eye;
     let Some(f) = scene.objects.get(front) else { return 0 };
     let inside = |lo: R, x: R, hi: R| lo <= x && x <= hi;
-    if inside(f.bounds.min.x, eye.x, f.bounds.max.x) && inside(f.bounds.min.y, eye.y, f.bounds.max.y) && inside(f.bounds.min.z, eye.z, f.bounds.max.z) {
+    if inside(f.bounds.min.x, eye.x, f.bounds.max.x)
+        && inside(f.bounds.min.y, eye.y, f.bounds.max.y)
+        && inside(f.bounds.min.z, eye.z, f.bounds.max.z)
+    {
         return 0;
     }
     // Beyond every parameter whose key is within the slack of the farthest corner's.
@@ -108,7 +111,11 @@ pub fn block_directions<R: Real>(cam: &Camera<R>, u: [R; 2], v: [R; 2]) -> [[R; 
         let (a, b, c, d) = (r * u[0], r * u[1], up * v[0], up * v[1]);
         [f + a.min(b) + c.min(d), f + a.max(b) + c.max(d)]
     };
-    [span(cam.forward.x, cam.right.x, cam.up.x), span(cam.forward.y, cam.right.y, cam.up.y), span(cam.forward.z, cam.right.z, cam.up.z)]
+    [
+        span(cam.forward.x, cam.right.x, cam.up.x),
+        span(cam.forward.y, cam.right.y, cam.up.y),
+        span(cam.forward.z, cam.right.z, cam.up.z),
+    ]
 }
 
 /// Whether no eye ray from `eye` whose direction's components lie in `dirs` meets box `b` at a
@@ -257,7 +264,11 @@ pub(crate) fn eye_hull<R: Real>(o: &Object<R>, projection: &Projection, pad: f64
         }
         let c = libm::ceil(far + MARGIN * (a.abs() + b.abs())) + 1.0;
         // An edge whose bound leaves `i32` culls nothing; one far below only widens to -2^30.
-        *edge = if c < (1u32 << 30) as f64 { [a as i32, b as i32, c.max(-((1u32 << 30) as f64)) as i32] } else { NO_HULL[0] };
+        *edge = if c < (1u32 << 30) as f64 {
+            [a as i32, b as i32, c.max(-((1u32 << 30) as f64)) as i32]
+        } else {
+            NO_HULL[0]
+        };
     }
     hull
 }
@@ -275,7 +286,11 @@ type Disc = [Vec3<f64>; 3];
 fn outline_discs<R: Real>(o: &Object<R>, place: &Affine<f64>, projection: &Projection) -> [Option<Disc>; 2] {
     let disc = |c: Vec3<f64>, p: Vec3<f64>, q: Vec3<f64>| {
         let at = place.point(c);
-        Some([projection.image(at), projection.from_eye.vector(place.point(c + p) - at), projection.from_eye.vector(place.point(c + q) - at)])
+        Some([
+            projection.image(at),
+            projection.from_eye.vector(place.point(c + p) - at),
+            projection.from_eye.vector(place.point(c + q) - at),
+        ])
     };
     let (x, z) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0));
     match o.shape {
@@ -354,7 +369,8 @@ mod tests {
     fn over_paper<R: Real>(mut each: impl FnMut(&Scene<'_, R>, &str) -> usize) -> usize {
         let mut sum = 0;
         for name in ["chair", "desk", "polyhedron", "spheres", "whitted"] {
-            let text = std::fs::read_to_string(std::format!("{}/scenes/{name}.scene", env!("CARGO_MANIFEST_DIR"))).unwrap();
+            let text =
+                std::fs::read_to_string(std::format!("{}/scenes/{name}.scene", env!("CARGO_MANIFEST_DIR"))).unwrap();
             let (mut storage, mut parts) = (std::vec![Object::<R>::default(); 64], Parts::default());
             let scene = crate::parse::<R>(&text, &mut storage, &mut parts).unwrap();
             sum += each(&scene, name);
@@ -371,7 +387,11 @@ mod tests {
             for (eye, look) in [((0.0, 2.0, -30.0), (0.0, 0.0, 0.0)), ((3.0, 4.0, 3.0), (6.0, 5.0, 9.0))] {
                 let (mut storage, mut parts) = (std::vec![Object::<crate::Fx>::default(); 24], Parts::default());
                 let mut b = SceneBuilder::new(&mut storage, &mut parts);
-                crate::generate::random_scene(&mut b, &crate::generate::RandomScene { objects: 24, composite_size: 3, spread: 12.0, seed }).unwrap();
+                crate::generate::random_scene(
+                    &mut b,
+                    &crate::generate::RandomScene { objects: 24, composite_size: 3, spread: 12.0, seed },
+                )
+                .unwrap();
                 b.camera.eye = Vec3::new(eye.0, eye.1, eye.2);
                 b.camera.look = Vec3::new(look.0, look.1, look.2);
                 b.camera.fov = crate::scene::FieldOfView::Within(70.0, 50.0);
@@ -427,16 +447,26 @@ mod tests {
                     for k in -4000..=4000 {
                         let s = f64::from(k) * 2.0;
                         let (u, v) = ((foot[0] + s * along[0]) / 1024.0, (foot[1] + s * along[1]) / 1024.0);
-                        let inside = |x: f64, lo: i32, hi: i32| x * 65536.0 >= f64::from(lo) && x * 65536.0 <= f64::from(hi);
+                        let inside =
+                            |x: f64, lo: i32, hi: i32| x * 65536.0 >= f64::from(lo) && x * 65536.0 <= f64::from(hi);
                         if !(inside(u, w[0], w[1]) && inside(v, w[2], w[3])) {
                             continue;
                         }
                         rays += 1;
                         let ray = cam.ray_through(R::from_f64(u), R::from_f64(v));
-                        assert!(o.intersect(&ray, R::ZERO, R::MAX).is_none(), "{what}, {}: object {i} hit at ({u}, {v}), outside its hull edge {a} u + {b} v <= {c}", R::NAME);
+                        assert!(
+                            o.intersect(&ray, R::ZERO, R::MAX).is_none(),
+                            "{what}, {}: object {i} hit at ({u}, {v}), outside its hull edge {a} u + {b} v <= {c}",
+                            R::NAME
+                        );
                     }
                 }
-                assert!(!every_object || edges == 0 || rays > before, "{what}, {}: object {i}'s hull edges all miss its window {w:?}: {:?}", R::NAME, o.eye_hull);
+                assert!(
+                    !every_object || edges == 0 || rays > before,
+                    "{what}, {}: object {i}'s hull edges all miss its window {w:?}: {:?}",
+                    R::NAME,
+                    o.eye_hull
+                );
             }
             rays
         }
@@ -471,14 +501,16 @@ mod tests {
                 let (id, t) = tracer.eye_hit(ray, &mut q);
                 (id, if id == crate::trace::NO_OBJECT { u16::MAX } else { t.depth_key() })
             };
-            let pixels: std::vec::Vec<(u32, u16)> = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| hit(x, y)).collect();
+            let pixels: std::vec::Vec<(u32, u16)> =
+                (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| hit(x, y)).collect();
             let all = if scene.objects().len() >= 64 { u64::MAX } else { (1u64 << scene.objects().len()) - 1 };
             let mut counted = 0;
             for size in [2usize, 4] {
                 for y0 in 0..h - size {
                     for x0 in 0..w - size {
                         let (xs, ys) = ([x0, x0 + size], [y0, y0 + size]);
-                        let corners = [(xs[0], ys[0]), (xs[1], ys[0]), (xs[0], ys[1]), (xs[1], ys[1])].map(|(x, y)| pixels[y * w + x]);
+                        let corners = [(xs[0], ys[0]), (xs[1], ys[0]), (xs[0], ys[1]), (xs[1], ys[1])]
+                            .map(|(x, y)| pixels[y * w + x]);
                         let id = corners[0].0;
                         if id == crate::trace::NO_OBJECT || corners.iter().any(|c| c.0 != id) {
                             continue;
@@ -486,7 +518,13 @@ mod tests {
                         let far = corners.iter().map(|c| c.1).max().unwrap();
                         let us = [Camera::<R>::ray_u(centre(xs[0]), w4), Camera::<R>::ray_u(centre(xs[1]), w4)];
                         let vs = [Camera::<R>::ray_v(centre(ys[0]), h4), Camera::<R>::ray_v(centre(ys[1]), h4)];
-                        let hidden = behind(scene, all & !(1 << id), id as usize, far, &block_directions(scene.camera(), us, vs));
+                        let hidden = behind(
+                            scene,
+                            all & !(1 << id),
+                            id as usize,
+                            far,
+                            &block_directions(scene.camera(), us, vs),
+                        );
                         counted += hidden.count_ones() as usize;
                         for y in ys[0]..=ys[1] {
                             for x in xs[0]..=xs[1] {

@@ -20,6 +20,7 @@ pub use builder::{check_value, SceneBuilder, IOR};
 pub use error::SceneError;
 pub use hull::{EyeHull, HULL_EDGES, NO_HULL};
 pub use model::{
-    axis_normal, lowest_terms, Camera, CameraDesc, FieldOfView, DEFAULT_FRAME, Composite, Culled, EyeWindow, ShadowWindow, Light, Material, Object, Parts, Scene, EYE_MARGIN, VIEW_MARGIN, MAX_COMPOSITES, MAX_LIGHTS,
-    MAX_MATERIALS, NO_COMPOSITE, WHOLE_PLANE,
+    axis_normal, lowest_terms, Camera, CameraDesc, Composite, Culled, EyeWindow, FieldOfView, Light, Material, Object,
+    Parts, Scene, ShadowWindow, DEFAULT_FRAME, EYE_MARGIN, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE,
+    VIEW_MARGIN, WHOLE_PLANE,
 };

@@ -1,11 +1,11 @@
 //! The validated scene: objects, composites, materials, lights and the camera.
 
-use crate::math::{Aabb, Affine, Linear, Ray, Vec3};
-use crate::scalar::{Pow2, Real};
-use crate::shape::{Shape, ShapeHit};
 use super::hull::EyeHull;
 #[cfg(feature = "eye-hulls")]
 use super::hull::NO_HULL;
+use crate::math::{Aabb, Affine, Linear, Ray, Vec3};
+use crate::scalar::{Pow2, Real};
+use crate::shape::{Shape, ShapeHit};
 use heapless::Vec;
 
 /// Most materials a scene may define.
@@ -282,7 +282,11 @@ fn window_coord_far(n: i32, d: i32) -> i32 {
     // A whole quotient of 2^15 or more is past the clamp.
     let q = if a / b >= 1 << 15 { u32::MAX } else { crate::fixed::shifted_quotient(a, b).0 };
     if n < 0 {
-        if q >= 1 << 31 { i32::MIN } else { -(q as i32) }
+        if q >= 1 << 31 {
+            i32::MIN
+        } else {
+            -(q as i32)
+        }
     } else {
         q.min(i32::MAX as u32) as i32
     }
@@ -479,7 +483,13 @@ impl<R: Real> Object<R> {
     /// outside the object's window, else the same answer as `intersect`, with the eye's
     /// object-space position taken from the scene instead of transformed again.
     #[inline]
-    pub fn intersect_eye_ray(&self, ray: &Ray<R>, uv: [i32; 2], tmin: R, tmax: R) -> Result<Option<ShapeHit<R>>, Culled> {
+    pub fn intersect_eye_ray(
+        &self,
+        ray: &Ray<R>,
+        uv: [i32; 2],
+        tmin: R,
+        tmax: R,
+    ) -> Result<Option<ShapeHit<R>>, Culled> {
         if !self.eye_window_meets([uv[0]; 2], [uv[1]; 2]) {
             return Err(Culled);
         }
@@ -777,7 +787,6 @@ impl<'a, R: Real> Scene<'a, R> {
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::window_coord;
@@ -786,7 +795,9 @@ mod tests {
     /// small and large (long division past 2^15) and divisors from 1 up.
     #[test]
     fn window_coord_is_the_wide_quotient_clamped() {
-        let wide = |n: i32, d: i32| ((i64::from(n) << 16) / i64::from(d.max(1))).clamp(i32::MIN.into(), i32::MAX.into()) as i32;
+        let wide = |n: i32, d: i32| {
+            ((i64::from(n) << 16) / i64::from(d.max(1))).clamp(i32::MIN.into(), i32::MAX.into()) as i32
+        };
         let mut x = 0x9e37_79b9_7f4a_7c15u64;
         for _ in 0..200_000 {
             x ^= x << 13;

@@ -5,9 +5,12 @@
 //! columns count bytes), the offending token and the reason. Parsing feeds a [`SceneBuilder`],
 //! which validates each object as it arrives, so range errors also point at their line.
 
+use super::{
+    check_value, CameraDesc, FieldOfView, Light, Material, Object, Parts, Scene, SceneBuilder, SceneError, IOR,
+    MAX_MATERIALS,
+};
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
-use super::{check_value, CameraDesc, FieldOfView, Light, Material, Object, Parts, Scene, SceneBuilder, SceneError, IOR, MAX_MATERIALS};
 use crate::shape::Shape;
 use crate::trace::MAX_DEPTH;
 use core::fmt;
@@ -88,7 +91,13 @@ impl fmt::Display for ParseErrorKind {
                     _ => {
                         write!(f, "; it takes ")?;
                         for (i, v) in valid.iter().enumerate() {
-                            let sep = if i == 0 { "" } else if i + 1 == valid.len() { " or " } else { ", " };
+                            let sep = if i == 0 {
+                                ""
+                            } else if i + 1 == valid.len() {
+                                " or "
+                            } else {
+                                ", "
+                            };
                             write!(f, "{sep}{v}")?;
                         }
                         Ok(())
@@ -103,7 +112,9 @@ impl fmt::Display for ParseErrorKind {
             ParseErrorKind::UnknownAxis => write!(f, "axis must be x, y or z"),
             ParseErrorKind::UnknownLightKind => write!(f, "light must be `directional` or `point`"),
             ParseErrorKind::BadDepth => write!(f, "depth must be a whole number from 0 to {MAX_DEPTH}"),
-            ParseErrorKind::NumberOutOfRange => write!(f, "number out of range: beyond the largest f64 (about 1.8e308)"),
+            ParseErrorKind::NumberOutOfRange => {
+                write!(f, "number out of range: beyond the largest f64 (about 1.8e308)")
+            }
             ParseErrorKind::SameAxisShear => {
                 write!(f, "a shear needs two different axes (`shear x y K`: x gains K times y)")
             }
@@ -344,7 +355,8 @@ impl<'t> Words<'t> {
         let v = parse_number(tok).ok_or_else(|| self.err(col, tok, ParseErrorKind::ExpectedNumber))?;
         if !v.is_finite() {
             let digits = tok.trim_start_matches(['+', '-']).starts_with(|c: char| c.is_ascii_digit() || c == '.');
-            let kind = if digits { ParseErrorKind::NumberOutOfRange } else { ParseErrorKind::Scene(SceneError::NotFinite) };
+            let kind =
+                if digits { ParseErrorKind::NumberOutOfRange } else { ParseErrorKind::Scene(SceneError::NotFinite) };
             return Err(self.err(col, tok, kind));
         }
         Ok((v, col, tok))
@@ -384,7 +396,11 @@ impl<'t> Words<'t> {
     fn coord(&mut self) -> Result<f64, ParseError<'t>> {
         let (v, col, tok) = self.number_at()?;
         if v.abs() >= self.limit {
-            return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::OutOfRange { limit: self.limit, scalar: self.scalar })));
+            return Err(self.err(
+                col,
+                tok,
+                ParseErrorKind::Scene(SceneError::OutOfRange { limit: self.limit, scalar: self.scalar }),
+            ));
         }
         Ok(v)
     }
@@ -534,7 +550,13 @@ impl<'t> Statement<'t> {
     /// An attribute the statement does not take: the error lists those it takes, and the
     /// nearest of them if the word is one or two letters off it.
     fn unknown(&self, col: u32, attr: &'t str) -> ParseError<'t> {
-        let near = self.valid.iter().map(|v| (edit_distance(attr, v), *v)).filter(|(d, _)| *d <= 2 && *d < attr.len()).min_by_key(|(d, _)| *d).map(|(_, v)| v);
+        let near = self
+            .valid
+            .iter()
+            .map(|v| (edit_distance(attr, v), *v))
+            .filter(|(d, _)| *d <= 2 && *d < attr.len())
+            .min_by_key(|(d, _)| *d)
+            .map(|(_, v)| v);
         self.w.err(col, attr, ParseErrorKind::UnknownAttribute { valid: self.valid, near })
     }
 
@@ -558,8 +580,12 @@ fn attributes(key: &str, light: Option<&str>) -> &'static [&'static str] {
         ("light", Some("point")) => &["pos", "intensity"],
         ("material", _) => &["ka", "kd", "ks", "kt", "ior"],
         ("sphere", _) => &["center", "radius", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
-        ("cylinder", _) => &["base", "radius", "height", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
-        ("cone", _) => &["base", "radius", "height", "top", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
+        ("cylinder", _) => {
+            &["base", "radius", "height", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]]
+        }
+        ("cone", _) => {
+            &["base", "radius", "height", "top", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]]
+        }
         ("box", _) => &["min", "max", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
         ("group", _) => &TRANSFORMS,
         _ => &[],
@@ -605,7 +631,9 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
     /// A scene error blamed on statement `st`; an object count is completed from the text.
     fn scene_err(&self, st: &Statement<'t>, e: SceneError) -> ParseError<'t> {
         st.err(match e {
-            SceneError::TooManyObjects { capacity, .. } => SceneError::TooManyObjects { capacity, needed: object_count(self.text) },
+            SceneError::TooManyObjects { capacity, .. } => {
+                SceneError::TooManyObjects { capacity, needed: object_count(self.text) }
+            }
             e => e,
         })
     }
@@ -746,7 +774,9 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
             }
         }
         let (shape, placement) = match key {
-            "sphere" => (Shape::Sphere, Affine::translate(pos).after(&Affine::scale(Vec3::new(radius, radius, radius)))),
+            "sphere" => {
+                (Shape::Sphere, Affine::translate(pos).after(&Affine::scale(Vec3::new(radius, radius, radius))))
+            }
             "box" => {
                 let size = hi - lo;
                 if !(size.x > 0.0 && size.y > 0.0 && size.z > 0.0) {
@@ -829,7 +859,11 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
 /// Kept out of line so that on a microcontroller the parser's frame is released before the
 /// render that follows it needs the stack.
 #[inline(never)]
-pub fn parse<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>], parts: &'a mut Parts<R>) -> Result<Scene<'a, R>, ParseError<'t>> {
+pub fn parse<'a, 't, R: Real>(
+    text: &'t str,
+    storage: &'a mut [Object<R>],
+    parts: &'a mut Parts<R>,
+) -> Result<Scene<'a, R>, ParseError<'t>> {
     parse_with(text, storage, parts, |_| {})
 }
 
@@ -872,13 +906,22 @@ mod tests {
     fn a_cone_wider_at_its_top_is_the_frustum_it_describes() {
         fn check<R: crate::Real>() {
             let text = "camera eye 0 1 -6 look 0 1 0\ncone base 0 0 0 radius 0.5 height 2 top 1.5\n";
-            let (mut storage, mut parts) = (std::vec![crate::scene::Object::<R>::default(); 4], crate::Parts::default());
+            let (mut storage, mut parts) =
+                (std::vec![crate::scene::Object::<R>::default(); 4], crate::Parts::default());
             let scene = crate::parse::<R>(text, &mut storage, &mut parts).unwrap();
             let o = &scene.objects()[0];
             // The radius at height y is 0.5 + y / 2: a level ray at distance d from the axis hits
             // below the radius, misses beyond it.
-            for (y, d, hits) in [(1.9, 1.4, true), (1.9, 1.5, false), (0.1, 0.5, true), (0.1, 0.6, false), (1.0, 0.95, true), (1.0, 1.05, false)] {
-                let ray = crate::Ray::new(crate::Vec3::new(-5.0, y, d).cast::<R>(), crate::Vec3::new(1.0, 0.0, 0.0).cast());
+            for (y, d, hits) in [
+                (1.9, 1.4, true),
+                (1.9, 1.5, false),
+                (0.1, 0.5, true),
+                (0.1, 0.6, false),
+                (1.0, 0.95, true),
+                (1.0, 1.05, false),
+            ] {
+                let ray =
+                    crate::Ray::new(crate::Vec3::new(-5.0, y, d).cast::<R>(), crate::Vec3::new(1.0, 0.0, 0.0).cast());
                 assert_eq!(o.intersect(&ray, R::ZERO, R::MAX).is_some(), hits, "{}: height {y}, distance {d}", R::NAME);
             }
         }
@@ -889,7 +932,22 @@ mod tests {
 
     #[test]
     fn numbers_parse_like_core_for_scene_values() {
-        for t in ["0", "1", "-2.5", "0.42", "+3", ".5", "5.", "1e3", "-1.25E-2", "123456.789", "0.1", "2.2", "1e-7", "3.14159"] {
+        for t in [
+            "0",
+            "1",
+            "-2.5",
+            "0.42",
+            "+3",
+            ".5",
+            "5.",
+            "1e3",
+            "-1.25E-2",
+            "123456.789",
+            "0.1",
+            "2.2",
+            "1e-7",
+            "3.14159",
+        ] {
             assert_eq!(parse_number(t), Some(t.parse::<f64>().unwrap()), "{t}");
         }
     }

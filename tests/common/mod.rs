@@ -29,7 +29,11 @@ pub fn lattice_storage<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> He
 }
 
 /// Builds the lattice with `cfg` in storage from [`lattice_storage`] with the same `cfg`.
-pub fn build_lattice<'a, R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, st: &'a mut HeapStorage<R>) -> Lattice<'a, R> {
+pub fn build_lattice<'a, R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    st: &'a mut HeapStorage<R>,
+) -> Lattice<'a, R> {
     st.view().split().1.lattice(scene, cfg).expect("lattice fits").0
 }
 
@@ -45,7 +49,12 @@ pub fn render_tracer<R: Real, A: Accelerator<R> + ?Sized>(t: &Tracer<'_, '_, R, 
 }
 
 /// Parses `text` in `R` with its view fitted to frames of `shape` (width and height).
-pub fn parse_for<'a, 't, R: Real>(text: &'t str, storage: &'a mut [Object<R>], parts: &'a mut lattice_rt::Parts<R>, shape: [u32; 2]) -> Result<Scene<'a, R>, lattice_rt::ParseError<'t>> {
+pub fn parse_for<'a, 't, R: Real>(
+    text: &'t str,
+    storage: &'a mut [Object<R>],
+    parts: &'a mut lattice_rt::Parts<R>,
+    shape: [u32; 2],
+) -> Result<Scene<'a, R>, lattice_rt::ParseError<'t>> {
     lattice_rt::scene::text::parse_with::<R>(text, storage, parts, |c| c.frame = shape)
 }
 
@@ -85,8 +94,8 @@ pub fn assert_golden(name: &str, pbm: &[u8]) {
         std::fs::write(&golden, pbm).unwrap();
         return;
     }
-    let want = std::fs::read(&golden)
-        .unwrap_or_else(|e| panic!("{golden}: {e}; run with UPDATE_GOLDEN=1 to create it"));
+    let want =
+        std::fs::read(&golden).unwrap_or_else(|e| panic!("{golden}: {e}; run with UPDATE_GOLDEN=1 to create it"));
     if want == pbm {
         return;
     }
@@ -106,7 +115,9 @@ pub fn assert_golden(name: &str, pbm: &[u8]) {
     } else {
         usize::MAX
     };
-    panic!("{name}: image differs from {golden} in {differing} pixels; actual: {actual}, diff (black = differs): {diff}");
+    panic!(
+        "{name}: image differs from {golden} in {differing} pixels; actual: {actual}, diff (black = differs): {diff}"
+    );
 }
 
 /// Gray levels (0..=64) of a frame rendered with a tracer.

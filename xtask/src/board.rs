@@ -14,10 +14,10 @@
 mod slot;
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
-use host_sim::uf2::{build_image, build_pico, kept_image, pico_built, pico_elf, write_uf2, Scenes};
-use board_frame::{Build, LADDER, ORBIT_FRAMES, PICO};
 use anyhow::{bail, Context, Result};
+use board_frame::{Build, LADDER, ORBIT_FRAMES, PICO};
 use board_records::{FrameDone, Record};
+use host_sim::uf2::{build_image, build_pico, kept_image, pico_built, pico_elf, write_uf2, Scenes};
 use lattice_rt::BitFrame;
 use object::{Object, ObjectSymbol};
 use std::fmt::Write as _;
@@ -33,7 +33,8 @@ const PANEL: (u32, u32) = (128, 64);
 const SETUP_TARGET: f64 = 0.5e6;
 /// What a frame may cost on the Pico (cycles at 125 MHz, LED on to LED off): 10 frames per
 /// second for the chair, 5 for the other paper scenes, 2 for the Whitted scene.
-const TARGETS: &[(&str, f64)] = &[("chair", 12.5e6), ("desk", 25e6), ("polyhedron", 25e6), ("spheres", 25e6), ("whitted", 62e6)];
+const TARGETS: &[(&str, f64)] =
+    &[("chair", 12.5e6), ("desk", 25e6), ("polyhedron", 25e6), ("spheres", 25e6), ("whitted", 62e6)];
 /// Cycles a frame may take before the run is called stuck (the Whitted scene needs about 1 G).
 const MAX_CYCLES_PER_FRAME: u64 = 3_000_000_000;
 /// The message the firmware logs when no display answers (checked in the run without one).
@@ -93,8 +94,18 @@ fn variant_image(feature: &str) -> String {
 /// writes its UF2 file into `frames_dir/<feature>` and runs it for `frames` frames (with `run.mjs`
 /// switches `extra`); returns the run and that folder.
 #[allow(clippy::too_many_arguments)]
-fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, frames_dir: &Path, bootrom: &Path, frames: usize, extra: &[&str]) -> Result<(BoardRun, PathBuf)> {
-    let elf = if no_build { kept_image(root, &variant_image(feature)) } else { build_pico_with(root, feature, all_scenes)? };
+fn run_variant(
+    root: &Path,
+    no_build: bool,
+    feature: &str,
+    all_scenes: bool,
+    frames_dir: &Path,
+    bootrom: &Path,
+    frames: usize,
+    extra: &[&str],
+) -> Result<(BoardRun, PathBuf)> {
+    let elf =
+        if no_build { kept_image(root, &variant_image(feature)) } else { build_pico_with(root, feature, all_scenes)? };
     let dir = frames_dir.join(variant_name(feature));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let uf2 = dir.join(format!("lattice-rt-{}.uf2", variant_image(feature)));
@@ -109,7 +120,8 @@ fn run_variant(root: &Path, no_build: bool, feature: &str, all_scenes: bool, fra
 fn embedded_scenes(root: &Path) -> Result<Vec<String>> {
     let list = match std::env::var("FIRMWARE_SCENES") {
         Ok(v) => v,
-        Err(_) => std::fs::read_to_string(root.join("firmware/default-scenes.txt")).context("cannot read firmware/default-scenes.txt")?,
+        Err(_) => std::fs::read_to_string(root.join("firmware/default-scenes.txt"))
+            .context("cannot read firmware/default-scenes.txt")?,
     };
     let names: Vec<String> = list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
     if names.is_empty() {
@@ -124,13 +136,18 @@ pub(crate) fn prepare_emulator(root: &Path) -> Result<PathBuf> {
     let board = root.join("firmware/board");
     if !board.join("node_modules/rp2040js/package.json").exists() {
         eprintln!("installing rp2040js (npm ci in firmware/board)");
-        let ok = Command::new("npm").current_dir(&board).args(["ci", "--no-audit", "--no-fund"]).status().context("cannot run npm (Node.js 18 or newer is needed)")?;
+        let ok = Command::new("npm")
+            .current_dir(&board)
+            .args(["ci", "--no-audit", "--no-fund"])
+            .status()
+            .context("cannot run npm (Node.js 18 or newer is needed)")?;
         if !ok.success() {
             bail!("`npm ci` in firmware/board failed");
         }
     }
     let bootrom = root.join("firmware/target/board/bootrom-b1.bin");
-    let ok = Command::new("python3").arg(board.join("bootrom.py")).arg(&bootrom).status().context("cannot run python3")?;
+    let ok =
+        Command::new("python3").arg(board.join("bootrom.py")).arg(&bootrom).status().context("cannot run python3")?;
     if !ok.success() {
         bail!("cannot get the RP2040 bootrom (firmware/board/bootrom.py)");
     }
@@ -248,7 +265,16 @@ struct LogLine {
 /// Runs `uf2` in the emulator (with `models` switches such as `--no-cache`) and decodes its log
 /// with the ELF's defmt table.
 #[allow(clippy::too_many_arguments)]
-fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usize, display: bool, work: &Path, models: &[&str]) -> Result<BoardRun> {
+fn run_emulator(
+    root: &Path,
+    elf: &Path,
+    uf2: &Path,
+    bootrom: &Path,
+    frames: usize,
+    display: bool,
+    work: &Path,
+    models: &[&str],
+) -> Result<BoardRun> {
     let elf_bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file = object::File::parse(&*elf_bytes)?;
     let rtt = file
@@ -265,7 +291,14 @@ fn run_emulator(root: &Path, elf: &Path, uf2: &Path, bootrom: &Path, frames: usi
     let records_path = work.join(if display { "records.bin" } else { "records-no-display.bin" });
     let mut cmd = Command::new("node");
     cmd.arg(root.join("firmware/board/run.mjs"))
-        .args(["--uf2".as_ref(), uf2.as_os_str(), "--bootrom".as_ref(), bootrom.as_os_str(), "--log".as_ref(), log_path.as_os_str()])
+        .args([
+            "--uf2".as_ref(),
+            uf2.as_os_str(),
+            "--bootrom".as_ref(),
+            bootrom.as_os_str(),
+            "--log".as_ref(),
+            log_path.as_os_str(),
+        ])
         .args(["--rtt", &format!("{rtt:#x}"), "--frames", &frames.to_string()])
         .args(["--records", &format!("{records_at:#x}")])
         .arg("--records-log")
@@ -320,7 +353,9 @@ fn decode_records(bytes: &mut [u8]) -> Result<Vec<Record>> {
     let mut start = 0;
     while let Some(len) = bytes[start..].iter().position(|&b| b == 0) {
         let frame = &mut bytes[start..=start + len];
-        records.push(Record::decode(frame).with_context(|| format!("the board's record at byte {start} does not decode"))?);
+        records.push(
+            Record::decode(frame).with_context(|| format!("the board's record at byte {start} does not decode"))?,
+        );
         start += len + 1;
     }
     Ok(records)
@@ -462,12 +497,29 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
     let slot_rows = s.slot_runs()?;
 
-    let spi_byte = levers.iter().find(|(feature, ..)| *feature == "spi").map_or(0, |(_, _, f, _)| f.bus_cycles / f.bus_bytes.max(1));
-    let summary = Summary { clk_hz: run.clk_sys_hz, emulated_ms: run.emulated_ms, idle_ms: run.idle_ms, xip_miss_cycles: run.xip_miss_cycles, scl_period: run.scl_period, spi_byte };
+    let spi_byte = levers
+        .iter()
+        .find(|(feature, ..)| *feature == "spi")
+        .map_or(0, |(_, _, f, _)| f.bus_cycles / f.bus_bytes.max(1));
+    let summary = Summary {
+        clk_hz: run.clk_sys_hz,
+        emulated_ms: run.emulated_ms,
+        idle_ms: run.idle_ms,
+        xip_miss_cycles: run.xip_miss_cycles,
+        scl_period: run.scl_period,
+        spi_byte,
+    };
     let profile = profile_shares(&s.elf, &frames_dir.join("profile.json"))?;
     let (flash, static_ram) = elf_sizes(&s.elf)?;
-    let mut md = report(&summary, &rows, (flash, static_ram, section_size(&s.elf, ".ram_code")?), &bare, &s.scenes, &profile)?;
-    md.push_str(&silicon_report(&summary, rows.first().map(|r| &r.frame), &models, alone.as_ref().map(|(f, _, setup)| (f, *setup)), &levers)?);
+    let mut md =
+        report(&summary, &rows, (flash, static_ram, section_size(&s.elf, ".ram_code")?), &bare, &s.scenes, &profile)?;
+    md.push_str(&silicon_report(
+        &summary,
+        rows.first().map(|r| &r.frame),
+        &models,
+        alone.as_ref().map(|(f, _, setup)| (f, *setup)),
+        &levers,
+    )?);
     md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
     md.push_str(&progressive_report(&progressive, run.clk_sys_hz)?);
@@ -503,7 +555,19 @@ impl<'a> Session<'a> {
         let scenes_dir = root.join("scenes");
         let chair = scenes_dir.join("chair.scene");
         let chair_text = host_sim::load::read(&chair)?;
-        Ok(Session { root, frames_dir, no_build, elf, uf2, bootrom, scenes, scenes_dir, chair, chair_text, checks: Checks::default() })
+        Ok(Session {
+            root,
+            frames_dir,
+            no_build,
+            elf,
+            uf2,
+            bootrom,
+            scenes,
+            scenes_dir,
+            chair,
+            chair_text,
+            checks: Checks::default(),
+        })
     }
 
     /// Runs the image with `feature` (the chair alone, or `all_scenes`) for `frames` frames, with
@@ -515,8 +579,21 @@ impl<'a> Session<'a> {
     /// The default image on every embedded scene: each frame against host-sim's, the log's
     /// errors, the display's set-up, the board's frame records.
     fn scenes_run(&mut self) -> Result<(BoardRun, Vec<SceneRow>)> {
-        eprintln!("running {} on the emulated RP2040 with an SSD1306 ({} scenes)", self.uf2.display(), self.scenes.len());
-        let mut run = run_emulator(self.root, &self.elf, &self.uf2, &self.bootrom, self.scenes.len(), true, self.frames_dir, &[])?;
+        eprintln!(
+            "running {} on the emulated RP2040 with an SSD1306 ({} scenes)",
+            self.uf2.display(),
+            self.scenes.len()
+        );
+        let mut run = run_emulator(
+            self.root,
+            &self.elf,
+            &self.uf2,
+            &self.bootrom,
+            self.scenes.len(),
+            true,
+            self.frames_dir,
+            &[],
+        )?;
         for l in &run.log {
             eprintln!("  device {:5} {}", l.level, l.text);
             if l.level == "ERROR" {
@@ -526,7 +603,9 @@ impl<'a> Session<'a> {
         if !run.ok {
             self.checks.fail(format!("the run did not finish: {}", run.reason));
         }
-        self.checks.check(run.display_initialised, || "the display was never initialised (switched on with its charge pump)".into());
+        self.checks.check(run.display_initialised, || {
+            "the display was never initialised (switched on with its charge pump)".into()
+        });
         let mut rows = Vec::new();
         for (index, frame) in std::mem::take(&mut run.frames).into_iter().enumerate() {
             let Some(name) = self.scenes.get(index).cloned() else { break };
@@ -581,7 +660,10 @@ impl<'a> Session<'a> {
         let panicked = bare.log.iter().any(|l| l.text.contains("panicked"));
         self.checks.check(bare.ok && said && !panicked && bare.led_toggles >= 4, || {
             let ran = if bare.ok { "ran" } else { "failed" };
-            format!("with no display: run {ran} ({}), message logged: {said}, panic: {panicked}, LED toggles: {}", bare.reason, bare.led_toggles)
+            format!(
+                "with no display: run {ran} ({}), message logged: {said}, panic: {panicked}, LED toggles: {}",
+                bare.reason, bare.led_toggles
+            )
         });
         Ok(bare)
     }
@@ -597,7 +679,13 @@ impl<'a> Session<'a> {
             eprintln!("running the image without {what}");
             let m = run_emulator(self.root, &self.elf, &self.uf2, &self.bootrom, 1, true, &dir, switches)?;
             match m.frames.into_iter().next() {
-                Some(f) if self.checks.check(f.pixels == want, || format!("without {what}: the {first} differs from host-sim")) => models.push((*what, f)),
+                Some(f)
+                    if self
+                        .checks
+                        .check(f.pixels == want, || format!("without {what}: the {first} differs from host-sim")) =>
+                {
+                    models.push((*what, f))
+                }
                 Some(_) => {}
                 None => self.checks.fail(format!("without {what}: no frame shown ({})", m.reason)),
             }
@@ -609,7 +697,12 @@ impl<'a> Session<'a> {
     /// it reported) and from each build-time lever's image ([`LEVERS`]).
     #[allow(clippy::type_complexity)]
     #[allow(clippy::type_complexity)]
-    fn lever_runs(&mut self) -> Result<(Option<(PanelFrame, Option<u64>, Option<u64>)>, Vec<(&'static str, &'static str, PanelFrame, Option<u64>)>)> {
+    fn lever_runs(
+        &mut self,
+    ) -> Result<(
+        Option<(PanelFrame, Option<u64>, Option<u64>)>,
+        Vec<(&'static str, &'static str, PanelFrame, Option<u64>)>,
+    )> {
         let want = host_frame(&self.scenes_dir, "chair", PICO_SCALAR, PICO)?;
         let (mut alone, mut levers) = (None, Vec::new());
         for (feature, what) in std::iter::once(&(CHAIR_ALONE, "")).chain(LEVERS) {
@@ -620,7 +713,9 @@ impl<'a> Session<'a> {
             match run.frames.into_iter().next() {
                 Some(f) => {
                     save_frame(&f.pixels, &dir.join("chair.png"))?;
-                    if self.checks.check(f.pixels == want, || format!("`{name}`: the chair differs from host-sim (see {}/chair.png)", dir.display())) {
+                    if self.checks.check(f.pixels == want, || {
+                        format!("`{name}`: the chair differs from host-sim (see {}/chair.png)", dir.display())
+                    }) {
                         if feature == &CHAIR_ALONE {
                             alone = Some((f, rays, setup_us));
                         } else {
@@ -638,13 +733,25 @@ impl<'a> Session<'a> {
     /// many were identical.
     fn orbit_run(&mut self) -> Result<(BoardRun, usize)> {
         let (orun, dir) = self.variant("orbit", false, ORBIT_CHECKED, &[])?;
-        let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(&self.chair, &self.chair_text, ORBIT_FRAMES, &board_frame::rendered(Build { orbit: true, ..PICO }))?;
+        let want = host_sim::orbit::orbit_frames::<lattice_rt::Fx>(
+            &self.chair,
+            &self.chair_text,
+            ORBIT_FRAMES,
+            &board_frame::rendered(Build { orbit: true, ..PICO }),
+        )?;
         let shown = orun.frames.len();
-        self.checks.check(shown >= ORBIT_CHECKED, || format!("orbit mode: {shown} of {ORBIT_CHECKED} frames shown ({})", orun.reason));
+        self.checks.check(shown >= ORBIT_CHECKED, || {
+            format!("orbit mode: {shown} of {ORBIT_CHECKED} frames shown ({})", orun.reason)
+        });
         let mut same = 0;
         for (i, f) in orun.frames.iter().enumerate() {
             save_frame(&f.pixels, &dir.join(format!("chair-{i}.png")))?;
-            if self.checks.check(want.get(i) == Some(&f.pixels), || format!("orbit mode: frame {i} of the chair differs from host-sim (see {}/chair-{i}.png)", dir.display())) {
+            if self.checks.check(want.get(i) == Some(&f.pixels), || {
+                format!(
+                    "orbit mode: frame {i} of the chair differs from host-sim (see {}/chair-{i}.png)",
+                    dir.display()
+                )
+            }) {
                 same += 1;
             }
         }
@@ -655,12 +762,19 @@ impl<'a> Session<'a> {
     fn ladder_rows<'r>(&mut self, lrun: &'r BoardRun) -> Result<Vec<Rung<'r>>> {
         let dir = self.frames_dir.join("ladder");
         let shown = lrun.frames.len();
-        self.checks.check(shown >= LADDER.len(), || format!("ladder: {shown} of {} frames shown ({})", LADDER.len(), lrun.reason));
+        self.checks.check(shown >= LADDER.len(), || {
+            format!("ladder: {shown} of {} frames shown ({})", LADDER.len(), lrun.reason)
+        });
         let mut rungs = Vec::new();
         for (i, (f, (what, tuning))) in lrun.frames.iter().zip(LADDER.iter()).enumerate() {
             save_frame(&f.pixels, &dir.join(format!("chair-{i}.png")))?;
             let want = ladder_frame(&self.chair, tuning)?;
-            self.checks.check(want == f.pixels, || format!("ladder rung {i} ({what}): the chair differs from host-sim (see {}/chair-{i}.png)", dir.display()));
+            self.checks.check(want == f.pixels, || {
+                format!(
+                    "ladder rung {i} ({what}): the chair differs from host-sim (see {}/chair-{i}.png)",
+                    dir.display()
+                )
+            });
             let reported = lrun.records.iter().find_map(|r| match r {
                 Record::Rung { rung, frame } if usize::from(*rung) == i => Some(*frame),
                 _ => None,
@@ -674,19 +788,34 @@ impl<'a> Session<'a> {
     }
 
     /// Progressive mode: every pass of every scene against host-sim's.
-    fn progressive_rows<'r>(&mut self, (prun, dir): &'r (BoardRun, PathBuf), rows: &'r [SceneRow]) -> Result<Vec<ProgressiveRow<'r>>> {
+    fn progressive_rows<'r>(
+        &mut self,
+        (prun, dir): &'r (BoardRun, PathBuf),
+        rows: &'r [SceneRow],
+    ) -> Result<Vec<ProgressiveRow<'r>>> {
         let wanted = PASSES * self.scenes.len();
         let shown = prun.frames.len();
-        self.checks.check(shown >= wanted, || format!("progressive mode: {shown} of {wanted} passes shown ({})", prun.reason));
+        self.checks
+            .check(shown >= wanted, || format!("progressive mode: {shown} of {wanted} passes shown ({})", prun.reason));
         let mut progressive = Vec::new();
         for (name, passes) in self.scenes.clone().iter().zip(prun.frames.chunks(PASSES)) {
             let path = self.scenes_dir.join(format!("{name}.scene"));
-            let want = host_sim::run::progressive_passes::<lattice_rt::Fx>(&path, &host_sim::load::read(&path)?, &board_frame::rendered(Build { progressive: true, ..PICO }))?;
+            let want = host_sim::run::progressive_passes::<lattice_rt::Fx>(
+                &path,
+                &host_sim::load::read(&path)?,
+                &board_frame::rendered(Build { progressive: true, ..PICO }),
+            )?;
             let mut same = 0;
             for (f, p) in passes.iter().zip(&want) {
                 let file = dir.join(format!("{name}-pass{}.png", p.pass));
                 save_frame(&f.pixels, &file)?;
-                if self.checks.check(f.pixels == p.bits, || format!("progressive mode: pass {} of {name} differs from host-sim (see {})", p.pass, file.display())) {
+                if self.checks.check(f.pixels == p.bits, || {
+                    format!(
+                        "progressive mode: pass {} of {name} differs from host-sim (see {})",
+                        p.pass,
+                        file.display()
+                    )
+                }) {
                     same += 1;
                 }
             }
@@ -703,7 +832,12 @@ impl<'a> Session<'a> {
     /// the eye rays without and with lines (`lined_rays`: what the chair-alone default image
     /// reported), and whether it was identical. Saves the panel picture docs/board.md shows
     /// beside `out` (beside the default image's chair, with lines).
-    fn outline_row<'r>(&mut self, (run, dir): &'r (BoardRun, PathBuf), out: &Path, lined_rays: Option<Option<u64>>) -> Result<Option<(&'r PanelFrame, [u64; 2], bool)>> {
+    fn outline_row<'r>(
+        &mut self,
+        (run, dir): &'r (BoardRun, PathBuf),
+        out: &Path,
+        lined_rays: Option<Option<u64>>,
+    ) -> Result<Option<(&'r PanelFrame, [u64; 2], bool)>> {
         let Some(f) = run.frames.first() else {
             self.checks.fail(format!("no-outline: no frame shown ({})", run.reason));
             return Ok(None);
@@ -716,7 +850,9 @@ impl<'a> Session<'a> {
             std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
             save_frame(&f.pixels, &images.join("board-chair-plain.png"))?;
         }
-        let same = self.checks.check(f.pixels == want.bits, || format!("no-outline: the chair differs from host-sim (see {})", file.display()));
+        let same = self.checks.check(f.pixels == want.bits, || {
+            format!("no-outline: the chair differs from host-sim (see {})", file.display())
+        });
         let rays = [reported_frame(&run.records, 0).map(|r| r.rays[0]), lined_rays.flatten()];
         self.checks.check(rays.iter().all(Option::is_some), || "no-outline: the board reported no frame record".into());
         Ok(Some((f, rays.map(|r| r.unwrap_or(0)), same)))
@@ -732,7 +868,8 @@ const PROFILE_ROWS: usize = 16;
 fn profile_shares(elf: &Path, samples: &Path) -> Result<Vec<(String, f64)>> {
     use object::{Object as _, ObjectSymbol as _, SymbolKind};
     let text = std::fs::read_to_string(samples).with_context(|| format!("cannot read {}", samples.display()))?;
-    let pairs: Vec<(u64, u64)> = serde_json::from_str(&text).with_context(|| format!("{} is not a profile", samples.display()))?;
+    let pairs: Vec<(u64, u64)> =
+        serde_json::from_str(&text).with_context(|| format!("{} is not a profile", samples.display()))?;
     let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file = object::File::parse(&*bytes)?;
     let mut syms: Vec<(u64, u64, String)> = file
@@ -766,11 +903,24 @@ fn profile_shares(elf: &Path, samples: &Path) -> Result<Vec<(String, f64)>> {
 fn orbit_report(frames: &[PanelFrame], same: usize, clk_hz: f64) -> Result<String> {
     let mut md = String::new();
     writeln!(md, "\n## Orbit mode\n")?;
-    writeln!(md, "The image built with `--features orbit` circles the camera around each scene, {ORBIT_FRAMES} frames per")?;
+    writeln!(
+        md,
+        "The image built with `--features orbit` circles the camera around each scene, {ORBIT_FRAMES} frames per"
+    )?;
     writeln!(md, "turn, in blue noise with silhouette lines (frames in motion, `board_frame::MOTION_DITHER`")?;
-    writeln!(md, "flickers least; `host-sim orbit` draws the same frames as a GIF). Built with the chair alone and run like the")?;
-    writeln!(md, "image above, {same} of its first {} frames were bit-identical to host-sim's orbit. A frame here is", frames.len())?;
-    writeln!(md, "whole: the scene parsed for the new camera, its lattice and windows built, every tile traced and sent.\n")?;
+    writeln!(
+        md,
+        "flickers least; `host-sim orbit` draws the same frames as a GIF). Built with the chair alone and run like the"
+    )?;
+    writeln!(
+        md,
+        "image above, {same} of its first {} frames were bit-identical to host-sim's orbit. A frame here is",
+        frames.len()
+    )?;
+    writeln!(
+        md,
+        "whole: the scene parsed for the new camera, its lattice and windows built, every tile traced and sent.\n"
+    )?;
     writeln!(md, "| frame | cycles | frames per second at {:.0} MHz |\n|---:|---:|---:|", clk_hz / 1e6)?;
     for (i, f) in frames.iter().enumerate() {
         writeln!(md, "| {i} | {:.1} M | {:.2} |", f.cycles as f64 / 1e6, clk_hz / f.cycles.max(1) as f64)?;
@@ -812,10 +962,14 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|")?;
     for r in rows {
         let mut at = 0u64;
-        let cumulative: Vec<u64> = r.passes.iter().map(|f| {
-            at += f.cycles;
-            at
-        }).collect();
+        let cumulative: Vec<u64> = r
+            .passes
+            .iter()
+            .map(|f| {
+                at += f.cycles;
+                at
+            })
+            .collect();
         let total = *cumulative.last().unwrap_or(&0);
         writeln!(
             md,
@@ -823,14 +977,23 @@ fn progressive_report(rows: &[ProgressiveRow<'_>], clk_hz: f64) -> Result<String
             r.name,
             r.same,
             r.passes.len(),
-            cumulative.iter().chain([&r.plain.cycles]).map(|c| format!("{:.1} M", *c as f64 / 1e6)).collect::<Vec<_>>().join(" | "),
+            cumulative
+                .iter()
+                .chain([&r.plain.cycles])
+                .map(|c| format!("{:.1} M", *c as f64 / 1e6))
+                .collect::<Vec<_>>()
+                .join(" | "),
             total as f64 / r.plain.cycles.max(1) as f64,
             100.0 * cumulative.first().copied().unwrap_or(0) as f64 / r.plain.cycles.max(1) as f64,
             r.rays.iter().map(u64::to_string).collect::<Vec<_>>().join(" / "),
             r.passes.iter().map(|f| f.bus_bytes).sum::<u64>(),
         )?;
     }
-    writeln!(md, "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The bus bytes are four panels' worth, each on the", 1e3 / mhz)?;
+    writeln!(
+        md,
+        "\nAt {mhz:.0} MHz a million cycles is {:.1} ms. The bus bytes are four panels' worth, each on the",
+        1e3 / mhz
+    )?;
     writeln!(md, "emulated bus for the time it takes there.")?;
     Ok(md)
 }
@@ -849,10 +1012,27 @@ fn outline_report(f: &PanelFrame, rays: [u64; 2], same: bool, lined: &PanelFrame
     writeln!(md, "inside a tile), so no ray is traced for the lines alone (host-sim's render traces hit-only rays")?;
     writeln!(md, "around a tile where the neighbour traced: the same lines). *Eye rays* are what the board reported.")?;
     writeln!(md, "Both rows are images built with the chair alone: `--features no-outline` leaves the lines out;")?;
-    writeln!(md, "the frame its panel showed was {} host-sim's.\n", if same { "bit-identical to" } else { "**not** the same as" })?;
+    writeln!(
+        md,
+        "the frame its panel showed was {} host-sim's.\n",
+        if same { "bit-identical to" } else { "**not** the same as" }
+    )?;
     writeln!(md, "| chair | cycles | eye rays | frames per second at {:.0} MHz |\n|---|---:|---:|---:|", clk_hz / 1e6)?;
-    writeln!(md, "| without lines (`no-outline`) | {:.1} M | {} | {:.2} |", f.cycles as f64 / 1e6, rays[0], clk_hz / f.cycles.max(1) as f64)?;
-    writeln!(md, "| with lines (the default image, the chair alone) | {:.1} M ({:.2}x) | {} | {:.2} |", lined.cycles as f64 / 1e6, lined.cycles as f64 / f.cycles.max(1) as f64, rays[1], clk_hz / lined.cycles.max(1) as f64)?;
+    writeln!(
+        md,
+        "| without lines (`no-outline`) | {:.1} M | {} | {:.2} |",
+        f.cycles as f64 / 1e6,
+        rays[0],
+        clk_hz / f.cycles.max(1) as f64
+    )?;
+    writeln!(
+        md,
+        "| with lines (the default image, the chair alone) | {:.1} M ({:.2}x) | {} | {:.2} |",
+        lined.cycles as f64 / 1e6,
+        lined.cycles as f64 / f.cycles.max(1) as f64,
+        rays[1],
+        clk_hz / lined.cycles.max(1) as f64
+    )?;
     writeln!(md, "\n![the chair on the emulated panel, with lines](images/board-chair.png) ![without lines](images/board-chair-plain.png)")?;
     Ok(md)
 }
@@ -944,36 +1124,92 @@ fn m3(cycles: u64) -> String {
 
 /// docs/board.md's head: the run, a frame per scene against the targets, where the first
 /// frame's time goes.
-fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u64, u64), bare: &BoardRun, scenes: &[String], profile: &[(String, f64)]) -> Result<String> {
+fn report(
+    s: &Summary,
+    rows: &[SceneRow],
+    (flash, static_ram, ram_code): (u64, u64, u64),
+    bare: &BoardRun,
+    scenes: &[String],
+    profile: &[(String, f64)],
+) -> Result<String> {
     let mut md = String::new();
     let mhz = s.clk_hz / 1e6;
     writeln!(md, "# The Pico image on an emulated board\n")?;
     writeln!(md, "Written by `cargo xtask board` (also run by `.ci/run`). It builds the image")?;
     writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, opt-level 2, flip-link), writes its UF2 file, and runs that")?;
-    writeln!(md, "file on an RP2040 as silicon runs it: [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 with what")?;
-    writeln!(md, "`firmware/board/silicon.mjs` adds from the RP2040 datasheet, **core 1** (started by the B1 bootrom and")?;
-    writeln!(md, "rp2040-hal's launch handshake, per-core SIO FIFOs, divider, NVIC and MPU stack guard), the **16 KiB")?;
-    writeln!(md, "XIP flash cache** and the **I2C bus's timing**, with an SSD1306 model on I2C0. It decodes the defmt log")?;
+    writeln!(
+        md,
+        "file on an RP2040 as silicon runs it: [rp2040js](https://www.npmjs.com/package/rp2040js) 1.4.1 with what"
+    )?;
+    writeln!(
+        md,
+        "`firmware/board/silicon.mjs` adds from the RP2040 datasheet, **core 1** (started by the B1 bootrom and"
+    )?;
+    writeln!(
+        md,
+        "rp2040-hal's launch handshake, per-core SIO FIFOs, divider, NVIC and MPU stack guard), the **16 KiB"
+    )?;
+    writeln!(
+        md,
+        "XIP flash cache** and the **I2C bus's timing**, with an SSD1306 model on I2C0. It decodes the defmt log"
+    )?;
     writeln!(md, "and requires every frame the panel shows to be bit-identical to host-sim's render of the scene")?;
-    writeln!(md, "(128x64, fixed point, Floyd-Steinberg error diffusion with silhouette lines, mirror, glass and shadow")?;
+    writeln!(
+        md,
+        "(128x64, fixed point, Floyd-Steinberg error diffusion with silhouette lines, mirror, glass and shadow"
+    )?;
     writeln!(md, "rays weighing less than half a gray step not traced, `board_frame::rendered`):")?;
-    writeln!(md, "the two cores take the tiles one at a time as they come free, and core 0 dithers each band of tiles")?;
+    writeln!(
+        md,
+        "the two cores take the tiles one at a time as they come free, and core 0 dithers each band of tiles"
+    )?;
     writeln!(md, "in order once all its tiles are traced, then sends it (trace, then dither). The scenes are baked")?;
-    writeln!(md, "into flash at build time (each parsed and its lattice built by `firmware/build.rs`, in fixed point as")?;
-    writeln!(md, "the board would), so a frame starts tracing at once; the `parse` image below does that on the board. Every")?;
-    writeln!(md, "figure below is what the emulated board ran; none is computed. Scenes embedded: {}.\n", scenes.join(", "))?;
+    writeln!(
+        md,
+        "into flash at build time (each parsed and its lattice built by `firmware/build.rs`, in fixed point as"
+    )?;
+    writeln!(
+        md,
+        "the board would), so a frame starts tracing at once; the `parse` image below does that on the board. Every"
+    )?;
+    writeln!(
+        md,
+        "figure below is what the emulated board ran; none is computed. Scenes embedded: {}.\n",
+        scenes.join(", ")
+    )?;
     writeln!(md, "## Per frame\n")?;
     writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;
-    writeln!(md, "frame on the panel: *to the first tile* is the scene's and the tracer's set-up, up to the moment the")?;
-    writeln!(md, "cores start on the tiles, as the board's own timer measured it (`FrameDone::setup_us`); *set-up* is the")?;
+    writeln!(
+        md,
+        "frame on the panel: *to the first tile* is the scene's and the tracer's set-up, up to the moment the"
+    )?;
+    writeln!(
+        md,
+        "cores start on the tiles, as the board's own timer measured it (`FrameDone::setup_us`); *set-up* is the"
+    )?;
     writeln!(md, "time up to the first byte of the first tile on the bus (that, and the first band's tracing on both")?;
     writeln!(md, "cores), then both cores tracing tiles and core 0")?;
-    writeln!(md, "dithering and sending every band. *Busy* is cycles a core ran instructions (waiting for the bus or the other")?;
+    writeln!(
+        md,
+        "dithering and sending every band. *Busy* is cycles a core ran instructions (waiting for the bus or the other"
+    )?;
     writeln!(md, "core in a loop included), *idle* cycles it slept (`wfe`). *Misses* are flash reads that missed")?;
-    writeln!(md, "the XIP cache ({} cycles each, queued when both cores miss); *bus* is the time the I2C bus was busy", s.xip_miss_cycles)?;
-    writeln!(md, "({} cycles per SCL period, {:.1} kHz). *Outside the tiles* is the frame's time outside core 0's share", s.scl_period, s.clk_hz / s.scl_period.max(1) as f64 / 1e3)?;
+    writeln!(
+        md,
+        "the XIP cache ({} cycles each, queued when both cores miss); *bus* is the time the I2C bus was busy",
+        s.xip_miss_cycles
+    )?;
+    writeln!(
+        md,
+        "({} cycles per SCL period, {:.1} kHz). *Outside the tiles* is the frame's time outside core 0's share",
+        s.scl_period,
+        s.clk_hz / s.scl_period.max(1) as f64 / 1e3
+    )?;
     writeln!(md, "of the tiles, as the board's own timer measured it (`FrameDone`: its frame time less its share's):")?;
-    writeln!(md, "the tracer's set-up (eye windows, the effect set) before the tiles and the wait for the last band's")?;
+    writeln!(
+        md,
+        "the tracer's set-up (eye windows, the effect set) before the tiles and the wait for the last band's"
+    )?;
     writeln!(md, "bytes on the bus after them.\n")?;
     writeln!(md, "| scene | cycles | frames per second at {mhz:.0} MHz | target | to the first tile | set-up | outside the tiles | core 0 busy | core 1 busy / idle | instructions | XIP misses (stall) | I2C bytes | bus | stack high-water |")?;
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
@@ -1003,16 +1239,38 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
         )?;
     }
     writeln!(md, "\nImage: {flash} bytes of flash, {static_ram} bytes of static RAM: {ram_code} bytes of code copied to SRAM at boot")?;
-    writeln!(md, "(`firmware/pico/ram-code.x`), core 1's 32 KiB stack and the statics. The stack high-water mark is core")?;
+    writeln!(
+        md,
+        "(`firmware/pico/ram-code.x`), core 1's 32 KiB stack and the statics. The stack high-water mark is core"
+    )?;
     writeln!(md, "0's (stack painting), as it logged it after each frame. The run emulated")?;
-    writeln!(md, "{:.2} s of board time, of which {:.2} s both cores slept between scenes (skipped, not emulated).\n", s.emulated_ms / 1e3, s.idle_ms / 1e3)?;
+    writeln!(
+        md,
+        "{:.2} s of board time, of which {:.2} s both cores slept between scenes (skipped, not emulated).\n",
+        s.emulated_ms / 1e3,
+        s.idle_ms / 1e3
+    )?;
     writeln!(md, "With no display on the bus the firmware logs `{NO_DISPLAY_MESSAGE} ...`, blinks the LED and")?;
-    writeln!(md, "retries every second ({} LED changes in {:.1} s of emulated time, no panic).\n", bare.led_toggles, bare.emulated_ms / 1e3)?;
+    writeln!(
+        md,
+        "retries every second ({} LED changes in {:.1} s of emulated time, no panic).\n",
+        bare.led_toggles,
+        bare.emulated_ms / 1e3
+    )?;
     if let (Some(first), false) = (scenes.first(), profile.is_empty()) {
         writeln!(md, "## Where the {first} frame's time goes on core 0\n")?;
-        writeln!(md, "Core 0's program counter sampled every 97th instruction of the first frame (the {first}, LED on")?;
-        writeln!(md, "to LED off), each sample credited to the function whose code holds it (`object` reads the ELF's")?;
-        writeln!(md, "symbols): shares of core 0's instructions, with code the compiler inlined counted in its caller.\n")?;
+        writeln!(
+            md,
+            "Core 0's program counter sampled every 97th instruction of the first frame (the {first}, LED on"
+        )?;
+        writeln!(
+            md,
+            "to LED off), each sample credited to the function whose code holds it (`object` reads the ELF's"
+        )?;
+        writeln!(
+            md,
+            "symbols): shares of core 0's instructions, with code the compiler inlined counted in its caller.\n"
+        )?;
         writeln!(md, "| share | function |\n|---:|---|")?;
         for (name, share) in profile {
             writeln!(md, "| {:.1} % | `{name}` |", share * 100.0)?;
@@ -1024,32 +1282,72 @@ fn report(s: &Summary, rows: &[SceneRow], (flash, static_ram, ram_code): (u64, u
 
 /// The section on the silicon models: how each is derived, what each adds, and the build-time
 /// levers against the default image.
-fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, PanelFrame)], alone: Option<(&PanelFrame, Option<u64>)>, levers: &[(&str, &str, PanelFrame, Option<u64>)]) -> Result<String> {
+fn silicon_report(
+    s: &Summary,
+    plain: Option<&PanelFrame>,
+    models: &[(&str, PanelFrame)],
+    alone: Option<(&PanelFrame, Option<u64>)>,
+    levers: &[(&str, &str, PanelFrame, Option<u64>)],
+) -> Result<String> {
     let mut md = String::new();
     writeln!(md, "## The board as silicon runs it\n")?;
     writeln!(md, "- **Core 1** starts in the bootrom at the reset vector and waits there for the launch sequence;")?;
     writeln!(md, "  rp2040-hal's `Multicore::spawn` (PSM reset of core 1, then 0, 0, 1, vector table, stack, entry,")?;
-    writeln!(md, "  each echoed through the FIFO) runs unchanged. The two cores are stepped interleaved by cycle count,")?;
+    writeln!(
+        md,
+        "  each echoed through the FIFO) runs unchanged. The two cores are stepped interleaved by cycle count,"
+    )?;
     writeln!(md, "  never more than one instruction apart. Each has its own SIO divider, interpolators, CPUID, event")?;
     writeln!(md, "  register, NVIC, SysTick and MPU; core 1's stack guard (the MPU region rp2040-hal installs) is")?;
     writeln!(md, "  enforced, so a stack overflow on core 1 stops the run. There is one firmware path: the image")?;
     writeln!(md, "  always starts core 1, here and on a board.")?;
-    writeln!(md, "- **The XIP cache**: 16 KiB, 2-way set-associative, 8-byte lines, least recently used way replaced,")?;
-    writeln!(md, "  shared by both cores, with its no-allocate and no-cache aliases. A miss costs the time the SSI takes")?;
+    writeln!(
+        md,
+        "- **The XIP cache**: 16 KiB, 2-way set-associative, 8-byte lines, least recently used way replaced,"
+    )?;
+    writeln!(
+        md,
+        "  shared by both cores, with its no-allocate and no-cache aliases. A miss costs the time the SSI takes"
+    )?;
     writeln!(md, "  to fetch one line as boot2 set it up (read from its registers): quad-I/O continuous read, no")?;
     writeln!(md, "  instruction, 32 address and mode bits on four lanes (8 SCK), 4 wait cycles, 64 data bits on four")?;
-    writeln!(md, "  lanes (16 SCK): 28 SCK periods of clk_sys / 2 = **{} cycles**. Misses of the two cores queue on", s.xip_miss_cycles)?;
+    writeln!(
+        md,
+        "  lanes (16 SCK): 28 SCK periods of clk_sys / 2 = **{} cycles**. Misses of the two cores queue on",
+        s.xip_miss_cycles
+    )?;
     writeln!(md, "  the one flash interface.")?;
-    writeln!(md, "- **The I2C bus**: the firmware sets IC_FS_SCL_HCNT, LCNT and SPKLEN; SCL is high HCNT + SPKLEN + 7")?;
-    writeln!(md, "  and low LCNT + 1 clk_sys cycles (DW_apb_i2c): **{} cycles per SCL period** at {:.0} MHz. START and", s.scl_period, s.clk_hz / 1e6)?;
+    writeln!(
+        md,
+        "- **The I2C bus**: the firmware sets IC_FS_SCL_HCNT, LCNT and SPKLEN; SCL is high HCNT + SPKLEN + 7"
+    )?;
+    writeln!(
+        md,
+        "  and low LCNT + 1 clk_sys cycles (DW_apb_i2c): **{} cycles per SCL period** at {:.0} MHz. START and",
+        s.scl_period,
+        s.clk_hz / 1e6
+    )?;
     writeln!(md, "  STOP take one period, every byte, address included, nine (eight bits and the acknowledge). The")?;
-    writeln!(md, "  16-entry TX FIFO fills while the bus is busy and a write waits for room, as on silicon; the display")?;
+    writeln!(
+        md,
+        "  16-entry TX FIFO fills while the bus is busy and a write waits for room, as on silicon; the display"
+    )?;
     writeln!(md, "  model receives each byte when the bus has delivered it.")?;
     writeln!(md, "- **The SPI bus** (the `spi` build): each byte takes DSS + 1 periods of clk_peri / (CPSDVSR x (1 +")?;
-    writeln!(md, "  SCR)), as the firmware set the PL022 up: **{} cycles a byte**. The display model hears a byte when", s.spi_byte)?;
-    writeln!(md, "  its last bit is on the wire, with chip select and data/command as the GPIOs are then; RES low resets it.")?;
+    writeln!(
+        md,
+        "  SCR)), as the firmware set the PL022 up: **{} cycles a byte**. The display model hears a byte when",
+        s.spi_byte
+    )?;
+    writeln!(
+        md,
+        "  its last bit is on the wire, with chip select and data/command as the GPIOs are then; RES low resets it."
+    )?;
     writeln!(md, "- Not modelled: contention between the cores on SRAM and the peripheral bus (the RP2040's striped")?;
-    writeln!(md, "  SRAM banks make it rare), and the bootrom's own flash set-up (there is no SSI flash model, so the")?;
+    writeln!(
+        md,
+        "  SRAM banks make it rare), and the bootrom's own flash set-up (there is no SSI flash model, so the"
+    )?;
     writeln!(md, "  run starts at boot2 as the bootrom leaves it).\n")?;
     let Some(plain) = plain else { return Ok(md) };
     let row = |md: &mut String, what: &str, f: &PanelFrame, base: &PanelFrame| -> Result<()> {
@@ -1070,7 +1368,10 @@ fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, Pane
         Ok(())
     };
     let header = |md: &mut String| -> Result<()> {
-        writeln!(md, "| | cycles | frames per second | core 0 busy / idle | core 1 busy / idle | XIP misses (stall) | bus |")?;
+        writeln!(
+            md,
+            "| | cycles | frames per second | core 0 busy / idle | core 1 busy / idle | XIP misses (stall) | bus |"
+        )?;
         writeln!(md, "|---|---:|---:|---:|---:|---:|---:|")?;
         Ok(())
     };
@@ -1096,8 +1397,17 @@ fn silicon_report(s: &Summary, plain: Option<&PanelFrame>, models: &[(&str, Pane
     let parsed = levers.iter().find(|l| l.0 == "parse").and_then(|l| l.3);
     if let (Some(baked), Some(parsed)) = (alone_setup, parsed) {
         let met = if baked as f64 * s.clk_hz / 1e6 <= SETUP_TARGET { "met" } else { "not met" };
-        writeln!(md, "\nThe chair's set-up (the board's timer from the LED going on to the first tile: the scene's and the")?;
-        writeln!(md, "tracer's set-up, `FrameDone::setup_us`): **{}** cycles baked (target {}: {met}), {} with `parse`.", cycles(baked), m(SETUP_TARGET as u64), cycles(parsed))?;
+        writeln!(
+            md,
+            "\nThe chair's set-up (the board's timer from the LED going on to the first tile: the scene's and the"
+        )?;
+        writeln!(
+            md,
+            "tracer's set-up, `FrameDone::setup_us`): **{}** cycles baked (target {}: {met}), {} with `parse`.",
+            cycles(baked),
+            m(SETUP_TARGET as u64),
+            cycles(parsed)
+        )?;
     }
     Ok(md)
 }
@@ -1120,7 +1430,10 @@ mod tests {
         let frame = r#"{"event":"frame","index":0,"cycles":31447325,"instructions":39300000,"busy":[31447325,26591316],"idle":[0,4856009],"coreInstructions":[1,2],"xipHits":5,"xipMisses":519,"xipStallCycles":29104,"setupCycles":3594371,"setupInstructions":1,"busBytes":2176,"busCycles":7900000,"i2cTransfers":384,"startMs":1,"endMs":2,"error":null,"pixels":"00ff"}"#;
         match Event::parse(frame).unwrap() {
             Event::Frame(f) => {
-                assert_eq!((f.cycles, f.busy, f.idle, f.xip_stall, f.bus_bytes), (31447325, [31447325, 26591316], [0, 4856009], 29104, 2176));
+                assert_eq!(
+                    (f.cycles, f.busy, f.idle, f.xip_stall, f.bus_bytes),
+                    (31447325, [31447325, 26591316], [0, 4856009], 29104, 2176)
+                );
                 assert_eq!(f.pixels, vec![0x00, 0xff]);
                 assert!(f.error.is_none());
             }

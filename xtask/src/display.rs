@@ -5,25 +5,29 @@
 //! viewing distance, by mean error and SSIM. Writes `docs/display.md`, a contact sheet per
 //! scene and the progressive passes of each scene.
 
-use host_sim::load::read;
-use host_sim::output::write_atomic;
-use host_sim::run::{progressive_passes, render_text};
+use crate::firmware::board_frame;
 use crate::tradeoff::reference;
 use anyhow::{Context, Result};
-use crate::firmware::board_frame;
 use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::Gray8;
 use embedded_graphics::prelude::*;
 use embedded_graphics::text::{Baseline, Text};
 use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
+use host_sim::load::read;
+use host_sim::output::write_atomic;
+use host_sim::run::{progressive_passes, render_text};
 use lattice_rt::{Dither, Frame, Fx, Tone};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// The dithers compared, with their report names.
-const DITHERS: [(&str, Dither); 4] =
-    [("bayer", Dither::Bayer), ("blue noise", Dither::BlueNoise), ("floyd-steinberg", Dither::FloydSteinberg), ("atkinson", Dither::Atkinson)];
+const DITHERS: [(&str, Dither); 4] = [
+    ("bayer", Dither::Bayer),
+    ("blue noise", Dither::BlueNoise),
+    ("floyd-steinberg", Dither::FloydSteinberg),
+    ("atkinson", Dither::Atkinson),
+];
 /// Tone curves tried (exponent in tenths).
 const GAMMAS: [u8; 5] = [6, 8, 10, 12, 15];
 /// Low-pass widths (Gaussian sigma in display pixels) the measure is taken at.
@@ -72,7 +76,11 @@ fn blur(img: &[f64], w: usize, h: usize, sigma: f64) -> Vec<f64> {
             for x in 0..w as isize {
                 let mut acc = 0.0;
                 for (i, d) in (-r..=r).enumerate() {
-                    let (sx, sy) = if horizontal { ((x + d).clamp(0, w as isize - 1), y) } else { (x, (y + d).clamp(0, h as isize - 1)) };
+                    let (sx, sy) = if horizontal {
+                        ((x + d).clamp(0, w as isize - 1), y)
+                    } else {
+                        (x, (y + d).clamp(0, h as isize - 1))
+                    };
                     acc += k[i] * src[sy as usize * w + sx as usize];
                 }
                 out[y as usize * w + x as usize] = acc / sum;
@@ -94,7 +102,8 @@ fn ssim(a: &[f64], b: &[f64], w: usize, h: usize) -> f64 {
     let mut total = 0.0;
     for i in 0..w * h {
         let (va, vb, cov) = (saa[i] - ma[i] * ma[i], sbb[i] - mb[i] * mb[i], sab[i] - ma[i] * mb[i]);
-        total += ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2)) / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2));
+        total +=
+            ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2)) / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2));
     }
     total / (w * h) as f64
 }
@@ -131,10 +140,14 @@ impl Sheet {
     fn place(&mut self, col: u32, row: u32, label: &str, w: usize, values: &[f64]) {
         let (x0, y0) = ((col * self.cell.0 + GAP) as i32, (row * self.cell.1 + GAP) as i32);
         let style = MonoTextStyle::new(&FONT_6X10, Gray8::WHITE);
-        Text::with_baseline(label, Point::new(x0, y0), style, Baseline::Top).draw(&mut self.display).expect("simulator");
+        Text::with_baseline(label, Point::new(x0, y0), style, Baseline::Top)
+            .draw(&mut self.display)
+            .expect("simulator");
         for (i, v) in values.iter().enumerate() {
             let p = Point::new(x0 + (i % w) as i32, y0 + LABEL as i32 + (i / w) as i32);
-            Pixel(p, Gray8::new((v * 255.0 / 64.0).round().clamp(0.0, 255.0) as u8)).draw(&mut self.display).expect("simulator");
+            Pixel(p, Gray8::new((v * 255.0 / 64.0).round().clamp(0.0, 255.0) as u8))
+                .draw(&mut self.display)
+                .expect("simulator");
         }
     }
     fn save(&self, path: &Path, scale: u32) -> Result<()> {
@@ -175,7 +188,8 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path, board: &Path) 
             }
         }
     }
-    let names: Vec<String> = scenes.iter().map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()).collect();
+    let names: Vec<String> =
+        scenes.iter().map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default()).collect();
     let (scores, frames, references) = score_looks(scenes, &looks)?;
     let n = scenes.len();
     let mut order: Vec<usize> = (0..looks.len()).collect();
@@ -185,7 +199,10 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path, board: &Path) 
     let sheet_links = contact_sheets(&names, &looks, &scores, &frames, &references, best, images)?;
     let (prog_rows, strip_file) = progressive_rows(scenes, &names, &references, best, images)?;
     let mut md = report(out, &names, &looks, &scores, &order, &sheet_links, &prog_rows, &strip_file)?;
-    let still = looks.iter().position(|l| DITHERS[l.dither].1 == board_frame::STILL_DITHER && l.outline && l.gamma == 10).context("the board's look is in the grid")?;
+    let still = looks
+        .iter()
+        .position(|l| DITHERS[l.dither].1 == board_frame::STILL_DITHER && l.outline && l.gamma == 10)
+        .context("the board's look is in the grid")?;
     md.push_str(&panel_section(&names, board, &references, &frames, still)?);
     write_atomic(out, md.as_bytes())?;
     println!("wrote {} (best: {}), contact sheets and passes in {}", out.display(), best.label(), images.display());
@@ -198,7 +215,13 @@ const PANEL: (u16, u16) = (128, 64);
 /// The frames of the emulated Pico's panel (`board/<scene>.pbm`, from `cargo xtask board`)
 /// scored like the looks above, beside the host's frame of the board's look (`still`): the
 /// section of docs/display.md, or a line saying they are missing.
-fn panel_section(names: &[String], board: &Path, references: &[Vec<f64>], frames: &[Vec<Vec<u8>>], still: usize) -> Result<String> {
+fn panel_section(
+    names: &[String],
+    board: &Path,
+    references: &[Vec<f64>],
+    frames: &[Vec<Vec<u8>>],
+    still: usize,
+) -> Result<String> {
     let (wu, hu) = (PANEL.0 as usize, PANEL.1 as usize);
     let mut md = String::from("\n## The Pico's panel\n\n");
     let mut rows = Vec::new();
@@ -209,7 +232,9 @@ fn panel_section(names: &[String], board: &Path, references: &[Vec<f64>], frames
             return Ok(md);
         };
         // A PBM's 1 is black: lit pixels are its 0 bits (128 pixels a row: no padding).
-        let raster = bytes.get(bytes.len().saturating_sub(lattice_rt::BitFrame::bytes(PANEL.0 as u32, PANEL.1 as u32))..).context("short PBM")?;
+        let raster = bytes
+            .get(bytes.len().saturating_sub(lattice_rt::BitFrame::bytes(PANEL.0 as u32, PANEL.1 as u32))..)
+            .context("short PBM")?;
         let bits: Vec<u8> = raster.iter().map(|b| !b).collect();
         let score = |b: &[u8]| SIGMAS.map(|s| measure(b, &references[i], wu, hu, s).1);
         rows.push((name, score(&bits), score(&frames[i][still]), bits == frames[i][still]));
@@ -220,7 +245,14 @@ fn panel_section(names: &[String], board: &Path, references: &[Vec<f64>], frames
     let n = rows.len().max(1) as f64;
     let mut sums = [0.0; 3];
     for (name, panel, host, same) in &rows {
-        writeln!(md, "| {name} | {:.3} | {:.3} | {:.3} | {} |", panel[0], panel[1], host[0], if *same { "yes" } else { "**no**" })?;
+        writeln!(
+            md,
+            "| {name} | {:.3} | {:.3} | {:.3} | {} |",
+            panel[0],
+            panel[1],
+            host[0],
+            if *same { "yes" } else { "**no**" }
+        )?;
         sums = [sums[0] + panel[0], sums[1] + panel[1], sums[2] + host[0]];
     }
     writeln!(md, "| mean | {:.3} | {:.3} | {:.3} | |", sums[0] / n, sums[1] / n, sums[2] / n)?;
@@ -268,7 +300,15 @@ fn score_looks(scenes: &[PathBuf], looks: &[Look]) -> Result<(Vec<Score>, Vec<Ve
 
 /// Contact sheets: rows are dithers, columns without and with the outline, at gamma 1.0 and
 /// at the best look's gamma; the reference gray first. The scene names and sheet files.
-fn contact_sheets(names: &[String], looks: &[Look], scores: &[Score], frames: &[Vec<Vec<u8>>], references: &[Vec<f64>], best: Look, images: &Path) -> Result<Vec<(String, PathBuf)>> {
+fn contact_sheets(
+    names: &[String],
+    looks: &[Look],
+    scores: &[Score],
+    frames: &[Vec<Vec<u8>>],
+    references: &[Vec<f64>],
+    best: Look,
+    images: &Path,
+) -> Result<Vec<(String, PathBuf)>> {
     let (w, h) = PANEL;
     let (wu, hu) = (w as usize, h as usize);
     let mut sheet_links = Vec::new();
@@ -280,7 +320,10 @@ fn contact_sheets(names: &[String], looks: &[Look], scores: &[Score], frames: &[
         for d in 0..DITHERS.len() {
             for (gi, &g) in gammas.iter().enumerate() {
                 for (oi, o) in [false, true].into_iter().enumerate() {
-                    let i = looks.iter().position(|l| l.dither == d && l.outline == o && l.gamma == g).expect("in the grid");
+                    let i = looks
+                        .iter()
+                        .position(|l| l.dither == d && l.outline == o && l.gamma == g)
+                        .expect("in the grid");
                     let short = ["bayer", "blue noise", "f-s", "atkinson"][d];
                     let gamma = if g == 10 { String::new() } else { format!(" g{:.1}", g as f64 / 10.0) };
                     let label = format!("{short}{}{gamma} {:.2}", if o { "+line" } else { "" }, scores[i].per_scene[s]);
@@ -298,7 +341,13 @@ fn contact_sheets(names: &[String], looks: &[Look], scores: &[Score], frames: &[
 
 /// Progressive passes with the best look (error diffusion cannot be split between cores, but
 /// progressive passes do not need that): the report's rows and the strip of passes.
-fn progressive_rows(scenes: &[PathBuf], names: &[String], references: &[Vec<f64>], best: Look, images: &Path) -> Result<(Vec<String>, PathBuf)> {
+fn progressive_rows(
+    scenes: &[PathBuf],
+    names: &[String],
+    references: &[Vec<f64>],
+    best: Look,
+    images: &Path,
+) -> Result<(Vec<String>, PathBuf)> {
     let (w, h) = PANEL;
     let (wu, hu) = (w as usize, h as usize);
     let n = scenes.len();
@@ -340,11 +389,22 @@ fn progressive_rows(scenes: &[PathBuf], names: &[String], references: &[Vec<f64>
 
 /// docs/display.md.
 #[allow(clippy::too_many_arguments)]
-fn report(out: &Path, names: &[String], looks: &[Look], scores: &[Score], order: &[usize], sheet_links: &[(String, PathBuf)], prog_rows: &[String], strip_file: &Path) -> Result<String> {
+fn report(
+    out: &Path,
+    names: &[String],
+    looks: &[Look],
+    scores: &[Score],
+    order: &[usize],
+    sheet_links: &[(String, PathBuf)],
+    prog_rows: &[String],
+    strip_file: &Path,
+) -> Result<String> {
     let (w, h) = PANEL;
     let n = names.len();
     let best = looks[order[0]];
-    let linear = |d: usize, o: bool| looks.iter().position(|l| l.dither == d && l.outline == o && l.gamma == 10).expect("in the grid");
+    let linear = |d: usize, o: bool| {
+        looks.iter().position(|l| l.dither == d && l.outline == o && l.gamma == 10).expect("in the grid")
+    };
     let mut md = String::new();
     writeln!(md, "# What the display shows\n")?;
     writeln!(

@@ -2,10 +2,10 @@
 //! time, Cortex-M instructions and flash, and what the contribution cutoff (Hall and
 //! Greenberg's adaptive tree depth) saves and costs. Writes `docs/effects.md`.
 
-use host_sim::shared::median;
-use host_sim::run::render_text;
-use host_sim::load::{object_storage, parse_scene, read};
 use anyhow::{Context, Result};
+use host_sim::load::{object_storage, parse_scene, read};
+use host_sim::run::render_text;
+use host_sim::shared::median;
 use lattice_rt::{Effects, Frame, Stats};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -27,7 +27,6 @@ fn shoot(path: &Path, text: &str, all: bool, cutoff: f64) -> Result<Shot> {
     })?;
     Ok(Shot { bits: r.bits, stats: r.stats, time: r.elapsed })
 }
-
 
 fn differ(a: &[u8], b: &[u8]) -> u32 {
     a.iter().zip(b).map(|(x, y)| (x ^ y).count_ones()).sum()
@@ -66,7 +65,9 @@ pub fn effects_cmd(scenes: &[PathBuf], runs: usize, out: &Path, firmware_csv: &P
         }
         let (d, a) = (d.expect("ran"), a.expect("ran"));
         let (md_, ma) = (median(td), median(ta));
-        let ins = |v: &str| fw.get(&(v.to_string(), name.clone())).map_or("-".to_string(), |x| format!("{:.1}", x.0 as f64 / 1e6));
+        let ins = |v: &str| {
+            fw.get(&(v.to_string(), name.clone())).map_or("-".to_string(), |x| format!("{:.1}", x.0 as f64 / 1e6))
+        };
         writeln!(
             md,
             "| {name} | {fx} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {} | {} |",
@@ -118,7 +119,12 @@ fn cutoff_section(md: &mut String, cut_rows: &[CutRow]) -> Result<()> {
     for (name, base, cuts) in cut_rows {
         let mut row = format!("| {name} | {base} |");
         for (_, rays, px) in cuts {
-            write!(row, " {rays} | {:.1} % | {px} ({:.2} %) |", 100.0 * (1.0 - *rays as f64 / *base as f64), 100.0 * *px as f64 / npx)?;
+            write!(
+                row,
+                " {rays} | {:.1} % | {px} ({:.2} %) |",
+                100.0 * (1.0 - *rays as f64 / *base as f64),
+                100.0 * *px as f64 / npx
+            )?;
         }
         writeln!(md, "{row}")?;
     }
@@ -135,7 +141,12 @@ fn flash_section(md: &mut String, fw: &BTreeMap<(String, String), (u64, u64)>) -
     ] {
         let flash = |v: &str| fw.iter().find(|((var, _), _)| var == v).map(|(_, x)| x.1);
         match (flash(derived), flash(all)) {
-            (Some(d), Some(a)) => writeln!(md, "| {label} | {fx} | {d} | {a} | {} bytes ({:.1} %) |", a as i64 - d as i64, 100.0 * (1.0 - d as f64 / a as f64))?,
+            (Some(d), Some(a)) => writeln!(
+                md,
+                "| {label} | {fx} | {d} | {a} | {} bytes ({:.1} %) |",
+                a as i64 - d as i64,
+                100.0 * (1.0 - d as f64 / a as f64)
+            )?,
             _ => writeln!(md, "| {label} | {fx} | - | - | (run `cargo xtask firmware` first) |")?,
         }
     }

@@ -2,17 +2,16 @@
 //! `-icount shift=0`, checks every frame bit for bit against the same render on the host,
 //! measures flash, RAM and instructions per frame, and writes `docs/firmware.md`.
 
-use host_sim::run::render_text;
-use host_sim::load::read;
-use host_sim::uf2::Scenes;
 use anyhow::{bail, Context, Result};
+use host_sim::load::read;
+use host_sim::run::render_text;
+use host_sim::uf2::Scenes;
 use object::{Object, ObjectSection, SectionFlags};
 use std::fmt::Write as _;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
 
 /// One firmware build.
 pub(crate) struct Variant {
@@ -40,16 +39,32 @@ const M33_BAKED: &str = "qemu-m33-f32-baked";
 const M33_PANEL: &str = "qemu-m33-f32-panel";
 
 /// The firmware scalars: (name in reports, cargo feature).
-pub const SCALARS: [(&str, &str); 4] =
-    [("f32", ""), ("fixed", "scalar-fixed"), ("f32-micromath", "scalar-micromath"), ("f32-micromath-newton", "scalar-micromath-newton")];
+pub const SCALARS: [(&str, &str); 4] = [
+    ("f32", ""),
+    ("fixed", "scalar-fixed"),
+    ("f32-micromath", "scalar-micromath"),
+    ("f32-micromath-newton", "scalar-micromath-newton"),
+];
 
 fn variants() -> Vec<Variant> {
     let mut v = Vec::new();
     for (board, target, machine, core, scalars) in [
-        ("m0", "thumbv6m-none-eabi", "mps2-an385", "Cortex-M0+ (thumbv6m, run on QEMU's Cortex-M3 board)", &SCALARS[..]),
+        (
+            "m0",
+            "thumbv6m-none-eabi",
+            "mps2-an385",
+            "Cortex-M0+ (thumbv6m, run on QEMU's Cortex-M3 board)",
+            &SCALARS[..],
+        ),
         ("m4f", "thumbv7em-none-eabihf", "mps2-an386", "Cortex-M4F (thumbv7em-none-eabihf)", &SCALARS[..]),
         // The Pico 2's core, in the Pico 2's scalar.
-        ("m33", "thumbv8m.main-none-eabihf", "mps2-an505", "Cortex-M33 (thumbv8m.main-none-eabihf, the Pico 2's core)", &SCALARS[..1]),
+        (
+            "m33",
+            "thumbv8m.main-none-eabihf",
+            "mps2-an505",
+            "Cortex-M33 (thumbv8m.main-none-eabihf, the Pico 2's core)",
+            &SCALARS[..1],
+        ),
     ] {
         for &(scalar, feature) in scalars {
             v.push(Variant {
@@ -151,14 +166,62 @@ fn variants() -> Vec<Variant> {
     // Then baked scenes: each scene and its lattice as tables in flash; nothing parsed or built.
     let matte = Some("chair,desk,polyhedron");
     for (name, machine, scenes, features, what) in [
-        ("qemu-m0-fixed-allfx", "mps2-an385", None, "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, all five scenes, every effect compiled in and on"),
-        ("qemu-m0-fixed-matte", "mps2-an385", matte, "qemu,scalar-fixed", "Cortex-M0+, fixed, the matte paper scenes, their effects only (shadows, composites)"),
-        ("qemu-m0-fixed-matte-allfx", "mps2-an385", matte, "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, the matte paper scenes, every effect compiled in"),
-        ("qemu-m0-fixed-baked", "mps2-an385", None, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, all five scenes baked into flash (no parser, set-up or lattice build linked)"),
-        ("qemu-m0-fixed-baked-allfx", "mps2-an385", None, "qemu,scalar-fixed,baked,effects-all", "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on"),
-        ("qemu-m0-fixed-baked-chair", "mps2-an385", Some("chair"), "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, only the chair, baked"),
-        ("qemu-m0-fixed-baked-matte", "mps2-an385", matte, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only (shadows, composites)"),
-        ("microbit-m0-fixed-baked", "microbit", None, "microbit,scalar-fixed,baked", "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, QEMU's microbit machine), fixed, all five scenes baked"),
+        (
+            "qemu-m0-fixed-allfx",
+            "mps2-an385",
+            None,
+            "qemu,scalar-fixed,effects-all",
+            "Cortex-M0+, fixed, all five scenes, every effect compiled in and on",
+        ),
+        (
+            "qemu-m0-fixed-matte",
+            "mps2-an385",
+            matte,
+            "qemu,scalar-fixed",
+            "Cortex-M0+, fixed, the matte paper scenes, their effects only (shadows, composites)",
+        ),
+        (
+            "qemu-m0-fixed-matte-allfx",
+            "mps2-an385",
+            matte,
+            "qemu,scalar-fixed,effects-all",
+            "Cortex-M0+, fixed, the matte paper scenes, every effect compiled in",
+        ),
+        (
+            "qemu-m0-fixed-baked",
+            "mps2-an385",
+            None,
+            "qemu,scalar-fixed,baked",
+            "Cortex-M0+, fixed, all five scenes baked into flash (no parser, set-up or lattice build linked)",
+        ),
+        (
+            "qemu-m0-fixed-baked-allfx",
+            "mps2-an385",
+            None,
+            "qemu,scalar-fixed,baked,effects-all",
+            "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on",
+        ),
+        (
+            "qemu-m0-fixed-baked-chair",
+            "mps2-an385",
+            Some("chair"),
+            "qemu,scalar-fixed,baked",
+            "Cortex-M0+, fixed, only the chair, baked",
+        ),
+        (
+            "qemu-m0-fixed-baked-matte",
+            "mps2-an385",
+            matte,
+            "qemu,scalar-fixed,baked",
+            "Cortex-M0+, fixed, the matte paper scenes baked, their effects only (shadows, composites)",
+        ),
+        (
+            "microbit-m0-fixed-baked",
+            "microbit",
+            None,
+            "microbit,scalar-fixed,baked",
+            "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, QEMU's microbit machine), fixed, all five scenes baked",
+        ),
     ] {
         v.push(Variant {
             name: name.into(),
@@ -256,7 +319,19 @@ pub(crate) fn elf_path(root: &Path, v: &Variant) -> PathBuf {
 
 /// The cargo arguments that build variant `v`.
 fn cargo_args(v: &Variant) -> Vec<&str> {
-    let mut args = vec!["build", "--manifest-path", "firmware/Cargo.toml", "--profile", v.profile, "--features", &v.features, "--bin", v.bin, "--target", v.target];
+    let mut args = vec![
+        "build",
+        "--manifest-path",
+        "firmware/Cargo.toml",
+        "--profile",
+        v.profile,
+        "--features",
+        &v.features,
+        "--bin",
+        v.bin,
+        "--target",
+        v.target,
+    ];
     if v.tiny {
         args.push("--no-default-features");
     }
@@ -267,7 +342,8 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
     let args = cargo_args(v);
     let built = Path::new(v.target).join(v.profile).join(v.bin);
     let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);
-    host_sim::uf2::build_image(root, &v.name, &args, scenes, &built).with_context(|| format!("building firmware variant {} failed", v.name))?;
+    host_sim::uf2::build_image(root, &v.name, &args, scenes, &built)
+        .with_context(|| format!("building firmware variant {} failed", v.name))?;
     Ok(())
 }
 
@@ -427,7 +503,8 @@ fn flash_parts(elf: &Path) -> Result<Vec<(&'static str, u64)>> {
     use object::{Object as _, ObjectSection as _, ObjectSymbol as _, SectionKind};
     let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file = object::File::parse(&*data)?;
-    let rodata: u64 = file.sections().filter(|s| s.name().is_ok_and(|n| n.starts_with(".rodata"))).map(|s| s.size()).sum();
+    let rodata: u64 =
+        file.sections().filter(|s| s.name().is_ok_and(|n| n.starts_with(".rodata"))).map(|s| s.size()).sum();
     let (flash, _) = elf_sizes(elf)?;
     let mut parts: Vec<(&'static str, u64)> = vec![
         ("tracer and renderer (`lattice_rt`)", 0),
@@ -469,7 +546,9 @@ fn baked_static_bytes(elf: &Path) -> Result<u64> {
     let file = object::File::parse(&*data)?;
     Ok(file
         .symbols()
-        .filter(|s| format!("{:#}", rustc_demangle::demangle(s.name().unwrap_or(""))).starts_with("firmware::app::baked::"))
+        .filter(|s| {
+            format!("{:#}", rustc_demangle::demangle(s.name().unwrap_or(""))).starts_with("firmware::app::baked::")
+        })
         .map(|s| s.size())
         .sum())
 }
@@ -490,12 +569,21 @@ fn tiny_refuses_spheres(root: &Path, v: &Variant) -> Result<Option<String>> {
         .output()
         .context("cannot run cargo")?;
     let text = String::from_utf8_lossy(&out.stderr);
-    let why = text.lines().find_map(|l| Some(l.split_once("spheres.scene: ")?.1.trim().to_string())).filter(|w| w.contains("which this build leaves out"));
+    let why = text
+        .lines()
+        .find_map(|l| Some(l.split_once("spheres.scene: ")?.1.trim().to_string()))
+        .filter(|w| w.contains("which this build leaves out"));
     Ok(why.filter(|_| !out.status.success()))
 }
 
 /// The `tiny` build against its targets: the chair in 16 KiB of flash and 4 KiB of RAM.
-fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identical: &std::collections::BTreeMap<(String, String), bool>, tally: &mut Tally) -> Result<()> {
+fn tiny_section(
+    md: &mut String,
+    root: &Path,
+    runs: &[(&Variant, Run)],
+    identical: &std::collections::BTreeMap<(String, String), bool>,
+    tally: &mut Tally,
+) -> Result<()> {
     let Some((v, r)) = runs.iter().find(|(v, _)| v.name == TINY) else { return Ok(()) };
     let flash = elf_sizes(&elf_path(root, v))?.0;
     let ram = r.statics + r.stack;
@@ -516,19 +604,39 @@ fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identica
         eprintln!("FAIL {TINY}: {ram} B of RAM in a 4096 B memory map, or no frame");
     }
     writeln!(md, "\n## The tiny build\n")?;
-    writeln!(md, "`{TINY}` (the `tiny` and `compact` features, `small` profile): the chair alone in the memory of the smallest")?;
-    writeln!(md, "Cortex-M0 parts, `firmware/tiny/memory.x`: 16 KiB of flash and 4 KiB of RAM, enforced by the linker,")?;
-    writeln!(md, "with flip-link placing the stack below the statics so that an overflow faults. It is built without the")?;
-    writeln!(md, "firmware's default features, `spheres` and `cones`: the chair has boxes and cylinders only, and the")?;
-    writeln!(md, "other shapes' intersection code is left out (built with the spheres scene, it {}).", match &refuses {
-        Some(why) => format!("is refused: *{why}*"),
-        None => "**is not refused**".into(),
-    })?;
+    writeln!(
+        md,
+        "`{TINY}` (the `tiny` and `compact` features, `small` profile): the chair alone in the memory of the smallest"
+    )?;
+    writeln!(
+        md,
+        "Cortex-M0 parts, `firmware/tiny/memory.x`: 16 KiB of flash and 4 KiB of RAM, enforced by the linker,"
+    )?;
+    writeln!(
+        md,
+        "with flip-link placing the stack below the statics so that an overflow faults. It is built without the"
+    )?;
+    writeln!(
+        md,
+        "firmware's default features, `spheres` and `cones`: the chair has boxes and cylinders only, and the"
+    )?;
+    writeln!(
+        md,
+        "other shapes' intersection code is left out (built with the spheres scene, it {}).",
+        match &refuses {
+            Some(why) => format!("is refused: *{why}*"),
+            None => "**is not refused**".into(),
+        }
+    )?;
     writeln!(md, "The harness logs through a few bytes of its own (`Line` in `firmware/src/bin/qemu.rs`), and the")?;
     writeln!(md, "render path's index checks panic without formatting their numbers (`lattice_rt::bounds`), so no")?;
     writeln!(md, "`core::fmt` code is linked.\n")?;
     writeln!(md, "| target | measured | limit | met |\n|---|---:|---:|---|")?;
-    writeln!(md, "| RAM (static + stack high-water, in the 4 KiB map) | {ram} B | 4096 B | {} |", if ram <= 4 << 10 { "yes" } else { "**no**" })?;
+    writeln!(
+        md,
+        "| RAM (static + stack high-water, in the 4 KiB map) | {ram} B | 4096 B | {} |",
+        if ram <= 4 << 10 { "yes" } else { "**no**" }
+    )?;
     // The image was linked in that memory map: the flash row can only say yes.
     writeln!(md, "| flash | {flash} B | 16384 B | {} |", if flash <= 16 << 10 { "yes" } else { "**no**" })?;
     writeln!(
@@ -543,19 +651,29 @@ fn tiny_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identica
 /// The baked builds against the memory targets (issue: flash at most 48 KiB with all five scenes
 /// and every effect, 32 KiB for the matte paper scenes with their effects, which must be at least
 /// 25 % smaller than the all-effects build; RAM at most 4 KiB for the chair, 6 KiB for all five).
-fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identical: &std::collections::BTreeMap<(String, String), bool>) -> Result<()> {
+fn baked_section(
+    md: &mut String,
+    root: &Path,
+    runs: &[(&Variant, Run)],
+    identical: &std::collections::BTreeMap<(String, String), bool>,
+) -> Result<()> {
     let run = |name: &str| runs.iter().find(|(v, _)| v.name == name);
     let flash = |name: &str| run(name).and_then(|(v, _)| elf_sizes(&elf_path(root, v)).ok()).map(|f| f.0);
     let ram = |name: &str| run(name).map(|(_, r)| r.statics + r.stack);
-    let (Some(all), Some(allfx), Some(chair), Some(matte)) =
-        (flash("qemu-m0-fixed-baked"), flash("qemu-m0-fixed-baked-allfx"), flash("qemu-m0-fixed-baked-chair"), flash("qemu-m0-fixed-baked-matte"))
-    else {
+    let (Some(all), Some(allfx), Some(chair), Some(matte)) = (
+        flash("qemu-m0-fixed-baked"),
+        flash("qemu-m0-fixed-baked-allfx"),
+        flash("qemu-m0-fixed-baked-chair"),
+        flash("qemu-m0-fixed-baked-matte"),
+    ) else {
         return Ok(());
     };
     writeln!(md, "\n## Baked scenes\n\nWith the `baked` feature `firmware/build.rs` parses each embedded scene and builds its lattice on\nthe host, in the firmware's scalar, and writes both as static tables (`lattice_rt::bake`); the\nfirmware links no parser, no scene set-up (f64 maths) and no lattice build, and keeps neither\nobjects nor lattice in RAM. Every frame is checked bit for bit against host-sim like the others.\n")?;
     writeln!(md, "The flash targets are measured on the images built for size (`small` profile: opt-level \"z\", the\nchoice for a part with little flash, and the firmware's `compact` feature: memcpy and memset as\nloops of a few dozen bytes instead of compiler-builtins') and, beside them, on the release profile's (opt-level \"s\",\nwhat the other rows of this report run); the instructions each costs are in the table above\n(`m0-fixed-baked` against `m0-fixed-baked-small`).\n")?;
     writeln!(md, "| target | build | measured | limit | met |\n|---|---|---:|---:|---|")?;
-    let mut row = |what: &str, build: &str, got: u64, limit: u64| writeln!(md, "| {what} | `{build}` | {got} B | {limit} B | {} |", if got <= limit { "yes" } else { "**no**" });
+    let mut row = |what: &str, build: &str, got: u64, limit: u64| {
+        writeln!(md, "| {what} | `{build}` | {got} B | {limit} B | {} |", if got <= limit { "yes" } else { "**no**" })
+    };
     for (what, build, limit) in [
         ("flash, all five scenes, every effect", "qemu-m0-fixed-baked-allfx-small", 48 << 10),
         ("flash, all five scenes, every effect", "qemu-m0-fixed-baked-allfx", 48 << 10),
@@ -569,7 +687,9 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
     row("RAM, the chair", "qemu-m0-fixed-baked-chair", ram("qemu-m0-fixed-baked-chair").unwrap_or(0), 4 << 10)?;
     row("RAM, all five scenes", "qemu-m0-fixed-baked", ram("qemu-m0-fixed-baked").unwrap_or(0), 6 << 10)?;
     let smaller = 1.0 - matte as f64 / allfx as f64;
-    let small = flash("qemu-m0-fixed-baked-matte-small").zip(flash("qemu-m0-fixed-baked-allfx-small")).map(|(m, a)| 1.0 - m as f64 / a as f64);
+    let small = flash("qemu-m0-fixed-baked-matte-small")
+        .zip(flash("qemu-m0-fixed-baked-allfx-small"))
+        .map(|(m, a)| 1.0 - m as f64 / a as f64);
     writeln!(
         md,
         "\nThe matte build is {:.1} % smaller than the all-effects build{} (target: at least 25 %); all five scenes\nwith their own effects take {all} B{}, the chair alone {chair} B.",
@@ -596,7 +716,8 @@ fn baked_section(md: &mut String, root: &Path, runs: &[(&Variant, Run)], identic
         for s in &r.scenes {
             let text = host_sim::load::read(&root.join("scenes").join(format!("{}.scene", s.name)))?;
             let mut storage = host_sim::load::object_storage::<lattice_rt::Fx>(&text)?;
-            let scene = lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage.objects, &mut storage.parts).map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?;
+            let scene = lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage.objects, &mut storage.parts)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?;
             objects += scene.objects().len();
             lists += size_of_val(scene.composites()) + size_of_val(scene.materials()) + size_of_val(scene.lights());
         }
@@ -666,7 +787,12 @@ struct Tally {
 
 /// Builds (unless `skip_build`) every variant, runs those with a machine in QEMU, and writes
 /// the builds table (flash and RAM) to `md`.
-fn build_and_run<'v>(root: &Path, variants: &'v [Variant], skip_build: bool, md: &mut String) -> Result<Vec<(&'v Variant, Run)>> {
+fn build_and_run<'v>(
+    root: &Path,
+    variants: &'v [Variant],
+    skip_build: bool,
+    md: &mut String,
+) -> Result<Vec<(&'v Variant, Run)>> {
     writeln!(md, "## Builds\n\n| variant | what | flash bytes | static RAM | stack high-water | RAM total |\n|---|---|---|---|---|---|")?;
     let mut runs = Vec::new();
     let bar = host_sim::progress::bar(variants.len(), "firmware variants");
@@ -687,8 +813,18 @@ fn build_and_run<'v>(root: &Path, variants: &'v [Variant], skip_build: bool, md:
             None => None,
         };
         match &run {
-            Some(r) => writeln!(md, "| {} | {} | {flash} | {} | {} | {} |", v.name, v.what, r.statics, r.stack, r.statics + r.stack)?,
-            None if v.name == "pico" => writeln!(md, "| {} | {} | {flash} | (docs/board.md) | (docs/board.md) | |", v.name, v.what)?,
+            Some(r) => writeln!(
+                md,
+                "| {} | {} | {flash} | {} | {} | {} |",
+                v.name,
+                v.what,
+                r.statics,
+                r.stack,
+                r.statics + r.stack
+            )?,
+            None if v.name == "pico" => {
+                writeln!(md, "| {} | {} | {flash} | (docs/board.md) | (docs/board.md) | |", v.name, v.what)?
+            }
             None => writeln!(md, "| {} | {} | {flash} | (not run) | (not run) | |", v.name, v.what)?,
         }
         if let Some(r) = run {
@@ -700,7 +836,11 @@ fn build_and_run<'v>(root: &Path, variants: &'v [Variant], skip_build: bool, md:
 }
 
 /// Every frame against the host's render in the same scalar, bit for bit: which were identical.
-fn check_frames(root: &Path, runs: &[(&Variant, Run)], tally: &mut Tally) -> Result<std::collections::BTreeMap<(String, String), bool>> {
+fn check_frames(
+    root: &Path,
+    runs: &[(&Variant, Run)],
+    tally: &mut Tally,
+) -> Result<std::collections::BTreeMap<(String, String), bool>> {
     let scenes_dir = root.join("scenes");
     let mut identical = std::collections::BTreeMap::new();
     for (v, r) in runs {
@@ -753,7 +893,10 @@ impl Table<'_> {
     /// The instructions table (one column per full-scene variant) into `md`; the CSV of every run.
     fn instructions(&self, variants: &[Variant], md: &mut String) -> Result<String> {
         writeln!(md, "## Instructions per frame (QEMU, `-icount shift=0`)\n\nSysTick ticks x instructions per tick (1 ns per instruction; the firmware times a loop of known\nlength: 40 on the an385/an386's 25 MHz SysTick, 50 on the an505's 20 MHz): deterministic, the same on\nany machine. Every frame below was checked bit for bit against host-sim in the same scalar.\n")?;
-        let cols: Vec<&Variant> = variants.iter().filter(|v| v.machine.is_some() && v.scenes.is_none() && !v.features.contains("effects-all")).collect();
+        let cols: Vec<&Variant> = variants
+            .iter()
+            .filter(|v| v.machine.is_some() && v.scenes.is_none() && !v.features.contains("effects-all"))
+            .collect();
         let header: String = cols.iter().map(|v| format!(" {} |", v.name.trim_start_matches("qemu-"))).collect();
         writeln!(md, "| scene | rays |{header}\n|---|---|{}", "---|".repeat(cols.len()))?;
         let mut csv = String::from("scene,scalar,board,instructions,rays,variant,flash\n");
@@ -764,13 +907,23 @@ impl Table<'_> {
                 if let Some(s) = r.scenes.iter().find(|s| &s.name == scene) {
                     let board = v.name.trim_start_matches("qemu-").split('-').next().unwrap_or("");
                     let flash = elf_sizes(&elf_path(self.root, v)).map(|f| f.0).unwrap_or(0);
-                    csv.push_str(&format!("{scene},{},{board},{},{},{},{flash}\n", v.scalar, s.ticks * r.per_tick, s.rays, v.name));
+                    csv.push_str(&format!(
+                        "{scene},{},{board},{},{},{},{flash}\n",
+                        v.scalar,
+                        s.ticks * r.per_tick,
+                        s.rays,
+                        v.name
+                    ));
                 }
             }
             for v in &cols {
                 match self.instructions_of(&v.name, scene) {
                     Some(ins) => {
-                        let ok = if self.identical.get(&(v.name.clone(), scene.clone())) == Some(&true) { "" } else { " (frame differs!)" };
+                        let ok = if self.identical.get(&(v.name.clone(), scene.clone())) == Some(&true) {
+                            ""
+                        } else {
+                            " (frame differs!)"
+                        };
                         row.push_str(&format!(" {:.1} M{ok} |", ins as f64 / 1e6));
                     }
                     None => row.push_str(" - |"),
@@ -797,7 +950,10 @@ impl Table<'_> {
             writeln!(md, "\nOn the M0 build, f32 soft-float needs {r:.2}x the instructions of fixed point over all scenes (target: 3x).")?;
         }
         if let Some(r) = self.ratio("qemu-m0-f32", "qemu-m4f-f32") {
-            writeln!(md, "The M0 build needs {r:.2}x the instructions of the M4F build in f32 (no FPU against an FPU).")?;
+            writeln!(
+                md,
+                "The M0 build needs {r:.2}x the instructions of the M4F build in f32 (no FPU against an FPU)."
+            )?;
         }
         if let Some(r) = self.ratio("qemu-m33-f32", "qemu-m4f-f32") {
             writeln!(md, "The M33 build (the Pico 2's core, built with the `speed` profile: opt-level 3) needs {r:.2}x the instructions of the M4F build (opt-level \"s\") in f32.")?;
@@ -806,7 +962,13 @@ impl Table<'_> {
             let each: Vec<String> = self
                 .names()
                 .iter()
-                .filter_map(|scene| Some(format!("{scene} {:.3}x", self.instructions_of("qemu-m0-fixed-progressive", scene)? as f64 / self.instructions_of("qemu-m0-fixed", scene)?.max(1) as f64)))
+                .filter_map(|scene| {
+                    Some(format!(
+                        "{scene} {:.3}x",
+                        self.instructions_of("qemu-m0-fixed-progressive", scene)? as f64
+                            / self.instructions_of("qemu-m0-fixed", scene)?.max(1) as f64
+                    ))
+                })
                 .collect();
             writeln!(md, "A progressive frame (four passes, the display updated after each) needs {r:.3}x the instructions of the plain frame over all scenes ({}; target: at most 1.05x).", each.join(", "))?;
         }
@@ -819,16 +981,35 @@ impl Table<'_> {
         if self.find(m33, "chair").is_none() || self.find(baked, "chair").is_none() {
             return Ok(());
         }
-        writeln!(md, "\n### The Pico 2's core (`{panel}`, `{baked}` and `{m33}`: the Pico 2's code on QEMU's mps2-an505)\n")?;
-        writeln!(md, "Targets: the whole frame on one core, in instructions; on both cores each takes about half, so 5 M")?;
-        writeln!(md, "on one core is 2.5 M per core, 60 frames per second at 150 MHz. `{panel}` renders the frame the")?;
-        writeln!(md, "Pico 2 image renders (the panels': 16x16 tiles, two-level sampling, Floyd-Steinberg, lines; the")?;
-        writeln!(md, "`panel-frame` feature); the others the QEMU boards' frame (8x8 tiles, one level, blue noise).\n")?;
+        writeln!(
+            md,
+            "\n### The Pico 2's core (`{panel}`, `{baked}` and `{m33}`: the Pico 2's code on QEMU's mps2-an505)\n"
+        )?;
+        writeln!(
+            md,
+            "Targets: the whole frame on one core, in instructions; on both cores each takes about half, so 5 M"
+        )?;
+        writeln!(
+            md,
+            "on one core is 2.5 M per core, 60 frames per second at 150 MHz. `{panel}` renders the frame the"
+        )?;
+        writeln!(
+            md,
+            "Pico 2 image renders (the panels': 16x16 tiles, two-level sampling, Floyd-Steinberg, lines; the"
+        )?;
+        writeln!(
+            md,
+            "`panel-frame` feature); the others the QEMU boards' frame (8x8 tiles, one level, blue noise).\n"
+        )?;
         writeln!(md, "| scene | the Pico 2's frame, baked | whole frame, baked (the Pico 2 image's scenes) | tiles alone, baked | whole frame, parsed | target (whole frame) | met (the Pico 2's frame) | frames per second at 150 MHz, one core, one instruction per cycle (the Pico 2's frame) |\n|---|---|---|---|---|---|---|---|")?;
         let m = |n: Option<u64>| n.map_or("-".to_string(), |n| format!("{:.2} M", n as f64 / 1e6));
         for scene in &self.names() {
             let tiles = self.find(baked, scene).map(|s| s.tiles * self.per_tick(baked));
-            let (Some(all), Some(tiles), Some(parsed)) = (self.instructions_of(baked, scene), tiles, self.instructions_of(m33, scene)) else { continue };
+            let (Some(all), Some(tiles), Some(parsed)) =
+                (self.instructions_of(baked, scene), tiles, self.instructions_of(m33, scene))
+            else {
+                continue;
+            };
             let own = self.instructions_of(panel, scene);
             let target = match scene.as_str() {
                 "chair" => Some(5e6),
@@ -841,7 +1022,14 @@ impl Table<'_> {
                 (None, _) => (String::new(), ""),
             };
             let fps = own.map_or("-".to_string(), |own| format!("{:.1}", 150e6 / own.max(1) as f64));
-            writeln!(md, "| {scene} | {} | {:.2} M | {:.2} M | {:.2} M | {target} | {met} | {fps} |", m(own), all as f64 / 1e6, tiles as f64 / 1e6, parsed as f64 / 1e6)?;
+            writeln!(
+                md,
+                "| {scene} | {} | {:.2} M | {:.2} M | {:.2} M | {target} | {met} | {fps} |",
+                m(own),
+                all as f64 / 1e6,
+                tiles as f64 / 1e6,
+                parsed as f64 / 1e6
+            )?;
         }
         writeln!(md, "\nThe whole frame is what `render_scene` does per frame: parse the scene text and build the lattice\n(parsed only), trace the tiles and send them; tiles alone is the part from the first tile to the last.\n`cargo xtask profile {baked}` (or `{panel}`) lists where a frame's instructions go, per function.")?;
         Ok(())
@@ -888,15 +1076,33 @@ fn float_audit_section(root: &Path, variants: &[Variant], md: &mut String, tally
 
 /// Soft-float routines of the ARM EABI and compiler-builtins (single and double precision).
 fn is_soft_float(name: &str) -> bool {
-    const PREFIXES: [&str; 9] = ["__aeabi_f", "__aeabi_d", "__aeabi_i2f", "__aeabi_i2d", "__aeabi_ui2f", "__aeabi_ui2d", "__aeabi_l2f", "__aeabi_l2d", "__aeabi_ul2"];
-    PREFIXES.iter().any(|p| name.starts_with(p)) || matches!(name, "__addsf3" | "__mulsf3" | "__divsf3" | "__adddf3" | "__muldf3" | "__divdf3" | "sqrtf" | "sqrt")
+    const PREFIXES: [&str; 9] = [
+        "__aeabi_f",
+        "__aeabi_d",
+        "__aeabi_i2f",
+        "__aeabi_i2d",
+        "__aeabi_ui2f",
+        "__aeabi_ui2d",
+        "__aeabi_l2f",
+        "__aeabi_l2d",
+        "__aeabi_ul2",
+    ];
+    PREFIXES.iter().any(|p| name.starts_with(p))
+        || matches!(
+            name,
+            "__addsf3" | "__mulsf3" | "__divsf3" | "__adddf3" | "__muldf3" | "__divdf3" | "sqrtf" | "sqrt"
+        )
 }
 
 /// Finds `llvm-objdump` (rustup's `llvm-tools` component) or a system one.
 fn objdump() -> Option<PathBuf> {
     let sysroot = Command::new("rustc").args(["--print", "sysroot"]).output().ok()?;
     let root = PathBuf::from(String::from_utf8_lossy(&sysroot.stdout).trim());
-    let found = std::fs::read_dir(root.join("lib/rustlib")).ok()?.flatten().map(|e| e.path().join("bin/llvm-objdump")).find(|p| p.exists());
+    let found = std::fs::read_dir(root.join("lib/rustlib"))
+        .ok()?
+        .flatten()
+        .map(|e| e.path().join("bin/llvm-objdump"))
+        .find(|p| p.exists());
     found.or_else(|| Command::new("llvm-objdump").arg("--version").output().ok().map(|_| PathBuf::from("llvm-objdump")))
 }
 
@@ -913,7 +1119,11 @@ fn call_graph(elf: &Path) -> Result<std::collections::HashMap<String, std::colle
                 current = line[a + 1..b].to_string();
                 graph.entry(current.clone()).or_default();
             }
-        } else if line.contains("\tbl\t") || line.contains("\tb\t") || line.contains("\tblx\t") || line.contains("\tb.w\t") {
+        } else if line.contains("\tbl\t")
+            || line.contains("\tb\t")
+            || line.contains("\tblx\t")
+            || line.contains("\tb.w\t")
+        {
             if let (Some(a), Some(b)) = (line.find('<'), line.rfind('>')) {
                 let target = line[a + 1..b].split('+').next().unwrap_or("").to_string();
                 if target != current {
@@ -953,8 +1163,11 @@ pub fn float_audit(elf: &Path) -> Result<(Vec<String>, Vec<String>)> {
             }
         }
     }
-    let mut setup: Vec<String> =
-        graph.iter().filter(|(f, calls)| !is_soft_float(f) && calls.iter().any(|c| is_soft_float(c))).map(|(f, _)| name(f)).collect();
+    let mut setup: Vec<String> = graph
+        .iter()
+        .filter(|(f, calls)| !is_soft_float(f) && calls.iter().any(|c| is_soft_float(c)))
+        .map(|(f, _)| name(f))
+        .collect();
     setup.sort();
     setup.dedup();
     Ok((reached, setup))

@@ -228,15 +228,27 @@ fn real_main() -> Result<()> {
     let root = std::env::current_dir()?;
     match Cli::parse().command {
         Command::Board { out, frames, no_build } => board::board_cmd(&root, &out, &frames, no_build),
-        Command::Playground { out, serve, check, screenshot, no_build } => playground::playground_cmd(&root, &playground::PlaygroundArgs { out, serve, check, screenshot, no_build }),
+        Command::Playground { out, serve, check, screenshot, no_build } => {
+            playground::playground_cmd(&root, &playground::PlaygroundArgs { out, serve, check, screenshot, no_build })
+        }
         Command::Firmware { out, no_build } => firmware::firmware_cmd(&root, &out, no_build),
         Command::Bench { quick, runs, out, plot } => bench::bench_cmd(quick, runs, &out, &plot),
         Command::Versus { scenes, runs, no_povray } => bench::versus_cmd(&scenes, runs, !no_povray),
-        Command::Memory { quick, runs, out, plot, tests_plot } => memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot }),
-        Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv } => tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv),
-        Command::Effects { scenes, runs, out, firmware_csv } => effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv),
-        Command::Display { scenes, out, images, board } => display::display_cmd(&default_scenes(scenes), &out, &images, &board),
-        Command::Profile { variant, scene, top, under } => profile::profile_cmd(&root, &profile::ProfileArgs { variant, scene, top, under }),
+        Command::Memory { quick, runs, out, plot, tests_plot } => {
+            memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot })
+        }
+        Command::Tradeoff { scenes, size, runs, out, plot, firmware_csv } => {
+            tradeoff::tradeoff_cmd(&default_scenes(scenes), size, runs, &out, &plot, &firmware_csv)
+        }
+        Command::Effects { scenes, runs, out, firmware_csv } => {
+            effects::effects_cmd(&default_scenes(scenes), runs, &out, &firmware_csv)
+        }
+        Command::Display { scenes, out, images, board } => {
+            display::display_cmd(&default_scenes(scenes), &out, &images, &board)
+        }
+        Command::Profile { variant, scene, top, under } => {
+            profile::profile_cmd(&root, &profile::ProfileArgs { variant, scene, top, under })
+        }
         Command::Motion { scenes, frames, out } => motion::motion_cmd(&default_scenes(scenes), frames, &out),
     }
 }

@@ -4,10 +4,10 @@
 //! end that keeps no lattice. Writes `docs/memory.md` and two plots.
 
 use crate::bench::{camera_rays, generated};
+use anyhow::{ensure, Result};
 use host_sim::load::{build_lattice, lattice_storage, object_storage, parse_scene, read, SceneStore};
 use host_sim::output::write_atomic;
 use host_sim::shared::{median, plot_link, PAPER_SCENES};
-use anyhow::{ensure, Result};
 use lattice_rt::lattice::Choice;
 use lattice_rt::{Accelerator, BoundingBox, BruteForce, Lattice, LatticeConfig, Query, Ray, Scene};
 use std::fmt::Write as _;
@@ -99,13 +99,21 @@ fn subjects(quick: bool) -> Result<Vec<Subject>> {
     for name in PAPER_SCENES {
         let path = Path::new("scenes").join(format!("{name}.scene"));
         let text = read(&path)?;
-        v.push(Subject { name: name.to_string(), objects: object_storage::<f64>(&text)?, source: Source::File(path, text) });
+        v.push(Subject {
+            name: name.to_string(),
+            objects: object_storage::<f64>(&text)?,
+            source: Source::File(path, text),
+        });
     }
     let sizes: &[usize] = if quick { &[100, 1000] } else { &[100, 1000, 10_000] };
     for clustered in [false, true] {
         for &n in sizes {
             let kind = if clustered { "clustered" } else { "uniform" };
-            v.push(Subject { name: format!("{kind} {n}"), objects: SceneStore::default(), source: Source::Generated(n, clustered) });
+            v.push(Subject {
+                name: format!("{kind} {n}"),
+                objects: SceneStore::default(),
+                source: Source::Generated(n, clustered),
+            });
         }
     }
     Ok(v)
@@ -178,7 +186,12 @@ fn sweep(scene: &Scene<'_, f64>, name: &str, runs: usize, md: &mut String) -> Re
     let m = measure(scene, &methods, &rays, runs)?;
     let auto_m = m[2];
     writeln!(md, "### {name}\n")?;
-    writeln!(md, "{} objects, {} composites. Automatic lattice: {auto}.\n", scene.objects().len(), scene.composites().len())?;
+    writeln!(
+        md,
+        "{} objects, {} composites. Automatic lattice: {auto}.\n",
+        scene.objects().len(),
+        scene.composites().len()
+    )?;
     writeln!(md, "| budget (bytes) | lattice built | bytes | us/ray | x automatic | object tests/ray | cells/ray |\n|---:|---|---:|---:|---:|---:|---:|")?;
     for (i, label) in [(0, "brute force"), (1, "bounding boxes")] {
         let x = m[i];
@@ -214,7 +227,10 @@ fn sweep(scene: &Scene<'_, f64>, name: &str, runs: usize, md: &mut String) -> Re
     writeln!(md)?;
     let at = |budget: usize| {
         let r = rows.iter().find(|r| r.budget == budget).expect("the quarter budgets are swept");
-        let best = (0..methods.len()).filter(|&i| methods[i].bytes <= budget).min_by_key(|&i| m[i].time).expect("brute force keeps no bytes");
+        let best = (0..methods.len())
+            .filter(|&i| methods[i].bytes <= budget)
+            .min_by_key(|&i| m[i].time)
+            .expect("brute force keeps no bytes");
         AtBudget {
             budget,
             built: methods[r.method].bytes,
@@ -255,7 +271,13 @@ fn lattices_within(scene: &Scene<'_, f64>, auto: Choice, budgets: &[usize]) -> (
 fn short(c: &Choice) -> String {
     let [x, y, z] = c.world;
     let subs = c.sizes.lattices - 1;
-    let shape = if subs > 0 { format!(" + {subs} sub") } else if !c.cfg.nested { " flat".into() } else { String::new() };
+    let shape = if subs > 0 {
+        format!(" + {subs} sub")
+    } else if !c.cfg.nested {
+        " flat".into()
+    } else {
+        String::new()
+    };
     format!("{x}x{y}x{z}{shape}, {}-bit", if c.sizes.narrow { 16 } else { 32 })
 }
 
@@ -270,7 +292,12 @@ pub fn memory_cmd(a: &MemoryArgs) -> Result<()> {
         let t0 = Instant::now();
         let summary = match &s.source {
             Source::File(path, text) => {
-                let scene = parse_scene::<f64>(path, text, &mut s.objects, &lattice_rt::Frame::new(RAYS.0 as u16, RAYS.1 as u16))?;
+                let scene = parse_scene::<f64>(
+                    path,
+                    text,
+                    &mut s.objects,
+                    &lattice_rt::Frame::new(RAYS.0 as u16, RAYS.1 as u16),
+                )?;
                 sweep(&scene, &s.name, runs, &mut sections)?
             }
             Source::Generated(n, clustered) => {
@@ -299,9 +326,23 @@ pub fn memory_cmd(a: &MemoryArgs) -> Result<()> {
     grid_section(&mut md, &summaries)?;
     writeln!(md, "\n## Every budget\n\nx automatic: time per ray over the automatic lattice's. The zero-byte rows keep no lattice.\n\n![object tests per ray against lattice bytes]({})\n", plot_link(&a.out, &a.tests_plot))?;
     md.push_str(&sections);
-    let series = |f: fn(&Summary) -> &Vec<(f64, f64)>| summaries.iter().map(|s| (s.name.clone(), f(s).clone())).collect::<Vec<_>>();
-    crate::plot::loglog(&a.plot, "Time per ray against lattice budget", "budget (bytes)", "time per ray / automatic lattice's", &series(|s| &s.time_points))?;
-    crate::plot::loglog(&a.tests_plot, "Object tests per ray against lattice budget", "budget (bytes)", "object tests per ray", &series(|s| &s.test_points))?;
+    let series = |f: fn(&Summary) -> &Vec<(f64, f64)>| {
+        summaries.iter().map(|s| (s.name.clone(), f(s).clone())).collect::<Vec<_>>()
+    };
+    crate::plot::loglog(
+        &a.plot,
+        "Time per ray against lattice budget",
+        "budget (bytes)",
+        "time per ray / automatic lattice's",
+        &series(|s| &s.time_points),
+    )?;
+    crate::plot::loglog(
+        &a.tests_plot,
+        "Object tests per ray against lattice budget",
+        "budget (bytes)",
+        "object tests per ray",
+        &series(|s| &s.test_points),
+    )?;
     write_atomic(&a.out, md.as_bytes())?;
     println!(
         "within 1.3x of the automatic lattice's time at a quarter of its bytes: lattice {} of {n}, best method {} of {n}; at a quarter of the 32-bit automatic: {} of {n}",
@@ -369,4 +410,3 @@ fn grid_section(md: &mut String, summaries: &[Summary]) -> Result<()> {
     }
     Ok(())
 }
-

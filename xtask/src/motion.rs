@@ -9,7 +9,6 @@ use host_sim::output::write_atomic;
 use lattice_rt::Frame;
 use std::path::Path;
 
-
 /// Flicker of one dither in motion: between consecutive frames of an orbit, the share of
 /// display pixels that change and the mean gray change (of 64 levels) that caused it.
 #[derive(Clone, Copy, Debug, Default)]
@@ -33,7 +32,6 @@ pub fn flicker(renders: &[host_sim::run::Rendered]) -> Flicker {
     f
 }
 
-
 /// `cargo xtask motion`: flicker of every dither along each scene's orbit, as docs/motion.md.
 pub fn motion_cmd(scenes: &[std::path::PathBuf], frames: u32, out: &Path) -> Result<()> {
     use lattice_rt::Dither;
@@ -41,7 +39,13 @@ pub fn motion_cmd(scenes: &[std::path::PathBuf], frames: u32, out: &Path) -> Res
     if !(2..=3600).contains(&frames) {
         bail!("--frames must be from 2 to 3600");
     }
-    let dithers = [("bayer", Dither::Bayer), ("blue noise", Dither::BlueNoise), ("pattern 4x4", Dither::Pattern(4)), ("floyd-steinberg", Dither::FloydSteinberg), ("atkinson", Dither::Atkinson)];
+    let dithers = [
+        ("bayer", Dither::Bayer),
+        ("blue noise", Dither::BlueNoise),
+        ("pattern 4x4", Dither::Pattern(4)),
+        ("floyd-steinberg", Dither::FloydSteinberg),
+        ("atkinson", Dither::Atkinson),
+    ];
     let mut md = String::new();
     writeln!(md, "# Dithers in motion\n")?;
     writeln!(md, "Written by `cargo xtask motion` ({frames} frames per turn of the orbit that")?;
@@ -58,7 +62,13 @@ pub fn motion_cmd(scenes: &[std::path::PathBuf], frames: u32, out: &Path) -> Res
             let frame = Frame { dither: *d, ..board_frame::FRAME };
             let f = flicker(&orbit_renders::<lattice_rt::Fx>(path, &text, frames, &frame)?);
             let ratio = f.flipped / f.gray_change.max(1e-9);
-            writeln!(md, "| {name} | {label} | {:.2} % | {:.2} | {:.2} % |", 100.0 * f.flipped, f.gray_change, 100.0 * ratio)?;
+            writeln!(
+                md,
+                "| {name} | {label} | {:.2} % | {:.2} | {:.2} % |",
+                100.0 * f.flipped,
+                f.gray_change,
+                100.0 * ratio
+            )?;
             sums[i].0 += f.flipped / scenes.len() as f64;
             sums[i].1 += f.gray_change / scenes.len() as f64;
         }
@@ -71,4 +81,3 @@ pub fn motion_cmd(scenes: &[std::path::PathBuf], frames: u32, out: &Path) -> Res
     println!("wrote {}", out.display());
     Ok(())
 }
-

@@ -47,7 +47,15 @@ pub fn playground_cmd(root: &Path, a: &PlaygroundArgs) -> Result<()> {
     println!("built the playground in {}", out.display());
     if a.check {
         let host_sim = root.join("target/release/host-sim");
-        run(Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())).current_dir(root).args(["build", "--release", "-p", "host-sim"]), "cargo build -p host-sim")?;
+        run(
+            Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())).current_dir(root).args([
+                "build",
+                "--release",
+                "-p",
+                "host-sim",
+            ]),
+            "cargo build -p host-sim",
+        )?;
         let mut test = Command::new("node");
         test.current_dir(root).arg("playground/test.mjs").arg("--dist").arg(&out).arg("--host-sim").arg(&host_sim);
         if let Some(s) = &a.screenshot {
@@ -56,14 +64,21 @@ pub fn playground_cmd(root: &Path, a: &PlaygroundArgs) -> Result<()> {
         run(&mut test, "the browser test (node playground/test.mjs)")?;
     }
     if let Some(addr) = &a.serve {
-        run(Command::new("node").current_dir(root).arg("playground/serve.mjs").arg(&out).arg(addr), "node playground/serve.mjs")?;
+        run(
+            Command::new("node").current_dir(root).arg("playground/serve.mjs").arg(&out).arg(addr),
+            "node playground/serve.mjs",
+        )?;
     }
     Ok(())
 }
 
 /// Builds the page into `out`.
 fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
-    let version = Command::new("wasm-bindgen").arg("--version").output().ok().map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+    let version = Command::new("wasm-bindgen")
+        .arg("--version")
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
     if version.as_deref() != Some(&format!("wasm-bindgen {WASM_BINDGEN}")) {
         bail!(
             "the page's glue needs wasm-bindgen {WASM_BINDGEN} (found: {}): cargo install --locked wasm-bindgen-cli --version {WASM_BINDGEN}; and rustup target add wasm32-unknown-unknown",
@@ -72,7 +87,17 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     eprintln!("building the core for the page (wasm32-unknown-unknown)");
-    run(Command::new(&cargo).current_dir(root).args(["build", "--release", "-p", "playground", "--target", "wasm32-unknown-unknown"]), "cargo build -p playground --target wasm32-unknown-unknown")?;
+    run(
+        Command::new(&cargo).current_dir(root).args([
+            "build",
+            "--release",
+            "-p",
+            "playground",
+            "--target",
+            "wasm32-unknown-unknown",
+        ]),
+        "cargo build -p playground --target wasm32-unknown-unknown",
+    )?;
     // Built beside `out` and renamed into place: a failed build leaves no half-written page.
     let staging = out.with_extension("partial");
     if staging.exists() {
@@ -80,7 +105,10 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     }
     std::fs::create_dir_all(&staging).with_context(|| format!("cannot create {}", staging.display()))?;
     let wasm = root.join("target/wasm32-unknown-unknown/release/playground.wasm");
-    run(Command::new("wasm-bindgen").arg("--target").arg("web").arg("--out-dir").arg(staging.join("pkg")).arg(&wasm), "wasm-bindgen")?;
+    run(
+        Command::new("wasm-bindgen").arg("--target").arg("web").arg("--out-dir").arg(staging.join("pkg")).arg(&wasm),
+        "wasm-bindgen",
+    )?;
     let web = root.join("playground/web");
     for f in ["index.html", "app.js", "style.css"] {
         copy(&web.join(f), &staging.join(f))?;
@@ -88,7 +116,10 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     let npm_dir = root.join("playground");
     if !npm_dir.join("node_modules/esbuild/package.json").exists() {
         eprintln!("installing esbuild and puppeteer-core (npm ci in playground)");
-        run(Command::new("npm").current_dir(&npm_dir).args(["ci", "--no-audit", "--no-fund"]), "npm ci in playground (Node.js 18 or newer)")?;
+        run(
+            Command::new("npm").current_dir(&npm_dir).args(["ci", "--no-audit", "--no-fund"]),
+            "npm ci in playground (Node.js 18 or newer)",
+        )?;
     }
     let bootrom = crate::board::prepare_emulator(root)?;
     run(
@@ -101,7 +132,11 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     let elf = if no_build { host_sim::uf2::pico_elf(root) } else { host_sim::uf2::build_pico(root)? };
     host_sim::uf2::write_uf2(&elf, &staging.join("pico.uf2"))?;
     // The slot image, which the page writes the editor's scene beside (`host-sim uf2 --scene`).
-    let slot = if no_build { host_sim::uf2::kept_image(root, "pico-slot") } else { host_sim::uf2::build_board(root, host_sim::uf2::Board::Pico, Some("slot"))? };
+    let slot = if no_build {
+        host_sim::uf2::kept_image(root, "pico-slot")
+    } else {
+        host_sim::uf2::build_board(root, host_sim::uf2::Board::Pico, Some("slot"))?
+    };
     host_sim::uf2::write_uf2(&slot, &staging.join("pico-slot.uf2"))?;
     copy(&bootrom, &staging.join("bootrom-b1.bin"))?;
     let scenes: Vec<String> = host_sim::shared::default_scene_paths()
@@ -115,7 +150,8 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     if out.exists() {
         std::fs::remove_dir_all(out).with_context(|| format!("cannot remove the old {}", out.display()))?;
     }
-    std::fs::rename(&staging, out).with_context(|| format!("cannot move {} to {}", staging.display(), out.display()))?;
+    std::fs::rename(&staging, out)
+        .with_context(|| format!("cannot move {} to {}", staging.display(), out.display()))?;
     Ok(())
 }
 
@@ -149,16 +185,28 @@ fn cost_fit(root: &Path) -> Result<serde_json::Value> {
         if f.len() < 6 || f[5] != "qemu-m0-fixed" {
             continue;
         }
-        let instr: f64 = f[3].parse().with_context(|| format!("{}:{}: instructions `{}`", csv_path.display(), i + 1, f[3]))?;
+        let instr: f64 =
+            f[3].parse().with_context(|| format!("{}:{}: instructions `{}`", csv_path.display(), i + 1, f[3]))?;
         let path = root.join(format!("scenes/{}.scene", f[0]));
         let text = host_sim::load::read(&path)?;
         let s = host_sim::run::render_text::<lattice_rt::Fx>(&path, &text, &board_records::frame::FRAME, |_| {})?.stats;
         rows.push(([s.total_rays() as f64, s.object_tests as f64], instr));
         names.push(f[0].to_string());
     }
-    let coef = fit(&rows).with_context(|| format!("{}: the qemu-m0-fixed rows cannot tell rays from object tests apart (run cargo xtask firmware)", csv_path.display()))?;
+    let coef = fit(&rows).with_context(|| {
+        format!(
+            "{}: the qemu-m0-fixed rows cannot tell rays from object tests apart (run cargo xtask firmware)",
+            csv_path.display()
+        )
+    })?;
     let worst = rows.iter().map(|(x, y)| ((x[0] * coef[0] + x[1] * coef[1]) / y - 1.0).abs()).fold(0.0, f64::max);
-    eprintln!("board cost fit: {:.0} instructions per ray, {:.0} per object test; worst error {:.1} % ({})", coef[0], coef[1], worst * 100.0, names.join(", "));
+    eprintln!(
+        "board cost fit: {:.0} instructions per ray, {:.0} per object test; worst error {:.1} % ({})",
+        coef[0],
+        coef[1],
+        worst * 100.0,
+        names.join(", ")
+    );
     Ok(serde_json::json!({
         "perRay": coef[0],
         "perTest": coef[1],

@@ -1,8 +1,8 @@
 //! The plots in docs/, drawn with `plotters` as SVG (grid lines, log axes, legends) and written
 //! atomically: a failed command leaves no half-written plot.
 
-use host_sim::output::write_atomic;
 use anyhow::{anyhow, Result};
+use host_sim::output::write_atomic;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -29,7 +29,10 @@ fn colour(i: usize) -> RGBAColor {
 const SIZE: (u32, u32) = (900, 540);
 
 /// Draws into an SVG string with `draw`, then writes it to `path`.
-fn write_svg(path: &Path, draw: impl FnOnce(DrawingArea<SVGBackend<'_>, plotters::coord::Shift>) -> Result<()>) -> Result<()> {
+fn write_svg(
+    path: &Path,
+    draw: impl FnOnce(DrawingArea<SVGBackend<'_>, plotters::coord::Shift>) -> Result<()>,
+) -> Result<()> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
@@ -51,7 +54,13 @@ fn decades(v: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 
 /// One line per series on log-log axes, dots at the measured points; a series whose name
 /// starts with `clustered` is drawn thin.
-pub fn loglog(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[(String, Vec<(f64, f64)>)]) -> Result<()> {
+pub fn loglog(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
     let xs = decades(series.iter().flat_map(|(_, v)| v.iter().map(|p| p.0)));
     let ys = decades(series.iter().flat_map(|(_, v)| v.iter().map(|p| p.1)));
     write_svg(path, |root| {
@@ -146,7 +155,9 @@ pub fn scatter(path: &Path, title: &str, x_desc: &str, y_desc: &str, points: &[L
             .map_err(|e| anyhow!("plot: {e}"))?;
         for (i, p) in points.iter().enumerate() {
             let style = ("sans-serif", 12).into_font().color(&colour(p.1));
-            right.draw(&Text::new(format!("{:2} {}: {}", i + 1, p.1, p.0), (8, 40 + 15 * i as i32), style)).map_err(|e| anyhow!("plot: {e}"))?;
+            right
+                .draw(&Text::new(format!("{:2} {}: {}", i + 1, p.1, p.0), (8, 40 + 15 * i as i32), style))
+                .map_err(|e| anyhow!("plot: {e}"))?;
         }
         Ok(())
     })
@@ -161,7 +172,8 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("plot-test-{}", std::process::id()));
         let (a, b) = (dir.join("a.svg"), dir.join("b.svg"));
         loglog(&a, "T", "x", "y", &[("lattice".into(), vec![(10.0, 0.5), (1000.0, 2.0)])]).unwrap();
-        scatter(&b, "T", "x", "y", &[("f64".into(), "scalar", 1.0, 0.5), ("bayer".into(), "dither", 2.0, 0.7)]).unwrap();
+        scatter(&b, "T", "x", "y", &[("f64".into(), "scalar", 1.0, 0.5), ("bayer".into(), "dither", 2.0, 0.7)])
+            .unwrap();
         for (path, label) in [(&a, "lattice"), (&b, "bayer")] {
             let svg = std::fs::read_to_string(path).unwrap();
             assert!(svg.starts_with("<svg") && svg.contains(label), "{}", path.display());

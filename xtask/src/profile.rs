@@ -68,7 +68,8 @@ fn run_logged(elf: &Path, machine: &str) -> Result<HashMap<u32, u64>> {
             }
         } else if let Some(rest) = line.strip_prefix("Trace ") {
             // `Trace 0: 0x7f... [flags/pc/...] name`: the block's host address names it.
-            let host = rest.split_whitespace().nth(1).and_then(|h| u64::from_str_radix(h.trim_start_matches("0x"), 16).ok());
+            let host =
+                rest.split_whitespace().nth(1).and_then(|h| u64::from_str_radix(h.trim_start_matches("0x"), 16).ok());
             let Some(host) = host else { continue };
             let entry = blocks.entry(host).or_default();
             if let Some(list) = listing.take() {
@@ -106,15 +107,22 @@ struct Profile {
 
 impl Profile {
     fn of(elf: &Path, counts: &HashMap<u32, u64>) -> Result<Profile> {
-        let loader = addr2line::Loader::new(elf).map_err(|e| anyhow::anyhow!("cannot read the debug information of {}: {e}", elf.display()))?;
+        let loader = addr2line::Loader::new(elf)
+            .map_err(|e| anyhow::anyhow!("cannot read the debug information of {}: {e}", elf.display()))?;
         let mut p = Profile { run: 0, harness: 0, inclusive: HashMap::new(), own: HashMap::new(), frames: Vec::new() };
         for (&pc, &n) in counts {
             p.run += n;
             let mut chain = Vec::new();
             let mut frames = loader.find_frames(u64::from(pc)).map_err(|e| anyhow::anyhow!("{e}"))?;
             while let Ok(Some(f)) = frames.next() {
-                let name = f.function.as_ref().and_then(|n| n.demangle().ok()).map_or_else(|| "(unknown)".to_string(), |n| short_name(&n));
-                let at = f.location.as_ref().map_or_else(String::new, |l| format!("{}:{}", l.file.map_or("?", |f| f.rsplit('/').next().unwrap_or(f)), l.line.unwrap_or(0)));
+                let name = f
+                    .function
+                    .as_ref()
+                    .and_then(|n| n.demangle().ok())
+                    .map_or_else(|| "(unknown)".to_string(), |n| short_name(&n));
+                let at = f.location.as_ref().map_or_else(String::new, |l| {
+                    format!("{}:{}", l.file.map_or("?", |f| f.rsplit('/').next().unwrap_or(f)), l.line.unwrap_or(0))
+                });
                 chain.push((name, at));
             }
             if chain.is_empty() || chain.iter().any(|(name, _)| HARNESS.iter().any(|h| name.ends_with(h))) {
@@ -137,8 +145,17 @@ impl Profile {
     fn report(&self, variant: &str, scene: &str, top: usize, under: Option<&str>) -> Result<String> {
         let frame = self.run - self.harness;
         let mut md = String::new();
-        writeln!(md, "# Instructions of `{variant}` rendering the {scene} (QEMU, `-icount shift=0`, every block logged)\n")?;
-        writeln!(md, "{} instructions ran; {} of them are the frame's, the rest the harness's ({}) and start-up code.", self.run, frame, HARNESS.join(", "))?;
+        writeln!(
+            md,
+            "# Instructions of `{variant}` rendering the {scene} (QEMU, `-icount shift=0`, every block logged)\n"
+        )?;
+        writeln!(
+            md,
+            "{} instructions ran; {} of them are the frame's, the rest the harness's ({}) and start-up code.",
+            self.run,
+            frame,
+            HARNESS.join(", ")
+        )?;
         writeln!(md, "Shares are of the frame's instructions.\n")?;
         let table = |md: &mut String, title: &str, map: &HashMap<String, u64>| -> Result<()> {
             writeln!(md, "## {title}\n\n| instructions | share | function |\n|---:|---:|---|")?;

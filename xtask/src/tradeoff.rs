@@ -2,12 +2,12 @@
 //! (f64, the scene's depth, no cutoff, one ray per pixel, Bayer), measures the error against a
 //! reference (f64, 4x4 rays per pixel) and the cost, and writes `docs/accuracy.md` and a plot.
 
-use host_sim::shared::median;
-use host_sim::run::render_text;
+use anyhow::Result;
 use host_sim::load::read;
 use host_sim::output::write_atomic;
+use host_sim::run::render_text;
+use host_sim::shared::median;
 use host_sim::shared::plot_link;
-use anyhow::Result;
 use lattice_rt::dither::Ditherer;
 use lattice_rt::{Dither, F32Micro, F32MicroNewton, Frame, Fx, Real, Sampling};
 use std::collections::BTreeMap;
@@ -47,22 +47,59 @@ fn configs() -> Vec<Config> {
     for d in 0..=4u8 {
         v.push(Config { knob: "depth", label: format!("depth {d}"), depth: Some(d), ..base.clone() });
     }
-    for (c, l) in [(1.0 / 256.0, "1/256"), (boards_cutoff(), BOARDS_CUTOFF), (1.0 / 64.0, "1/64 (one level)"), (1.0 / 16.0, "1/16")] {
+    for (c, l) in [
+        (1.0 / 256.0, "1/256"),
+        (boards_cutoff(), BOARDS_CUTOFF),
+        (1.0 / 64.0, "1/64 (one level)"),
+        (1.0 / 16.0, "1/16"),
+    ] {
         v.push(Config { knob: "cutoff", label: format!("cutoff {l}"), cutoff: c, ..base.clone() });
     }
     for n in [8u8, 4, 2] {
-        v.push(Config { knob: "sampling", label: format!("pattern {n}x{n} (1 ray per block)"), dither: Dither::Pattern(n), ..base.clone() });
+        v.push(Config {
+            knob: "sampling",
+            label: format!("pattern {n}x{n} (1 ray per block)"),
+            dither: Dither::Pattern(n),
+            ..base.clone()
+        });
     }
     v.push(Config { knob: "sampling", label: "4 rays/pixel".into(), sampling: Sampling::Grid2x2, ..base.clone() });
-    v.push(Config { knob: "sampling", label: "edges only: 4 rays at object edges".into(), sampling: Sampling::Edges { contrast: u8::MAX }, ..base.clone() });
+    v.push(Config {
+        knob: "sampling",
+        label: "edges only: 4 rays at object edges".into(),
+        sampling: Sampling::Edges { contrast: u8::MAX },
+        ..base.clone()
+    });
     for c in [16u8, 24] {
-        v.push(Config { knob: "sampling", label: format!("edges + contrast >= {c}: 4 rays there"), sampling: Sampling::Edges { contrast: c }, ..base.clone() });
+        v.push(Config {
+            knob: "sampling",
+            label: format!("edges + contrast >= {c}: 4 rays there"),
+            sampling: Sampling::Edges { contrast: c },
+            ..base.clone()
+        });
     }
     for c in [2u8, 4, 8] {
-        v.push(Config { knob: "sampling", label: format!("adaptive, contrast <= {c}: every 2nd pixel traced, the rest filled"), sampling: Sampling::Adaptive { contrast: c, coarse: false }, ..base.clone() });
+        v.push(Config {
+            knob: "sampling",
+            label: format!("adaptive, contrast <= {c}: every 2nd pixel traced, the rest filled"),
+            sampling: Sampling::Adaptive { contrast: c, coarse: false },
+            ..base.clone()
+        });
     }
-    v.push(Config { knob: "sampling", label: PICO_ONE_LEVEL.into(), sampling: board_records::frame::SAMPLING, tile: board_records::frame::PANEL_TILE, ..base.clone() });
-    v.push(Config { knob: "sampling", label: PICO_ADAPTIVE.into(), sampling: board_records::frame::PANEL_SAMPLING, tile: board_records::frame::PANEL_TILE, ..base.clone() });
+    v.push(Config {
+        knob: "sampling",
+        label: PICO_ONE_LEVEL.into(),
+        sampling: board_records::frame::SAMPLING,
+        tile: board_records::frame::PANEL_TILE,
+        ..base.clone()
+    });
+    v.push(Config {
+        knob: "sampling",
+        label: PICO_ADAPTIVE.into(),
+        sampling: board_records::frame::PANEL_SAMPLING,
+        tile: board_records::frame::PANEL_TILE,
+        ..base.clone()
+    });
     v.push(Config { knob: "dither", label: "floyd-steinberg".into(), dither: Dither::FloydSteinberg, ..base.clone() });
     v.push(Config { knob: "dither", label: "atkinson".into(), dither: Dither::Atkinson, ..base.clone() });
     v
@@ -112,26 +149,37 @@ fn shoot(text: &str, path: &Path, c: &Config, w: u16, h: u16) -> Result<Shot> {
 
 /// Gray levels (0..=64, as reals) of `n x n` f64 rays per pixel, averaged.
 pub fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Vec<f64>> {
-    host_sim::run::with_tracer::<f64, _>(path, text, &Frame::new(w, h), |_| {}, |tracer| {
-        let scene = tracer.scene();
-        let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(scene)];
-        let mut q = lattice_rt::Query::new(&mut mb);
-        let (ws, hs) = (2 * n * w as usize, 2 * n * h as usize);
-        let mut out = Vec::with_capacity(w as usize * h as usize);
-        for y in 0..h as usize {
-            for x in 0..w as usize {
-                let mut sum = 0.0;
-                for j in 0..n {
-                    for i in 0..n {
-                        let ray = scene.camera().ray((2 * n * x + 2 * i + 1) as i32, (2 * n * y + 2 * j + 1) as i32, ws as i32, hs as i32);
-                        sum += tracer.radiance(ray, &mut q);
+    host_sim::run::with_tracer::<f64, _>(
+        path,
+        text,
+        &Frame::new(w, h),
+        |_| {},
+        |tracer| {
+            let scene = tracer.scene();
+            let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(scene)];
+            let mut q = lattice_rt::Query::new(&mut mb);
+            let (ws, hs) = (2 * n * w as usize, 2 * n * h as usize);
+            let mut out = Vec::with_capacity(w as usize * h as usize);
+            for y in 0..h as usize {
+                for x in 0..w as usize {
+                    let mut sum = 0.0;
+                    for j in 0..n {
+                        for i in 0..n {
+                            let ray = scene.camera().ray(
+                                (2 * n * x + 2 * i + 1) as i32,
+                                (2 * n * y + 2 * j + 1) as i32,
+                                ws as i32,
+                                hs as i32,
+                            );
+                            sum += tracer.radiance(ray, &mut q);
+                        }
                     }
+                    out.push(sum / (n * n) as f64 * 64.0);
                 }
-                out.push(sum / (n * n) as f64 * 64.0);
             }
-        }
-        Ok(out)
-    })
+            Ok(out)
+        },
+    )
 }
 
 /// The reference dithered the way a configuration dithers (ordered per pixel, or error
@@ -145,7 +193,10 @@ fn dither_reference(levels: &[u8], w: usize, h: usize, d: Dither) -> Vec<bool> {
         dither.next_band();
         for tx in (0..w).step_by(t) {
             let (tw, th) = (t.min(w - tx), t.min(h - ty));
-            let tile: Vec<u8> = (0..th).flat_map(|y| (0..tw).map(move |x| (y, x))).map(|(y, x)| levels[(ty + y) * w + tx + x]).collect();
+            let tile: Vec<u8> = (0..th)
+                .flat_map(|y| (0..tw).map(move |x| (y, x)))
+                .map(|(y, x)| levels[(ty + y) * w + tx + x])
+                .collect();
             let mut bits = vec![embedded_graphics::pixelcolor::BinaryColor::Off; tw * th];
             dither.tile(tx, ty, tw, th, &tile, &mut bits);
             for (k, b) in bits.iter().enumerate() {
@@ -175,12 +226,19 @@ struct Tally {
     same_settings_diff: usize,
 }
 
-
 /// The command.
-pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Path, plot: &Path, firmware_csv: &Path) -> Result<()> {
+pub fn tradeoff_cmd(
+    scenes: &[PathBuf],
+    size: (u16, u16),
+    runs: usize,
+    out: &Path,
+    plot: &Path,
+    firmware_csv: &Path,
+) -> Result<()> {
     let configs = configs();
     let (tallies, per_scene) = measure(scenes, &configs, size, runs)?;
-    let names: Vec<String> = scenes.iter().filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string())).collect();
+    let names: Vec<String> =
+        scenes.iter().filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().to_string())).collect();
     let instr = firmware_instructions(firmware_csv, &names, size);
     let mut md = String::new();
     let points = knob_table(&mut md, &configs, &tallies, &instr, &names, size, runs)?;
@@ -188,7 +246,13 @@ pub fn tradeoff_cmd(scenes: &[PathBuf], size: (u16, u16), runs: usize, out: &Pat
     targets_section(&mut md, &configs, &tallies, &names, &per_scene)?;
     writeln!(md, "\n![error against cost]({})", plot_link(out, plot))?;
     let title = "Error against cost, one knob at a time";
-    crate::plot::scatter(plot, title, "host ms per frame (median, mean over scenes)", "mean abs gray error (levels of 64)", &points)?;
+    crate::plot::scatter(
+        plot,
+        title,
+        "host ms per frame (median, mean over scenes)",
+        "mean abs gray error (levels of 64)",
+        &points,
+    )?;
     write_atomic(out, md.as_bytes())?;
     println!("wrote {} and {}", out.display(), plot.display());
     Ok(())
@@ -242,7 +306,8 @@ fn measure(scenes: &[PathBuf], configs: &[Config], (w, h): (u16, u16), runs: usi
             t.rays += s.rays;
             t.time += median(times[i].clone());
             if c.knob == "scalar" || c.knob == "default" {
-                let same = (0..npx).filter(|&p| bit(&s.bits, w as usize, p) != bit(&default_bits, w as usize, p)).count();
+                let same =
+                    (0..npx).filter(|&p| bit(&s.bits, w as usize, p) != bit(&default_bits, w as usize, p)).count();
                 t.same_settings_diff += same;
                 per_scene.insert((name.clone(), c.scalar), (same, npx));
             }
@@ -268,7 +333,15 @@ fn firmware_instructions(firmware_csv: &Path, names: &[String], (w, h): (u16, u1
 }
 
 /// The main table: one row per knob setting; the points of the plot.
-fn knob_table(md: &mut String, configs: &[Config], tallies: &[Tally], instr: &BTreeMap<(String, String), u64>, names: &[String], (w, h): (u16, u16), runs: usize) -> Result<Vec<(String, &'static str, f64, f64)>> {
+fn knob_table(
+    md: &mut String,
+    configs: &[Config],
+    tallies: &[Tally],
+    instr: &BTreeMap<(String, String), u64>,
+    names: &[String],
+    (w, h): (u16, u16),
+    runs: usize,
+) -> Result<Vec<(String, &'static str, f64, f64)>> {
     writeln!(md, "# What accuracy costs\n")?;
     writeln!(
         md,
@@ -288,7 +361,9 @@ fn knob_table(md: &mut String, configs: &[Config], tallies: &[Tally], instr: &BT
         let ms = t.time.as_secs_f64() * 1e3 / scenes_n;
         let (m0, m4) = if c.knob == "scalar" || c.knob == "default" {
             let s = if c.scalar == "f64" { "" } else { c.scalar };
-            let get = |b: &str| instr.get(&(s.to_string(), b.to_string())).map(|v| format!("{:.0}", *v as f64 / 1e6 / scenes_n));
+            let get = |b: &str| {
+                instr.get(&(s.to_string(), b.to_string())).map(|v| format!("{:.0}", *v as f64 / 1e6 / scenes_n))
+            };
             (get("m0").unwrap_or_else(|| "-".into()), get("m4f").unwrap_or_else(|| "-".into()))
         } else {
             ("-".into(), "-".into())
@@ -306,7 +381,10 @@ fn knob_table(md: &mut String, configs: &[Config], tallies: &[Tally], instr: &BT
         points.push((c.label.clone(), c.knob, ms, mean));
     }
     if instr.is_empty() {
-        writeln!(md, "\n(No `docs/firmware.csv` at {w}x{h}: run `cargo xtask firmware` first for the Cortex-M columns.)")?;
+        writeln!(
+            md,
+            "\n(No `docs/firmware.csv` at {w}x{h}: run `cargo xtask firmware` first for the Cortex-M columns.)"
+        )?;
     }
     writeln!(md, "\nCortex-M columns are per scene on average (the f64 row has no firmware build).\n")?;
     Ok(points)
@@ -317,18 +395,45 @@ fn scalar_section(md: &mut String, names: &[String], per_scene: &PerScene) -> Re
     writeln!(md, "## Each scalar against f64 at the same settings\n\nShare of dithered pixels that differ from the f64 frame rendered with the same settings\n(1 ray per pixel, Bayer): the error the scalar alone adds.\n")?;
     writeln!(md, "| scene | f32 | f32-micromath | f32-micromath-newton | fixed |\n|---|---|---|---|---|")?;
     for n in names {
-        let cell = |s: &'static str| per_scene.get(&(n.clone(), s)).map_or("-".into(), |(d, p)| format!("{:.3} %", 100.0 * *d as f64 / *p as f64));
-        writeln!(md, "| {n} | {} | {} | {} | {} |", cell("f32"), cell("f32-micromath"), cell("f32-micromath-newton"), cell("fixed"))?;
+        let cell = |s: &'static str| {
+            per_scene
+                .get(&(n.clone(), s))
+                .map_or("-".into(), |(d, p)| format!("{:.3} %", 100.0 * *d as f64 / *p as f64))
+        };
+        writeln!(
+            md,
+            "| {n} | {} | {} | {} | {} |",
+            cell("f32"),
+            cell("f32-micromath"),
+            cell("f32-micromath-newton"),
+            cell("fixed")
+        )?;
     }
     Ok(())
 }
 
 /// The targets: the scalars' worst scenes, anti-aliasing and adaptive sub-sampling.
-fn targets_section(md: &mut String, configs: &[Config], tallies: &[Tally], names: &[String], per_scene: &PerScene) -> Result<()> {
-    let worst = |s: &'static str| names.iter().filter_map(|n| per_scene.get(&(n.clone(), s))).map(|(d, p)| 100.0 * *d as f64 / *p as f64).fold(0.0, f64::max);
+fn targets_section(
+    md: &mut String,
+    configs: &[Config],
+    tallies: &[Tally],
+    names: &[String],
+    per_scene: &PerScene,
+) -> Result<()> {
+    let worst = |s: &'static str| {
+        names
+            .iter()
+            .filter_map(|n| per_scene.get(&(n.clone(), s)))
+            .map(|(d, p)| 100.0 * *d as f64 / *p as f64)
+            .fold(0.0, f64::max)
+    };
     let find = |label: &str| configs.iter().position(|c| c.label.starts_with(label)).map(|i| &tallies[i]);
     writeln!(md, "\n## Targets\n")?;
-    writeln!(md, "- fixed point vs f64: worst scene {:.3} % of dithered pixels differ (target at most 0.5 %).", worst("fixed"))?;
+    writeln!(
+        md,
+        "- fixed point vs f64: worst scene {:.3} % of dithered pixels differ (target at most 0.5 %).",
+        worst("fixed")
+    )?;
     writeln!(md, "- f32 + libm vs f64: worst scene {:.3} % (target at most 0.05 %).", worst("f32"))?;
     if let (Some(one), Some(four)) = (find("f64, 1 ray"), find("4 rays")) {
         let err = |t: &Tally| t.abs_sum / t.pixels.max(1) as f64;
@@ -349,9 +454,21 @@ fn targets_section(md: &mut String, configs: &[Config], tallies: &[Tally], names
     let cutoff = format!("cutoff {BOARDS_CUTOFF}");
     let boards = [
         (format!("the boards' contribution cutoff, {BOARDS_CUTOFF}"), cutoff.as_str(), "without"),
-        ("adaptive sub-sampling (the QEMU boards' default, contrast 4) in their 8x8 tiles".into(), "adaptive, contrast <= 4", "with one ray per pixel"),
-        ("adaptive sub-sampling in one level (contrast 4) in the Pico's 16x16 tiles".into(), PICO_ONE_LEVEL, "with one ray per pixel"),
-        ("adaptive sub-sampling in two levels (the panels' default, contrast 4) in the Pico's 16x16 tiles".into(), PICO_ADAPTIVE, "with one ray per pixel"),
+        (
+            "adaptive sub-sampling (the QEMU boards' default, contrast 4) in their 8x8 tiles".into(),
+            "adaptive, contrast <= 4",
+            "with one ray per pixel",
+        ),
+        (
+            "adaptive sub-sampling in one level (contrast 4) in the Pico's 16x16 tiles".into(),
+            PICO_ONE_LEVEL,
+            "with one ray per pixel",
+        ),
+        (
+            "adaptive sub-sampling in two levels (the panels' default, contrast 4) in the Pico's 16x16 tiles".into(),
+            PICO_ADAPTIVE,
+            "with one ray per pixel",
+        ),
     ];
     for (what, label, against) in boards {
         if let (Some(one), Some(a)) = (find("f64, 1 ray"), find(label)) {

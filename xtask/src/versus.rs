@@ -2,10 +2,10 @@
 //! own "Trace Time" for the same scene (exported with `export --pov`), the same size, one
 //! thread (`+WT1`), no anti-aliasing, with and without shadows.
 
+use anyhow::{bail, Context, Result};
 use host_sim::pov::{export, PovMode};
 use host_sim::run::render_band;
 use host_sim::shared::median;
-use anyhow::{bail, Context, Result};
 use lattice_rt::{Accelerator, Effects, Frame, Scene, Tracer};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -87,7 +87,13 @@ fn povray(pov: &str, work: &Path, name: &str) -> Result<Duration> {
 /// Times `scene` in host-sim (its default tracer over `accel`, one core) and, given a work
 /// folder, in POV-Ray, interleaved `runs` times, with and without shadows (POV-Ray's time is
 /// zero without one).
-pub fn compare(name: &str, scene: &Scene<'_, f64>, accel: &(dyn Accelerator<f64> + Sync), runs: usize, work: Option<&Path>) -> Result<Vec<Row>> {
+pub fn compare(
+    name: &str,
+    scene: &Scene<'_, f64>,
+    accel: &(dyn Accelerator<f64> + Sync),
+    runs: usize,
+    work: Option<&Path>,
+) -> Result<Vec<Row>> {
     if let Some(work) = work {
         std::fs::create_dir_all(work).with_context(|| format!("cannot create {}", work.display()))?;
     }
@@ -109,7 +115,14 @@ pub fn compare(name: &str, scene: &Scene<'_, f64>, accel: &(dyn Accelerator<f64>
                 pov.push(povray(&pov_text, work, name)?);
             }
         }
-        rows.push(Row { scene: name.to_string(), n: scene.objects().len(), shadows, ours: median(ours), pov: if pov.is_empty() { Duration::ZERO } else { median(pov) }, tests });
+        rows.push(Row {
+            scene: name.to_string(),
+            n: scene.objects().len(),
+            shadows,
+            ours: median(ours),
+            pov: if pov.is_empty() { Duration::ZERO } else { median(pov) },
+            tests,
+        });
     }
     Ok(rows)
 }
@@ -118,7 +131,11 @@ pub fn compare(name: &str, scene: &Scene<'_, f64>, accel: &(dyn Accelerator<f64>
 pub fn section(rows: &[Row], runs: usize) -> Result<String> {
     let mut md = String::new();
     writeln!(md, "## Against POV-Ray 3.7\n")?;
-    writeln!(md, "Each scene exported with `host-sim export --pov` and rendered by POV-Ray at {}x{}, one thread", SIZE.0, SIZE.1)?;
+    writeln!(
+        md,
+        "Each scene exported with `host-sim export --pov` and rendered by POV-Ray at {}x{}, one thread",
+        SIZE.0, SIZE.1
+    )?;
     writeln!(md, "(`+WT1`), no anti-aliasing, no output file; POV-Ray's own *Trace Time* (parsing and bounding")?;
     writeln!(md, "left out) against host-sim's render time on one core (lattice built before, f64, the tracer's")?;
     writeln!(md, "defaults, dithering and 1-bit output included). Medians of {runs} runs, the two interleaved.")?;
@@ -127,7 +144,11 @@ pub fn section(rows: &[Row], runs: usize) -> Result<String> {
     writeln!(md, "{TARGET}x faster on every scene, {PAPER_TARGET}x on the paper's.\n")?;
     writeln!(md, "| scene | N | shadows | host-sim ms | POV-Ray trace ms | host-sim faster by | object tests/ray |\n|---|---:|---|---:|---:|---:|---:|")?;
     for r in rows {
-        let (pov, by) = if r.pov.is_zero() { ("-".into(), "-".into()) } else { (format!("{:.1}", r.pov.as_secs_f64() * 1e3), format!("{:.2}x", r.speedup())) };
+        let (pov, by) = if r.pov.is_zero() {
+            ("-".into(), "-".into())
+        } else {
+            (format!("{:.1}", r.pov.as_secs_f64() * 1e3), format!("{:.2}x", r.speedup()))
+        };
         writeln!(
             md,
             "| {} | {} | {} | {:.1} | {pov} | {by} | {:.2} |",
@@ -139,7 +160,10 @@ pub fn section(rows: &[Row], runs: usize) -> Result<String> {
         )?;
     }
     let timed: Vec<&Row> = rows.iter().filter(|r| !r.pov.is_zero()).collect();
-    if let (Some(lo), Some(hi)) = (timed.iter().min_by(|a, b| a.speedup().total_cmp(&b.speedup())), timed.iter().max_by(|a, b| a.speedup().total_cmp(&b.speedup()))) {
+    if let (Some(lo), Some(hi)) = (
+        timed.iter().min_by(|a, b| a.speedup().total_cmp(&b.speedup())),
+        timed.iter().max_by(|a, b| a.speedup().total_cmp(&b.speedup())),
+    ) {
         let met = timed.iter().filter(|r| r.speedup() >= TARGET).count();
         let paper: Vec<&&Row> = timed.iter().filter(|r| PAPER_SCENES.contains(&r.scene.as_str())).collect();
         let paper_met = paper.iter().filter(|r| r.speedup() >= PAPER_TARGET).count();

@@ -143,12 +143,26 @@ fn main() -> ! {
     cp.SYST.enable_interrupt();
     cp.SYST.enable_counter();
     let board = env!("FIRMWARE_CORE");
-    Line::new().text("BOARD ").text(board).text(" scalar ").text(<Scalar as lattice_rt::Real>::NAME).text(" size ").dec(FRAME.width.into()).text("x").dec(FRAME.height.into()).end();
+    Line::new()
+        .text("BOARD ")
+        .text(board)
+        .text(" scalar ")
+        .text(<Scalar as lattice_rt::Real>::NAME)
+        .text(" size ")
+        .dec(FRAME.width.into())
+        .text("x")
+        .dec(FRAME.height.into())
+        .end();
     // SysTick's clock differs between the machines (25 MHz on the an385/an386, 20 MHz on the
     // an505): a loop of exactly CALIBRATE_INSTRUCTIONS instructions tells the host the rate.
     let t0 = ticks();
     spin(CALIBRATE_INSTRUCTIONS / 2);
-    Line::new().text("CALIBRATE instructions ").dec(CALIBRATE_INSTRUCTIONS.into()).text(" ticks ").dec(ticks() - t0).end();
+    Line::new()
+        .text("CALIBRATE instructions ")
+        .dec(CALIBRATE_INSTRUCTIONS.into())
+        .text(" ticks ")
+        .dec(ticks() - t0)
+        .end();
     let mut st = SceneMemory::new();
     let mut second = ShareMemory::new();
     let mut bits = [0u8; BitFrame::bytes(FRAME.width as u32, FRAME.height as u32)];
@@ -188,7 +202,12 @@ fn main() -> ! {
             }
         }
     }
-    Line::new().text("RAM stack_high_water ").dec(stack::high_water() as u64).text(" static ").dec(stack::static_bytes() as u64).end();
+    Line::new()
+        .text("RAM stack_high_water ")
+        .dec(stack::high_water() as u64)
+        .text(" static ")
+        .dec(stack::static_bytes() as u64)
+        .end();
     debug::exit(if failed { debug::EXIT_FAILURE } else { debug::EXIT_SUCCESS });
     loop {
         cortex_m::asm::wfi();

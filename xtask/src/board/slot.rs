@@ -72,13 +72,16 @@ impl Session<'_> {
     /// Builds the slot image (unless `no_build`), writes each case's UF2 file and runs it for
     /// one frame, checking the panel and the log.
     pub(super) fn slot_runs(&mut self) -> Result<Vec<SlotRow>> {
-        let elf = if self.no_build { kept_image(self.root, "pico-slot") } else { build_pico_with(self.root, "slot", true)? };
+        let elf =
+            if self.no_build { kept_image(self.root, "pico-slot") } else { build_pico_with(self.root, "slot", true)? };
         let dir = self.frames_dir.join("slot");
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let base = dir.join("lattice-rt-pico-slot.uf2");
         write_uf2(&elf, &base)?;
         let image = std::fs::read(&base).with_context(|| format!("cannot read {}", base.display()))?;
-        let too_big: String = std::iter::once("camera eye 0 4 -30\n".to_string()).chain((0..70).map(|i| format!("sphere center {} {} 0 radius 0.4\n", i % 10 - 5, i / 10))).collect();
+        let too_big: String = std::iter::once("camera eye 0 4 -30\n".to_string())
+            .chain((0..70).map(|i| format!("sphere center {} {} 0 radius 0.4\n", i % 10 - 5, i / 10)))
+            .collect();
         let mistake = "camera eye 0 1 -6\nsphere raduis 1\n";
         let user = slot::with::scene(&image, USER_SCENE).map_err(|e| anyhow::anyhow!("the user's scene: {e}"))?;
         // The user's file with the first byte of its scene changed after it was written: the
@@ -89,11 +92,36 @@ impl Session<'_> {
         let (stored, mut damaged) = (slot::checksum(USER_SCENE.as_bytes()), USER_SCENE.as_bytes().to_vec());
         damaged[0] ^= 0x20;
         let cases = [
-            Case { name: "user", what: "a scene of the user's (`host-sim uf2 --scene`)", uf2: user, expect: Expect::Frame(USER_SCENE) },
-            Case { name: "empty", what: "the slot image alone (nothing in its slot)", uf2: image.clone(), expect: Expect::Message(SlotError::Empty.to_string()) },
-            Case { name: "corrupt", what: "the user's file with a byte of its scene changed", uf2: corrupt, expect: Expect::Message(SlotError::Corrupt { stored, computed: slot::checksum(&damaged) }.to_string()) },
-            Case { name: "too-big", what: "70 spheres (room for 64), written past the host's check", uf2: slot::with::unchecked(&image, &too_big).map_err(anyhow::Error::msg)?, expect: Expect::Message(refused(&too_big)) },
-            Case { name: "mistake", what: "a misspelt attribute, written past the host's check", uf2: slot::with::unchecked(&image, mistake).map_err(anyhow::Error::msg)?, expect: Expect::Message(refused(mistake)) },
+            Case {
+                name: "user",
+                what: "a scene of the user's (`host-sim uf2 --scene`)",
+                uf2: user,
+                expect: Expect::Frame(USER_SCENE),
+            },
+            Case {
+                name: "empty",
+                what: "the slot image alone (nothing in its slot)",
+                uf2: image.clone(),
+                expect: Expect::Message(SlotError::Empty.to_string()),
+            },
+            Case {
+                name: "corrupt",
+                what: "the user's file with a byte of its scene changed",
+                uf2: corrupt,
+                expect: Expect::Message(SlotError::Corrupt { stored, computed: slot::checksum(&damaged) }.to_string()),
+            },
+            Case {
+                name: "too-big",
+                what: "70 spheres (room for 64), written past the host's check",
+                uf2: slot::with::unchecked(&image, &too_big).map_err(anyhow::Error::msg)?,
+                expect: Expect::Message(refused(&too_big)),
+            },
+            Case {
+                name: "mistake",
+                what: "a misspelt attribute, written past the host's check",
+                uf2: slot::with::unchecked(&image, mistake).map_err(anyhow::Error::msg)?,
+                expect: Expect::Message(refused(mistake)),
+            },
         ];
         let mut rows = Vec::new();
         for case in cases {
@@ -109,7 +137,10 @@ impl Session<'_> {
             let (want, shown) = match &case.expect {
                 Expect::Frame(text) => {
                     let frame = board_records::frame::rendered(board_records::frame::PICO);
-                    (host_sim::run::render_text::<Fx>(Path::new("slot"), text, &frame, |_| {})?.bits, "the scene's frame".to_string())
+                    (
+                        host_sim::run::render_text::<Fx>(Path::new("slot"), text, &frame, |_| {})?.bits,
+                        "the scene's frame".to_string(),
+                    )
                 }
                 Expect::Message(m) => (message_frame(&cut(m)), format!("\"{}\"", cut(m))),
             };
@@ -119,12 +150,20 @@ impl Session<'_> {
                 save_frame(&f.pixels, &case_dir.join("panel.png"))?;
             }
             let name = case.name;
-            self.checks.check(run.ok && run.frames.len() == frames, || format!("slot {name}: the board showed {} of {frames} panels ({})", run.frames.len(), run.reason));
-            self.checks.check(same, || format!("slot {name}: the panel is not {shown} (see {}/panel.png)", case_dir.display()));
+            self.checks.check(run.ok && run.frames.len() == frames, || {
+                format!("slot {name}: the board showed {} of {frames} panels ({})", run.frames.len(), run.reason)
+            });
+            self.checks.check(same, || {
+                format!("slot {name}: the panel is not {shown} (see {}/panel.png)", case_dir.display())
+            });
             let errors: Vec<&str> = run.log.iter().filter(|l| l.level == "ERROR").map(|l| l.text.as_str()).collect();
             match &case.expect {
-                Expect::Frame(_) => self.checks.check(errors.is_empty(), || format!("slot {name}: the device logged errors: {errors:?}")),
-                Expect::Message(m) => self.checks.check(errors.iter().any(|e| e.contains(&cut(m))), || format!("slot {name}: the log does not say `{m}`: {errors:?}")),
+                Expect::Frame(_) => self
+                    .checks
+                    .check(errors.is_empty(), || format!("slot {name}: the device logged errors: {errors:?}")),
+                Expect::Message(m) => self.checks.check(errors.iter().any(|e| e.contains(&cut(m))), || {
+                    format!("slot {name}: the log does not say `{m}`: {errors:?}")
+                }),
             };
             rows.push(SlotRow { name, what: case.what, shown, cycles: frame.map(|f| f.cycles), same });
         }
@@ -141,10 +180,20 @@ pub(super) fn slot_report(rows: &[SlotRow]) -> Result<String> {
         "The `slot` image (`host-sim uf2 --features slot`, built once) holds no scene: it reads scene text from the slot at 1 MiB into the flash (`board_records::slot`: a magic, the length, a CRC-32, the text), parses it on the board and shows it. `host-sim uf2 --scene FILE` (and the playground's page) writes a scene beside the prebuilt image, checking it first as the Pico will read it; nothing is compiled. The image keeps its code in flash (the parser, the lattice builder and every effect would leave too little SRAM for the scene's room of {} objects). Each case below is one UF2 file run on the emulated Pico, its panel compared bit for bit with what the host draws (the frame, or the message in `board_records::message`'s font), and its log read for the message.\n",
         slot::ROOM.objects
     )?;
-    writeln!(md, "| case | UF2 file | the panel shows | cycles to the panel | bit-identical |\n|---|---|---|---:|---|")?;
+    writeln!(
+        md,
+        "| case | UF2 file | the panel shows | cycles to the panel | bit-identical |\n|---|---|---|---:|---|"
+    )?;
     for r in rows {
         let cycles = r.cycles.map_or("-".into(), |c| format!("{:.1} M", c as f64 / 1e6));
-        writeln!(md, "| {} | {} | {} | {cycles} | {} |", r.name, r.what, r.shown.replace('|', "\\|"), if r.same { "yes" } else { "**no**" })?;
+        writeln!(
+            md,
+            "| {} | {} | {} | {cycles} | {} |",
+            r.name,
+            r.what,
+            r.shown.replace('|', "\\|"),
+            if r.same { "yes" } else { "**no**" }
+        )?;
     }
     writeln!(md, "\nCycles are those of the panel checked: for the scene, from the LED going on to its going out (the scene parsed, its lattice built, the frame traced and sent); for a message, its drawing and sending (a refused scene's attempt comes first, then the message; the empty and corrupt slots show theirs at once, again every 3 s).")?;
     Ok(md)

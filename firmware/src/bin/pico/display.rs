@@ -47,7 +47,11 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
         Err(display_interface::DisplayError::OutOfBoundsError)
     }
 
-    fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(&mut self, area: &Rectangle, colors: I) -> Result<(), Self::Error> {
+    fn fill_contiguous<I: IntoIterator<Item = BinaryColor>>(
+        &mut self,
+        area: &Rectangle,
+        colors: I,
+    ) -> Result<(), Self::Error> {
         let (x0, y0) = (area.top_left.x, area.top_left.y);
         let (w, h) = (area.size.width as usize, area.size.height as usize);
         if y0 < 0 || x0 < 0 || y0 % 8 != 0 || h > BAND_ROWS || x0 as usize + w > WIDTH as usize {

@@ -97,7 +97,8 @@ fn main() -> ! {
     };
     let sio = hal::Sio::new(pac.SIO);
     let pins = hal::gpio::Pins::new(pac.IO_BANK0, pac.PADS_BANK0, sio.gpio_bank0, &mut pac.RESETS);
-    let wiring::Connected { display: interface, mut led, mut reset } = wiring::connect(pins, pac.I2C0, pac.SPI0, &mut pac.RESETS, &clocks);
+    let wiring::Connected { display: interface, mut led, mut reset } =
+        wiring::connect(pins, pac.I2C0, pac.SPI0, &mut pac.RESETS, &clocks);
     #[cfg(feature = "pico")]
     let timer_block = pac.TIMER;
     #[cfg(feature = "pico2")]
@@ -109,14 +110,20 @@ fn main() -> ! {
     while display.init().is_err() || display::flush().is_err() {
         defmt::error!(
             "no SSD1306 answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
-            Wiring::SDA, Wiring::SCL, Wiring::ADDRESS
+            Wiring::SDA,
+            Wiring::SCL,
+            Wiring::ADDRESS
         );
         sleep::blink(&mut led, &mut alarm, 5);
     }
     #[cfg(feature = "spi")]
     defmt::info!(
         "the display on SPI0: SCK GP{}, MOSI GP{}, CS GP{}, DC GP{}, RES GP{}",
-        Wiring::SCK, Wiring::MOSI, Wiring::CS, Wiring::DC, Wiring::RES
+        Wiring::SCK,
+        Wiring::MOSI,
+        Wiring::CS,
+        Wiring::DC,
+        Wiring::RES
     );
     let cores = cores::TwoCores::start(&mut pac.PSM, &mut pac.PPB, sio.fifo);
     modes::report(board_records::Record::Started {
@@ -126,7 +133,13 @@ fn main() -> ! {
     });
     defmt::info!(
         "lattice-rt on the {}: {} scenes, {}x{}, {} MHz, {} at {} kHz, both cores",
-        BOARD, SCENES.len(), WIDTH, HEIGHT, clocks.system_clock.freq().to_MHz(), Wiring::BUS, Wiring::BUS_KHZ
+        BOARD,
+        SCENES.len(),
+        WIDTH,
+        HEIGHT,
+        clocks.system_clock.freq().to_MHz(),
+        Wiring::BUS,
+        Wiring::BUS_KHZ
     );
     let mut st = SceneMemory::new();
     // The second share's memory (with what trace, then dither keeps of every tile: 24 KiB) is a

@@ -1,21 +1,21 @@
 //! What the firmware shows, one mode per build: the embedded scenes in turn (the default), an
 //! orbit around each (`orbit`), or the ladder of levers on the first scene (`ladder`).
 
-use crate::sleep::{sleep_ms, Alarm0, Timer};
 use crate::cores::TwoCores;
-use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::pixelcolor::BinaryColor;
-use embedded_hal::digital::OutputPin;
-use firmware::app::{render_embedded_at, AppError, Board, Embedded, Report, SceneMemory, ShareMemory, Shot};
-#[cfg(not(any(feature = "ladder", feature = "slot")))]
-use firmware::app::EMBEDDED;
-#[cfg(not(any(feature = "ladder", feature = "slot")))]
-use firmware::stack;
-use display_interface::DisplayError;
-use lattice_rt::render::RenderError;
+use crate::sleep::{sleep_ms, Alarm0, Timer};
 #[cfg(any(feature = "ladder", not(feature = "orbit")))]
 use board_records::FrameDone;
 use board_records::{Channel, Record};
+use display_interface::DisplayError;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::pixelcolor::BinaryColor;
+use embedded_hal::digital::OutputPin;
+#[cfg(not(any(feature = "ladder", feature = "slot")))]
+use firmware::app::EMBEDDED;
+use firmware::app::{render_embedded_at, AppError, Board, Embedded, Report, SceneMemory, ShareMemory, Shot};
+#[cfg(not(any(feature = "ladder", feature = "slot")))]
+use firmware::stack;
+use lattice_rt::render::RenderError;
 
 /// The pause between two scenes.
 const PAUSE_MS: u32 = 3000;
@@ -86,7 +86,9 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         // The frame is on the panel once the bus has sent its last queued byte.
         let sent = crate::display::flush();
         let _ = self.led.set_low();
-        let result = result.and_then(|r| sent.map(|()| r).map_err(|_| AppError::Render(RenderError::Draw(DisplayError::BusWriteError))));
+        let result = result.and_then(|r| {
+            sent.map(|()| r).map_err(|_| AppError::Render(RenderError::Draw(DisplayError::BusWriteError)))
+        });
         result.map(|r| {
             let setup_us = r.tiles_at.saturating_sub(t0.ticks());
             (r, ((timer.get_counter() - t0).to_micros(), setup_us))
@@ -111,7 +113,9 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         let band = u32::from(firmware::app::RENDERED.tile);
         for y0 in (0..h).step_by(band as usize) {
             let rows = band.min(h - y0);
-            let colors = (y0..y0 + rows).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| BinaryColor::from(frame.get(x, y)));
+            let colors = (y0..y0 + rows)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| BinaryColor::from(frame.get(x, y)));
             self.target.fill_contiguous(&Rectangle::new(Point::new(0, y0 as i32), Size::new(w, rows)), colors)?;
         }
         let sent = crate::display::flush();
@@ -129,14 +133,21 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
 /// panel that says why there is none (the slot empty or corrupt, the scene refused at its line
 /// and column or too big for the image's storage), also logged.
 #[cfg(feature = "slot")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+    mut panel: Panel<'_, T, L>,
+) -> ! {
     use firmware::slot::Message;
     loop {
         let failed = match firmware::slot::text() {
             Ok(text) => match panel.show(text, &Shot::default()) {
                 Ok((r, micros)) => {
                     report(Record::Frame(frame_done(0, &r, micros)));
-                    defmt::info!("slot: {} ms, rays {}, object tests {}", micros.0 / 1000, r.stats.total_rays(), r.stats.object_tests);
+                    defmt::info!(
+                        "slot: {} ms, rays {}, object tests {}",
+                        micros.0 / 1000,
+                        r.stats.total_rays(),
+                        r.stats.object_tests
+                    );
                     None
                 }
                 Err(e) => Some(Message::of(e)),
@@ -156,7 +167,9 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
 
 /// The embedded scenes in turn, each frame's time and statistics logged.
 #[cfg(not(any(feature = "orbit", feature = "ladder", feature = "slot")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+    mut panel: Panel<'_, T, L>,
+) -> ! {
     loop {
         for (i, (name, scene)) in EMBEDDED.iter().copied().enumerate() {
             match panel.show(scene, &Shot::default()) {
@@ -181,7 +194,9 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
 
 /// Orbit mode: the camera circles each scene, frame after frame, for one turn.
 #[cfg(all(feature = "orbit", not(feature = "ladder")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+    mut panel: Panel<'_, T, L>,
+) -> ! {
     use firmware::app::ORBIT_FRAMES;
     loop {
         for (scene, (name, text)) in EMBEDDED.iter().copied().enumerate() {
@@ -198,7 +213,12 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
             let centi_fps = ORBIT_FRAMES as u64 * 100_000_000 / us;
             defmt::info!(
                 "{}: orbit of {} frames in {} ms: {}.{=u64:02} frames per second, stack high-water {} B",
-                name, ORBIT_FRAMES, us / 1000, centi_fps / 100, centi_fps % 100, stack::high_water()
+                name,
+                ORBIT_FRAMES,
+                us / 1000,
+                centi_fps / 100,
+                centi_fps % 100,
+                stack::high_water()
             );
             panel.pause();
         }
@@ -207,7 +227,9 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
 
 /// The ladder: the first scene once per rung, from the paper's method to the default.
 #[cfg(feature = "ladder")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(mut panel: Panel<'_, T, L>) -> ! {
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+    mut panel: Panel<'_, T, L>,
+) -> ! {
     use firmware::app::{EMBEDDED, LADDER};
     loop {
         let (name, text) = EMBEDDED[0];
@@ -217,7 +239,14 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
                     report(Record::Rung { rung: rung as u8, frame: frame_done(0, &r, (us, setup_us)) });
                     defmt::info!(
                         "ladder {}: {}: {} us, shares {} us and {} us, object tests {}, cells {} ({})",
-                        rung, name, us, r.share_us[0], r.share_us[1], r.stats.object_tests, r.stats.cells_visited, what
+                        rung,
+                        name,
+                        us,
+                        r.share_us[0],
+                        r.share_us[1],
+                        r.stats.object_tests,
+                        r.stats.cells_visited,
+                        what
                     )
                 }
                 Err(e) => {

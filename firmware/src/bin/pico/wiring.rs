@@ -62,7 +62,10 @@ pub type Interface = ssd1306::prelude::SPIInterface<
         hal::spi::Spi<
             hal::spi::Enabled,
             pac::SPI0,
-            (Pin<bank0::Gpio19, hal::gpio::FunctionSpi, PullDown>, Pin<bank0::Gpio18, hal::gpio::FunctionSpi, PullDown>),
+            (
+                Pin<bank0::Gpio19, hal::gpio::FunctionSpi, PullDown>,
+                Pin<bank0::Gpio18, hal::gpio::FunctionSpi, PullDown>,
+            ),
             8,
         >,
         Output<bank0::Gpio17>,
@@ -94,7 +97,13 @@ pub struct Connected {
 /// Sets the pins up as [`Wiring`] says: the display's bus (I2C0 on the default build, SPI0 with
 /// `spi`; the other controller is left in reset), and the on-board LED.
 #[allow(unused_variables)]
-pub fn connect(pins: hal::gpio::Pins, i2c0: pac::I2C0, spi0: pac::SPI0, resets: &mut pac::RESETS, clocks: &hal::clocks::ClocksManager) -> Connected {
+pub fn connect(
+    pins: hal::gpio::Pins,
+    i2c0: pac::I2C0,
+    spi0: pac::SPI0,
+    resets: &mut pac::RESETS,
+    clocks: &hal::clocks::ClocksManager,
+) -> Connected {
     #[cfg(not(feature = "spi"))]
     let (display, reset) = {
         let sda = pins.gpio4.reconfigure::<hal::gpio::FunctionI2C, hal::gpio::PullUp>();
@@ -106,12 +115,23 @@ pub fn connect(pins: hal::gpio::Pins, i2c0: pac::I2C0, spi0: pac::SPI0, resets: 
     #[cfg(feature = "spi")]
     let (display, reset) = {
         use hal::Clock;
-        let pins_spi = (pins.gpio19.into_function::<hal::gpio::FunctionSpi>(), pins.gpio18.into_function::<hal::gpio::FunctionSpi>());
-        let bus = hal::spi::Spi::<_, _, _, 8>::new(spi0, pins_spi).init(resets, clocks.peripheral_clock.freq(), Wiring::SPI_HZ.Hz(), embedded_hal::spi::MODE_0);
+        let pins_spi = (
+            pins.gpio19.into_function::<hal::gpio::FunctionSpi>(),
+            pins.gpio18.into_function::<hal::gpio::FunctionSpi>(),
+        );
+        let bus = hal::spi::Spi::<_, _, _, 8>::new(spi0, pins_spi).init(
+            resets,
+            clocks.peripheral_clock.freq(),
+            Wiring::SPI_HZ.Hz(),
+            embedded_hal::spi::MODE_0,
+        );
         let cs = pins.gpio17.into_push_pull_output_in_state(hal::gpio::PinState::High);
         let Ok(device) = embedded_hal_bus::spi::ExclusiveDevice::new_no_delay(bus, cs);
         let dc = pins.gpio20.into_push_pull_output();
-        (ssd1306::prelude::SPIInterface::new(device, dc), pins.gpio21.into_push_pull_output_in_state(hal::gpio::PinState::High))
+        (
+            ssd1306::prelude::SPIInterface::new(device, dc),
+            pins.gpio21.into_push_pull_output_in_state(hal::gpio::PinState::High),
+        )
     };
     Connected { display, led: pins.gpio25.into_push_pull_output(), reset }
 }

@@ -31,7 +31,8 @@ pub struct QueuedI2c<P> {
 /// in 8-row bands, fewer in higher ones), so the cores never wait for the bus and trace the later
 /// passes while it sends the earlier ones (with two passes' worth, core 0 waited for room during
 /// the third pass: the chair took 1.06x the still frame).
-const QUEUED: usize = if cfg!(feature = "progressive") { 4 * 1152 + 96 } else { 2 * (BAND_PAGES * firmware::app::WIDTH as usize + 16) };
+const QUEUED: usize =
+    if cfg!(feature = "progressive") { 4 * 1152 + 96 } else { 2 * (BAND_PAGES * firmware::app::WIDTH as usize + 16) };
 
 /// SSD1306 pages (8 rows each) in a band of tiles.
 const BAND_PAGES: usize = super::BAND_ROWS.div_ceil(8);
@@ -166,7 +167,11 @@ impl<P> embedded_hal::i2c::ErrorType for QueuedI2c<P> {
 }
 
 impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
-    fn transaction(&mut self, address: u8, operations: &mut [embedded_hal::i2c::Operation<'_>]) -> Result<(), Self::Error> {
+    fn transaction(
+        &mut self,
+        address: u8,
+        operations: &mut [embedded_hal::i2c::Operation<'_>],
+    ) -> Result<(), Self::Error> {
         use embedded_hal::i2c::Operation;
         if address != self.address {
             return Err(hal::i2c::Error::AddressOutOfRange(u16::from(address)));
@@ -209,4 +214,9 @@ impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
 }
 
 /// An I2C module resets itself at power-on: nothing to pulse.
-pub fn reset<DI, D>(_display: &mut ssd1306::Ssd1306<DI, ssd1306::prelude::DisplaySize128x64, ssd1306::mode::BasicMode>, _line: &mut crate::wiring::Reset, _delay: &mut D) {}
+pub fn reset<DI, D>(
+    _display: &mut ssd1306::Ssd1306<DI, ssd1306::prelude::DisplaySize128x64, ssd1306::mode::BasicMode>,
+    _line: &mut crate::wiring::Reset,
+    _delay: &mut D,
+) {
+}

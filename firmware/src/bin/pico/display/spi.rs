@@ -15,7 +15,11 @@ pub fn flush() -> Result<(), core::convert::Infallible> {
 
 /// Pulses the module's RES line (high, low for 10 ms, high) before the display is set up, as
 /// the SSD1306 needs after power-on.
-pub fn reset<DI, D: embedded_hal::delay::DelayNs>(display: &mut ssd1306::Ssd1306<DI, ssd1306::prelude::DisplaySize128x64, ssd1306::mode::BasicMode>, line: &mut crate::wiring::Reset, delay: &mut D) {
+pub fn reset<DI, D: embedded_hal::delay::DelayNs>(
+    display: &mut ssd1306::Ssd1306<DI, ssd1306::prelude::DisplaySize128x64, ssd1306::mode::BasicMode>,
+    line: &mut crate::wiring::Reset,
+    delay: &mut D,
+) {
     // The pin's error type is Infallible.
     let _ = display.reset(line, delay);
 }
