@@ -208,10 +208,6 @@ mod writer {
         fn literal(&self, out: &mut String) {
             let o = self;
             out.push_str("Object::from_tables(");
-            #[cfg(feature = "eye-hulls")]
-            let hull = &o.eye_hull;
-            #[cfg(not(feature = "eye-hulls"))]
-            let hull = &crate::scene::NO_HULL;
             let parts: [&dyn Literal; 15] = [
                 &o.shape,
                 &o.to_object,
@@ -225,9 +221,9 @@ mod writer {
                 &o.inv_dir_scale,
                 &o.eye_local,
                 &o.light_local,
-                &o.eye_window,
-                hull,
-                &o.shadow_window,
+                o.region.eye_window(),
+                o.region.eye_hull(),
+                o.region.shadow_window(),
             ];
             for (i, p) in parts.iter().enumerate() {
                 if i > 0 {

@@ -21,8 +21,10 @@ pub mod fixed;
 pub use fixed::Fx;
 pub mod math;
 pub use math::{Aabb, Affine, Linear, Ray, Vec3};
+pub mod camera;
 pub mod shape;
 pub use shape::{Shape, ShapeHit};
+pub mod cull;
 pub mod scene;
 pub use scene::text::{parse, ParseError};
 pub use scene::{Parts, Scene, SceneBuilder, SceneError};
@@ -45,7 +47,6 @@ pub use trace::{Effects, EyeRays, Tracer};
 pub mod dither;
 pub mod sample;
 pub use dither::{Dither, Tone};
-mod cover;
 pub mod outline;
 pub mod render;
 pub use render::{

@@ -11,12 +11,11 @@
 
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Tone, MAX_TILE};
-use crate::math::{Ray, Vec3};
 use crate::outline::Apron;
 use crate::sample::Sampler;
 pub use crate::sample::{level, Hits, Sampling, Shot};
 use crate::scalar::Real;
-use crate::scene::{Camera, Scene};
+use crate::scene::Camera;
 use crate::trace::Tracer;
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -143,7 +142,7 @@ impl Frame {
 
     /// Entries of [`Scratch::with_cover`] a render of this frame uses (a few per tile).
     pub fn cover_len(&self) -> usize {
-        crate::cover::Tiling {
+        crate::cull::tiles::Tiling {
             t: self.tile.max(1) as usize,
             size: (self.width as usize, self.height as usize),
             margin: 0,
@@ -592,56 +591,6 @@ pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Bi
     )
 }
 
-/// Whether the pixels of a tile at `(x0, y0)` between columns `xs` and rows `ys` (inclusive),
-/// whose corners' eye rays hit object `id` (or nothing), the farthest at depth key `far`, may be
-/// filled from those rays in the coarse level of adaptive sampling: no other object among the
-/// tile's `candidates` can appear in them ([`Scene::eye_region_among_meets`]) but behind `id`
-/// ([`crate::scene::hull::behind`]), and the object neither mirrors nor refracts (in the
-/// effects simulated). A tile with more than 64 objects' candidates is never filled so.
-#[allow(clippy::too_many_arguments)]
-fn alone<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
-    tracer: &Tracer<'_, '_, R, A, E>,
-    candidates: u64,
-    (x0, y0): (usize, usize),
-    (xs, ys): ([usize; 2], [usize; 2]),
-    id: u16,
-    far: u16,
-    size: (i32, i32),
-) -> bool {
-    let scene = tracer.scene();
-    // A scene of more than 64 objects gives every tile this mask (`Scene::eye_candidates`).
-    if candidates == u64::MAX {
-        return false;
-    }
-    if let Some(o) = scene.objects().get(id as usize) {
-        if tracer.branches(crate::bounds::at(scene.materials(), o.material as usize)) != (false, false) {
-            return false;
-        }
-    }
-    let others = candidates & !(1u64.checked_shl(id as u32).unwrap_or(0));
-    if others == 0 {
-        return true;
-    }
-    // The rays that matter are those through the pixels' centres: the rectangle from the first
-    // corner's centre to the last's (window `v` runs up the image).
-    let (w4, h4) = size;
-    let centre = |p: usize| 4 * p as i32 + 2;
-    let (lo, hi) = (
-        Camera::<R>::window_uv(centre(x0 + xs[0]), centre(y0 + ys[1]), w4, h4),
-        Camera::<R>::window_uv(centre(x0 + xs[1]), centre(y0 + ys[0]), w4, h4),
-    );
-    let (u, v) = ([lo[0], hi[0]], [lo[1], hi[1]]);
-    if !scene.eye_region_among_meets(others, u, v) {
-        return true;
-    }
-    // Another object can appear there: unless it lies behind `id` all over the block.
-    let us = [Camera::<R>::ray_u(centre(x0 + xs[0]), w4), Camera::<R>::ray_u(centre(x0 + xs[1]), w4)];
-    let vs = [Camera::<R>::ray_v(centre(y0 + ys[0]), h4), Camera::<R>::ray_v(centre(y0 + ys[1]), h4)];
-    let dirs = crate::scene::hull::block_directions(scene.camera(), us, vs);
-    let hidden = crate::scene::hull::behind(scene, others, id as usize, far, &dirs);
-    hidden != 0 && !scene.eye_region_among_meets(others & !hidden, u, v)
-}
-
 /// A pass of a progressive frame as the tile loop takes it: which pass, and the rays kept
 /// between passes, for the whole share (its tiles before `frame`'s rows first) or for the tiles
 /// of `frame`'s rows alone.
@@ -682,8 +631,8 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let keys = frame.outline || matches!(frame.sampling, Sampling::Adaptive { coarse: true, .. });
     // Past 64 objects the tiles' candidate masks hold every object: list the objects whose
     // windows meet each tile instead, when the scratch has room.
-    let tiling = crate::cover::Tiling { t, size: (w, h), margin: block };
-    let many = cfg!(feature = "tile-lists") && crate::cover::lists(tracer.scene().objects().len());
+    let tiling = crate::cull::tiles::Tiling { t, size: (w, h), margin: block };
+    let many = cfg!(feature = "tile-lists") && crate::cull::tiles::lists(tracer.scene().objects().len());
     let counted = many && tiling.count(tracer.scene(), (frame.rows.0 as usize, frame.rows.1 as usize), scratch.cover);
     let cover: &[u32] = scratch.cover;
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
@@ -698,7 +647,7 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
     let cam = tracer.scene().camera();
     let (w4, h4) = (4 * w as i32, 4 * h as i32);
     // The eye ray through `(sx, sy)` (quarter pixels), its window position given to the query.
-    let mut window = Window::<R>::new(cam, w4, h4);
+    let mut window = crate::camera::EyeRayCache::<R>::new(cam, w4, h4);
     let mut eye = |q: &mut Query<'_>, sx: usize, sy: usize| {
         let (uv, ray) = window.at(sx as i32, sy as i32);
         q.set_eye_ray(Some(uv));
@@ -722,12 +671,18 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
                 q.set_eye_list(if counted { tiling.list(cover, (tx, ty)) } else { None });
                 u64::MAX
             } else {
-                let c = tile_candidates(tracer.scene(), at, block, (w4, h4));
+                let c = crate::cull::tiles::tile_candidates(
+                    tracer.scene(),
+                    (at.x0, at.tw),
+                    (at.y0, at.th),
+                    block,
+                    (w4, h4),
+                );
                 q.set_eye_candidates(c);
                 c
             };
             let mut alone = |xs: [usize; 2], ys: [usize; 2], id: u16, far: u16| {
-                alone(tracer, candidates, (x0, y0), (xs, ys), id, far, (w4, h4))
+                crate::cull::block::alone(tracer, candidates, (x0, y0), (xs, ys), id, far, (w4, h4))
             };
             let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
                 let ray = eye(&mut q, sx, sy);
@@ -805,88 +760,6 @@ fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Binar
         }
     }
     Ok(q.stats)
-}
-
-/// Where a frame's eye rays pass the window: per quarter-pixel column its window coordinate
-/// ([`Camera::window_u`]) and its part of the ray's direction ([`Camera::column`]), and of the
-/// last row asked for its window coordinate and its part ([`Camera::row`]), each kept from the
-/// last ray that needed it. Each depends on one position alone, so a tile's rays (row by row)
-/// compute them, a division and three products, once per column and row instead of once per
-/// ray; the rays are the same ([`Camera::ray_from`]). With 8x8 tiles (the `tile8` feature: the
-/// 4 KiB boards) a column keeps its ray factor ([`Camera::ray_u`]) instead and each ray takes
-/// the three products: its part would take 88 more bytes of stack, which those boards do not
-/// have.
-struct Window<'c, R> {
-    camera: &'c Camera<R>,
-    size: (i32, i32),
-    cols: [(i32, i32, ColumnPart<R>); MAX_TILE],
-    row: (i32, i32, Vec3<R>),
-}
-
-/// What [`Window`] keeps of a column for its rays: the ray factor ([`Camera::ray_u`]) with 8x8
-/// tiles, else the column's part of the direction.
-#[cfg(feature = "tile8")]
-type ColumnPart<R> = R;
-/// What [`Window`] keeps of a column for its rays: the ray factor ([`Camera::ray_u`]) with 8x8
-/// tiles, else the column's part of the direction.
-#[cfg(not(feature = "tile8"))]
-type ColumnPart<R> = Vec3<R>;
-
-/// The [`ColumnPart`] of ray factor `u`.
-#[cfg(feature = "tile8")]
-fn column_part<R: Real>(_: &Camera<R>, u: R) -> ColumnPart<R> {
-    u
-}
-/// The [`ColumnPart`] of ray factor `u`.
-#[cfg(not(feature = "tile8"))]
-fn column_part<R: Real>(camera: &Camera<R>, u: R) -> ColumnPart<R> {
-    camera.column(u)
-}
-
-/// The column's part of the direction ([`Camera::column`]) from what the window kept of it.
-#[cfg(feature = "tile8")]
-fn column_of<R: Real>(camera: &Camera<R>, part: ColumnPart<R>) -> Vec3<R> {
-    camera.column(part)
-}
-/// The column's part of the direction ([`Camera::column`]) from what the window kept of it.
-#[cfg(not(feature = "tile8"))]
-fn column_of<R: Real>(_: &Camera<R>, part: ColumnPart<R>) -> Vec3<R> {
-    part
-}
-
-impl<'c, R: Real> Window<'c, R> {
-    fn new(camera: &'c Camera<R>, w4: i32, h4: i32) -> Self {
-        let none = column_part(camera, R::ZERO);
-        Window {
-            camera,
-            size: (w4, h4),
-            cols: [(-1, 0, none); MAX_TILE],
-            row: (-1, 0, Vec3::new(R::ZERO, R::ZERO, R::ZERO)),
-        }
-    }
-
-    /// Window position (2^-16 units) and the eye ray through `(sx, sy)`.
-    #[inline]
-    fn at(&mut self, sx: i32, sy: i32) -> ([i32; 2], Ray<R>) {
-        let (w4, h4) = self.size;
-        let c = &mut self.cols[(sx as usize >> 2) % MAX_TILE];
-        if c.0 != sx {
-            *c = (sx, Camera::<R>::window_u(sx, w4), column_part(self.camera, Camera::<R>::ray_u(sx, w4)));
-        }
-        let r = &mut self.row;
-        if r.0 != sy {
-            *r = (sy, Camera::<R>::window_v(sy, h4), self.camera.row(Camera::<R>::ray_v(sy, h4)));
-        }
-        ([c.1, r.1], self.camera.ray_from(column_of(self.camera, c.2), r.2))
-    }
-}
-
-/// The objects the eye rays of the tile `at` can hit: those whose window meets the tile's
-/// (widened by a `block` on each side, beyond any ray the sampler shoots in the tile), on an
-/// image of `size` quarter pixels.
-fn tile_candidates<R: Real>(scene: &Scene<'_, R>, at: Block, block: usize, size: (i32, i32)) -> u64 {
-    let (u, v) = crate::cover::tile_window::<R>((at.x0, at.tw), (at.y0, at.th), block, size);
-    scene.eye_candidates(u, v)
 }
 
 /// A tile of pass `n` of a progressive frame: a preview of `n`x`n` blocks (each side a constant

@@ -269,7 +269,7 @@ impl HeapScratch {
             mailbox: alloc::vec![0; Query::mailbox_len(scene)],
             rows: alloc::vec![0; frame.scratch_len()],
             // Only scenes of more than 64 objects list windows per tile.
-            cover: alloc::vec![0; if crate::cover::lists(scene.objects().len()) { frame.cover_len() } else { 0 }],
+            cover: alloc::vec![0; if crate::cull::tiles::lists(scene.objects().len()) { frame.cover_len() } else { 0 }],
         }
     }
 

@@ -329,7 +329,7 @@ fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query
     // The candidates are counted as they come (cheaper than a population count on a core
     // without one): the others are culled.
     let mut candidates = 0u32;
-    crate::scene::model::any_object(q.eye_candidates(), n, |i| {
+    crate::cull::any_object(q.eye_candidates(), n, |i| {
         candidates += 1;
         crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, q);
         false

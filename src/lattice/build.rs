@@ -1,7 +1,8 @@
 //! Building a lattice into caller-provided storage: coordinate lists, then cells and references
 //! in two passes (count, then fill).
 
-use super::plan::{axis_planes, lattice_bounds, lattice_resolution, uniform_coord};
+use super::config::uniform_coord;
+use super::plan::{axis_planes, lattice_bounds, lattice_resolution};
 use super::{cluster, for_each_item, index, Lattice, LatticeConfig, SubLattice};
 use crate::math::Aabb;
 use crate::scalar::Real;

@@ -8,7 +8,7 @@
 //! resolution gives its objects, so finding the dense cells and planning their lattices takes
 //! a pass or two over the free objects per 4096 world cells and no storage.
 
-use super::plan::{resolution, uniform_coord};
+use super::config::{resolution, uniform_coord};
 use super::{locate_by, LatticeConfig, NO_COMPOSITE};
 use crate::math::{Aabb, Vec3};
 use crate::scalar::Real;

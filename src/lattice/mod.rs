@@ -26,6 +26,7 @@
 mod budget;
 mod build;
 mod cluster;
+mod config;
 mod index;
 mod plan;
 mod walk;
@@ -33,7 +34,8 @@ mod walk;
 #[cfg(feature = "budget")]
 pub use budget::Choice;
 pub use build::{LatticeError, LatticeStorage};
-pub use plan::{LatticeConfig, LatticeSizes, Resolution, Spacing, MAX_PER_AXIS};
+pub use config::{LatticeConfig, Resolution, Spacing, MAX_PER_AXIS};
+pub use plan::LatticeSizes;
 
 use crate::accel::{Accelerator, Hit, Query};
 use crate::math::{Aabb, Ray, Vec3};

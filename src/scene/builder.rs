@@ -1,11 +1,10 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::hull::Projection;
-use super::model::{
-    lowest_terms, resolvable_pixels, shadow_whole_plane, Camera, CameraDesc, Composite, EyeWindow, Light, Material,
-    Object, Parts, Scene, ShadowWindow, EYE_MARGIN, NO_COMPOSITE, WHOLE_PLANE,
-};
+use super::model::{Composite, Light, Material, Object, Parts, Scene, NO_COMPOSITE};
+use crate::camera::{lowest_terms, resolvable_pixels, Camera, CameraDesc};
+use crate::cull::build::{shadow_basis, Regions};
+use crate::cull::Region;
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
@@ -259,10 +258,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             // The camera is known at `finish`, which sets both.
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             light_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
-            eye_window: WHOLE_PLANE,
-            #[cfg(feature = "eye-hulls")]
-            eye_hull: super::hull::NO_HULL,
-            shadow_window: shadow_whole_plane(),
+            region: Region::everywhere(),
         };
         self.len += 1;
         Ok(())
@@ -315,28 +311,14 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             world = world.union(&o.bounds);
         }
         let shadow_basis = shadow_basis(&self.parts.lights);
-        // A point's light-window position is two dot products in R: widen every window by what
-        // their rounding can reach anywhere in the world (the scalar's padding at its corners).
-        let margin = world.pad_for::<R>();
-        // One projection for every object's eye window and hull.
-        let projection = Projection::new(&camera);
+        let regions = Regions::new(&camera, shadow_basis, &world);
         for o in self.storage[..self.len].iter_mut() {
             o.eye_local = o.point_local(camera.eye);
             o.light_local = match self.parts.lights.first() {
                 Some(Light::Directional { to_light, .. }) => o.direction_local(*to_light),
                 _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             };
-            o.eye_window = projection.as_ref().map_or(WHOLE_PLANE, |p| eye_window(&o.bounds, p));
-            #[cfg(feature = "eye-hulls")]
-            {
-                // The padding the object's world box got (`Aabb::pad_for`), on its own box.
-                let pad = o.bounds.pad_for::<R>();
-                o.eye_hull = projection.as_ref().map_or(super::hull::NO_HULL, |p| super::hull::eye_hull(o, p, pad));
-            }
-            o.shadow_window = match shadow_basis {
-                Some((a, b)) => shadow_window(&o.bounds, a.cast(), b.cast(), margin),
-                None => shadow_whole_plane(),
-            };
+            o.region = regions.of(o);
         }
         let bound = brightness_bound(&self.parts.materials, &self.parts.lights, self.ambient, self.background);
         let (len, ambient, background, max_depth) = (self.len, self.ambient, self.background, self.max_depth);
@@ -380,60 +362,6 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             shadow_basis,
         })
     }
-}
-
-/// The [`EyeWindow`] of a box: its eight corners projected through the camera's eye onto the
-/// window plane (`projection`: in `f64`, from the camera's vectors as the scalar holds them),
-/// widened by [`EYE_MARGIN`]. The image of a box wholly in front of the eye is the convex hull
-/// of its corners' images, so every eye ray that meets the box passes inside.
-fn eye_window<R: Real>(b: &Aabb<R>, projection: &Projection) -> EyeWindow {
-    let (min, max) = (b.min.cast::<f64>(), b.max.cast::<f64>());
-    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-    for p in (Aabb { min, max }).corners() {
-        // A corner on or behind the eye plane: the box's image is unbounded.
-        let Some(image) = projection.window(p) else { return WHOLE_PLANE };
-        for (a, w) in image.into_iter().enumerate() {
-            lo[a] = lo[a].min(w);
-            hi[a] = hi[a].max(w);
-        }
-    }
-    // Rounded outwards; `as` saturates, so a window beyond the i32 range only widens.
-    let (below, above) = (|w: f64| libm::floor(w * 65536.0) as i32, |w: f64| libm::ceil(w * 65536.0) as i32);
-    [
-        below(lo[0]).saturating_sub(EYE_MARGIN),
-        above(hi[0]).saturating_add(EYE_MARGIN),
-        below(lo[1]).saturating_sub(EYE_MARGIN),
-        above(hi[1]).saturating_add(EYE_MARGIN),
-    ]
-}
-
-/// Two unit vectors across the first light when it is directional (in the scalar, as the
-/// tracer projects with them): shadow rays towards it are parallel, so each object's shadow
-/// window is a rectangle in their plane.
-fn shadow_basis<R: Real>(lights: &[Light<R>]) -> Option<(Vec3<R>, Vec3<R>)> {
-    let Some(Light::Directional { to_light, .. }) = lights.first() else { return None };
-    let l = to_light.cast::<f64>().normalize();
-    let helper = if l.x.abs() < 0.9 { Vec3::new(1.0, 0.0, 0.0) } else { Vec3::new(0.0, 1.0, 0.0) };
-    let a = l.cross(helper).normalize();
-    let b = l.cross(a).normalize();
-    Some((a.cast(), b.cast()))
-}
-
-/// The [`ShadowWindow`] of a box: its corners' coordinates along `a` and `b` (the basis as
-/// the scalar holds it, in `f64`), widened by `margin`.
-fn shadow_window<R: Real>(b: &Aabb<R>, x: Vec3<f64>, y: Vec3<f64>, margin: f64) -> ShadowWindow<R> {
-    let (min, max) = (b.min.cast::<f64>(), b.max.cast::<f64>());
-    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-    for p in (Aabb { min, max }).corners() {
-        for (k, w) in [p.dot(x), p.dot(y)].into_iter().enumerate() {
-            lo[k] = lo[k].min(w);
-            hi[k] = hi[k].max(w);
-        }
-    }
-    // Rounded outwards into the scalar (beyond its range the window is unbounded there).
-    let down = |w: f64| R::from_f64(w - margin - (w.abs() + 1.0) * R::pad_eps().to_f64());
-    let up = |w: f64| R::from_f64(w + margin + (w.abs() + 1.0) * R::pad_eps().to_f64());
-    [down(lo[0]), up(hi[0]), down(lo[1]), up(hi[1])]
 }
 
 /// Whether `v` is finite and of length 1 (to rounding).

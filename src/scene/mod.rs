@@ -7,20 +7,20 @@
 //! slice, so the capacity is the caller's choice and running out is an ordinary error.
 //!
 //! Rooms: [`model`] (what a validated scene is), [`builder`] (how one is validated),
-//! [`hull`] (where on the image an object can appear), [`error`] (why one is refused) and
-//! [`text`] (the plain-text format, one function per statement).
+//! [`error`] (why one is refused) and [`text`] (the plain-text format, one function per
+//! statement). Where on the image an object can appear is [`crate::cull`]'s; the camera is
+//! [`crate::camera`]'s.
 
 pub mod builder;
 pub mod error;
-pub mod hull;
 pub mod model;
 pub mod text;
 
+pub use crate::camera::{lowest_terms, Camera, CameraDesc, FieldOfView, DEFAULT_FRAME, VIEW_MARGIN};
+pub use crate::cull::{Culled, EyeHull, EyeWindow, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE};
 pub use builder::{check_value, SceneBuilder, IOR};
 pub use error::SceneError;
-pub use hull::{EyeHull, HULL_EDGES, NO_HULL};
 pub use model::{
-    axis_normal, lowest_terms, Camera, CameraDesc, Composite, Culled, EyeWindow, FieldOfView, Light, Material, Object,
-    Parts, Scene, ShadowWindow, DEFAULT_FRAME, EYE_MARGIN, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, NO_COMPOSITE,
-    VIEW_MARGIN, WHOLE_PLANE,
+    axis_normal, Composite, Light, Material, Object, Parts, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS,
+    NO_COMPOSITE,
 };

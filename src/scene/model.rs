@@ -1,8 +1,7 @@
 //! The validated scene: objects, composites, materials, lights and the camera.
 
-use super::hull::EyeHull;
-#[cfg(feature = "eye-hulls")]
-use super::hull::NO_HULL;
+use crate::camera::Camera;
+use crate::cull::{any_object, Culled, EyeHull, EyeWindow, Region, ShadowWindow};
 use crate::math::{Aabb, Affine, Linear, Ray, Vec3};
 use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
@@ -56,253 +55,6 @@ pub enum Light<R> {
     },
 }
 
-/// A scene's field of view, in degrees.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FieldOfView {
-    /// The angle across the frame; the angle down follows from the frame's shape (square
-    /// pixels).
-    Across(f64),
-    /// A view of at least this angle across and this angle down: the frame shows all of it,
-    /// with square pixels, and more along the axis where its shape is wider than the view's
-    /// (`fov 40 25`, the paper's 160x100 window, on a 128x64 panel shows 47.9 x 25 degrees).
-    Within(f64, f64),
-}
-
-impl FieldOfView {
-    /// The paper's view: 40 x 25 degrees.
-    pub const PAPER: FieldOfView = FieldOfView::Within(40.0, 25.0);
-
-    /// The tangents of half the angle across and down for a frame of `w x h` pixels (both at
-    /// least 1): square pixels, and a [`FieldOfView::Within`] view fully inside.
-    pub fn half_tangents(self, [w, h]: [u32; 2]) -> (f64, f64) {
-        let aspect = f64::from(w.max(1)) / f64::from(h.max(1));
-        let tan = |deg: f64| libm::tan(deg * core::f64::consts::PI / 180.0 / 2.0);
-        match self {
-            FieldOfView::Across(a) => (tan(a), tan(a) / aspect),
-            FieldOfView::Within(a, d) => {
-                let (tx, ty) = (tan(a), tan(d));
-                if tx < ty * aspect {
-                    (ty * aspect, ty)
-                } else {
-                    (tx, tx / aspect)
-                }
-            }
-        }
-    }
-
-    /// The angles given, in degrees (the angle across twice for [`FieldOfView::Across`]).
-    pub fn angles(self) -> [f64; 2] {
-        match self {
-            FieldOfView::Across(a) => [a, a],
-            FieldOfView::Within(a, d) => [a, d],
-        }
-    }
-}
-
-/// The frame shape a camera is fitted to unless told otherwise: the boards' 128x64 panel.
-pub const DEFAULT_FRAME: [u32; 2] = [128, 64];
-
-/// The camera as given in a scene (eye, look-at, up, field of view in degrees), and the shape of
-/// the frame it is fitted to.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraDesc {
-    /// Viewpoint `V`.
-    pub eye: Vec3<f64>,
-    /// Point looked at.
-    pub look: Vec3<f64>,
-    /// Up direction.
-    pub up: Vec3<f64>,
-    /// The field of view (the paper's: 40 x 25 degrees).
-    pub fov: FieldOfView,
-    /// Width and height of the frame the view is fitted to, in pixels (any multiple of them
-    /// renders the same view): pixels are square, and the render refuses a frame of another
-    /// shape ([`crate::render::RenderError::FrameShape`]).
-    pub frame: [u32; 2],
-}
-
-impl CameraDesc {
-    /// The camera moved `turn` of a full circle (0..1) around the vertical line through the
-    /// point it looks at (the line along `up`): the eye keeps its height and distance, and still
-    /// looks at `look`. Frames of an orbit.
-    pub fn orbit(&self, turn: f64) -> CameraDesc {
-        if turn == 0.0 {
-            // Exactly the scene's camera (look + (eye - look) may round).
-            return *self;
-        }
-        let (sin, cos) = libm::sincos(turn * 2.0 * core::f64::consts::PI);
-        let axis = self.up.normalize();
-        let v = self.eye - self.look;
-        // Rodrigues' rotation of the eye's offset about the axis.
-        let rotated = v * cos + axis.cross(v) * sin + axis * (axis.dot(v) * (1.0 - cos));
-        CameraDesc { eye: self.look + rotated, ..*self }
-    }
-}
-
-impl Default for CameraDesc {
-    fn default() -> Self {
-        CameraDesc {
-            eye: Vec3::new(0.0, 0.0, -10.0),
-            look: Vec3::zero(),
-            up: Vec3::new(0.0, 1.0, 0.0),
-            fov: FieldOfView::PAPER,
-            frame: DEFAULT_FRAME,
-        }
-    }
-}
-
-/// The camera reduced to what eye rays need.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera<R> {
-    /// Viewpoint.
-    pub eye: Vec3<R>,
-    /// Unit view direction.
-    pub forward: Vec3<R>,
-    /// Right vector scaled by `tan(fov_x / 2)`.
-    pub right: Vec3<R>,
-    /// Up vector scaled by `tan(fov_y / 2)`.
-    pub up: Vec3<R>,
-    /// The most pixels across and down the scalar resolves through this view: neighbouring
-    /// pixels at least [`VIEW_MARGIN`] units of the scalar's last place apart (computed at
-    /// set-up, so the render checks a frame against it with integers).
-    pub resolves: [u32; 2],
-    /// The frame shape the view was fitted to, in lowest terms (`[2, 1]` for 128x64).
-    pub shape: [u32; 2],
-}
-
-/// `[w, h]` divided by their greatest common divisor (`[0, 0]` stays).
-pub fn lowest_terms([w, h]: [u32; 2]) -> [u32; 2] {
-    let (mut a, mut b) = (w, h);
-    while b != 0 {
-        (a, b) = (b, a % b);
-    }
-    match (w.checked_div(a), h.checked_div(a)) {
-        (Some(w), Some(h)) => [w, h],
-        _ => [w, h],
-    }
-}
-
-/// How many times the scalar's resolution the angle between neighbouring pixels must be: an
-/// eye ray's direction (and the eye itself, relative to its distance) is rounded to about one
-/// unit of the last place, so edges then move by at most 1/32 of a pixel.
-pub const VIEW_MARGIN: f64 = 32.0;
-
-/// The most pixels a window side of half-width `tan_half` (the tangent of half the field of
-/// view) may be divided into in `R` (see [`Camera::resolves`]).
-pub fn resolvable_pixels<R: Real>(tan_half: f64) -> u32 {
-    let n = 2.0 * tan_half / (VIEW_MARGIN * R::RESOLUTION);
-    if n >= u32::MAX as f64 {
-        u32::MAX
-    } else {
-        n as u32
-    }
-}
-
-impl<R: Real> Camera<R> {
-    /// The window position `(u, v)` of [`Camera::ray`]`(sx2, sy2, w2, h2)` in units of 2^-16,
-    /// in integers (to within one unit), for [`Object::intersect_eye_ray`].
-    pub fn window_uv(sx2: i32, sy2: i32, w2: i32, h2: i32) -> [i32; 2] {
-        [Self::window_u(sx2, w2), Self::window_v(sy2, h2)]
-    }
-
-    /// The `u` of [`Camera::window_uv`] (it depends on the horizontal position alone).
-    pub fn window_u(sx2: i32, w2: i32) -> i32 {
-        window_coord(2 * sx2 - w2, w2)
-    }
-
-    /// The `v` of [`Camera::window_uv`] (it depends on the vertical position alone).
-    pub fn window_v(sy2: i32, h2: i32) -> i32 {
-        window_coord(h2 - 2 * sy2, h2)
-    }
-
-    /// The eye ray through the point `(sx, sy)` of a `w x h` window, in pixel units from the
-    /// top-left corner (pixel centres are at `i + 0.5`).
-    pub fn ray(&self, sx2: i32, sy2: i32, w2: i32, h2: i32) -> Ray<R> {
-        self.ray_through(Self::ray_u(sx2, w2), Self::ray_v(sy2, h2))
-    }
-
-    /// The factor of `right` in the direction of [`Camera::ray`] (it depends on the horizontal
-    /// position alone). Arguments are doubled coordinates so that pixel centres stay integers.
-    #[inline]
-    pub fn ray_u(sx2: i32, w2: i32) -> R {
-        ratio::<R>(2 * sx2 - w2, w2)
-    }
-
-    /// The factor of `up` in the direction of [`Camera::ray`] (the vertical position's alone).
-    #[inline]
-    pub fn ray_v(sy2: i32, h2: i32) -> R {
-        ratio::<R>(h2 - 2 * sy2, h2)
-    }
-
-    /// The eye ray with direction `forward + right * u + up * v`.
-    #[inline]
-    pub fn ray_through(&self, u: R, v: R) -> Ray<R> {
-        self.ray_from(self.column(u), self.row(v))
-    }
-
-    /// The part of [`Camera::ray_through`]'s direction that a column of the window shares,
-    /// `forward + right * u`: a renderer keeps it per column ([`Camera::ray_from`]).
-    #[inline]
-    pub fn column(&self, u: R) -> Vec3<R> {
-        self.forward + self.right * u
-    }
-
-    /// The part of [`Camera::ray_through`]'s direction that a row of the window shares,
-    /// `up * v`.
-    #[inline]
-    pub fn row(&self, v: R) -> Vec3<R> {
-        self.up * v
-    }
-
-    /// The eye ray of a [`Camera::column`] and a [`Camera::row`]: the same ray as
-    /// [`Camera::ray_through`], the same sums in the same order, without its six products.
-    #[inline]
-    pub fn ray_from(&self, column: Vec3<R>, row: Vec3<R>) -> Ray<R> {
-        Ray::new(self.eye, column + row)
-    }
-}
-
-/// `(n << 16) / d` (`d` at least 1) truncated towards zero, clamped to `i32`: one 32-bit
-/// division while `n` is small (a microcontroller's divider does that in a few cycles), else
-/// long division in 32 bits (no 64-bit division routine linked).
-fn window_coord(n: i32, d: i32) -> i32 {
-    let d = d.max(1);
-    if n.unsigned_abs() < 1 << 15 {
-        (n << 16) / d
-    } else {
-        window_coord_far(n, d)
-    }
-}
-
-/// [`window_coord`] of a numerator of 2^15 or more (a window thousands of pixels wide), kept
-/// out of the way of the common case.
-#[cold]
-#[inline(never)]
-fn window_coord_far(n: i32, d: i32) -> i32 {
-    let (a, b) = (n.unsigned_abs(), d as u32);
-    // A whole quotient of 2^15 or more is past the clamp.
-    let q = if a / b >= 1 << 15 { u32::MAX } else { crate::fixed::shifted_quotient(a, b).0 };
-    if n < 0 {
-        if q >= 1 << 31 {
-            i32::MIN
-        } else {
-            -(q as i32)
-        }
-    } else {
-        q.min(i32::MAX as u32) as i32
-    }
-}
-
-/// `n / d` in `R`, as `from_i32(n) / from_i32(d)`; a window side that is a power of two (up to
-/// 2^14, as every board's is) divides by [`Real::div_pow2`], the same value without a division.
-#[inline]
-fn ratio<R: Real>(n: i32, d: i32) -> R {
-    if d > 0 && d <= 1 << 14 && d & (d - 1) == 0 {
-        R::from_i32(n).div_pow2(d.trailing_zeros())
-    } else {
-        R::from_i32(n) / R::from_i32(d)
-    }
-}
-
 /// One primitive placed in the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Object<R> {
@@ -340,45 +92,9 @@ pub struct Object<R> {
     /// as [`Object::intersect`] maps a ray's direction (zero otherwise): the same for every
     /// shadow ray towards that light, so it is mapped once per scene instead of once per test.
     pub(crate) light_local: Vec3<R>,
-    /// The part of the image the object can appear in, as an [`EyeWindow`].
-    pub(crate) eye_window: EyeWindow,
-    /// The same part more tightly, as an [`EyeHull`] (with the `eye-hulls` feature).
-    #[cfg(feature = "eye-hulls")]
-    pub(crate) eye_hull: EyeHull,
-    /// Where a shadow ray towards the scene's first light can meet it, as a [`ShadowWindow`].
-    pub(crate) shadow_window: ShadowWindow<R>,
+    /// Where it can appear, to each kind of ray that culling tests ([`crate::cull`]).
+    pub(crate) region: Region<R>,
 }
-
-/// Where shadow rays towards the scene's first light (when it is directional, so its rays are
-/// parallel) can meet an object: `[a_lo, a_hi, b_lo, b_hi]`, the object's padded box projected
-/// along the light onto the plane of [`Scene::shadow_basis`], widened by the rounding of that
-/// projection. A shadow ray whose origin projects outside cannot hit the object.
-pub type ShadowWindow<R> = [R; 4];
-
-/// The shadow window that culls nothing.
-pub fn shadow_whole_plane<R: Real>() -> ShadowWindow<R> {
-    [-R::MAX, R::MAX, -R::MAX, R::MAX]
-}
-
-/// Where on the image an object can appear: `[u_lo, u_hi, v_lo, v_hi]` in units of 2^-16 of
-/// the camera's window coordinates `u` and `v` (each running -1..1 across the image, as in
-/// [`Camera::ray`]), from its padded box's corners projected through the eye and widened by
-/// [`EYE_MARGIN`]. An eye ray whose `(u, v)` lies outside cannot hit the object, so its exact
-/// test is skipped: the picture is the same, the work less. A box not wholly in front of the
-/// eye gets the whole plane.
-pub type EyeWindow = [i32; 4];
-
-/// An eye ray passes outside an object's [`EyeWindow`]: it cannot hit the object.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Culled;
-
-/// The window that culls nothing.
-pub const WHOLE_PLANE: EyeWindow = [i32::MIN, i32::MAX, i32::MIN, i32::MAX];
-
-/// How far (in 2^-16 units of `u`, `v`) an eye window is widened beyond the projected box:
-/// 2^-6, about one pixel of a 128-pixel-wide image and hundreds of times the rounding of any
-/// scalar's eye-ray direction.
-pub const EYE_MARGIN: i32 = 1 << 10;
 
 impl<R: Real> Default for Object<R> {
     /// A placeholder (unit sphere at the origin) for filling storage arrays.
@@ -397,10 +113,7 @@ impl<R: Real> Default for Object<R> {
             inv_dir_scale: R::pow2(0),
             eye_local: z,
             light_local: z,
-            eye_window: WHOLE_PLANE,
-            #[cfg(feature = "eye-hulls")]
-            eye_hull: NO_HULL,
-            shadow_window: shadow_whole_plane(),
+            region: Region::everywhere(),
         }
     }
 }
@@ -427,9 +140,6 @@ impl<R> Object<R> {
         eye_hull: EyeHull,
         shadow_window: ShadowWindow<R>,
     ) -> Self {
-        // A build without the feature keeps no hull (a baked table's is dropped here).
-        #[cfg(not(feature = "eye-hulls"))]
-        let _ = eye_hull;
         Object {
             shape,
             to_object,
@@ -443,10 +153,7 @@ impl<R> Object<R> {
             inv_dir_scale,
             eye_local,
             light_local,
-            eye_window,
-            #[cfg(feature = "eye-hulls")]
-            eye_hull,
-            shadow_window,
+            region: Region::from_tables(eye_window, eye_hull, shadow_window),
         }
     }
 }
@@ -463,19 +170,15 @@ impl<R: Real> Object<R> {
     /// inclusive bounds, see [`EyeWindow`]).
     #[inline]
     pub fn eye_window_meets(&self, u: [i32; 2], v: [i32; 2]) -> bool {
-        let w = &self.eye_window;
-        w[0] <= u[1] && u[0] <= w[1] && w[2] <= v[1] && v[0] <= w[3]
+        self.region.eye_window_meets(u, v)
     }
 
     /// Whether the object can appear in the window rectangle `u` x `v` (as
     /// [`Object::eye_window_meets`] takes it): its eye window meets it, and so does its
-    /// [`EyeHull`] where the build keeps one (the `eye-hulls` feature).
+    /// [`crate::cull::EyeHull`] where the build keeps one (the `eye-hulls` feature).
     #[inline]
     pub fn eye_region_meets(&self, u: [i32; 2], v: [i32; 2]) -> bool {
-        #[cfg(feature = "eye-hulls")]
-        return self.eye_window_meets(u, v) && super::hull::hull_meets(&self.eye_hull, u, v);
-        #[cfg(not(feature = "eye-hulls"))]
-        return self.eye_window_meets(u, v);
+        self.region.eye_meets(u, v)
     }
 
     /// [`Object::intersect`] for an eye ray (its origin the camera's eye) through window
@@ -508,8 +211,12 @@ impl<R: Real> Object<R> {
     /// the light can meet the object: `w` lies in its [`ShadowWindow`].
     #[inline]
     pub fn shadow_window_holds(&self, w: [R; 2]) -> bool {
-        let sw = &self.shadow_window;
-        w[0] >= sw[0] && w[0] <= sw[1] && w[1] >= sw[2] && w[1] <= sw[3]
+        self.region.shadow_holds(w)
+    }
+
+    /// Where the object can appear ([`crate::cull`]).
+    pub fn region(&self) -> &Region<R> {
+        &self.region
     }
 
     /// A world point in object space, as the ray tests take it: relative to the object's
@@ -705,27 +412,6 @@ impl<'a, R> Scene<'a, R> {
     }
 }
 
-/// Calls `f` with each object of a mask (bit `i`: object `i`, of the first 64) that a scene of
-/// `n` objects has, lowest first, until `f` answers true; returns whether it did. The mask is
-/// taken by halves of 32 bits (a Cortex-M0+ counts and shifts 64-bit values in library calls),
-/// each cut to the objects there are; two plain loops, which the tracer's eye rays run faster
-/// than an iterator's state.
-#[inline(always)]
-pub(crate) fn any_object(mask: u64, n: usize, mut f: impl FnMut(usize) -> bool) -> bool {
-    let below = |n: usize| if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
-    for (half, base) in [(mask as u32, 0), ((mask >> 32) as u32, 32)] {
-        let mut left = half & below(n.saturating_sub(base));
-        while left != 0 {
-            let i = base + left.trailing_zeros() as usize;
-            left &= left - 1;
-            if f(i) {
-                return true;
-            }
-        }
-    }
-    false
-}
-
 impl<'a, R: Real> Scene<'a, R> {
     /// The objects (bit `i`: object `i`, for the first 64) that can appear in the window
     /// rectangle `u` x `v` (2^-16 units, inclusive bounds, see [`EyeWindow`];
@@ -784,33 +470,5 @@ impl<'a, R: Real> Scene<'a, R> {
     /// Box holding the viewpoint and every object (the paper's world range).
     pub fn world(&self) -> Aabb<R> {
         self.world
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::window_coord;
-
-    /// The window coordinate is the 64-bit quotient, truncated and clamped, for numerators
-    /// small and large (long division past 2^15) and divisors from 1 up.
-    #[test]
-    fn window_coord_is_the_wide_quotient_clamped() {
-        let wide = |n: i32, d: i32| {
-            ((i64::from(n) << 16) / i64::from(d.max(1))).clamp(i32::MIN.into(), i32::MAX.into()) as i32
-        };
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        for _ in 0..200_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            let n = (x as i32) >> (x % 31);
-            let d = ((x >> 32) as i32 >> ((x >> 40) % 31)).max(-5);
-            assert_eq!(window_coord(n, d), wide(n, d), "({n} << 16) / {d}");
-        }
-        for n in [i32::MIN, i32::MIN + 1, -(1 << 15), (1 << 15) - 1, 1 << 15, i32::MAX, 0, -1] {
-            for d in [-1, 0, 1, 2, 3, 1 << 15, (1 << 16) + 1, i32::MAX] {
-                assert_eq!(window_coord(n, d), wide(n, d), "({n} << 16) / {d}");
-            }
-        }
     }
 }

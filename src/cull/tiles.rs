@@ -98,7 +98,7 @@ impl Tiling {
         let Some((counts, lists)) = cover.split_at_mut_checked(nx * ny) else { return false };
         span_mut(counts, first * nx..end * nx).fill(0);
         for (i, o) in scene.objects().iter().enumerate() {
-            let (cols, rows) = self.met::<R>(o.eye_window);
+            let (cols, rows) = self.met::<R>(o.region.eye_window);
             for ty in rows.start.max(first)..rows.end.min(end) {
                 for tile in ty * nx + cols.start..ty * nx + cols.end {
                     let count = at_mut(counts, tile);
@@ -151,6 +151,20 @@ pub(crate) const fn lists(objects: usize) -> bool {
 /// tests each listed object's window (a few comparisons) and the objects it meets, which costs
 /// less than a walk through the cells in front of them.
 pub(crate) const LIST: usize = 16;
+
+/// The objects the eye rays of the tile at `x` (its first column and its width) and `y` can hit: those whose window meets the tile's
+/// (widened by a `block` on each side, beyond any ray the sampler shoots in the tile), on an
+/// image of `size` quarter pixels.
+pub(crate) fn tile_candidates<R: Real>(
+    scene: &Scene<'_, R>,
+    x: (usize, usize),
+    y: (usize, usize),
+    block: usize,
+    size: (i32, i32),
+) -> u64 {
+    let (u, v) = tile_window::<R>(x, y, block, size);
+    scene.eye_candidates(u, v)
+}
 
 #[cfg(test)]
 mod tests {
