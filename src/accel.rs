@@ -434,7 +434,7 @@ pub(crate) fn slack<R: Real>(ray: &Ray<R>) -> R {
 /// if the mapped x values straddle 0 and the mapped y values straddle 0 (and the box is not
 /// wholly behind the origin). The paper maps two corners; we map all eight, which makes the
 /// test conservative for any orientation, so it never rejects a box the ray really enters; each
-/// box is taken [`slack`] wider, as a lattice takes its boxes.
+/// box is taken `slack` wider, as a lattice takes its boxes.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BoundingBox;
 

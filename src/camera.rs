@@ -2,7 +2,7 @@
 //! square pixels), the camera reduced to what eye rays need ([`Camera`]), the pixel-position
 //! conversions (a pixel's doubled or quarter-pixel coordinates to a window position in 2^-16
 //! units and to a ray factor), and the per-column cache the tile loop makes its eye rays with
-//! ([`EyeRayCache`]). Every eye ray of the tracer is made here.
+//! (`EyeRayCache`). Every eye ray of the tracer is made here.
 //!
 //! Words: the camera's *window* is the plane `forward + u right + v up` with `u` and `v` each
 //! running -1..1 across the image; a *window position* is a point of it in integer units of
@@ -320,6 +320,11 @@ impl<'c, R: Real> EyeRayCache<'c, R> {
             cols: [(-1, 0, none); MAX_TILE],
             row: (-1, 0, Vec3::new(R::ZERO, R::ZERO, R::ZERO)),
         }
+    }
+
+    /// The image's size in quarter pixels, as the cache was made for.
+    pub(crate) fn size(&self) -> (i32, i32) {
+        self.size
     }
 
     /// Window position (2^-16 units) and the eye ray through `(sx, sy)`.

@@ -125,7 +125,7 @@ type Acc = [[i16; MAX_TILE + 2 * EDGE_PAD + 3]; MAX_TILE + 2];
 
 /// Columns dithered beyond each side of the image and not drawn, each row's first (or last) gray
 /// carried into them: the border columns then get and give error as every other column does.
-/// With the row's start seeded ([`row_seed`]), they keep the border columns within the
+/// With the row's start seeded (`row_seed`), they keep the border columns within the
 /// interior's spread (`error_diffusion_draws_no_seam_at_the_edges`); without them column 0 was
 /// lit too seldom or too often and columns 1 and 2 the other way (a seam).
 pub const EDGE_PAD: usize = 6;
@@ -280,7 +280,7 @@ impl<'c> Carry<'c> {
     /// columns to the next tile, the rows below to the next band, and what falls beyond the
     /// pads or the last row is dropped. A tile at the image's left (right) edge dithers the
     /// [`EDGE_PAD`] columns beyond it too, as pixels that are not drawn; at the left edge each
-    /// row starts with its [`row_seed`].
+    /// row starts with its `row_seed`.
     #[inline(always)]
     fn diffuse(
         &mut self,

@@ -44,7 +44,7 @@ impl Mul for Fx {
     type Output = Fx;
     /// `|a| * |b|` rounded half away from zero, then signed; saturates. Both factors below 1
     /// (the common case: unit vectors and normals, the objects' scaled matrices) take one
-    /// 32-bit product inline; the rest goes to [`product`].
+    /// 32-bit product inline; the rest goes to `product`.
     #[inline]
     fn mul(self, o: Fx) -> Fx {
         let neg = (self.0 ^ o.0) < 0;
@@ -86,7 +86,7 @@ fn product(a: u32, b: u32) -> i32 {
     (ah * b + al * bh + ((al * bl + 0x8000) >> 16)) as i32
 }
 
-/// [`product`] of factors both 1 or more, one of them 128 or more: the partial products summed
+/// `product` of factors both 1 or more, one of them 128 or more: the partial products summed
 /// in 64 bits (two instructions an add on a Cortex-M0+), so no step needs an overflow check.
 /// Out of line and cold: rare in a frame, and its registers would make every product save more
 /// (inlined into it where built for size, as one function is smaller).

@@ -8,7 +8,7 @@ use crate::scalar::Real;
 
 /// Where on the image an object can appear: `[u_lo, u_hi, v_lo, v_hi]` in units of 2^-16 of
 /// the camera's window coordinates `u` and `v` (each running -1..1 across the image, as in
-/// [`Camera::ray`]), from its padded box's corners projected through the eye and widened by
+/// [`crate::camera::Camera::ray`]), from its padded box's corners projected through the eye and widened by
 /// [`EYE_MARGIN`]. An eye ray whose `(u, v)` lies outside cannot hit the object, so its exact
 /// test is skipped: the picture is the same, the work less. A box not wholly in front of the
 /// eye gets the whole plane.
@@ -28,7 +28,7 @@ pub struct Culled;
 
 /// Where shadow rays towards the scene's first light (when it is directional, so its rays are
 /// parallel) can meet an object: `[a_lo, a_hi, b_lo, b_hi]`, the object's padded box projected
-/// along the light onto the plane of [`Scene::shadow_basis`], widened by the rounding of that
+/// along the light onto the plane of `Scene::shadow_basis`, widened by the rounding of that
 /// projection. A shadow ray whose origin projects outside cannot hit the object.
 pub type ShadowWindow<R> = [R; 4];
 
@@ -45,7 +45,7 @@ pub const HULL_EDGES: usize = 6;
 /// running -1..1 across the image), `a` and `b` at most 2^14 in size. Their intersection holds
 /// the image of the object's padded box widened by 2^-10 (a 16th of a pixel of a 128-pixel-wide
 /// image, 32 times the rounding of a fixed-point eye ray's direction; an eye window is widened
-/// 16 times more, [`EYE_MARGIN`](super::EYE_MARGIN)); an edge that culls nothing is
+/// 16 times more, [`EYE_MARGIN`]); an edge that culls nothing is
 /// `[0, 0, i32::MAX]` ([`NO_HULL`]).
 pub type EyeHull = [[i32; 3]; HULL_EDGES];
 
@@ -56,11 +56,11 @@ pub const NO_HULL: EyeHull = [[0, 0, i32::MAX]; HULL_EDGES];
 /// every tile's and pixel's lies well within.
 const REACH: i32 = 1 << 21;
 
-/// 2^-16 units (an [`EyeWindow`](super::EyeWindow)'s) per unit of the hull's 2^-10.
+/// 2^-16 units (an [`EyeWindow`]'s) per unit of the hull's 2^-10.
 const SHIFT: u32 = 6;
 
 /// Whether the window rectangle `u` x `v` (2^-16 units, inclusive bounds, as an
-/// [`EyeWindow`](super::EyeWindow) takes it) meets the hull: no edge has the whole rectangle
+/// [`EyeWindow`] takes it) meets the hull: no edge has the whole rectangle
 /// outside. The rectangle is rounded outwards to the hull's units.
 #[inline]
 pub fn hull_meets(hull: &EyeHull, u: [i32; 2], v: [i32; 2]) -> bool {

@@ -50,7 +50,7 @@ pub struct LatticeConfig {
     /// Whether cell starts and references may be 16-bit, two to a word, when they fit (at most
     /// 65 535 references, 32 767 objects and composites): the lattice's index memory halves.
     pub index16: bool,
-    /// Most bytes the lattice may take ([`LatticeSizes::bytes`]); building then picks the
+    /// Most bytes the lattice may take ([`LatticeSizes::bytes`](super::LatticeSizes::bytes)); building then picks the
     /// lattice of least estimated cost within it (`Lattice::choose`). `None`: the resolutions
     /// as configured (feature `budget`).
     #[cfg(feature = "budget")]

@@ -1140,7 +1140,12 @@ fn call_graph(elf: &Path) -> Result<std::collections::HashMap<String, std::colle
 pub fn float_audit(elf: &Path) -> Result<(Vec<String>, Vec<String>)> {
     let graph = call_graph(elf)?;
     let name = |m: &str| format!("{:#}", rustc_demangle::demangle(m));
-    let roots: Vec<&String> = graph.keys().filter(|k| name(k).starts_with("lattice_rt::render::render")).collect();
+    // Every render entry point and the tile loop, in whichever room of `render` it lives.
+    let root = |n: &str| {
+        n.strip_prefix("lattice_rt::render::")
+            .is_some_and(|rest| rest.rsplit("::").next().is_some_and(|f| f.starts_with("render")))
+    };
+    let roots: Vec<&String> = graph.keys().filter(|k| root(&name(k))).collect();
     if roots.is_empty() {
         bail!("no lattice_rt::render::render in {}", elf.display());
     }
