@@ -401,7 +401,13 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     if a.json {
         return print_json(&report);
     }
-    let r = &report;
+    print_stats(&report, &scene, &cfg, a);
+    Ok(())
+}
+
+/// `stats`'s report as text: the scene, its lattice, the work per eye ray and the full render.
+fn print_stats<R: Real>(r: &StatsReport, scene: &Scene<'_, R>, cfg: &LatticeConfig, a: &StatsArgs) {
+    let fx = Effects::of(scene);
     println!("scene {} ({})", r.scene, r.scalar);
     println!(
         "  objects {}, composites {}, materials {}, lights {}, depth {}",
@@ -413,7 +419,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
         println!("  {name}: {} x {} x {} cells", n[0], n[1], n[2]);
     }
     if cfg.budget.is_some() {
-        println!("  within {} bytes: {}", a.budget.unwrap_or(0), Lattice::choose(&scene, &cfg));
+        println!("  within {} bytes: {}", a.budget.unwrap_or(0), Lattice::choose(scene, cfg));
     }
     println!(
         "  lattice: {} cells, {} references, {} bytes, built in {:.3} ms",
@@ -425,7 +431,7 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     );
     for m in &r.per_eye_ray {
         if m.method == "default" {
-            let how = match Tracer::new(&scene, &BruteForce).eye_rays() {
+            let how = match Tracer::new(scene, &BruteForce).eye_rays() {
                 EyeRays::Windows => "every object's window on the image (its box projected through the eye) is tested and only the objects whose window holds the ray are intersected: no cell is walked, whichever method is chosen",
                 EyeRays::Accelerator => "the lattice is walked, skipping objects whose window on the image misses the ray",
                 EyeRays::Plain => "the method chosen answers them",
@@ -465,7 +471,6 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
         bbox / lat,
         r.identical
     );
-    Ok(())
 }
 
 /// Work per eye ray of each accelerator (answering every eye ray, then the tracer's default),

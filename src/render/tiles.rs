@@ -293,9 +293,9 @@ fn emit<D: DrawTarget<Color = BinaryColor>>(
     let TileAt { x0, y0, tw, th, .. } = at;
     match out {
         Out::Keep(store) => {
-            let mut sides = tile.sides;
-            sides.levels[..tw * th].copy_from_slice(&tile.levels[..tw * th]);
-            store[*kept] = sides;
+            let stored = &mut store[*kept];
+            *stored = tile.sides;
+            stored.levels[..tw * th].copy_from_slice(&tile.levels[..tw * th]);
             *kept += 1;
         }
         Out::Draw(target) => {

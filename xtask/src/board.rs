@@ -1127,13 +1127,23 @@ fn m3(cycles: u64) -> String {
 fn report(
     s: &Summary,
     rows: &[SceneRow],
-    (flash, static_ram, ram_code): (u64, u64, u64),
+    image: (u64, u64, u64),
     bare: &BoardRun,
     scenes: &[String],
     profile: &[(String, f64)],
 ) -> Result<String> {
     let mut md = String::new();
-    let mhz = s.clk_hz / 1e6;
+    report_intro(&mut md, scenes)?;
+    report_frames(&mut md, s, rows)?;
+    report_image(&mut md, s, image, bare)?;
+    if let (Some(first), false) = (scenes.first(), profile.is_empty()) {
+        report_profile(&mut md, first, profile)?;
+    }
+    Ok(md)
+}
+
+/// The report's first paragraph: what was built, what it ran on, what is checked.
+fn report_intro(md: &mut String, scenes: &[String]) -> Result<()> {
     writeln!(md, "# The Pico image on an emulated board\n")?;
     writeln!(md, "Written by `cargo xtask board` (also run by `.ci/run`). It builds the image")?;
     writeln!(md, "`cargo pico` flashes (`cargo pico-build`: fixed point, opt-level 2, flip-link), writes its UF2 file, and runs that")?;
@@ -1177,6 +1187,12 @@ fn report(
         "figure below is what the emulated board ran; none is computed. Scenes embedded: {}.\n",
         scenes.join(", ")
     )?;
+    Ok(())
+}
+
+/// The per-frame table and what its columns mean.
+fn report_frames(md: &mut String, s: &Summary, rows: &[SceneRow]) -> Result<()> {
+    let mhz = s.clk_hz / 1e6;
     writeln!(md, "## Per frame\n")?;
     writeln!(md, "A frame runs from the moment the board's LED (GP25) goes on to the moment it goes out with the")?;
     writeln!(
@@ -1238,6 +1254,16 @@ fn report(
             r.stack.map_or("-".to_string(), |b| format!("{b} B")),
         )?;
     }
+    Ok(())
+}
+
+/// The image's flash and RAM, the emulated time, and the run with no display on the bus.
+fn report_image(
+    md: &mut String,
+    s: &Summary,
+    (flash, static_ram, ram_code): (u64, u64, u64),
+    bare: &BoardRun,
+) -> Result<()> {
     writeln!(md, "\nImage: {flash} bytes of flash, {static_ram} bytes of static RAM: {ram_code} bytes of code copied to SRAM at boot")?;
     writeln!(
         md,
@@ -1257,39 +1283,25 @@ fn report(
         bare.led_toggles,
         bare.emulated_ms / 1e3
     )?;
-    if let (Some(first), false) = (scenes.first(), profile.is_empty()) {
-        writeln!(md, "## Where the {first} frame's time goes on core 0\n")?;
-        writeln!(
-            md,
-            "Core 0's program counter sampled every 97th instruction of the first frame (the {first}, LED on"
-        )?;
-        writeln!(
-            md,
-            "to LED off), each sample credited to the function whose code holds it (`object` reads the ELF's"
-        )?;
-        writeln!(
-            md,
-            "symbols): shares of core 0's instructions, with code the compiler inlined counted in its caller.\n"
-        )?;
-        writeln!(md, "| share | function |\n|---:|---|")?;
-        for (name, share) in profile {
-            writeln!(md, "| {:.1} % | `{name}` |", share * 100.0)?;
-        }
-        writeln!(md)?;
-    }
-    Ok(md)
+    Ok(())
 }
 
-/// The section on the silicon models: how each is derived, what each adds, and the build-time
-/// levers against the default image.
-fn silicon_report(
-    s: &Summary,
-    plain: Option<&PanelFrame>,
-    models: &[(&str, PanelFrame)],
-    alone: Option<(&PanelFrame, Option<u64>)>,
-    levers: &[(&str, &str, PanelFrame, Option<u64>)],
-) -> Result<String> {
-    let mut md = String::new();
+/// Where the first frame's time goes on core 0, by function.
+fn report_profile(md: &mut String, first: &str, profile: &[(String, f64)]) -> Result<()> {
+    writeln!(md, "## Where the {first} frame's time goes on core 0\n")?;
+    writeln!(md, "Core 0's program counter sampled every 97th instruction of the first frame (the {first}, LED on")?;
+    writeln!(md, "to LED off), each sample credited to the function whose code holds it (`object` reads the ELF's")?;
+    writeln!(md, "symbols): shares of core 0's instructions, with code the compiler inlined counted in its caller.\n")?;
+    writeln!(md, "| share | function |\n|---:|---|")?;
+    for (name, share) in profile {
+        writeln!(md, "| {:.1} % | `{name}` |", share * 100.0)?;
+    }
+    writeln!(md)?;
+    Ok(())
+}
+
+/// How each silicon model is derived from the datasheet, and what is not modelled.
+fn silicon_models(md: &mut String, s: &Summary) -> Result<()> {
     writeln!(md, "## The board as silicon runs it\n")?;
     writeln!(md, "- **Core 1** starts in the bootrom at the reset vector and waits there for the launch sequence;")?;
     writeln!(md, "  rp2040-hal's `Multicore::spawn` (PSM reset of core 1, then 0, 0, 1, vector table, stack, entry,")?;
@@ -1349,6 +1361,20 @@ fn silicon_report(
         "  SRAM banks make it rare), and the bootrom's own flash set-up (there is no SSI flash model, so the"
     )?;
     writeln!(md, "  run starts at boot2 as the bootrom leaves it).\n")?;
+    Ok(())
+}
+
+/// The section on the silicon models: how each is derived, what each adds, and the build-time
+/// levers against the default image.
+fn silicon_report(
+    s: &Summary,
+    plain: Option<&PanelFrame>,
+    models: &[(&str, PanelFrame)],
+    alone: Option<(&PanelFrame, Option<u64>)>,
+    levers: &[(&str, &str, PanelFrame, Option<u64>)],
+) -> Result<String> {
+    let mut md = String::new();
+    silicon_models(&mut md, s)?;
     let Some(plain) = plain else { return Ok(md) };
     let row = |md: &mut String, what: &str, f: &PanelFrame, base: &PanelFrame| -> Result<()> {
         writeln!(

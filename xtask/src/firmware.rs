@@ -46,257 +46,128 @@ pub const SCALARS: [(&str, &str); 4] = [
     ("f32-micromath-newton", "scalar-micromath-newton"),
 ];
 
-fn variants() -> Vec<Variant> {
-    let mut v = Vec::new();
-    for (board, target, machine, core, scalars) in [
-        (
-            "m0",
-            "thumbv6m-none-eabi",
-            "mps2-an385",
-            "Cortex-M0+ (thumbv6m, run on QEMU's Cortex-M3 board)",
-            &SCALARS[..],
-        ),
-        ("m4f", "thumbv7em-none-eabihf", "mps2-an386", "Cortex-M4F (thumbv7em-none-eabihf)", &SCALARS[..]),
-        // The Pico 2's core, in the Pico 2's scalar.
-        (
-            "m33",
-            "thumbv8m.main-none-eabihf",
-            "mps2-an505",
-            "Cortex-M33 (thumbv8m.main-none-eabihf, the Pico 2's core)",
-            &SCALARS[..1],
-        ),
-    ] {
-        for &(scalar, feature) in scalars {
-            v.push(Variant {
-                name: format!("qemu-{board}-{scalar}"),
-                target,
-                profile: if board == "m33" { "speed" } else { "release" },
-                features: ["qemu", feature].iter().filter(|f| !f.is_empty()).cloned().collect::<Vec<_>>().join(","),
-                bin: "qemu",
-                machine: Some(machine),
-                scenes: None,
-                scalar,
-                what: format!("{core}, {scalar}, all five scenes"),
-                tiny: false,
-            });
-        }
-    }
-    // The Pico 2's image bakes its scenes: its core's frame without parsing or set-up.
-    v.push(Variant {
-        name: M33_BAKED.into(),
-        target: "thumbv8m.main-none-eabihf",
-        profile: "speed",
-        features: "qemu,baked".into(),
-        bin: "qemu",
-        machine: Some("mps2-an505"),
-        scenes: None,
-        scalar: "f32",
-        what: "Cortex-M33 (the Pico 2's core), f32, all five scenes baked, as the Pico 2 image has them".into(),
-        tiny: false,
-    });
-    // And the frame the Pico 2 image renders: the panels' (16x16 tiles, two-level sampling,
-    // Floyd-Steinberg, silhouette lines), not the QEMU boards'.
-    v.push(Variant {
-        name: M33_PANEL.into(),
-        target: "thumbv8m.main-none-eabihf",
-        profile: "speed",
-        features: "qemu-machine,panel-frame,baked".into(),
-        bin: "qemu",
-        machine: Some("mps2-an505"),
-        scenes: None,
-        scalar: "f32",
-        what: "Cortex-M33 (the Pico 2's core), f32, all five scenes baked, in the Pico 2 image's own frame (the panels': 16x16 tiles, two-level sampling, Floyd-Steinberg, lines)".into(),
-        tiny: false,
-    });
-    for (scalar, feature) in [SCALARS[0], SCALARS[1]] {
-        v.push(Variant {
-            name: format!("qemu-m0-{scalar}-chair"),
-            target: "thumbv6m-none-eabi",
-            profile: "release",
-            features: format!("qemu,{feature}").trim_end_matches(',').to_string(),
-            bin: "qemu",
-            machine: Some("mps2-an385"),
-            scenes: Some("chair"),
-            scalar,
-            what: format!("Cortex-M0+, {scalar}, only the chair embedded"),
-            tiny: false,
-        });
-    }
-    // The smallest board: a BBC micro:bit (nRF51822, Cortex-M0, 16 KiB of RAM), the chair alone.
-    v.push(Variant {
-        name: "microbit-m0-fixed-chair".into(),
-        target: "thumbv6m-none-eabi",
-        profile: "release",
-        features: "microbit,scalar-fixed".into(),
-        bin: "qemu",
-        machine: Some("microbit"),
-        scenes: Some("chair"),
-        scalar: "fixed",
-        what: "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, run on QEMU's microbit machine), fixed, only the chair embedded".into(),
-        tiny: false,
-    });
-    // What adaptive sub-sampling saves: the same build tracing one eye ray per pixel.
-    v.push(Variant {
-        name: "qemu-m0-fixed-exact".into(),
-        target: "thumbv6m-none-eabi",
-        profile: "release",
-        features: "qemu,scalar-fixed,exact-sampling".into(),
-        bin: "qemu",
-        machine: Some("mps2-an385"),
-        scenes: None,
-        scalar: "fixed",
-        what: "Cortex-M0+, fixed, all five scenes, one eye ray per pixel (exact-sampling) instead of adaptive sub-sampling".into(),
-        tiny: false,
-    });
-    // What a progressive frame costs: the same build showing each frame in four passes.
-    v.push(Variant {
-        name: "qemu-m0-fixed-progressive".into(),
-        target: "thumbv6m-none-eabi",
-        profile: "release",
-        features: "qemu,scalar-fixed,progressive".into(),
-        bin: "qemu",
-        machine: Some("mps2-an385"),
-        scenes: None,
-        scalar: "fixed",
-        what: "Cortex-M0+, fixed, all five scenes, each frame in four progressive passes (8x8, 4x4, 2x2 blocks, then the frame; the last pass is the frame checked)".into(),
-        tiny: false,
-    });
-    // What the effect set saves: every effect forced in, and the matte paper scenes with their
-    // derived set against every effect (the same scenes, so the difference is the effect code).
-    // Then baked scenes: each scene and its lattice as tables in flash; nothing parsed or built.
-    let matte = Some("chair,desk,polyhedron");
-    for (name, machine, scenes, features, what) in [
-        (
-            "qemu-m0-fixed-allfx",
-            "mps2-an385",
-            None,
-            "qemu,scalar-fixed,effects-all",
-            "Cortex-M0+, fixed, all five scenes, every effect compiled in and on",
-        ),
-        (
-            "qemu-m0-fixed-matte",
-            "mps2-an385",
-            matte,
-            "qemu,scalar-fixed",
-            "Cortex-M0+, fixed, the matte paper scenes, their effects only (shadows, composites)",
-        ),
-        (
-            "qemu-m0-fixed-matte-allfx",
-            "mps2-an385",
-            matte,
-            "qemu,scalar-fixed,effects-all",
-            "Cortex-M0+, fixed, the matte paper scenes, every effect compiled in",
-        ),
-        (
-            "qemu-m0-fixed-baked",
-            "mps2-an385",
-            None,
-            "qemu,scalar-fixed,baked",
-            "Cortex-M0+, fixed, all five scenes baked into flash (no parser, set-up or lattice build linked)",
-        ),
-        (
-            "qemu-m0-fixed-baked-allfx",
-            "mps2-an385",
-            None,
-            "qemu,scalar-fixed,baked,effects-all",
-            "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on",
-        ),
-        (
-            "qemu-m0-fixed-baked-chair",
-            "mps2-an385",
-            Some("chair"),
-            "qemu,scalar-fixed,baked",
-            "Cortex-M0+, fixed, only the chair, baked",
-        ),
-        (
-            "qemu-m0-fixed-baked-matte",
-            "mps2-an385",
-            matte,
-            "qemu,scalar-fixed,baked",
-            "Cortex-M0+, fixed, the matte paper scenes baked, their effects only (shadows, composites)",
-        ),
-        (
-            "microbit-m0-fixed-baked",
-            "microbit",
-            None,
-            "microbit,scalar-fixed,baked",
-            "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, QEMU's microbit machine), fixed, all five scenes baked",
-        ),
-    ] {
-        v.push(Variant {
+impl Variant {
+    /// A build of the `qemu` binary in the `release` profile, for QEMU machine `machine`.
+    fn qemu(
+        name: impl Into<String>,
+        (target, machine): (&'static str, &'static str),
+        features: impl Into<String>,
+        scalar: &'static str,
+        what: impl Into<String>,
+    ) -> Variant {
+        Variant {
             name: name.into(),
-            target: "thumbv6m-none-eabi",
+            target,
             profile: "release",
             features: features.into(),
             bin: "qemu",
             machine: Some(machine),
-            scenes,
-            scalar: "fixed",
+            scenes: None,
+            scalar,
             what: what.into(),
             tiny: false,
-        });
+        }
     }
-    // The baked images the flash targets are about, built for size (the `small` profile:
-    // opt-level "z", and the `compact` feature: the compiler's memory helpers as small loops),
-    // for parts with little flash; their frames are
-    // run and checked like the rest.
-    for (name, scenes, features, what) in [
-        ("qemu-m0-fixed-baked-small", None, "qemu,scalar-fixed,baked,compact", "Cortex-M0+, fixed, all five scenes baked, built for size (`small` profile: opt-level \"z\", `compact` feature)"),
-        ("qemu-m0-fixed-baked-allfx-small", None, "qemu,scalar-fixed,baked,effects-all,compact", "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on, built for size"),
-        ("qemu-m0-fixed-baked-matte-small", matte, "qemu,scalar-fixed,baked,compact", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only, built for size"),
-    ] {
-        v.push(Variant {
-            name: name.into(),
-            target: "thumbv6m-none-eabi",
-            profile: "small",
-            features: features.into(),
-            bin: "qemu",
-            machine: Some("mps2-an385"),
-            scenes,
-            scalar: "fixed",
-            what: what.into(),
-            tiny: false,
-        });
-    }
-    // The smallest parts: the chair alone in 16 KiB of flash and 4 KiB of RAM, linker-enforced
-    // (tiny/memory.x).
-    v.push(Variant {
-        name: TINY.into(),
-        target: "thumbv6m-none-eabi",
-        profile: "small",
-        features: "tiny,scalar-fixed,baked,compact".into(),
-        bin: "qemu",
-        machine: Some("mps2-an385"),
-        scenes: Some("chair"),
-        scalar: "fixed",
-        what: "the smallest Cortex-M0 parts' memory (tiny/memory.x: 16 KiB of flash and 4 KiB of RAM, linker-enforced, flip-link), fixed, only the chair, baked, built for size".into(),
-        tiny: true,
-    });
-    v.push(Variant {
-        name: "pico".into(),
-        target: "thumbv6m-none-eabi",
-        profile: "release",
-        features: "pico".into(),
-        bin: "pico",
-        machine: None,
-        scenes: None,
-        scalar: "fixed",
-        what: "Raspberry Pi Pico + SSD1306, fixed, all five scenes baked (run on an emulated board by `cargo xtask board`: docs/board.md)".into(),
-        tiny: false,
-    });
-    v.push(Variant {
-        name: "pico2".into(),
-        target: "thumbv8m.main-none-eabihf",
-        profile: "speed",
-        features: "pico2".into(),
-        bin: "pico",
-        machine: None,
-        scenes: None,
-        scalar: "f32",
-        what: "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes baked (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32-baked)".into(),
-        tiny: false,
-    });
+}
+
+/// The Cortex-M0+ target and the QEMU board it runs on (a Cortex-M3 board: QEMU has no M0+ one).
+const M0: (&str, &str) = ("thumbv6m-none-eabi", "mps2-an385");
+/// The micro:bit: a Cortex-M0 with 16 KiB of RAM.
+const MICROBIT: (&str, &str) = ("thumbv6m-none-eabi", "microbit");
+/// The Pico 2's core (Cortex-M33) and QEMU's M33 board.
+const M33: (&str, &str) = ("thumbv8m.main-none-eabihf", "mps2-an505");
+/// The matte paper scenes: what the effect set saves is measured on them.
+const MATTE: Option<&str> = Some("chair,desk,polyhedron");
+
+/// A row of [`FIXED_M0`].
+type FixedRow =
+    (&'static str, (&'static str, &'static str), &'static str, Option<&'static str>, &'static str, &'static str);
+
+/// The fixed-point Cortex-M0 variants, one row each: name, board, profile, scenes (`None`: all
+/// five), features, what it is. What adaptive sampling, progressive frames and the effect set
+/// cost; baked scenes (each scene and its lattice as tables in flash, nothing parsed or built);
+/// the same built for size (the `small` profile, opt-level "z", and the `compact` feature: the
+/// compiler's memory helpers as small loops) for parts with little flash; and the smallest
+/// parts, the chair alone in 16 KiB of flash and 4 KiB of RAM (tiny/memory.x, linker-enforced).
+#[rustfmt::skip]
+const FIXED_M0: [FixedRow; 15] = [
+    ("microbit-m0-fixed-chair", MICROBIT, "release", Some("chair"), "microbit,scalar-fixed", "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, run on QEMU's microbit machine), fixed, only the chair embedded"),
+    ("qemu-m0-fixed-exact", M0, "release", None, "qemu,scalar-fixed,exact-sampling", "Cortex-M0+, fixed, all five scenes, one eye ray per pixel (exact-sampling) instead of adaptive sub-sampling"),
+    ("qemu-m0-fixed-progressive", M0, "release", None, "qemu,scalar-fixed,progressive", "Cortex-M0+, fixed, all five scenes, each frame in four progressive passes (8x8, 4x4, 2x2 blocks, then the frame; the last pass is the frame checked)"),
+    ("qemu-m0-fixed-allfx", M0, "release", None, "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, all five scenes, every effect compiled in and on"),
+    ("qemu-m0-fixed-matte", M0, "release", MATTE, "qemu,scalar-fixed", "Cortex-M0+, fixed, the matte paper scenes, their effects only (shadows, composites)"),
+    ("qemu-m0-fixed-matte-allfx", M0, "release", MATTE, "qemu,scalar-fixed,effects-all", "Cortex-M0+, fixed, the matte paper scenes, every effect compiled in"),
+    ("qemu-m0-fixed-baked", M0, "release", None, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, all five scenes baked into flash (no parser, set-up or lattice build linked)"),
+    ("qemu-m0-fixed-baked-allfx", M0, "release", None, "qemu,scalar-fixed,baked,effects-all", "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on"),
+    ("qemu-m0-fixed-baked-chair", M0, "release", Some("chair"), "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, only the chair, baked"),
+    ("qemu-m0-fixed-baked-matte", M0, "release", MATTE, "qemu,scalar-fixed,baked", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only (shadows, composites)"),
+    ("microbit-m0-fixed-baked", MICROBIT, "release", None, "microbit,scalar-fixed,baked", "BBC micro:bit (nRF51822, Cortex-M0, 16 KiB RAM, QEMU's microbit machine), fixed, all five scenes baked"),
+    ("qemu-m0-fixed-baked-small", M0, "small", None, "qemu,scalar-fixed,baked,compact", "Cortex-M0+, fixed, all five scenes baked, built for size (`small` profile: opt-level \"z\", `compact` feature)"),
+    ("qemu-m0-fixed-baked-allfx-small", M0, "small", None, "qemu,scalar-fixed,baked,effects-all,compact", "Cortex-M0+, fixed, all five scenes baked, every effect compiled in and on, built for size"),
+    ("qemu-m0-fixed-baked-matte-small", M0, "small", MATTE, "qemu,scalar-fixed,baked,compact", "Cortex-M0+, fixed, the matte paper scenes baked, their effects only, built for size"),
+    (TINY, M0, "small", Some("chair"), "tiny,scalar-fixed,baked,compact", "the smallest Cortex-M0 parts' memory (tiny/memory.x: 16 KiB of flash and 4 KiB of RAM, linker-enforced, flip-link), fixed, only the chair, baked, built for size"),
+];
+
+/// Every firmware build the report makes, in its order.
+fn variants() -> Vec<Variant> {
+    let mut v = scalar_variants();
+    v.extend(FIXED_M0.iter().map(|&(name, board, profile, scenes, features, what)| Variant {
+        profile,
+        scenes,
+        tiny: name == TINY,
+        ..Variant::qemu(name, board, features, "fixed", what)
+    }));
+    v.extend(pico_variants());
     v
+}
+
+/// Each core in each of its scalars with all five scenes; the Pico 2's core with its scenes
+/// baked and in its own frame; the chair alone on a Cortex-M0+ in f32 and fixed point.
+fn scalar_variants() -> Vec<Variant> {
+    let mut v = Vec::new();
+    for (board, target, core, scalars) in [
+        ("m0", M0, "Cortex-M0+ (thumbv6m, run on QEMU's Cortex-M3 board)", &SCALARS[..]),
+        ("m4f", ("thumbv7em-none-eabihf", "mps2-an386"), "Cortex-M4F (thumbv7em-none-eabihf)", &SCALARS[..]),
+        // The Pico 2's core, in the Pico 2's scalar.
+        ("m33", M33, "Cortex-M33 (thumbv8m.main-none-eabihf, the Pico 2's core)", &SCALARS[..1]),
+    ] {
+        for &(scalar, feature) in scalars {
+            let features = ["qemu", feature].iter().filter(|f| !f.is_empty()).cloned().collect::<Vec<_>>().join(",");
+            let what = format!("{core}, {scalar}, all five scenes");
+            let variant = Variant::qemu(format!("qemu-{board}-{scalar}"), target, features, scalar, what);
+            v.push(Variant { profile: if board == "m33" { "speed" } else { "release" }, ..variant });
+        }
+    }
+    // The Pico 2's image bakes its scenes: its core's frame without parsing or set-up.
+    let baked = "Cortex-M33 (the Pico 2's core), f32, all five scenes baked, as the Pico 2 image has them";
+    v.push(Variant { profile: "speed", ..Variant::qemu(M33_BAKED, M33, "qemu,baked", "f32", baked) });
+    // And the frame the Pico 2 image renders: the panels' (16x16 tiles, two-level sampling,
+    // Floyd-Steinberg, silhouette lines), not the QEMU boards'.
+    let panel = "Cortex-M33 (the Pico 2's core), f32, all five scenes baked, in the Pico 2 image's own frame (the panels': 16x16 tiles, two-level sampling, Floyd-Steinberg, lines)";
+    v.push(Variant {
+        profile: "speed",
+        ..Variant::qemu(M33_PANEL, M33, "qemu-machine,panel-frame,baked", "f32", panel)
+    });
+    for (scalar, feature) in [SCALARS[0], SCALARS[1]] {
+        let features = format!("qemu,{feature}").trim_end_matches(',').to_string();
+        let what = format!("Cortex-M0+, {scalar}, only the chair embedded");
+        v.push(Variant {
+            scenes: Some("chair"),
+            ..Variant::qemu(format!("qemu-m0-{scalar}-chair"), M0, features, scalar, what)
+        });
+    }
+    v
+}
+
+/// The boards' own images: built and sized here; run on the emulated board by `cargo xtask
+/// board` (the Pico), or only built (the Pico 2: no RP2350 emulator here).
+fn pico_variants() -> [Variant; 2] {
+    let pico = "Raspberry Pi Pico + SSD1306, fixed, all five scenes baked (run on an emulated board by `cargo xtask board`: docs/board.md)";
+    let pico2 = "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes baked (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32-baked)";
+    [
+        Variant { bin: "pico", machine: None, ..Variant::qemu("pico", M0, "pico", "fixed", pico) },
+        Variant { bin: "pico", machine: None, profile: "speed", ..Variant::qemu("pico2", M33, "pico2", "f32", pico2) },
+    ]
 }
 
 /// Variant `name` of [`variants`] built with `scene` alone, kept apart from the report's image
