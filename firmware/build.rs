@@ -19,6 +19,103 @@ use std::{env, fs, path::PathBuf};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
+    link(&out);
+    println!("cargo:rerun-if-changed=default-scenes.txt");
+    let names = env::var("FIRMWARE_SCENES")
+        .unwrap_or_else(|_| fs::read_to_string("default-scenes.txt").expect("default-scenes.txt"));
+    let mut list = String::new();
+    let mut sizes = Sizes { objects: 1, lattices: 1, coords: 1, words: 1, rows: 0 };
+    let mut effects = 0u8;
+    // Baked scenes: asked for (`baked`), or the Raspberry Pi boards' default: their frames are
+    // shown from the scenes' own cameras, so nothing needs parsing on the board, unless the
+    // camera moves (`orbit`) or run-time parsing is asked for (`parse`).
+    let baked = has("baked") || (has("rp") && !has("orbit") && !has("parse"));
+    println!("cargo::rustc-check-cfg=cfg(baked_scenes)");
+    if baked {
+        println!("cargo:rustc-cfg=baked_scenes");
+    }
+    let mut tables = String::new();
+    // Whether the windows answer every ray of every embedded scene (`EyeRays::serve_every_ray`):
+    // then a baked build gives its tracer brute force in place of the lattice, which it never
+    // asks (`windows_only`). The ladder's rungs walk the lattice on purpose.
+    let mut windows_only = baked && !has("ladder");
+    // The slot image embeds no scene: it reads one from flash at run time.
+    let names = if has("slot") { String::new() } else { names };
+    let scenes: Vec<(&str, PathBuf, String)> = names
+        .split(',')
+        .map(str::trim)
+        .filter(|n| !n.is_empty())
+        .map(|name| {
+            let path = PathBuf::from(format!("../scenes/{name}.scene"));
+            println!("cargo:rerun-if-changed={}", path.display());
+            let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
+            (name, path, text)
+        })
+        .collect();
+    for (name, path, text) in &scenes {
+        let (s, e, serves) = plan_in_scalar(path, text, None);
+        effects |= e;
+        windows_only &= serves;
+        sizes = sizes.max(s);
+        let abs = fs::canonicalize(path).unwrap();
+        writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
+    }
+    println!("cargo::rustc-check-cfg=cfg(windows_only)");
+    if windows_only {
+        println!("cargo:rustc-cfg=windows_only");
+    }
+    if baked {
+        // Baked once it is known whether the tracer asks the lattices: where it never does,
+        // they are left out of flash.
+        for (name, path, text) in &scenes {
+            plan_in_scalar(path, text, Some((name, !windows_only, &mut tables)));
+        }
+    }
+    if has("effects-all") {
+        effects = lattice_rt::Effects::ALL.bits();
+    }
+    if has("slot") {
+        // Room for any scene within the slot's: its rows are the frame's (any scene's), every
+        // effect compiled in (the tracer still simulates only those the scene calls for).
+        let (any, ..) = plan_in_scalar(std::path::Path::new("slot"), "sphere\n", None);
+        sizes = any.max(board_records::slot::ROOM);
+        effects = lattice_rt::Effects::ALL.bits();
+    }
+    write_capacities(&out, &list, &sizes, effects);
+    if baked {
+        let names: Vec<String> = scenes.iter().map(|(n, ..)| format!("({n:?}, &{})", table_name(n))).collect();
+        writeln!(
+            tables,
+            "/// The baked scenes, by name.\npub static BAKED: [(&str, &Baked<S>); {}] = [{}];",
+            names.len(),
+            names.join(", ")
+        )
+        .unwrap();
+        fs::write(out.join("baked.rs"), tables).unwrap();
+    }
+}
+
+/// `capacities.rs`: the embedded scenes (`list`, one `(name, text)` line each), the storage
+/// capacities they need and the effects compiled in.
+fn write_capacities(out: &std::path::Path, list: &str, sizes: &Sizes, effects: u8) {
+    let count = list.lines().count();
+    let code = format!(
+        "/// The scenes embedded in this build (`FIRMWARE_SCENES`).\n\
+         pub const SCENES: [(&str, &str); {count}] = [\n{list}];\n\
+         /// Most primitives in an embedded scene.\npub const MAX_OBJECTS: usize = {};\n\
+         /// Most lattices (world + composites).\npub const MAX_LATTICES: usize = {};\n\
+         /// Coordinate-list entries.\npub const MAX_COORDS: usize = {};\n\
+         /// Words: cells + 1, references and the mailbox.\npub const MAX_WORDS: usize = {};\n\
+         /// Render rows (dither carries, edge ids).\npub const MAX_ROWS: usize = {};\n\
+         /// Effects compiled in: those the embedded scenes call for (`Effects` bits).\npub const EFFECTS: u8 = {effects};\n",
+        sizes.objects, sizes.lattices, sizes.coords, sizes.words, sizes.rows
+    );
+    fs::write(out.join("capacities.rs"), code).unwrap();
+}
+
+/// The memory map of the board being built, the linker scripts and the link-time settings: the
+/// Pico's hot code in SRAM, defmt's log level, the core's name in reports.
+fn link(out: &std::path::Path) {
     let (pico, pico2, microbit, tiny) = (has("pico"), has("pico2"), has("microbit"), has("tiny"));
     let target = env::var("TARGET").unwrap_or_default();
     let m33 = target.starts_with("thumbv8m");
@@ -79,92 +176,6 @@ fn main() {
     println!("cargo:rerun-if-env-changed=DEFMT_LOG");
     if env::var_os("DEFMT_LOG").is_none() {
         println!("cargo:rustc-env=DEFMT_LOG=info");
-    }
-
-    println!("cargo:rerun-if-changed=default-scenes.txt");
-    let names = env::var("FIRMWARE_SCENES")
-        .unwrap_or_else(|_| fs::read_to_string("default-scenes.txt").expect("default-scenes.txt"));
-    let mut list = String::new();
-    let mut sizes = Sizes { objects: 1, lattices: 1, coords: 1, words: 1, rows: 0 };
-    let mut effects = 0u8;
-    // Baked scenes: asked for (`baked`), or the Raspberry Pi boards' default: their frames are
-    // shown from the scenes' own cameras, so nothing needs parsing on the board, unless the
-    // camera moves (`orbit`) or run-time parsing is asked for (`parse`).
-    let baked = has("baked") || (has("rp") && !has("orbit") && !has("parse"));
-    println!("cargo::rustc-check-cfg=cfg(baked_scenes)");
-    if baked {
-        println!("cargo:rustc-cfg=baked_scenes");
-    }
-    let mut tables = String::new();
-    // Whether the windows answer every ray of every embedded scene (`EyeRays::serve_every_ray`):
-    // then a baked build gives its tracer brute force in place of the lattice, which it never
-    // asks (`windows_only`). The ladder's rungs walk the lattice on purpose.
-    let mut windows_only = baked && !has("ladder");
-    // The slot image embeds no scene: it reads one from flash at run time.
-    let names = if has("slot") { String::new() } else { names };
-    let scenes: Vec<(&str, PathBuf, String)> = names
-        .split(',')
-        .map(str::trim)
-        .filter(|n| !n.is_empty())
-        .map(|name| {
-            let path = PathBuf::from(format!("../scenes/{name}.scene"));
-            println!("cargo:rerun-if-changed={}", path.display());
-            let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
-            (name, path, text)
-        })
-        .collect();
-    for (name, path, text) in &scenes {
-        let (s, e, serves) = plan_in_scalar(path, text, None);
-        effects |= e;
-        windows_only &= serves;
-        sizes = sizes.max(s);
-        let abs = fs::canonicalize(path).unwrap();
-        writeln!(list, "    ({name:?}, include_str!({:?})),", abs.display()).unwrap();
-    }
-    println!("cargo::rustc-check-cfg=cfg(windows_only)");
-    if windows_only {
-        println!("cargo:rustc-cfg=windows_only");
-    }
-    if baked {
-        // Baked once it is known whether the tracer asks the lattices: where it never does,
-        // they are left out of flash.
-        for (name, path, text) in &scenes {
-            plan_in_scalar(path, text, Some((name, !windows_only, &mut tables)));
-        }
-    }
-    let count = list.lines().count();
-    if has("effects-all") {
-        effects = lattice_rt::Effects::ALL.bits();
-    }
-    if has("slot") {
-        // Room for any scene within the slot's: its rows are the frame's (any scene's), every
-        // effect compiled in (the tracer still simulates only those the scene calls for).
-        let (any, ..) = plan_in_scalar(std::path::Path::new("slot"), "sphere\n", None);
-        sizes = any.max(board_records::slot::ROOM);
-        effects = lattice_rt::Effects::ALL.bits();
-    }
-    let code = format!(
-        "/// The scenes embedded in this build (`FIRMWARE_SCENES`).\n\
-         pub const SCENES: [(&str, &str); {count}] = [\n{list}];\n\
-         /// Most primitives in an embedded scene.\npub const MAX_OBJECTS: usize = {};\n\
-         /// Most lattices (world + composites).\npub const MAX_LATTICES: usize = {};\n\
-         /// Coordinate-list entries.\npub const MAX_COORDS: usize = {};\n\
-         /// Words: cells + 1, references and the mailbox.\npub const MAX_WORDS: usize = {};\n\
-         /// Render rows (dither carries, edge ids).\npub const MAX_ROWS: usize = {};\n\
-         /// Effects compiled in: those the embedded scenes call for (`Effects` bits).\npub const EFFECTS: u8 = {effects};\n",
-        sizes.objects, sizes.lattices, sizes.coords, sizes.words, sizes.rows
-    );
-    fs::write(out.join("capacities.rs"), code).unwrap();
-    if baked {
-        let names: Vec<String> = scenes.iter().map(|(n, ..)| format!("({n:?}, &{})", table_name(n))).collect();
-        writeln!(
-            tables,
-            "/// The baked scenes, by name.\npub static BAKED: [(&str, &Baked<S>); {}] = [{}];",
-            names.len(),
-            names.join(", ")
-        )
-        .unwrap();
-        fs::write(out.join("baked.rs"), tables).unwrap();
     }
 }
 

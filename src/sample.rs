@@ -377,38 +377,7 @@ fn adaptive<R: Real>(
     // Without the feature the branch is a constant false and its code is not linked (the
     // render refuses such frames: `RenderError::CoarseNotCompiled`).
     if cfg!(feature = "coarse-sampling") && coarse {
-        for y in coarse_lines(th) {
-            for x in coarse_lines(tw) {
-                shoot_at(shoot, levels, ids, depths, y * tw + x, centre(x, y));
-            }
-        }
-        // The pass between, row by row in pixel order.
-        for y in traced_lines(th) {
-            let ys = between(y, th);
-            for x in traced_lines(tw).filter(|&x| !(coarse_line(x, tw) && coarse_line(y, th))) {
-                let xs = between(x, tw);
-                let i = y * tw + x;
-                // Two neighbours on a coarse line, else the four corners.
-                let filled = if xs[0] == xs[1] || ys[0] == ys[1] {
-                    fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id, far| {
-                        alone(xs, ys, id, far)
-                    })
-                } else {
-                    fill(
-                        levels,
-                        ids,
-                        depths,
-                        i,
-                        [ys[0] * tw + xs[0], ys[0] * tw + xs[1], ys[1] * tw + xs[0], ys[1] * tw + xs[1]],
-                        contrast,
-                        |id, far| alone(xs, ys, id, far),
-                    )
-                };
-                if !filled {
-                    shoot_at(shoot, levels, ids, depths, i, centre(x, y));
-                }
-            }
-        }
+        coarse_pass(((x0, y0), (tw, th)), contrast, (shoot, alone), (levels, hits));
     } else {
         for y in traced_lines(th) {
             for x in traced_lines(tw) {
@@ -419,9 +388,72 @@ fn adaptive<R: Real>(
             }
         }
     }
-    // The second pass, row by row in pixel order (so rays are shot in the same order): on a
-    // traced row the pixels between two traced ones (odd columns but the last), on any other
-    // row every pixel, from the pixels above and below it or from the four corners.
+    refine((x0, y0), (tw, th), contrast, shoot, levels, hits);
+}
+
+/// Two-level sampling's first pass over a tile: the rays of the coarse lines, then on the
+/// traced lines between them each pixel filled from two or four coarse neighbours where
+/// [`fill`] allows (and `alone` says nothing else can show there), else traced.
+#[inline(always)]
+fn coarse_pass<R: Real>(
+    ((x0, y0), (tw, th)): ((usize, usize), (usize, usize)),
+    contrast: u8,
+    (shoot, alone): (
+        &mut impl FnMut(usize, usize) -> Shot<R>,
+        &mut impl FnMut([usize; 2], [usize; 2], u16, u16) -> bool,
+    ),
+    (levels, Hits { object: ids, depth: depths }): (&mut [u8; MAX_TILE * MAX_TILE], &mut Hits),
+) {
+    let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
+    for y in coarse_lines(th) {
+        for x in coarse_lines(tw) {
+            shoot_at(shoot, levels, ids, depths, y * tw + x, centre(x, y));
+        }
+    }
+    // The pass between, row by row in pixel order.
+    for y in traced_lines(th) {
+        let ys = between(y, th);
+        for x in traced_lines(tw).filter(|&x| !(coarse_line(x, tw) && coarse_line(y, th))) {
+            let xs = between(x, tw);
+            let i = y * tw + x;
+            // Two neighbours on a coarse line, else the four corners.
+            let filled = if xs[0] == xs[1] || ys[0] == ys[1] {
+                fill(levels, ids, depths, i, [ys[0] * tw + xs[0], ys[1] * tw + xs[1]], contrast, |id, far| {
+                    alone(xs, ys, id, far)
+                })
+            } else {
+                fill(
+                    levels,
+                    ids,
+                    depths,
+                    i,
+                    [ys[0] * tw + xs[0], ys[0] * tw + xs[1], ys[1] * tw + xs[0], ys[1] * tw + xs[1]],
+                    contrast,
+                    |id, far| alone(xs, ys, id, far),
+                )
+            };
+            if !filled {
+                shoot_at(shoot, levels, ids, depths, i, centre(x, y));
+            }
+        }
+    }
+}
+
+/// The second pass of adaptive sampling, row by row in pixel order (so rays are shot in the
+/// same order): on a traced row the pixels between two traced ones (odd columns but the last),
+/// on any other row every pixel, from the pixels above and below it or from the four corners.
+#[inline(always)]
+fn refine<R: Real>(
+    (x0, y0): (usize, usize),
+    (tw, th): (usize, usize),
+    contrast: u8,
+    shoot: &mut impl FnMut(usize, usize) -> Shot<R>,
+    levels: &mut [u8; MAX_TILE * MAX_TILE],
+    hits: &mut Hits,
+) {
+    let ids = &mut hits.object;
+    let depths = &mut hits.depth;
+    let centre = |x: usize, y: usize| (4 * (x0 + x) + 2, 4 * (y0 + y) + 2);
     for y in 0..th {
         let row = y * tw;
         if traced(y, th) {

@@ -18,7 +18,7 @@
 //! same. Fixed point, whose absolute precision is the same everywhere, uses
 //! `offset_eps * (1 + size)`.
 
-use crate::accel::{Accelerator, BruteForce, Query, RayKind};
+use crate::accel::{Accelerator, BruteForce, Hit, Query, RayKind};
 use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
@@ -320,7 +320,7 @@ impl EyeRays {
 /// candidates ([`Query::eye_candidates`]) in index order, each window checked again for the ray
 /// itself (as [`BruteForce`] would check every object's); objects that are no candidates are
 /// counted as culled, as their windows would have culled them.
-fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query<'_>) -> Option<crate::accel::Hit<R>> {
+fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query<'_>) -> Option<Hit<R>> {
     let n = scene.objects.len();
     if n > 64 {
         return BruteForce.nearest(scene, ray, R::ZERO, R::MAX, q);
@@ -523,7 +523,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// x86-64: the hit would come back through memory, written field by field and read in wider
     /// moves that wait for those stores to retire.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
-    fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, q: &mut Query<'_>) -> Option<crate::accel::Hit<R>> {
+    fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, q: &mut Query<'_>) -> Option<Hit<R>> {
         let found = match uv {
             Some(uv) if self.eye_rays != EyeRays::Plain => {
                 q.set_eye_ray(Some(uv));
@@ -604,57 +604,91 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 first = hit.object;
                 depth = hit.t;
             }
-            let obj = at(scene.objects, hit.object as usize);
-            let m = at(scene.materials, obj.material as usize);
-            let p = obj.surface_point(hit.point, hit.normal);
-            // Children (a mirror or a refracted ray) need the unit direction; without them only
-            // the side the ray meets is asked, which the direction as traced gives.
-            let (reflects, refracts) = self.branches(m);
-            let children = node.depth < self.max_depth && (reflects || refracts);
-            let d = if children { ray.dir.normalize() } else { ray.dir };
-            let side = facing(d, q.world_normal(scene, hit.object, hit.normal));
-            let n = side.normal;
-            // Rays off the outer side of the surface, towards where its normal points (shadow
-            // rays to lights in front, the mirror ray), leave the object: every primitive is
-            // convex, so they cannot meet it again.
-            let leaving = if side.entering { hit.object } else { NO_OBJECT };
-            let eps = R::offset(p.max_abs(), obj.size());
-            let outside = p + n * eps;
-            let mut local = scene.ambient * m.ka;
-            if m.kd > R::ZERO {
-                // Lit from outside, the point's shadow rays leave its own (convex) object.
-                q.set_leaving((leaving != NO_OBJECT).then_some(leaving));
-                for (l, light) in scene.lights.iter().enumerate() {
-                    local += self.direct(l, light, outside, n, m.kd, node.weight, q);
-                }
-                q.set_leaving(None);
-            }
-            total += node.weight.weigh(local);
-            if !children {
-                continue;
-            }
-            let child = |ray, w: R, kind, leaving| Node {
-                ray,
-                meta: Meta { weight: node.weight * w, depth: node.depth + 1, kind, leaving },
-            };
-            let cos_i = -d.dot(n);
-            let mirror = d + n * (cos_i + cos_i);
-            let mut reflect_w = if reflects { m.ks } else { R::ZERO };
-            if refracts {
-                match refract(d, n, side.eta(m.ior)) {
-                    // Total internal reflection: the transmitted share is reflected.
-                    None => reflect_w += m.kt,
-                    Some(dir) if node.weight * m.kt > self.cutoff => {
-                        let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction, NO_OBJECT));
-                    }
-                    Some(_) => {}
-                }
-            }
-            if reflect_w > R::ZERO && node.weight * reflect_w > self.cutoff {
-                let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection, leaving));
-            }
+            total += self.shade(ray, node, &hit, &mut stack, q);
         }
         (total.max(R::ZERO).min(R::ONE), first, depth)
+    }
+
+    /// A hit node's share of the pixel: its local term (ambient, and each light's direct term)
+    /// times its weight; its children (a mirror and a refracted ray, when the material has them
+    /// and the tree is not at its depth) pushed on `stack`.
+    #[inline(always)]
+    fn shade(
+        &self,
+        ray: &Ray<R>,
+        node: Meta<R>,
+        hit: &Hit<R>,
+        stack: &mut Vec<Node<R>, { MAX_DEPTH as usize + 2 }>,
+        q: &mut Query<'_>,
+    ) -> R {
+        let scene = self.scene;
+        let obj = at(scene.objects, hit.object as usize);
+        let m = at(scene.materials, obj.material as usize);
+        let p = obj.surface_point(hit.point, hit.normal);
+        // Children (a mirror or a refracted ray) need the unit direction; without them only
+        // the side the ray meets is asked, which the direction as traced gives.
+        let (reflects, refracts) = self.branches(m);
+        let children = node.depth < self.max_depth && (reflects || refracts);
+        let d = if children { ray.dir.normalize() } else { ray.dir };
+        let side = facing(d, q.world_normal(scene, hit.object, hit.normal));
+        let n = side.normal;
+        // Rays off the outer side of the surface, towards where its normal points (shadow
+        // rays to lights in front, the mirror ray), leave the object: every primitive is
+        // convex, so they cannot meet it again.
+        let leaving = if side.entering { hit.object } else { NO_OBJECT };
+        let eps = R::offset(p.max_abs(), obj.size());
+        let outside = p + n * eps;
+        let mut local = scene.ambient * m.ka;
+        if m.kd > R::ZERO {
+            // Lit from outside, the point's shadow rays leave its own (convex) object.
+            q.set_leaving((leaving != NO_OBJECT).then_some(leaving));
+            for (l, light) in scene.lights.iter().enumerate() {
+                local += self.direct(l, light, outside, n, m.kd, node.weight, q);
+            }
+            q.set_leaving(None);
+        }
+        let lit = node.weight.weigh(local);
+        if children {
+            self.push_children(node, (d, &side, p), (eps, outside, leaving), (reflects, refracts, m), stack);
+        }
+        lit
+    }
+
+    /// The children of a hit node at point `p` (the `side` of the surface the ray's direction `d`
+    /// meets):
+    /// the refracted ray from just inside, the mirror ray from `outside` (leaving `leaving`),
+    /// each pushed when its weight passes the cutoff; total internal reflection adds the
+    /// transmitted share to the mirror ray's.
+    #[inline(always)]
+    fn push_children(
+        &self,
+        node: Meta<R>,
+        (d, side, p): (Vec3<R>, &Side<R>, Vec3<R>),
+        (eps, outside, leaving): (R, Vec3<R>, u32),
+        (reflects, refracts, m): (bool, bool, &Material<R>),
+        stack: &mut Vec<Node<R>, { MAX_DEPTH as usize + 2 }>,
+    ) {
+        let n = side.normal;
+        let child = |ray, w: R, kind, leaving| Node {
+            ray,
+            meta: Meta { weight: node.weight * w, depth: node.depth + 1, kind, leaving },
+        };
+        let cos_i = -d.dot(n);
+        let mirror = d + n * (cos_i + cos_i);
+        let mut reflect_w = if reflects { m.ks } else { R::ZERO };
+        if refracts {
+            match refract(d, n, side.eta(m.ior)) {
+                // Total internal reflection: the transmitted share is reflected.
+                None => reflect_w += m.kt,
+                Some(dir) if node.weight * m.kt > self.cutoff => {
+                    let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction, NO_OBJECT));
+                }
+                Some(_) => {}
+            }
+        }
+        if reflect_w > R::ZERO && node.weight * reflect_w > self.cutoff {
+            let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection, leaving));
+        }
     }
 
     /// `Ip * Kd * max(0, L.N)` for one light, or zero if the light is behind the surface or
@@ -695,49 +729,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 _ => None,
             };
             let tried = last.filter(|&i| !q.skips(i) && (i as usize) < self.scene.objects.len());
-            if let Some(i) = tried {
-                let o = at(self.scene.objects, i as usize);
-                let hit = match across {
-                    // Outside its window the remembered occluder cannot hide the light.
-                    Some(w) if !o.shadow_window_holds(w) => None,
-                    Some(_) => {
-                        q.stats.object_tests += 1;
-                        o.intersect_first_light_ray(&ray, R::ZERO, reach)
-                    }
-                    None => {
-                        q.stats.object_tests += 1;
-                        o.intersect(&ray, R::ZERO, reach)
-                    }
-                };
-                if hit.is_some() {
-                    q.stats.hit(RayKind::Shadow, true);
-                    return R::ZERO;
-                }
+            if self.hides(tried, &ray, across, reach, q) {
+                q.stats.hit(RayKind::Shadow, true);
+                return R::ZERO;
             }
             // Missed: the search below need not test it again.
             q.set_tried(tried);
-            let hidden = match across {
-                // Towards the first light, when it is directional, a small scene's shadow rays
-                // test the objects whose shadow window holds the ray, with no walk.
-                Some(w) if self.eye_rays == EyeRays::Windows => {
-                    let found = self.shadow_by_windows(&ray, w, reach, q);
-                    q.set_occluder(l, found);
-                    found.is_some()
-                }
-                _ => {
-                    q.set_first_light_ray(across);
-                    let hidden = if self.tests_every_object() {
-                        BruteForce.occluded(self.scene, &ray, R::ZERO, reach, q)
-                    } else {
-                        self.accel.occluded(self.scene, &ray, R::ZERO, reach, q)
-                    };
-                    q.set_first_light_ray::<R>(None);
-                    // Remembered only while the light stays hidden: a lit point forgets it, so
-                    // points in the light pay no extra test.
-                    q.remember_occluder(l, hidden);
-                    hidden
-                }
-            };
+            let hidden = self.occluded(l, &ray, across, reach, q);
             q.set_tried(None);
             if hidden {
                 q.stats.hit(RayKind::Shadow, true);
@@ -745,6 +743,56 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             }
         }
         term
+    }
+
+    /// Whether object `tried` (the one that last hid the light, if any) hides it along the
+    /// shadow ray `ray` (position `across` the first light when it is directional) within
+    /// `reach`.
+    #[inline(always)]
+    fn hides(&self, tried: Option<u32>, ray: &Ray<R>, across: Option<[R; 2]>, reach: R, q: &mut Query<'_>) -> bool {
+        let Some(i) = tried else { return false };
+        let o = at(self.scene.objects, i as usize);
+        let hit = match across {
+            // Outside its window the remembered occluder cannot hide the light.
+            Some(w) if !o.shadow_window_holds(w) => None,
+            Some(_) => {
+                q.stats.object_tests += 1;
+                o.intersect_first_light_ray(ray, R::ZERO, reach)
+            }
+            None => {
+                q.stats.object_tests += 1;
+                o.intersect(ray, R::ZERO, reach)
+            }
+        };
+        hit.is_some()
+    }
+
+    /// Whether anything hides light `l` along the shadow ray `ray` within `reach`: by the shadow
+    /// windows, or by the accelerator (the occluder found remembered for the next point).
+    #[inline(always)]
+    fn occluded(&self, l: usize, ray: &Ray<R>, across: Option<[R; 2]>, reach: R, q: &mut Query<'_>) -> bool {
+        match across {
+            // Towards the first light, when it is directional, a small scene's shadow rays
+            // test the objects whose shadow window holds the ray, with no walk.
+            Some(w) if self.eye_rays == EyeRays::Windows => {
+                let found = self.shadow_by_windows(ray, w, reach, q);
+                q.set_occluder(l, found);
+                found.is_some()
+            }
+            _ => {
+                q.set_first_light_ray(across);
+                let hidden = if self.tests_every_object() {
+                    BruteForce.occluded(self.scene, ray, R::ZERO, reach, q)
+                } else {
+                    self.accel.occluded(self.scene, ray, R::ZERO, reach, q)
+                };
+                q.set_first_light_ray::<R>(None);
+                // Remembered only while the light stays hidden: a lit point forgets it, so
+                // points in the light pay no extra test.
+                q.remember_occluder(l, hidden);
+                hidden
+            }
+        }
     }
 
     /// The first object (in index order) whose shadow window holds the shadow ray's position

@@ -1,5 +1,6 @@
 //! Scenes, capacities and the render loop.
 
+use crate::schedule::{Schedule, Take, TraceTile, Traced1};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::BinaryColor;
@@ -513,68 +514,6 @@ struct DitherMemory<'m> {
     carries: &'m mut [i16],
 }
 
-/// The tiles of a frame traced, then dithered, as both cores see them: each tile's storage is
-/// free (to be traced), then done (to be dithered), then free again for the next progressive
-/// pass; `next` is the next of the frame's tiles to trace, pass after pass, each pass in raster
-/// order, so the bands finish in order.
-struct TileBoard<'l> {
-    free: [Option<Slot<'l>>; TILES],
-    done: [Option<Slot<'l>>; TILES],
-    next: usize,
-}
-
-/// One tile's storage in trace, then dither: what it keeps for its dithering, and in a
-/// progressive build its rays between passes (a build without passes keeps the board's arrays
-/// of slots at one pointer each: they are on core 0's stack).
-struct Slot<'l> {
-    kept: &'l mut KeptTile,
-    #[cfg(feature = "progressive")]
-    rays: &'l mut [Traced; TILE_RAYS],
-}
-
-impl<'l> Slot<'l> {
-    /// The slot of `kept` and `rays`.
-    #[allow(unused_variables)]
-    fn new(kept: &'l mut KeptTile, rays: &'l mut [Traced; TILE_RAYS]) -> Self {
-        Slot {
-            kept,
-            #[cfg(feature = "progressive")]
-            rays,
-        }
-    }
-
-    /// What the tile keeps and its rays (none without passes).
-    fn parts(&mut self) -> (&mut KeptTile, &mut [Traced]) {
-        #[cfg(feature = "progressive")]
-        return (&mut *self.kept, &mut self.rays[..]);
-        #[cfg(not(feature = "progressive"))]
-        (&mut *self.kept, &mut [])
-    }
-}
-
-/// What a core gets when it asks for the next tile: the tile (its pass, its index and its
-/// storage; once traced, the trace's result), or why there is none.
-enum Take<T> {
-    /// The next tile, or what tracing it gave.
-    Tile(T),
-    /// The next tile's last pass is not dithered yet: ask again.
-    Wait,
-    /// Every tile of every pass is taken.
-    Finished,
-}
-
-/// Traces one tile of a frame: pass `PASSES[p]`, the band it is in, the share that holds it
-/// alone, what it keeps, and the rays it keeps between progressive passes.
-type TraceTile<'a> = dyn FnMut(
-        &mut lattice_rt::Scratch<'_>,
-        usize,
-        Frame,
-        Share,
-        &mut [KeptTile],
-        &mut [Traced],
-    ) -> Result<Stats, RenderError<core::convert::Infallible>>
-    + 'a;
-
 /// A frame on two cores, trace then dither: the cores take the frame's tiles one at a time as
 /// they come free (`Share::single`), in raster order, and trace each into its levels
 /// (`trace_share`); core 0, between its tiles, dithers each band whose tiles are all traced,
@@ -606,60 +545,19 @@ fn trace_then_dither<
     ),
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
-    let DitherMemory { mailbox, rows, kept, rays, above, band: band_bits, carries } = memory;
-    let (t, w, h) = (frame.tile as usize, frame.width as usize, frame.height as usize);
-    let tiles_x = w.div_ceil(t).min(TILES_X);
-    let tiles = (tiles_x * h.div_ceil(t)).min(TILES).min(kept.len());
-    let mut board = TileBoard { free: [const { None }; TILES], done: [const { None }; TILES], next: 0 };
-    for (slot, (l, r)) in board.free.iter_mut().zip(kept.iter_mut().zip(rays.iter_mut())).take(tiles) {
-        *slot = Some(Slot::new(l, r));
-    }
-    let board = critical_section::Mutex::new(core::cell::RefCell::new(board));
-    // Takes the next tile if it is free, traces it and marks it done (handed over even when the
-    // trace failed, so no core waits for it).
-    let take = |scratch: &mut lattice_rt::Scratch<'_>, trace: &mut TraceTile<'_>| {
-        let taken = critical_section::with(|cs| {
-            let mut b = board.borrow(cs).borrow_mut();
-            let i = b.next;
-            if i >= PASSES.len() * tiles {
-                return Take::Finished;
-            }
-            match b.free[i % tiles].take() {
-                Some(slot) => {
-                    b.next += 1;
-                    Take::Tile((i / tiles, i % tiles, slot))
-                }
-                None => Take::Wait,
-            }
-        });
-        let (p, k, mut slot) = match taken {
-            Take::Tile(tile) => tile,
-            Take::Wait => return Take::Wait,
-            Take::Finished => return Take::Finished,
-        };
-        let (tx, ty) = (k % tiles_x, k / tiles_x);
-        let band = Frame { rows: (ty as u16, ty as u16 + 1), ..*frame };
-        let (l, r) = slot.parts();
-        let traced = trace(scratch, p, band, Share::single(tx, ty, tiles_x), core::slice::from_mut(l), r);
-        critical_section::with(|cs| board.borrow(cs).borrow_mut().done[k] = Some(slot));
-        Take::Tile(traced)
-    };
+    let DitherMemory { mailbox, rows, kept, rays, above, band, carries } = memory;
+    let schedule = FrameSchedule::new(frame, PASSES.len(), kept, rays);
     let mut there = (Stats::default(), None, 0);
     let mut here: (Stats, Result<(), AppError<'t, D::Error>>, u64) = (Stats::default(), Ok(()), 0);
     cores.join(
+        // Core 1 traces tiles until every tile of every pass is taken.
         &mut || {
             let t0 = now();
             let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-            let mut trace = |scratch: &mut lattice_rt::Scratch<'_>,
-                             p: usize,
-                             band: Frame,
-                             share: Share,
-                             l: &mut [KeptTile],
-                             r: &mut [Traced]| {
-                trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, &mut lattice_rt::NoHooks)
-            };
+            let mut no_hooks = lattice_rt::NoHooks;
+            let mut trace = tile_tracer(tracer, &mut no_hooks);
             loop {
-                match take(&mut scratch, &mut trace) {
+                match schedule.take(&mut scratch, &mut trace) {
                     Take::Tile(Ok(s)) => there.0.add(&s),
                     Take::Tile(Err(e)) => there.1 = there.1.or(Some(e)),
                     Take::Wait => core::hint::spin_loop(),
@@ -668,80 +566,18 @@ fn trace_then_dither<
             }
             there.2 = now() - t0;
         },
+        // Core 0 dithers and sends each band once its tiles are traced, and traces in between.
         &mut || {
             let t0 = now();
-            let mut trace =
-                |scratch: &mut lattice_rt::Scratch<'_>,
-                 p: usize,
-                 band: Frame,
-                 share: Share,
-                 l: &mut [KeptTile],
-                 r: &mut [Traced]| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, hooks);
-            let bands = tiles.div_ceil(tiles_x);
-            here.1 = (|| {
-                for &pass in PASSES {
-                    // Only a finished frame (a progressive one's last pass) has silhouette lines.
-                    let shows = Frame { outline: frame.outline && pass <= 1, ..*frame };
-                    let mut ditherer = Ditherer::new(frame.dither, w, &mut *carries)
-                        .ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
-                    let (mut band, mut from) = (0, 0);
-                    // The right column's hits of the last tile dithered (`dither_tiles`).
-                    let mut left = [(0, 0); lattice_rt::dither::MAX_TILE];
-                    while band < bands {
-                        // A band whose tiles are all traced, dithered and sent in one transfer,
-                        // and its tiles freed for the next pass. The frame's last band goes in
-                        // parts, its tiles traced since its last part each time: so once the last
-                        // tile is traced, what is left on the bus is its part, not the whole band
-                        // (parts of every band cost more addressing bytes than the bus had time
-                        // for in a progressive frame).
-                        let parts = band + 1 == bands && Some(&pass) == PASSES.last();
-                        let ready = critical_section::with(|cs| {
-                            let mut b = board.borrow(cs).borrow_mut();
-                            let row = &mut b.done[band * tiles_x + from..(band + 1) * tiles_x];
-                            let traced = row.iter().take_while(|r| r.is_some()).count();
-                            if traced == 0 || (traced < row.len() && !parts) {
-                                return None;
-                            }
-                            let mut out: [Option<Slot<'_>>; TILES_X] = [const { None }; TILES_X];
-                            out.iter_mut().zip(row.iter_mut()).take(traced).for_each(|(o, r)| *o = r.take());
-                            Some(out)
-                        });
-                        if let Some(mut part) = ready {
-                            let tile =
-                                |tx: usize| part.get(tx.wrapping_sub(from)).and_then(|l| l.as_ref()).map(|l| &*l.kept);
-                            let next = dither_tiles(
-                                &shows,
-                                (band, from),
-                                tile,
-                                (&mut *above, &mut *band_bits, &mut left),
-                                &mut ditherer,
-                                target,
-                            )
-                            .map_err(AppError::Render)?;
-                            critical_section::with(|cs| {
-                                let mut b = board.borrow(cs).borrow_mut();
-                                for (tx, slot) in part.iter_mut().enumerate() {
-                                    if let Some(slot) = slot.take() {
-                                        b.free[band * tiles_x + from + tx] = Some(slot);
-                                    }
-                                }
-                            });
-                            (band, from) = if next >= tiles_x { (band + 1, 0) } else { (band, next) };
-                            continue;
-                        }
-                        match take(scratch, &mut trace) {
-                            Take::Tile(traced) => here.0.add(&traced.map_err(|e| AppError::Render(e.widen()))?),
-                            Take::Wait | Take::Finished => core::hint::spin_loop(),
-                        }
-                    }
-                    shown(pass);
-                }
+            let mut trace = tile_tracer(tracer, &mut *hooks);
+            let mut dither = BandDither { frame, above: &mut *above, band: &mut *band, carries: &mut *carries };
+            here.1 = PASSES.iter().try_for_each(|&pass| {
+                dither.pass(&schedule, pass, (&mut *scratch, &mut trace, &mut here.0), &mut *target)?;
+                shown(pass);
                 Ok(())
-            })();
+            });
             if here.1.is_err() {
-                // Core 0 stops at the error: no tile of a later pass will be freed, so core 1,
-                // which may be waiting for one, is told that every tile is taken.
-                critical_section::with(|cs| board.borrow(cs).borrow_mut().next = usize::MAX);
+                schedule.stop();
             }
             here.2 = now() - t0;
         },
@@ -752,6 +588,70 @@ fn trace_then_dither<
     }
     here.0.add(&there.0);
     Ok((here.0, [there.2, here.2]))
+}
+
+/// The scheduler of [`trace_then_dither`] for this build's frame.
+type FrameSchedule<'l> = Schedule<'l, TILES, TILES_X, TILE_RAYS>;
+
+/// The one way a core traces a tile in trace, then dither: [`trace_tile`] of pass `PASSES[p]`,
+/// with `hooks` (core 0's report progress; core 1 has none).
+fn tile_tracer<'h, R: Real, A: Accelerator<R> + ?Sized>(
+    tracer: &'h Tracer<'_, '_, R, A, EFFECTS>,
+    hooks: &'h mut impl Hooks,
+) -> impl FnMut(&mut lattice_rt::Scratch<'_>, usize, Frame, Share, &mut [KeptTile], &mut [Traced]) -> Traced1 + 'h {
+    move |scratch, p, band, share, l, r| trace_tile(tracer, &band, share, PASSES[p], (l, r), scratch, hooks)
+}
+
+/// Core 0's side of trace, then dither: the bottom row's hits of the band last dithered, the
+/// band's pixels and the dither's carries.
+struct BandDither<'f, 'm> {
+    frame: &'f Frame,
+    above: &'m mut [(u16, u16)],
+    band: &'m mut [BinaryColor],
+    carries: &'m mut [i16],
+}
+
+impl BandDither<'_, '_> {
+    /// One pass of the frame: each band dithered and sent once its tiles are traced (the
+    /// frame's last band in parts, as its tiles come), its tiles freed for the next pass; while
+    /// no band is ready, core 0 traces the next tile (`work`: its scratch, its trace and its
+    /// statistics).
+    fn pass<'t, D: DrawTarget<Color = BinaryColor>>(
+        &mut self,
+        schedule: &FrameSchedule<'_>,
+        pass: u8,
+        (scratch, trace, stats): (&mut lattice_rt::Scratch<'_>, &mut TraceTile<'_>, &mut Stats),
+        target: &mut D,
+    ) -> Result<(), AppError<'t, D::Error>> {
+        let (w, tiles_x) = (self.frame.width as usize, schedule.tiles_x());
+        // Only a finished frame (a progressive one's last pass) has silhouette lines.
+        let shows = Frame { outline: self.frame.outline && pass <= 1, ..*self.frame };
+        let mut ditherer = Ditherer::new(self.frame.dither, w, &mut *self.carries)
+            .ok_or(AppError::Render(RenderError::ScratchTooSmall { needed: Carry::len(w) }))?;
+        let (mut band, mut from) = (0, 0);
+        // The right column's hits of the last tile dithered (`dither_tiles`).
+        let mut left = [(0, 0); lattice_rt::dither::MAX_TILE];
+        while band < schedule.bands() {
+            // The frame's last band goes in parts: once the last tile is traced, what is left on
+            // the bus is its part, not the whole band (parts of every band cost more addressing
+            // bytes than the bus had time for in a progressive frame).
+            let parts = band + 1 == schedule.bands() && Some(&pass) == PASSES.last();
+            let Some(mut part) = schedule.ready(band, from, parts) else {
+                match schedule.take(scratch, trace) {
+                    Take::Tile(traced) => stats.add(&traced.map_err(|e| AppError::Render(e.widen()))?),
+                    Take::Wait | Take::Finished => core::hint::spin_loop(),
+                }
+                continue;
+            };
+            let tile = |tx: usize| part.get(tx.wrapping_sub(from)).and_then(|l| l.as_ref()).map(|l| l.kept());
+            let rows = (&mut *self.above, &mut *self.band, &mut left);
+            let next =
+                dither_tiles(&shows, (band, from), tile, rows, &mut ditherer, target).map_err(AppError::Render)?;
+            schedule.free(band, from, &mut part);
+            (band, from) = if next >= tiles_x { (band + 1, 0) } else { (band, next) };
+        }
+        Ok(())
+    }
 }
 
 /// One tile traced for trace, then dither: pass `pass` of a progressive frame (`trace_pass`,

@@ -19,6 +19,7 @@ pub mod app;
 /// and check it against Rust's own slice copies.
 #[cfg(feature = "compact")]
 pub mod builtins;
+pub mod schedule;
 #[cfg(feature = "slot")]
 pub mod slot;
 pub mod stack;

@@ -105,69 +105,76 @@ pub fn export(scene: &Scene<'_, f64>, mode: PovMode) -> Result<String> {
             }
         }
     }
-    let n = scene.objects().len();
-    for (i, o) in scene.objects().iter().enumerate() {
-        // object = A (world - origin), A = to_object * unscale; so world = A^-1 object + origin.
-        let a = o.world_to_object();
-        let unrepresentable = |why: String| Unrepresentable { object: i, why };
-        let inv = a.inverse().ok_or_else(|| unrepresentable("its transform has no inverse".into()))?;
-        let m = Affine { m: inv.m };
-        for j in 0..3 {
-            let col = (0..3).map(|r| m.m[r][j].abs()).fold(0.0, f64::max);
-            if col < POV_SMALLEST {
-                return Err(unrepresentable(format!(
-                    "POV-Ray cannot represent its transform: it scales a direction by {col:e}, and POV-Ray reads a matrix column below {POV_SMALLEST:e} as a scale by zero"
-                ))
-                .into());
-            }
-        }
-        let prim = match o.shape() {
-            Shape::Sphere => "sphere { <0, 0, 0>, 1".to_string(),
-            Shape::Cylinder => "cylinder { <0, 0, 0>, <0, 1, 0>, 1".to_string(),
-            Shape::Cone { top } => format!("cone {{ <0, 0, 0>, 1, <0, 1, 0>, {top}"),
-            Shape::Box => "box { <0, 0, 0>, <1, 1, 1>".to_string(),
-        };
-        let mat = &scene.materials()[o.material() as usize];
-        let look = match mode {
-            PovMode::Ids => {
-                let [r, g, b] = id_rgb(i, n).map(|c| c as f64 / 255.0);
-                format!("pigment {{ rgb <{r:e}, {g:e}, {b:e}> }} finish {{ ambient 1 diffuse 0 }}")
-            }
-            PovMode::Full => {
-                let pig = if mat.kt > 0.0 { format!("rgbt <1, 1, 1, {}>", mat.kt) } else { "rgb 1".into() };
-                let interior = if mat.kt > 0.0 { format!(" interior {{ ior {} }}", mat.ior) } else { String::new() };
-                format!(
-                    "pigment {{ {pig} }} finish {{ ambient {} diffuse {} specular 0 phong 0 reflection {{ {} }} }}{interior}",
-                    mat.ka, mat.kd, mat.ks
-                )
-            }
-        };
-        // Shortest round-trip scientific notation: every f64 exactly, however small or large.
-        let matrix = format!(
-            "matrix <{:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}>",
-            m.m[0][0],
-            m.m[1][0],
-            m.m[2][0],
-            m.m[0][1],
-            m.m[1][1],
-            m.m[2][1],
-            m.m[0][2],
-            m.m[1][2],
-            m.m[2][2],
-            m.m[0][3] + o.origin().x,
-            m.m[1][3] + o.origin().y,
-            m.m[2][3] + o.origin().z
-        );
-        if mode == PovMode::Full && mat.kt > 0.0 {
-            // Whitted's shadow rays stop at glass; POV-Ray would let filtered light through.
-            // The visible glass casts no shadow, an invisible opaque twin casts the shadow.
-            writeln!(s, "{prim} {look} no_shadow\n  {matrix} }}")?;
-            writeln!(s, "{prim} pigment {{ rgb 0 }} no_image no_reflection\n  {matrix} }}")?;
-        } else {
-            writeln!(s, "{prim} {look}\n  {matrix} }}")?;
-        }
+    for i in 0..scene.objects().len() {
+        object(&mut s, scene, i, mode)?;
     }
     Ok(s)
+}
+
+/// Object `i` of `scene` as POV-Ray text: its primitive, its look (the material, or in an id
+/// export its id colour) and its placement as a matrix.
+fn object(s: &mut String, scene: &Scene<'_, f64>, i: usize, mode: PovMode) -> Result<()> {
+    let (o, n) = (&scene.objects()[i], scene.objects().len());
+    // object = A (world - origin), A = to_object * unscale; so world = A^-1 object + origin.
+    let a = o.world_to_object();
+    let unrepresentable = |why: String| Unrepresentable { object: i, why };
+    let inv = a.inverse().ok_or_else(|| unrepresentable("its transform has no inverse".into()))?;
+    let m = Affine { m: inv.m };
+    for j in 0..3 {
+        let col = (0..3).map(|r| m.m[r][j].abs()).fold(0.0, f64::max);
+        if col < POV_SMALLEST {
+            return Err(unrepresentable(format!(
+                "POV-Ray cannot represent its transform: it scales a direction by {col:e}, and POV-Ray reads a matrix column below {POV_SMALLEST:e} as a scale by zero"
+            ))
+            .into());
+        }
+    }
+    let prim = match o.shape() {
+        Shape::Sphere => "sphere { <0, 0, 0>, 1".to_string(),
+        Shape::Cylinder => "cylinder { <0, 0, 0>, <0, 1, 0>, 1".to_string(),
+        Shape::Cone { top } => format!("cone {{ <0, 0, 0>, 1, <0, 1, 0>, {top}"),
+        Shape::Box => "box { <0, 0, 0>, <1, 1, 1>".to_string(),
+    };
+    let mat = &scene.materials()[o.material() as usize];
+    let look = match mode {
+        PovMode::Ids => {
+            let [r, g, b] = id_rgb(i, n).map(|c| c as f64 / 255.0);
+            format!("pigment {{ rgb <{r:e}, {g:e}, {b:e}> }} finish {{ ambient 1 diffuse 0 }}")
+        }
+        PovMode::Full => {
+            let pig = if mat.kt > 0.0 { format!("rgbt <1, 1, 1, {}>", mat.kt) } else { "rgb 1".into() };
+            let interior = if mat.kt > 0.0 { format!(" interior {{ ior {} }}", mat.ior) } else { String::new() };
+            format!(
+                "pigment {{ {pig} }} finish {{ ambient {} diffuse {} specular 0 phong 0 reflection {{ {} }} }}{interior}",
+                mat.ka, mat.kd, mat.ks
+            )
+        }
+    };
+    // Shortest round-trip scientific notation: every f64 exactly, however small or large.
+    let matrix = format!(
+        "matrix <{:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}, {:e}>",
+        m.m[0][0],
+        m.m[1][0],
+        m.m[2][0],
+        m.m[0][1],
+        m.m[1][1],
+        m.m[2][1],
+        m.m[0][2],
+        m.m[1][2],
+        m.m[2][2],
+        m.m[0][3] + o.origin().x,
+        m.m[1][3] + o.origin().y,
+        m.m[2][3] + o.origin().z
+    );
+    if mode == PovMode::Full && mat.kt > 0.0 {
+        // Whitted's shadow rays stop at glass; POV-Ray would let filtered light through.
+        // The visible glass casts no shadow, an invisible opaque twin casts the shadow.
+        writeln!(s, "{prim} {look} no_shadow\n  {matrix} }}")?;
+        writeln!(s, "{prim} pigment {{ rgb 0 }} no_image no_reflection\n  {matrix} }}")?;
+    } else {
+        writeln!(s, "{prim} {look}\n  {matrix} }}")?;
+    }
+    Ok(())
 }
 
 /// Renders POV-Ray text to 8-bit gray values (`w x h`, red channel) with `povray`.

@@ -183,25 +183,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         };
         // `place` is `to_world` after an invertible group transform: checking it covers both.
         let inv = checked_inverse(&place)?;
-        let top = match shape {
-            Shape::Cone { top } => top,
-            _ => 0.0,
-        };
-        check_finite(&[top])?;
-        if top < 0.0 {
-            return Err(SceneError::NonPositiveSize);
-        }
-        // The canonical cone narrows from radius 1 at its base (the sides of its box lie at 1):
-        // one wider at its top is the cone of the top's radius turned over onto it.
-        let (shape, place, inv) = if top > 1.0 {
-            let over = Affine::translate(Vec3::new(0.0, 1.0, 0.0))
-                .after(&Affine::rotate(0, 180.0))
-                .after(&Affine::scale(Vec3::new(top, 1.0, top)));
-            let place = place.after(&over);
-            (Shape::Cone { top: 1.0 / top }, place, checked_inverse(&place)?)
-        } else {
-            (shape, place, inv)
-        };
+        let (shape, place, inv) = upright(shape, place, inv)?;
         let bounds = world_bounds(&shape, &place);
         // The padded box is what the lattice registers: it must be in range too.
         let padded = bounds.padded_for::<R>();
@@ -224,23 +206,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             Shape::Cone { top } => Shape::Cone { top: R::from_f64(top) },
             Shape::Box => Shape::Box,
         };
-        // Largest stretch of a direction into object space, rounded up to a power of two.
-        let m = &inv.m;
-        let stretch =
-            (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(0.0, f64::max);
-        let largest = m.iter().flat_map(|r| r[..3].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
-        // An object so small that its inverse transform leaves f64's comfortable range is too
-        // small for any scene (its own coordinates would overflow).
-        if !(stretch < 1e200 && largest > 1e-200) {
-            return Err(SceneError::ObjectOutOfRange {
-                object: self.len,
-                reach: f64::INFINITY,
-                limit: R::LIMIT,
-                scalar: R::NAME,
-            });
-        }
-        let dir_scale = 1.0 / pow2_at_least(stretch);
-        let unscale = pow2_at_least(largest);
+        let (dir_scale, unscale) = scales::<R>(&inv, self.len)?;
         let mut scaled = inv;
         scaled.m.iter_mut().flatten().for_each(|v| *v /= unscale);
         scaled.m.iter_mut().for_each(|row| row[3] = 0.0);
@@ -275,37 +241,13 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if self.parts.materials.is_empty() {
             self.add_material(Material::DEFAULT)?;
         }
-        let c = self.camera;
+        let c = &self.camera;
         check_range::<R>(c.eye)?;
         check_range::<R>(c.look)?;
-        let angles = c.fov.angles();
-        check_finite(&[c.up.x, c.up.y, c.up.z, angles[0], angles[1]])?;
+        check_finite(&[c.up.x, c.up.y, c.up.z, c.fov.angles()[0], c.fov.angles()[1]])?;
         check_value::<R>("ambient", self.ambient)?;
         check_value::<R>("background", self.background)?;
-        if !angles.iter().all(|a| *a > 0.0 && *a < 180.0) || c.frame.contains(&0) {
-            return Err(SceneError::BadFieldOfView);
-        }
-        let forward = (c.look - c.eye).normalize();
-        let right = forward.cross(c.up);
-        if forward.max_abs() == 0.0 || right.length() < 1e-9 * c.up.length() || c.up.max_abs() == 0.0 {
-            return Err(SceneError::DegenerateCamera);
-        }
-        // Left-handed like POV-Ray: x right, y up, z into the screen, so right = up x forward.
-        let right = -right.normalize();
-        let up = forward.cross(right).normalize();
-        if !(is_unit(forward) && is_unit(right) && is_unit(up)) {
-            // Directions so short (subnormal) or long that normalising them overflowed.
-            return Err(SceneError::DegenerateCamera);
-        }
-        let (tx, ty) = c.fov.half_tangents(c.frame);
-        let camera = Camera {
-            eye: c.eye.cast(),
-            forward: forward.cast(),
-            right: (right * tx).cast(),
-            up: (up * ty).cast(),
-            resolves: [resolvable_pixels::<R>(tx), resolvable_pixels::<R>(ty)],
-            shape: lowest_terms(c.frame),
-        };
+        let camera = camera::<R>(c)?;
         let mut world = Aabb { min: camera.eye, max: camera.eye };
         for o in &self.storage[..self.len] {
             world = world.union(&o.bounds);
@@ -326,26 +268,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let parts: &'a Parts<R> = self.parts;
         check_range::<R>(world.min.cast())?;
         check_range::<R>(world.max.cast())?;
-        // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
-        // coordinates never exceed those of the world box's corners in its space.
-        for (i, o) in objects.iter().enumerate() {
-            let inv = o.to_object.cast::<f64>();
-            let unscale = R::pow2_value(o.unscale);
-            let reach = world
-                .corners()
-                .into_iter()
-                .map(|p| (inv.vector(p.cast() - o.origin().cast()) * unscale).max_abs())
-                .fold(0.0, f64::max);
-            if reach >= R::LIMIT {
-                return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
-            }
-        }
-        for (i, o) in objects.iter().enumerate() {
-            let (size, smallest) = thickness(o);
-            if size < smallest {
-                return Err(SceneError::ObjectTooThin { object: i, size, smallest, scalar: R::NAME });
-            }
-        }
+        check_objects(objects, &world)?;
         if !(bound < R::LIMIT) {
             return Err(SceneError::TooBright { bound, limit: R::LIMIT, scalar: R::NAME });
         }
@@ -362,6 +285,107 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             shadow_basis,
         })
     }
+}
+
+/// The camera of `c` (its numbers checked finite and in range): a field of view between 0 and
+/// 180 degrees, a frame of some size, and directions that span a view.
+fn camera<R: Real>(c: &CameraDesc) -> Result<Camera<R>, SceneError> {
+    let angles = c.fov.angles();
+    if !angles.iter().all(|a| *a > 0.0 && *a < 180.0) || c.frame.contains(&0) {
+        return Err(SceneError::BadFieldOfView);
+    }
+    let forward = (c.look - c.eye).normalize();
+    let right = forward.cross(c.up);
+    if forward.max_abs() == 0.0 || right.length() < 1e-9 * c.up.length() || c.up.max_abs() == 0.0 {
+        return Err(SceneError::DegenerateCamera);
+    }
+    // Left-handed like POV-Ray: x right, y up, z into the screen, so right = up x forward.
+    let right = -right.normalize();
+    let up = forward.cross(right).normalize();
+    if !(is_unit(forward) && is_unit(right) && is_unit(up)) {
+        // Directions so short (subnormal) or long that normalising them overflowed.
+        return Err(SceneError::DegenerateCamera);
+    }
+    let (tx, ty) = c.fov.half_tangents(c.frame);
+    Ok(Camera {
+        eye: c.eye.cast(),
+        forward: forward.cast(),
+        right: (right * tx).cast(),
+        up: (up * ty).cast(),
+        resolves: [resolvable_pixels::<R>(tx), resolvable_pixels::<R>(ty)],
+        shape: lowest_terms(c.frame),
+    })
+}
+
+/// Checks each object against what the scalar can hold: its own coordinates of the world box's
+/// corners within the scalar's range, and thick enough for the scalar to resolve.
+fn check_objects<R: Real>(objects: &[Object<R>], world: &Aabb<R>) -> Result<(), SceneError> {
+    // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
+    // coordinates never exceed those of the world box's corners in its space.
+    for (i, o) in objects.iter().enumerate() {
+        let inv = o.to_object.cast::<f64>();
+        let unscale = R::pow2_value(o.unscale);
+        let reach = world
+            .corners()
+            .into_iter()
+            .map(|p| (inv.vector(p.cast() - o.origin().cast()) * unscale).max_abs())
+            .fold(0.0, f64::max);
+        if reach >= R::LIMIT {
+            return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
+        }
+    }
+    for (i, o) in objects.iter().enumerate() {
+        let (size, smallest) = thickness(o);
+        if size < smallest {
+            return Err(SceneError::ObjectTooThin { object: i, size, smallest, scalar: R::NAME });
+        }
+    }
+    Ok(())
+}
+
+/// A shape, its placement and the placement's inverse.
+type Placed = (Shape<f64>, Affine<f64>, Affine<f64>);
+
+/// A shape placed by `place` (inverse `inv`) as the canonical shapes take it: a cone's top
+/// radius checked, and a cone wider at its top than at its base turned over onto its top.
+fn upright(shape: Shape<f64>, place: Affine<f64>, inv: Affine<f64>) -> Result<Placed, SceneError> {
+    let top = match shape {
+        Shape::Cone { top } => top,
+        _ => 0.0,
+    };
+    check_finite(&[top])?;
+    if top < 0.0 {
+        return Err(SceneError::NonPositiveSize);
+    }
+    // The canonical cone narrows from radius 1 at its base (the sides of its box lie at 1):
+    // one wider at its top is the cone of the top's radius turned over onto it.
+    Ok(if top > 1.0 {
+        let over = Affine::translate(Vec3::new(0.0, 1.0, 0.0))
+            .after(&Affine::rotate(0, 180.0))
+            .after(&Affine::scale(Vec3::new(top, 1.0, top)));
+        let place = place.after(&over);
+        (Shape::Cone { top: 1.0 / top }, place, checked_inverse(&place)?)
+    } else {
+        (shape, place, inv)
+    })
+}
+
+/// For the object `object` whose world-to-object map is `inv`: the power of two its object-space
+/// directions are multiplied by (to about unit length) and the one its map is divided by (its
+/// largest entry into `(0.5, 1]`); an object so small or large that the map leaves `f64`'s
+/// comfortable range is refused.
+fn scales<R: Real>(inv: &Affine<f64>, object: usize) -> Result<(f64, f64), SceneError> {
+    // Largest stretch of a direction into object space, rounded up to a power of two.
+    let m = &inv.m;
+    let stretch =
+        (0..3).map(|i| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2])).fold(0.0, f64::max);
+    let largest = m.iter().flat_map(|r| r[..3].iter()).fold(0.0f64, |a, v| a.max(v.abs()));
+    // An object so small that its inverse transform leaves f64's comfortable range is too
+    // small for any scene (its own coordinates would overflow).
+    if !(stretch < 1e200 && largest > 1e-200) {
+        return Err(SceneError::ObjectOutOfRange { object, reach: f64::INFINITY, limit: R::LIMIT, scalar: R::NAME });
+    }
+    Ok((1.0 / pow2_at_least(stretch), pow2_at_least(largest)))
 }
 
 /// Whether `v` is finite and of length 1 (to rounding).

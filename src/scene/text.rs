@@ -258,31 +258,7 @@ pub fn parse_number(tok: &str) -> Option<f64> {
         return None;
     }
     if i < b.len() {
-        if b[i] != b'e' && b[i] != b'E' {
-            return None;
-        }
-        i += 1;
-        let eneg = match b.get(i) {
-            Some(b'-') => {
-                i += 1;
-                true
-            }
-            Some(b'+') => {
-                i += 1;
-                false
-            }
-            _ => false,
-        };
-        let (mut e, mut edigits) = (0i32, 0);
-        while i < b.len() && b[i].is_ascii_digit() {
-            e = (e * 10 + (b[i] - b'0') as i32).min(10_000);
-            edigits += 1;
-            i += 1;
-        }
-        if edigits == 0 || i < b.len() {
-            return None;
-        }
-        exp10 += if eneg { -e } else { e };
+        exp10 += exponent(&b[i..])?;
     }
     // Zero is zero whatever the exponent (`0e999` would otherwise be 0 * inf).
     if mant == 0 {
@@ -299,6 +275,22 @@ pub fn parse_number(tok: &str) -> Option<f64> {
     }
     let v = if exp10 < 0 { mant as f64 / p } else { mant as f64 * p };
     Some(if neg { -v } else { v })
+}
+
+/// The exponent part of a number, `e` or `E`, an optional sign and at least one digit (held to
+/// 10,000 in size, far past any `f64`), or `None` if `b` is anything else.
+fn exponent(b: &[u8]) -> Option<i32> {
+    let (neg, digits) = match b {
+        [b'e' | b'E', b'-', rest @ ..] => (true, rest),
+        [b'e' | b'E', b'+', rest @ ..] => (false, rest),
+        [b'e' | b'E', rest @ ..] => (false, rest),
+        _ => return None,
+    };
+    if digits.is_empty() || !digits.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let e = digits.iter().fold(0i32, |e, d| (e * 10 + (d - b'0') as i32).min(10_000));
+    Some(if neg { -e } else { e })
 }
 
 /// The words of one line with their columns.

@@ -312,29 +312,7 @@ fn scaling(md: &mut String, quick: bool, runs: usize) -> Result<Series> {
                 if !clustered && label == "lattice, nested" {
                     continue;
                 }
-                let (PerRay { time, tests, boxes, cells }, bytes, per) = match cfg {
-                    None => {
-                        let cap = (20_000_000 / n).clamp(50, all_rays.len());
-                        let rays = &all_rays[..cap];
-                        let a: &dyn Accelerator<f64> = if label == "brute force" { &BruteForce } else { &BoundingBox };
-                        let measured = per_ray(&scene, a, rays, runs);
-                        let bytes =
-                            if label == "bounding box" { n * std::mem::size_of::<lattice_rt::Aabb<f64>>() } else { 0 };
-                        (PerRay { cells: 0.0, ..measured }, bytes, String::from("-"))
-                    }
-                    Some(cfg) => {
-                        let mut bufs = lattice_storage(&scene, &cfg)?;
-                        let lat = build_lattice(&mut bufs, &scene, &cfg)?;
-                        let measured = per_ray(&scene, &lat, &all_rays, runs);
-                        let w = if lat.narrow() { 2 } else { 4 };
-                        let other = lat.bytes() - w * (lat.ref_count() + lat.cell_count() + 1);
-                        (
-                            measured,
-                            lat.bytes(),
-                            format!("{w} x {} refs + {w} x {} cells + {other}", lat.ref_count(), lat.cell_count() + 1),
-                        )
-                    }
-                };
+                let (PerRay { time, tests, boxes, cells }, bytes, per) = measure(&scene, &label, cfg, &all_rays, runs)?;
                 let us = time.as_secs_f64() * 1e6;
                 writeln!(
                     md,
@@ -351,6 +329,49 @@ fn scaling(md: &mut String, quick: bool, runs: usize) -> Result<Series> {
             host_sim::progress::log(&bar, format_args!("  {kind} N={n} done"));
         }
     }
+    scaling_summary(md, &series, &sizes)?;
+    stadium_scaling(md, if quick { [100, 1000] } else { [1_000, 100_000] }, runs)?;
+    Ok(series)
+}
+
+/// One method's work per eye ray on `scene` (`cfg`: a lattice's configuration, `None` for brute
+/// force and bounding boxes, which answer fewer rays at large N), its bytes, and how the
+/// lattice's bytes divide.
+fn measure(
+    scene: &lattice_rt::Scene<'_, f64>,
+    label: &str,
+    cfg: Option<LatticeConfig>,
+    all_rays: &[lattice_rt::Ray<f64>],
+    runs: usize,
+) -> Result<(PerRay, usize, String)> {
+    let n = scene.objects().len();
+    Ok(match cfg {
+        None => {
+            let cap = (20_000_000 / n).clamp(50, all_rays.len());
+            let rays = &all_rays[..cap];
+            let a: &dyn Accelerator<f64> = if label == "brute force" { &BruteForce } else { &BoundingBox };
+            let measured = per_ray(scene, a, rays, runs);
+            let bytes = if label == "bounding box" { n * std::mem::size_of::<lattice_rt::Aabb<f64>>() } else { 0 };
+            (PerRay { cells: 0.0, ..measured }, bytes, String::from("-"))
+        }
+        Some(cfg) => {
+            let mut bufs = lattice_storage(scene, &cfg)?;
+            let lat = build_lattice(&mut bufs, scene, &cfg)?;
+            let measured = per_ray(scene, &lat, all_rays, runs);
+            let w = if lat.narrow() { 2 } else { 4 };
+            let other = lat.bytes() - w * (lat.ref_count() + lat.cell_count() + 1);
+            (
+                measured,
+                lat.bytes(),
+                format!("{w} x {} refs + {w} x {} cells + {other}", lat.ref_count(), lat.cell_count() + 1),
+            )
+        }
+    })
+}
+
+/// The scaling section's sentences: the lattice against bounding boxes, time against N, the
+/// clustered scenes' three lattices, and the scaling target.
+fn scaling_summary(md: &mut String, series: &Series, sizes: &[usize]) -> Result<()> {
     let at = |key: &str, n: f64| {
         series.iter().find(|(k, _)| k == key).and_then(|(_, v)| v.iter().find(|p| p.0 == n)).map(|p| p.1)
     };
@@ -380,8 +401,7 @@ fn scaling(md: &mut String, quick: bool, runs: usize) -> Result<Series> {
         let met = if b / a <= SCALING_TARGET { "met" } else { "not met" };
         writeln!(md, "Scaling target (the default nested lattice, clustered): us per ray at N = {big} is {:.2}x that at N = 1 000 (target: at most {SCALING_TARGET}x, {met}). This scene's sparse tenth is spread over a stadium whose side grows as the cube root of N, so from N = 1 000 to 100 000 an eye ray crosses about 100^(1/3) = 4.6 times as many cells, and passes as many more objects (cells per ray above): the growth is the scene's, and no lattice removes it. The fixed stadium below keeps the stadium and grows only the cluster.", b / a)?;
     }
-    stadium_scaling(md, if quick { [100, 1000] } else { [1_000, 100_000] }, runs)?;
-    Ok(series)
+    Ok(())
 }
 
 /// The teapot in a fixed stadium ([`stadium`]: only the cluster grows, the floor, the ring of

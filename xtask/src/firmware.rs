@@ -576,33 +576,7 @@ fn baked_section(
         writeln!(md, "Parsed at run time the same five scenes take {f} B of flash and {r} B of RAM.")?;
     }
     if let Some((v, r)) = run("qemu-m0-fixed-baked-allfx") {
-        let parts = flash_parts(&elf_path(root, v))?;
-        writeln!(md, "\nWhere the {allfx} B of `qemu-m0-fixed-baked-allfx` go (symbol sizes from its ELF):\n\n| part | bytes |\n|---|---:|")?;
-        for (part, bytes) in parts.into_iter().filter(|p| p.1 > 0) {
-            writeln!(md, "| {part} | {bytes} |")?;
-        }
-        // The tables' parts: the objects, each scene's header, and its composites, materials
-        // and lights (exactly as many as it has).
-        let (mut objects, mut lists) = (0, 0);
-        for s in &r.scenes {
-            let text = host_sim::load::read(&root.join("scenes").join(format!("{}.scene", s.name)))?;
-            let mut storage = host_sim::load::object_storage::<lattice_rt::Fx>(&text)?;
-            let scene = lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage.objects, &mut storage.parts)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?;
-            objects += scene.objects().len();
-            lists += size_of_val(scene.composites()) + size_of_val(scene.materials()) + size_of_val(scene.lights());
-        }
-        // A `Baked` holds slices (pointers): its size is the target's, from the ELF's symbols.
-        let baked = baked_static_bytes(&elf_path(root, v))? / r.scenes.len().max(1) as u64;
-        let object = size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>();
-        writeln!(
-            md,
-            "\nOf the tables, the {objects} objects take {objects} x {object} = {} B, the {} scenes' `Baked` statics\n{} x {baked} = {} B (each scene's camera, world box and lattice header, and slices of its\ncomposites, materials and lights) and those lists {lists} B; the rest are the lattices (cells,\nreferences, coordinate lists) and constants.",
-            objects * object,
-            r.scenes.len(),
-            r.scenes.len(),
-            r.scenes.len() as u64 * baked
-        )?;
+        baked_flash_parts(md, root, v, r, allfx)?;
     }
     let mb = "microbit-m0-fixed-baked";
     if let Some((_, r)) = run(mb) {
@@ -617,6 +591,39 @@ fn baked_section(
             r.statics + r.stack
         )?;
     }
+    Ok(())
+}
+
+/// Where the flash of the baked all-effects image `v` (run `r`, `allfx` bytes) goes: its
+/// parts by symbol, then the tables' objects, `Baked` statics and lists.
+fn baked_flash_parts(md: &mut String, root: &Path, v: &Variant, r: &Run, allfx: u64) -> Result<()> {
+    let parts = flash_parts(&elf_path(root, v))?;
+    writeln!(md, "\nWhere the {allfx} B of `qemu-m0-fixed-baked-allfx` go (symbol sizes from its ELF):\n\n| part | bytes |\n|---|---:|")?;
+    for (part, bytes) in parts.into_iter().filter(|p| p.1 > 0) {
+        writeln!(md, "| {part} | {bytes} |")?;
+    }
+    // The tables' parts: the objects, each scene's header, and its composites, materials
+    // and lights (exactly as many as it has).
+    let (mut objects, mut lists) = (0, 0);
+    for s in &r.scenes {
+        let text = host_sim::load::read(&root.join("scenes").join(format!("{}.scene", s.name)))?;
+        let mut storage = host_sim::load::object_storage::<lattice_rt::Fx>(&text)?;
+        let scene = lattice_rt::parse::<lattice_rt::Fx>(&text, &mut storage.objects, &mut storage.parts)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", s.name))?;
+        objects += scene.objects().len();
+        lists += size_of_val(scene.composites()) + size_of_val(scene.materials()) + size_of_val(scene.lights());
+    }
+    // A `Baked` holds slices (pointers): its size is the target's, from the ELF's symbols.
+    let baked = baked_static_bytes(&elf_path(root, v))? / r.scenes.len().max(1) as u64;
+    let object = size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>();
+    writeln!(
+        md,
+        "\nOf the tables, the {objects} objects take {objects} x {object} = {} B, the {} scenes' `Baked` statics\n{} x {baked} = {} B (each scene's camera, world box and lattice header, and slices of its\ncomposites, materials and lights) and those lists {lists} B; the rest are the lattices (cells,\nreferences, coordinate lists) and constants.",
+        objects * object,
+        r.scenes.len(),
+        r.scenes.len(),
+        r.scenes.len() as u64 * baked
+    )?;
     Ok(())
 }
 

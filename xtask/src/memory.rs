@@ -193,37 +193,7 @@ fn sweep(scene: &Scene<'_, f64>, name: &str, runs: usize, md: &mut String) -> Re
         scene.composites().len()
     )?;
     writeln!(md, "| budget (bytes) | lattice built | bytes | us/ray | x automatic | object tests/ray | cells/ray |\n|---:|---|---:|---:|---:|---:|---:|")?;
-    for (i, label) in [(0, "brute force"), (1, "bounding boxes")] {
-        let x = m[i];
-        writeln!(md, "| 0 | none: {label} | 0 | {:.3} | {:.2} | {:.2} | - |", x.us(), x.us() / auto_m.us(), x.tests)?;
-    }
-    let (mut time_points, mut test_points) = (Vec::new(), Vec::new());
-    for r in &rows {
-        let x = m[r.method];
-        let what = match &r.choice {
-            None => "none fits: bounding boxes".to_string(),
-            Some(c) => short(c),
-        };
-        let bytes = methods[r.method].bytes;
-        let mark = if r.budget == quarter {
-            " (a quarter of automatic)"
-        } else if r.budget == auto_wide_bytes / 4 {
-            " (a quarter of automatic with 32-bit indices)"
-        } else {
-            ""
-        };
-        writeln!(
-            md,
-            "| {}{mark} | {what} | {bytes} | {:.3} | {:.2} | {:.2} | {} |",
-            r.budget,
-            x.us(),
-            x.us() / auto_m.us(),
-            x.tests,
-            if r.choice.is_some() { format!("{:.1}", x.cells) } else { "-".into() }
-        )?;
-        time_points.push((r.budget as f64, x.us() / auto_m.us()));
-        test_points.push((r.budget as f64, x.tests));
-    }
+    let (time_points, test_points) = sweep_rows(md, &m, &methods, &rows, [quarter, auto_wide_bytes / 4])?;
     writeln!(md)?;
     let at = |budget: usize| {
         let r = rows.iter().find(|r| r.budget == budget).expect("the quarter budgets are swept");
@@ -241,6 +211,53 @@ fn sweep(scene: &Scene<'_, f64>, name: &str, runs: usize, md: &mut String) -> Re
     };
     let quarters = [at(quarter), at(auto_wide_bytes / 4)];
     Ok(Summary { name: name.into(), auto, auto_wide_bytes, quarters, time_points, test_points })
+}
+
+/// The sweep's table rows: brute force and bounding boxes, then the lattice built within each
+/// budget (`marks`: the budgets of a quarter of the automatic lattice, with 16- and 32-bit
+/// indices), each against the automatic lattice (method 2). Returns the points of the time and
+/// the tests plotted against the budget.
+#[allow(clippy::type_complexity)]
+fn sweep_rows(
+    md: &mut String,
+    m: &[Measured],
+    methods: &[Method<'_>],
+    rows: &[Row],
+    [quarter, wide_quarter]: [usize; 2],
+) -> Result<(Vec<(f64, f64)>, Vec<(f64, f64)>)> {
+    let auto_m = m[2];
+    for (i, label) in [(0, "brute force"), (1, "bounding boxes")] {
+        let x = m[i];
+        writeln!(md, "| 0 | none: {label} | 0 | {:.3} | {:.2} | {:.2} | - |", x.us(), x.us() / auto_m.us(), x.tests)?;
+    }
+    let (mut time_points, mut test_points) = (Vec::new(), Vec::new());
+    for r in rows {
+        let x = m[r.method];
+        let what = match &r.choice {
+            None => "none fits: bounding boxes".to_string(),
+            Some(c) => short(c),
+        };
+        let bytes = methods[r.method].bytes;
+        let mark = if r.budget == quarter {
+            " (a quarter of automatic)"
+        } else if r.budget == wide_quarter {
+            " (a quarter of automatic with 32-bit indices)"
+        } else {
+            ""
+        };
+        writeln!(
+            md,
+            "| {}{mark} | {what} | {bytes} | {:.3} | {:.2} | {:.2} | {} |",
+            r.budget,
+            x.us(),
+            x.us() / auto_m.us(),
+            x.tests,
+            if r.choice.is_some() { format!("{:.1}", x.cells) } else { "-".into() }
+        )?;
+        time_points.push((r.budget as f64, x.us() / auto_m.us()));
+        test_points.push((r.budget as f64, x.tests));
+    }
+    Ok((time_points, test_points))
 }
 
 /// The lattice `Lattice::choose` picks within each budget: every distinct lattice of the sweep

@@ -113,6 +113,28 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     for f in ["index.html", "app.js", "style.css"] {
         copy(&web.join(f), &staging.join(f))?;
     }
+    board_files(root, &staging, no_build)?;
+    let scenes: Vec<String> = host_sim::shared::default_scene_paths()
+        .iter()
+        .map(|p| p.file_stem().expect("scenes/<name>.scene").to_string_lossy().into_owned())
+        .collect();
+    let board = serde_json::json!({ "uf2": "pico.uf2", "slotUf2": "pico-slot.uf2", "bootrom": "bootrom-b1.bin", "scenes": scenes });
+    std::fs::write(staging.join("board.json"), board.to_string()).context("cannot write board.json")?;
+    let cost = cost_fit(root)?;
+    std::fs::write(staging.join("cost.json"), cost.to_string()).context("cannot write cost.json")?;
+    if out.exists() {
+        std::fs::remove_dir_all(out).with_context(|| format!("cannot remove the old {}", out.display()))?;
+    }
+    std::fs::rename(&staging, out)
+        .with_context(|| format!("cannot move {} to {}", staging.display(), out.display()))?;
+    Ok(())
+}
+
+/// The emulated board's files in `staging`: its worker bundled by esbuild, the Pico image and
+/// the slot image as UF2 files (built, or as the last build left them with `no_build`), and
+/// the RP2040 bootrom.
+fn board_files(root: &Path, staging: &Path, no_build: bool) -> Result<()> {
+    let web = root.join("playground/web");
     let npm_dir = root.join("playground");
     if !npm_dir.join("node_modules/esbuild/package.json").exists() {
         eprintln!("installing esbuild and puppeteer-core (npm ci in playground)");
@@ -139,19 +161,6 @@ fn build(root: &Path, out: &Path, no_build: bool) -> Result<()> {
     };
     host_sim::uf2::write_uf2(&slot, &staging.join("pico-slot.uf2"))?;
     copy(&bootrom, &staging.join("bootrom-b1.bin"))?;
-    let scenes: Vec<String> = host_sim::shared::default_scene_paths()
-        .iter()
-        .map(|p| p.file_stem().expect("scenes/<name>.scene").to_string_lossy().into_owned())
-        .collect();
-    let board = serde_json::json!({ "uf2": "pico.uf2", "slotUf2": "pico-slot.uf2", "bootrom": "bootrom-b1.bin", "scenes": scenes });
-    std::fs::write(staging.join("board.json"), board.to_string()).context("cannot write board.json")?;
-    let cost = cost_fit(root)?;
-    std::fs::write(staging.join("cost.json"), cost.to_string()).context("cannot write cost.json")?;
-    if out.exists() {
-        std::fs::remove_dir_all(out).with_context(|| format!("cannot remove the old {}", out.display()))?;
-    }
-    std::fs::rename(&staging, out)
-        .with_context(|| format!("cannot move {} to {}", staging.display(), out.display()))?;
     Ok(())
 }
 

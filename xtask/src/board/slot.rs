@@ -68,6 +68,56 @@ fn message_frame(message: &str) -> Vec<u8> {
     bits
 }
 
+/// The slot cases: the user's scene, the slot image alone, the user's file corrupted, and two
+/// scenes written past the host's check (too many objects, a misspelt attribute), each with
+/// what the board must show.
+fn cases(image: &[u8]) -> Result<[Case; 5]> {
+    let too_big: String = std::iter::once("camera eye 0 4 -30\n".to_string())
+        .chain((0..70).map(|i| format!("sphere center {} {} 0 radius 0.4\n", i % 10 - 5, i / 10)))
+        .collect();
+    let mistake = "camera eye 0 1 -6\nsphere raduis 1\n";
+    let user = slot::with::scene(image, USER_SCENE).map_err(|e| anyhow::anyhow!("the user's scene: {e}"))?;
+    // The user's file with the first byte of its scene changed after it was written: the
+    // slot's first block carries the header, then the text.
+    let mut corrupt = user.clone();
+    let first_slot_block = corrupt.len() / slot::uf2::BLOCK - slot::uf2::slot_blocks(USER_SCENE.as_bytes());
+    corrupt[first_slot_block * slot::uf2::BLOCK + 32 + slot::HEADER] ^= 0x20;
+    let (stored, mut damaged) = (slot::checksum(USER_SCENE.as_bytes()), USER_SCENE.as_bytes().to_vec());
+    damaged[0] ^= 0x20;
+    Ok([
+        Case {
+            name: "user",
+            what: "a scene of the user's (`host-sim uf2 --scene`)",
+            uf2: user,
+            expect: Expect::Frame(USER_SCENE),
+        },
+        Case {
+            name: "empty",
+            what: "the slot image alone (nothing in its slot)",
+            uf2: image.to_vec(),
+            expect: Expect::Message(SlotError::Empty.to_string()),
+        },
+        Case {
+            name: "corrupt",
+            what: "the user's file with a byte of its scene changed",
+            uf2: corrupt,
+            expect: Expect::Message(SlotError::Corrupt { stored, computed: slot::checksum(&damaged) }.to_string()),
+        },
+        Case {
+            name: "too-big",
+            what: "70 spheres (room for 64), written past the host's check",
+            uf2: slot::with::unchecked(image, &too_big).map_err(anyhow::Error::msg)?,
+            expect: Expect::Message(refused(&too_big)),
+        },
+        Case {
+            name: "mistake",
+            what: "a misspelt attribute, written past the host's check",
+            uf2: slot::with::unchecked(image, mistake).map_err(anyhow::Error::msg)?,
+            expect: Expect::Message(refused(mistake)),
+        },
+    ])
+}
+
 impl Session<'_> {
     /// Builds the slot image (unless `no_build`), writes each case's UF2 file and runs it for
     /// one frame, checking the panel and the log.
@@ -79,95 +129,57 @@ impl Session<'_> {
         let base = dir.join("lattice-rt-pico-slot.uf2");
         write_uf2(&elf, &base)?;
         let image = std::fs::read(&base).with_context(|| format!("cannot read {}", base.display()))?;
-        let too_big: String = std::iter::once("camera eye 0 4 -30\n".to_string())
-            .chain((0..70).map(|i| format!("sphere center {} {} 0 radius 0.4\n", i % 10 - 5, i / 10)))
-            .collect();
-        let mistake = "camera eye 0 1 -6\nsphere raduis 1\n";
-        let user = slot::with::scene(&image, USER_SCENE).map_err(|e| anyhow::anyhow!("the user's scene: {e}"))?;
-        // The user's file with the first byte of its scene changed after it was written: the
-        // slot's first block carries the header, then the text.
-        let mut corrupt = user.clone();
-        let first_slot_block = corrupt.len() / slot::uf2::BLOCK - slot::uf2::slot_blocks(USER_SCENE.as_bytes());
-        corrupt[first_slot_block * slot::uf2::BLOCK + 32 + slot::HEADER] ^= 0x20;
-        let (stored, mut damaged) = (slot::checksum(USER_SCENE.as_bytes()), USER_SCENE.as_bytes().to_vec());
-        damaged[0] ^= 0x20;
-        let cases = [
-            Case {
-                name: "user",
-                what: "a scene of the user's (`host-sim uf2 --scene`)",
-                uf2: user,
-                expect: Expect::Frame(USER_SCENE),
-            },
-            Case {
-                name: "empty",
-                what: "the slot image alone (nothing in its slot)",
-                uf2: image.clone(),
-                expect: Expect::Message(SlotError::Empty.to_string()),
-            },
-            Case {
-                name: "corrupt",
-                what: "the user's file with a byte of its scene changed",
-                uf2: corrupt,
-                expect: Expect::Message(SlotError::Corrupt { stored, computed: slot::checksum(&damaged) }.to_string()),
-            },
-            Case {
-                name: "too-big",
-                what: "70 spheres (room for 64), written past the host's check",
-                uf2: slot::with::unchecked(&image, &too_big).map_err(anyhow::Error::msg)?,
-                expect: Expect::Message(refused(&too_big)),
-            },
-            Case {
-                name: "mistake",
-                what: "a misspelt attribute, written past the host's check",
-                uf2: slot::with::unchecked(&image, mistake).map_err(anyhow::Error::msg)?,
-                expect: Expect::Message(refused(mistake)),
-            },
-        ];
+        let cases = cases(&image)?;
         let mut rows = Vec::new();
         for case in cases {
-            let case_dir = dir.join(case.name);
-            std::fs::create_dir_all(&case_dir).with_context(|| format!("cannot create {}", case_dir.display()))?;
-            let file = case_dir.join(format!("lattice-rt-pico-slot-{}.uf2", case.name));
-            host_sim::output::write_atomic(&file, &case.uf2)?;
-            eprintln!("running the slot image: {} ({})", case.name, case.what);
-            // A scene the board refuses lights the LED for its attempt (a blank "frame" to the
-            // runner) before the message: two LED cycles, the message the last.
-            let frames = if matches!(case.expect, Expect::Frame(_)) { 1 } else { 2 };
-            let run = run_emulator(self.root, &elf, &file, &self.bootrom, frames, true, &case_dir, &[])?;
-            let (want, shown) = match &case.expect {
-                Expect::Frame(text) => {
-                    let frame = board_records::frame::rendered(board_records::frame::PICO);
-                    (
-                        host_sim::run::render_text::<Fx>(Path::new("slot"), text, &frame, |_| {})?.bits,
-                        "the scene's frame".to_string(),
-                    )
-                }
-                Expect::Message(m) => (message_frame(&cut(m)), format!("\"{}\"", cut(m))),
-            };
-            let frame = run.frames.last();
-            let same = frame.is_some_and(|f| f.pixels == want);
-            if let Some(f) = frame {
-                save_frame(&f.pixels, &case_dir.join("panel.png"))?;
-            }
-            let name = case.name;
-            self.checks.check(run.ok && run.frames.len() == frames, || {
-                format!("slot {name}: the board showed {} of {frames} panels ({})", run.frames.len(), run.reason)
-            });
-            self.checks.check(same, || {
-                format!("slot {name}: the panel is not {shown} (see {}/panel.png)", case_dir.display())
-            });
-            let errors: Vec<&str> = run.log.iter().filter(|l| l.level == "ERROR").map(|l| l.text.as_str()).collect();
-            match &case.expect {
-                Expect::Frame(_) => self
-                    .checks
-                    .check(errors.is_empty(), || format!("slot {name}: the device logged errors: {errors:?}")),
-                Expect::Message(m) => self.checks.check(errors.iter().any(|e| e.contains(&cut(m))), || {
-                    format!("slot {name}: the log does not say `{m}`: {errors:?}")
-                }),
-            };
-            rows.push(SlotRow { name, what: case.what, shown, cycles: frame.map(|f| f.cycles), same });
+            rows.push(self.slot_case(&elf, &dir, case)?);
         }
         Ok(rows)
+    }
+
+    /// Runs one case's UF2 file for a frame (or the attempt and the message) and checks the
+    /// panel and the log.
+    fn slot_case(&mut self, elf: &Path, dir: &Path, case: Case) -> Result<SlotRow> {
+        let case_dir = dir.join(case.name);
+        std::fs::create_dir_all(&case_dir).with_context(|| format!("cannot create {}", case_dir.display()))?;
+        let file = case_dir.join(format!("lattice-rt-pico-slot-{}.uf2", case.name));
+        host_sim::output::write_atomic(&file, &case.uf2)?;
+        eprintln!("running the slot image: {} ({})", case.name, case.what);
+        // A scene the board refuses lights the LED for its attempt (a blank "frame" to the
+        // runner) before the message: two LED cycles, the message the last.
+        let frames = if matches!(case.expect, Expect::Frame(_)) { 1 } else { 2 };
+        let run = run_emulator(self.root, elf, &file, &self.bootrom, frames, true, &case_dir, &[])?;
+        let (want, shown) = match &case.expect {
+            Expect::Frame(text) => {
+                let frame = board_records::frame::rendered(board_records::frame::PICO);
+                (
+                    host_sim::run::render_text::<Fx>(Path::new("slot"), text, &frame, |_| {})?.bits,
+                    "the scene's frame".to_string(),
+                )
+            }
+            Expect::Message(m) => (message_frame(&cut(m)), format!("\"{}\"", cut(m))),
+        };
+        let frame = run.frames.last();
+        let same = frame.is_some_and(|f| f.pixels == want);
+        if let Some(f) = frame {
+            save_frame(&f.pixels, &case_dir.join("panel.png"))?;
+        }
+        let name = case.name;
+        self.checks.check(run.ok && run.frames.len() == frames, || {
+            format!("slot {name}: the board showed {} of {frames} panels ({})", run.frames.len(), run.reason)
+        });
+        self.checks
+            .check(same, || format!("slot {name}: the panel is not {shown} (see {}/panel.png)", case_dir.display()));
+        let errors: Vec<&str> = run.log.iter().filter(|l| l.level == "ERROR").map(|l| l.text.as_str()).collect();
+        match &case.expect {
+            Expect::Frame(_) => {
+                self.checks.check(errors.is_empty(), || format!("slot {name}: the device logged errors: {errors:?}"))
+            }
+            Expect::Message(m) => self.checks.check(errors.iter().any(|e| e.contains(&cut(m))), || {
+                format!("slot {name}: the log does not say `{m}`: {errors:?}")
+            }),
+        };
+        Ok(SlotRow { name, what: case.what, shown, cycles: frame.map(|f| f.cycles), same })
     }
 }
 
