@@ -36,7 +36,7 @@
 //! In the order data flows: [`scene`] (the scene format, [`parse`], validation into the
 //! tracer's scalar), [`camera`], [`cull`] (where each object can appear on the image), [`lattice`]
 //! and the other [`accel`]erators, [`trace`] (the intersection tree, without recursion),
-//! [`sample`], [`outline`] and [`dither`], and [`render`] (the tile loop, progressive passes,
+//! [`sample`], [`outline`] and [`dither`], and [`render`](mod@render) (the tile loop, progressive passes,
 //! two-core bands). [`storage`] and [`load`] hold and fill the memory; [`bake`] writes a scene
 //! as static tables. The repository's `ARCHITECTURE.md` draws the whole.
 //!

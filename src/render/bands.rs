@@ -4,7 +4,7 @@
 //! from tile to tile and still draw it bit for bit as [`super::render`] does.
 
 use super::frame::{Frame, RenderError, Share, TileAt};
-use super::tiles::{render_tiles, Nowhere, Out};
+use super::tiles::{render_tiles, KeptTile, Nowhere, Out};
 use super::Hooks;
 use crate::accel::{Accelerator, Stats};
 use crate::dither::{Ditherer, MAX_TILE};
@@ -16,44 +16,6 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
-
-/// What trace, then dither keeps of a traced tile until it is dithered ([`trace_share`],
-/// [`dither_band`]): its gray levels (tone curve and the silhouette lines inside it applied),
-/// and for the lines across its borders what its pixels hit (object and depth key) along its
-/// four sides: the left column and top row as sampled, and the right column and bottom row as
-/// the apron of the tiles right of it and below takes them ([`Sampler::side`](crate::sample::Sampler::side): the eye rays
-/// through their centres, or with adaptive sampling the fill between two traced pixels that
-/// hit the same object).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct KeptTile {
-    /// Gray levels, row-major, `tw * th` of them.
-    pub levels: [u8; MAX_TILE * MAX_TILE],
-    /// The left column's hits, one per tile row.
-    pub left: [(u16, u16); MAX_TILE],
-    /// The top row's hits, one per tile column.
-    pub top: [(u16, u16); MAX_TILE],
-    /// The right column's rays through the centres, one per tile row.
-    pub right: [(u16, u16); MAX_TILE],
-    /// The bottom row's rays through the centres, one per tile column.
-    pub bottom: [(u16, u16); MAX_TILE],
-}
-
-impl KeptTile {
-    /// Nothing kept yet.
-    pub const EMPTY: KeptTile = KeptTile {
-        levels: [0; MAX_TILE * MAX_TILE],
-        left: [(0, 0); MAX_TILE],
-        top: [(0, 0); MAX_TILE],
-        right: [(0, 0); MAX_TILE],
-        bottom: [(0, 0); MAX_TILE],
-    };
-}
-
-impl Default for KeptTile {
-    fn default() -> Self {
-        Self::EMPTY
-    }
-}
 
 /// The first half of a frame rendered **trace, then dither**: one share's tiles in the frame's
 /// band of tile rows, traced and kept ([`KeptTile`]) for [`dither_band`] instead of dithered

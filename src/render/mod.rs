@@ -15,14 +15,17 @@
 
 mod bands;
 pub(crate) mod frame;
+mod pass;
 mod progressive;
 mod tiles;
 
 pub use crate::sample::{level, Hits, Sampling, Shot};
 pub use crate::storage::Scratch;
-pub use bands::{dither_band, dither_tiles, trace_share, BandRows, KeptTile};
+pub use bands::{dither_band, dither_tiles, trace_share, BandRows};
 pub use frame::{Frame, RenderError, Share, TileGrid};
-pub use progressive::{render_pass, trace_pass, Traced};
+pub use pass::Traced;
+pub use progressive::{render_pass, trace_pass};
+pub use tiles::KeptTile;
 
 use crate::accel::{Accelerator, Stats};
 use crate::scalar::Real;

@@ -2,9 +2,8 @@
 //! gray levels (sample), tone and silhouette lines (finish), then dithered and drawn or kept
 //! (emit).
 
-use super::bands::KeptTile;
 use super::frame::{check, resolves, Frame, RenderError, Share, TileAt};
-use super::progressive::{pass_tile, Pass};
+use super::pass::{pass_tile, Pass};
 use super::Hooks;
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, MAX_TILE};
@@ -328,4 +327,42 @@ fn outline_tile(
     }
     let apron = Apron { left: (x0 > 0).then_some(&left[..th]), up: (y0 > 0).then_some(&up[..tw]) };
     crate::outline::tile(tw, th, hits, apron, levels);
+}
+
+/// What trace, then dither keeps of a traced tile until it is dithered ([`trace_share`](super::trace_share),
+/// [`dither_band`](super::dither_band)): its gray levels (tone curve and the silhouette lines inside it applied),
+/// and for the lines across its borders what its pixels hit (object and depth key) along its
+/// four sides: the left column and top row as sampled, and the right column and bottom row as
+/// the apron of the tiles right of it and below takes them ([`Sampler::side`](crate::sample::Sampler::side): the eye rays
+/// through their centres, or with adaptive sampling the fill between two traced pixels that
+/// hit the same object).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KeptTile {
+    /// Gray levels, row-major, `tw * th` of them.
+    pub levels: [u8; MAX_TILE * MAX_TILE],
+    /// The left column's hits, one per tile row.
+    pub left: [(u16, u16); MAX_TILE],
+    /// The top row's hits, one per tile column.
+    pub top: [(u16, u16); MAX_TILE],
+    /// The right column's rays through the centres, one per tile row.
+    pub right: [(u16, u16); MAX_TILE],
+    /// The bottom row's rays through the centres, one per tile column.
+    pub bottom: [(u16, u16); MAX_TILE],
+}
+
+impl KeptTile {
+    /// Nothing kept yet.
+    pub const EMPTY: KeptTile = KeptTile {
+        levels: [0; MAX_TILE * MAX_TILE],
+        left: [(0, 0); MAX_TILE],
+        top: [(0, 0); MAX_TILE],
+        right: [(0, 0); MAX_TILE],
+        bottom: [(0, 0); MAX_TILE],
+    };
+}
+
+impl Default for KeptTile {
+    fn default() -> Self {
+        Self::EMPTY
+    }
 }
