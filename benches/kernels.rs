@@ -57,7 +57,7 @@ fn walk_and_tile(c: &mut Criterion) {
     c.bench_function("lattice nearest, desk eye ray", |b| {
         b.iter(|| {
             let mut q = Query::new(&mut mb);
-            lat.nearest(&scene, black_box(&ray), 0.0, f64::MAX, &mut q)
+            lat.nearest(&scene, black_box(&ray), 0.0, f64::MAX, &lattice_rt::accel::Filter::NONE, &mut q)
         })
     });
     let tracer = Tracer::new(&scene, &lat);
@@ -96,9 +96,9 @@ fn levers(c: &mut Criterion) {
         b.iter(|| black_box(&scene.objects()[0]).world_normal(black_box(up)))
     });
     let mut mb = vec![0; Query::mailbox_len(&scene)];
-    let mut q = Query::new(&mut mb);
-    c.bench_function("world normal, floor top, fixed: kept by the query", |b| {
-        b.iter(|| q.world_normal(black_box(&scene), 0, black_box(up)))
+    let mut w = lattice_rt::trace::Work::new(&mut mb);
+    c.bench_function("world normal, floor top, fixed: kept by the tracer's work", |b| {
+        b.iter(|| w.world_normal(black_box(&scene), 0, black_box(up)))
     });
     let (x, p) = (Fx::from_f64(2.71), Fx::from_f64(0.125));
     c.bench_function("fixed times 2^-3: product", |b| b.iter(|| black_box(x) * black_box(p)));

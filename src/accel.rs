@@ -11,7 +11,7 @@
 use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
-use crate::scene::{Culled, Scene, MAX_LIGHTS};
+use crate::scene::{Culled, Scene};
 
 /// The nearest intersection found for a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,42 +93,15 @@ impl Stats {
     }
 }
 
-/// Per-query scratch: statistics and the mailbox (one stamp per object and per composite).
+/// An accelerator's scratch for the rays it answers: statistics, and the mailbox (one stamp per
+/// object and per composite, so a ray tests each once). It holds nothing about the ray being
+/// traced: what a ray may skip comes with the ray ([`Filter`]).
 #[derive(Debug)]
 pub struct Query<'m> {
     /// Counts so far.
     pub stats: Stats,
     mailbox: &'m mut [u32],
     ray_id: u32,
-    /// Whether the ray being traced is an eye ray (see [`Query::set_eye_ray`]).
-    eye_on: bool,
-    /// Its window position, both coordinates packed in one word ([`pack_uv`]): written and read
-    /// whole, so a read finds the write in the store buffer (two narrow stores read as one
-    /// wide load stall until they retire, on x86).
-    eye_uv: u64,
-    /// When the ray being traced is a shadow ray towards the scene's first light, and that
-    /// light is directional, its position across the light ([`Real::to_raw`] bits of the
-    /// coordinates [`crate::scene::Object::shadow_window`]s are in; see [`Query::set_first_light_ray`]).
-    first_light: Option<[u64; 2]>,
-    /// The last world normal [`Query::world_normal`] mapped from a unit axis: the object, the
-    /// axis ([`crate::scene::axis_normal`]) and the normal's components as [`Real::to_raw`] bits.
-    axis_normal: Option<(u32, u8, [u64; 3])>,
-    /// The object the last test that hit was made against.
-    last_hit: u32,
-    /// Whether a lattice walk tests an object's box before the object (see
-    /// [`Query::set_box_tests`]).
-    box_tests: bool,
-    /// Objects the ray being traced is known to miss, so not tested ([`u32::MAX`]: none): the
-    /// one it leaves ([`Query::set_leaving`]) and one already tried ([`Query::set_tried`]).
-    skip: [u32; 2],
-    /// Per light, the object that last hid it ([`u32::MAX`]: none yet).
-    occluders: [u32; MAX_LIGHTS],
-    /// The objects (bit `i`: object `i`) whose eye window meets the current tile; the others
-    /// cannot be hit by its eye rays (see [`Query::set_eye_candidates`]).
-    eye_candidates: u64,
-    /// The objects whose eye window meets the current tile, when a render listed them (see
-    /// [`Query::set_eye_list`]); `None`: not listed.
-    eye_list: Option<&'m [u32]>,
 }
 
 impl<'m> Query<'m> {
@@ -136,142 +109,11 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query {
-            stats: Stats::default(),
-            mailbox,
-            ray_id: 0,
-            eye_on: false,
-            eye_uv: 0,
-            first_light: None,
-            axis_normal: None,
-            last_hit: u32::MAX,
-            box_tests: true,
-            skip: [u32::MAX; 2],
-            occluders: [u32::MAX; MAX_LIGHTS],
-            eye_candidates: u64::MAX,
-            eye_list: None,
-        }
+        Query { stats: Stats::default(), mailbox, ray_id: 0 }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
         scene.objects.len() + scene.composites.len()
-    }
-    /// Declares the next ray traced an eye ray through window position `uv` (from
-    /// [`crate::scene::Camera::window_uv`]), or not one (`None`). The tracer keeps it for the
-    /// eye ray alone; objects whose window the eye ray misses are then not tested.
-    pub fn set_eye_ray(&mut self, uv: Option<[i32; 2]>) {
-        self.eye_on = uv.is_some();
-        if let Some(uv) = uv {
-            self.eye_uv = pack_uv(uv);
-        }
-    }
-    /// Declares whether the next ray traced is a shadow ray towards the scene's first light,
-    /// when that light is directional (its direction the light's `to_light`): objects then take
-    /// the direction's object-space image from the scene ([`crate::scene::Object::intersect_first_light_ray`]).
-    /// `at` is the ray's position across the light (the origin's products with the two axes of
-    /// the scene's shadow basis): objects whose shadow window does not hold it are not tested.
-    pub fn set_first_light_ray<R: Real>(&mut self, at: Option<[R; 2]>) {
-        self.first_light = at.map(|w| [w[0].to_raw(), w[1].to_raw()]);
-    }
-    /// Declares the object the next rays leave (`None`: none): they start outside it, on the
-    /// side of the tangent plane its outward normal points to, and travel away from that plane.
-    /// Every primitive is convex, so lies wholly behind that plane: such a ray cannot hit it,
-    /// and it is not tested.
-    pub fn set_leaving(&mut self, object: Option<u32>) {
-        self.skip[0] = object.unwrap_or(u32::MAX);
-    }
-    /// Declares an object the next rays were already tested against and missed (`None`: none),
-    /// so that it is not tested again.
-    pub fn set_tried(&mut self, object: Option<u32>) {
-        self.skip[1] = object.unwrap_or(u32::MAX);
-    }
-    /// Whether object `i` is known to be missed by the ray being traced (see
-    /// [`Query::set_leaving`] and [`Query::set_tried`]).
-    #[inline]
-    pub fn skips(&self, i: u32) -> bool {
-        self.skip[0] == i || self.skip[1] == i
-    }
-    /// Declares which objects the eye rays to come can hit at all (bit `i`: object `i`; from
-    /// [`crate::scene::Scene::eye_candidates`] for the tile being rendered): tracing by
-    /// windows then tests only these, and counts the others as culled, as their windows would
-    /// have culled them ray by ray. `u64::MAX` (the default) holds every object.
-    pub fn set_eye_candidates(&mut self, objects: u64) {
-        self.eye_candidates = objects;
-    }
-    /// Declares which objects the eye rays to come can hit at all, in index order (those whose
-    /// window meets the tile being rendered), or that they are not listed (`None`): eye rays
-    /// through an accelerator then test the listed objects instead of asking it.
-    pub fn set_eye_list(&mut self, objects: Option<&'m [u32]>) {
-        self.eye_list = objects;
-    }
-    /// The objects eye rays can hit, if listed (see [`Query::set_eye_list`]).
-    pub fn eye_list(&self) -> Option<&'m [u32]> {
-        self.eye_list
-    }
-    /// The objects eye rays can hit (see [`Query::set_eye_candidates`]).
-    pub fn eye_candidates(&self) -> u64 {
-        self.eye_candidates
-    }
-    /// The eye-ray window position, if the query is for an eye ray.
-    #[inline]
-    pub fn eye_ray(&self) -> Option<[i32; 2]> {
-        self.eye_on.then(|| unpack_uv(self.eye_uv))
-    }
-    /// Switches a lattice walk's box test before each object's own (on by default): the same
-    /// hits, fewer exact tests where objects are smaller than the cells that list them, at six
-    /// crossings per object met.
-    pub fn set_box_tests(&mut self, on: bool) {
-        self.box_tests = on;
-    }
-    /// Whether a lattice walk tests boxes before objects for the rays to come
-    /// ([`Query::set_box_tests`]).
-    #[inline]
-    pub fn box_tests(&self) -> bool {
-        self.box_tests
-    }
-    /// Whether the ray is tested through windows ([`crate::scene::EyeWindow`]s or
-    /// [`crate::scene::ShadowWindow`]s): an eye ray, or a shadow ray towards the first light.
-    #[inline]
-    pub(crate) fn by_windows(&self) -> bool {
-        self.eye_on || self.first_light.is_some()
-    }
-    /// The object that last hid light `l` from a shaded point, if any.
-    pub fn occluder(&self, l: usize) -> Option<u32> {
-        self.occluders.get(l).copied().filter(|&i| i != u32::MAX)
-    }
-    /// After an `occluded` query towards light `l`: remembers the occluder it found (the object
-    /// of its hit) if `hidden`, else forgets light `l`'s.
-    pub fn remember_occluder(&mut self, l: usize, hidden: bool) {
-        if let Some(o) = self.occluders.get_mut(l) {
-            *o = if hidden { self.last_hit } else { u32::MAX };
-        }
-    }
-    /// Remembers `occluder` as what hides light `l` (`None`: the light is not hidden, forget).
-    pub fn set_occluder(&mut self, l: usize, occluder: Option<u32>) {
-        if let Some(o) = self.occluders.get_mut(l) {
-            *o = occluder.unwrap_or(u32::MAX);
-        }
-    }
-    /// Forgets the remembered occluders (the render does so at every band of tiles, so a band's
-    /// work does not depend on the bands rendered before it, on whichever core or thread).
-    pub fn forget_occluders(&mut self) {
-        self.occluders = [u32::MAX; MAX_LIGHTS];
-    }
-    /// [`crate::scene::Object::world_normal`] of object `i` of the scene this query serves: a unit-axis
-    /// normal (a box's face, a cap) that is the last one asked for is given again without
-    /// mapping it anew (neighbouring eye rays mostly hit one face, the floor's above all).
-    #[inline]
-    pub fn world_normal<R: Real>(&mut self, scene: &Scene<'_, R>, i: u32, n_obj: Vec3<R>) -> Vec3<R> {
-        let o = at(scene.objects, i as usize);
-        let Some(axis) = crate::scene::axis_normal(n_obj) else { return o.world_normal(n_obj) };
-        if let Some((j, k, raw)) = self.axis_normal {
-            if (j, k) == (i, axis) {
-                return Vec3::new(R::from_raw(raw[0]), R::from_raw(raw[1]), R::from_raw(raw[2]));
-            }
-        }
-        let n = o.axis_world_normal(axis);
-        self.axis_normal = Some((i, axis, [n.x.to_raw(), n.y.to_raw(), n.z.to_raw()]));
-        n
     }
     /// Starts a new ray: every mailbox entry becomes unvisited.
     pub fn next_ray(&mut self) {
@@ -295,6 +137,93 @@ impl<'m> Query<'m> {
     }
 }
 
+/// What one ray may skip, given with the ray to [`Accelerator::nearest`] and
+/// [`Accelerator::occluded`]: the objects it is known to miss, the objects whose regions it
+/// passes outside ([`crate::cull`]: an eye ray's window position, a shadow ray's position across
+/// a directional first light), and whether a lattice walk tests an object's box before it. The
+/// answer is the same whatever the filter says; only the work differs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Filter {
+    /// Whether the ray is an eye ray with a window position.
+    eye_on: bool,
+    /// Its window position, both coordinates packed in one word ([`pack_uv`]): written and read
+    /// whole, so a read finds the write in the store buffer (two narrow stores read as one
+    /// wide load stall until they retire, on x86).
+    eye_uv: u64,
+    /// A shadow ray towards the scene's first light, when that light is directional: its
+    /// position across the light ([`Real::to_raw`] bits of the coordinates objects' shadow
+    /// windows are in).
+    first_light: Option<[u64; 2]>,
+    /// Objects the ray is known to miss ([`u32::MAX`]: none): the one it leaves and one already
+    /// tried.
+    skip: [u32; 2],
+    /// Whether a lattice walk tests an object's box before the object.
+    box_tests: bool,
+}
+
+impl Filter {
+    /// A ray that skips nothing, with box tests on.
+    pub const NONE: Filter =
+        Filter { eye_on: false, eye_uv: 0, first_light: None, skip: [u32::MAX; 2], box_tests: true };
+
+    /// An eye ray through window position `uv` (from [`crate::camera::Camera::window_uv`]), or
+    /// not one (`None`): objects whose eye region does not hold it are not tested.
+    #[inline]
+    pub fn eye(self, uv: Option<[i32; 2]>) -> Self {
+        Filter { eye_on: uv.is_some(), eye_uv: uv.map_or(0, pack_uv), ..self }
+    }
+    /// A shadow ray towards the scene's first light, when that light is directional (its
+    /// direction the light's `to_light`), at position `at` across the light (the origin's
+    /// products with the two axes of the scene's shadow basis), or not one (`None`): objects
+    /// then take the direction's object-space image from the scene, and objects whose shadow
+    /// window does not hold `at` are not tested.
+    #[inline]
+    pub fn first_light<R: Real>(self, at: Option<[R; 2]>) -> Self {
+        Filter { first_light: at.map(|w| [w[0].to_raw(), w[1].to_raw()]), ..self }
+    }
+    /// The object the ray leaves (`None`: none): it starts outside it, on the side of the
+    /// tangent plane its outward normal points to, and travels away from that plane. Every
+    /// primitive is convex, so lies wholly behind that plane: the ray cannot hit it.
+    #[inline]
+    pub fn leaving(self, object: Option<u32>) -> Self {
+        Filter { skip: [object.unwrap_or(u32::MAX), self.skip[1]], ..self }
+    }
+    /// An object the ray was already tested against and missed (`None`: none).
+    #[inline]
+    pub fn tried(self, object: Option<u32>) -> Self {
+        Filter { skip: [self.skip[0], object.unwrap_or(u32::MAX)], ..self }
+    }
+    /// Switches a lattice walk's box test before each object's own (on by default): the same
+    /// hits, fewer exact tests where objects are smaller than the cells that list them, at six
+    /// crossings per object met.
+    #[inline]
+    pub fn box_tests(self, on: bool) -> Self {
+        Filter { box_tests: on, ..self }
+    }
+    /// Whether object `i` is known to be missed by the ray ([`Filter::leaving`],
+    /// [`Filter::tried`]).
+    #[inline]
+    pub fn skips(&self, i: u32) -> bool {
+        self.skip[0] == i || self.skip[1] == i
+    }
+    /// The eye ray's window position, if the ray is an eye ray with one.
+    #[inline]
+    pub fn eye_ray(&self) -> Option<[i32; 2]> {
+        self.eye_on.then(|| unpack_uv(self.eye_uv))
+    }
+    /// Whether a lattice walk tests boxes before objects ([`Filter::box_tests`]).
+    #[inline]
+    pub fn tests_boxes(&self) -> bool {
+        self.box_tests
+    }
+    /// Whether the ray is tested through regions: an eye ray, or a shadow ray towards the first
+    /// light.
+    #[inline]
+    pub(crate) fn by_windows(&self) -> bool {
+        self.eye_on || self.first_light.is_some()
+    }
+}
+
 /// How far apart two hits at about `p` may lie along a ray and still be one point: the offset a
 /// secondary ray takes there off a unit object ([`Real::offset`]). Faces of two objects that
 /// coincide (a glass box on a floor) meet within it, and which is hit then is decided by object
@@ -310,7 +239,7 @@ pub fn reach<R: Real>(best: &Option<Hit<R>>, tmax: R) -> R {
     best.map_or(tmax, |b| (b.t + b.tie).min(tmax))
 }
 
-/// A window position packed in one word (see `Query::eye_uv`).
+/// A window position packed in one word (see `Filter::eye_uv`).
 #[inline]
 fn pack_uv(uv: [i32; 2]) -> u64 {
     u64::from(uv[0] as u32) | (u64::from(uv[1] as u32) << 32)
@@ -333,15 +262,15 @@ pub fn offer<R: Real>(
     tmin: R,
     tmax: R,
     best: &mut Option<Hit<R>>,
-    q: &mut Query<'_>,
+    (f, q): (&Filter, &mut Query<'_>),
 ) -> bool {
-    if q.skips(i as u32) {
+    if f.skips(i as u32) {
         q.stats.culled += 1;
         return false;
     }
     let limit = reach(best, tmax);
     let o = at(scene.objects, i);
-    let hit = match q.eye_ray() {
+    let hit = match f.eye_ray() {
         Some(uv) => match o.intersect_eye_ray(ray, uv, tmin, limit) {
             Ok(hit) => hit,
             Err(Culled) => {
@@ -349,7 +278,7 @@ pub fn offer<R: Real>(
                 return false;
             }
         },
-        None => match q.first_light {
+        None => match f.first_light {
             Some(w) => {
                 if !o.shadow_window_holds([R::from_raw(w[0]), R::from_raw(w[1])]) {
                     q.stats.culled += 1;
@@ -364,7 +293,6 @@ pub fn offer<R: Real>(
     match hit {
         Some(h) => {
             let t = h.t;
-            q.last_hit = i as u32;
             let tie = tie(ray.at(t));
             let better = match best {
                 Some(b) if (t - b.t).abs() <= tie.max(b.tie) => (i as u32) < b.object,
@@ -384,10 +312,11 @@ pub fn offer<R: Real>(
 pub trait Accelerator<R: Real> {
     /// Short name for reports.
     fn name(&self) -> &'static str;
-    /// The nearest hit with `tmin < t <= tmax`.
-    fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>>;
-    /// Whether anything is hit with `tmin < t <= tmax` (shadow rays).
-    fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool;
+    /// The nearest hit with `t0 < t <= t1`, skipping what `f` allows.
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>>;
+    /// An object hit with `t0 < t <= t1`, if any (shadow rays: the occluder), skipping what
+    /// `f` allows.
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32>;
 }
 
 /// Tests every object for every ray.
@@ -398,16 +327,16 @@ impl<R: Real> Accelerator<R> for BruteForce {
     fn name(&self) -> &'static str {
         "brute"
     }
-    fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>> {
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>> {
         let mut best = None;
-        for i in 0..scene.objects.len() {
-            offer(scene, i, ray, tmin, tmax, &mut best, q);
+        for i in 0..s.objects.len() {
+            offer(s, i, ray, t0, t1, &mut best, (f, q));
         }
         best
     }
-    fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool {
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
         let mut best = None;
-        (0..scene.objects.len()).any(|i| offer(scene, i, ray, tmin, tmax, &mut best, q))
+        (0..s.objects.len()).find(|&i| offer(s, i, ray, t0, t1, &mut best, (f, q))).map(|i| i as u32)
     }
 }
 
@@ -487,14 +416,14 @@ impl BoundingBox {
         tmin: R,
         tmax: R,
         any: bool,
-        q: &mut Query<'_>,
+        (f, q): (&Filter, &mut Query<'_>),
     ) -> Option<Hit<R>> {
         let frame = RayFrame::new(ray);
         let slack = slack(ray);
         let mut best = None;
         for (i, o) in scene.objects.iter().enumerate() {
             q.stats.inside_tests += 1;
-            if frame.passes(&o.bounds.padded(slack)) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
+            if frame.passes(&o.bounds.padded(slack)) && offer(scene, i, ray, tmin, tmax, &mut best, (f, q)) && any {
                 return best;
             }
         }
@@ -506,10 +435,10 @@ impl<R: Real> Accelerator<R> for BoundingBox {
     fn name(&self) -> &'static str {
         "bbox"
     }
-    fn nearest(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> Option<Hit<R>> {
-        Self::run(scene, ray, tmin, tmax, false, q)
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>> {
+        Self::run(s, ray, t0, t1, false, (f, q))
     }
-    fn occluded(&self, scene: &Scene<'_, R>, ray: &Ray<R>, tmin: R, tmax: R, q: &mut Query<'_>) -> bool {
-        Self::run(scene, ray, tmin, tmax, true, q).is_some()
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
+        Self::run(s, ray, t0, t1, true, (f, q)).map(|h| h.object)
     }
 }

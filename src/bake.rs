@@ -371,7 +371,8 @@ mod tests {
             let (a, b) = (p(), p());
             let ray = Ray::new(a, b - a);
             let hit = |s: &Scene<'_, Fx>, l: &Lattice<'_, Fx>, mb: &mut [u32]| {
-                l.nearest(s, &ray, Fx(0), Fx::MAX, &mut Query::new(mb)).map(|h| (h.object, h.t))
+                l.nearest(s, &ray, Fx(0), Fx::MAX, &crate::accel::Filter::NONE, &mut Query::new(mb))
+                    .map(|h| (h.object, h.t))
             };
             assert_eq!(hit(&scene, &lattice, &mut mb), hit(&tables, &copy, &mut mb));
         }

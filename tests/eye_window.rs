@@ -9,6 +9,7 @@ mod common;
 use common::{build_lattice, lattice_storage, scene_text, ACCELS};
 use lattice_rt::generate::{random_scene, RandomScene};
 use lattice_rt::scene::{Camera, Object};
+use lattice_rt::trace::Work;
 use lattice_rt::{
     parse, Accelerator, BoundingBox, BruteForce, EyeRays, Fx, LatticeConfig, Query, Real, Scene, SceneBuilder, Tracer,
 };
@@ -29,28 +30,27 @@ fn same_with_and_without<R: Real>(scene: &Scene<'_, R>, w: i32, h: i32, what: &s
         let mut reference = Tracer::new(scene, a);
         reference.set_eye_rays(EyeRays::Plain);
         let mut mb0 = vec![0; Query::mailbox_len(scene)];
-        let mut q0 = Query::new(&mut mb0);
+        let mut q0 = Work::new(&mut mb0);
         for how in [EyeRays::Accelerator, EyeRays::Windows] {
             let mut tracer = Tracer::new(scene, a);
             tracer.set_eye_rays(how);
             let mut mb = vec![0; Query::mailbox_len(scene)];
-            let mut q = Query::new(&mut mb);
+            let mut q = Work::new(&mut mb);
             let (w4, h4) = (4 * w, 4 * h);
             for sy in (1..h4).step_by(2) {
                 for sx in (1..w4).step_by(2) {
                     let ray = scene.camera().ray(sx, sy, w4, h4);
-                    let plain = reference.radiance_and_object(ray, &mut q0);
+                    let plain = reference.radiance_and_object(ray, None, &mut q0);
                     // Without the eye ray's window position only shadow windows act.
-                    q.set_eye_ray(None);
-                    let shadows_only = tracer.radiance_and_object(ray, &mut q);
-                    q.set_eye_ray(Some(Camera::<R>::window_uv(sx, sy, w4, h4)));
-                    let windowed = tracer.radiance_and_object(ray, &mut q);
+                    let shadows_only = tracer.radiance_and_object(ray, None, &mut q);
+                    let uv = Camera::<R>::window_uv(sx, sy, w4, h4);
+                    let windowed = tracer.radiance_and_object(ray, Some(uv), &mut q);
                     let at = format!("{what}, {}, {accel:?}, {how:?}: eye ray ({sx}, {sy}) of ({w4}, {h4})", R::NAME);
                     assert_eq!(plain, shadows_only, "{at}, shadow windows");
                     assert_eq!(plain, windowed, "{at}");
                 }
             }
-            culled += q.stats.culled;
+            culled += q.stats().culled;
         }
     }
     culled
@@ -293,7 +293,7 @@ fn kept_axis_normals_are_the_objects_own() {
         let mut parts = lattice_rt::Parts::default();
         let scene = parse::<R>(&scene_text("whitted"), &mut storage, &mut parts).unwrap();
         let mut mb = vec![0; Query::mailbox_len(&scene)];
-        let mut q = Query::new(&mut mb);
+        let mut q = Work::new(&mut mb);
         let (o, z, h) = (R::ONE, R::ZERO, R::HALF);
         let v = lattice_rt::Vec3::new;
         let normals =

@@ -138,12 +138,11 @@ fn objects_behind_a_block_s_object_show_in_none_of_its_pixels() {
         let (w4, h4) = (4 * w as i32, 4 * h as i32);
         let tracer = Tracer::new(scene, &BruteForce);
         let mut mailbox = std::vec![0; Query::mailbox_len(scene)];
-        let mut q = Query::new(&mut mailbox);
+        let mut work = crate::trace::Work::new(&mut mailbox);
         let centre = |p: usize| 4 * p as i32 + 2;
         let mut hit = |x: usize, y: usize| {
             let ray = scene.camera().ray(centre(x), centre(y), w4, h4);
-            q.set_eye_ray(None);
-            let (id, t) = tracer.eye_hit(ray, &mut q);
+            let (id, t) = tracer.eye_hit(ray, None, &mut work);
             (id, if id == crate::trace::NO_OBJECT { u16::MAX } else { t.depth_key() })
         };
         let pixels: std::vec::Vec<(u32, u16)> =

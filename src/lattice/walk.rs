@@ -2,7 +2,7 @@
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
 use super::{index, locate, Lattice, MAX_NESTING};
-use crate::accel::{offer, reach, slack, Hit, Query};
+use crate::accel::{offer, reach, slack, Filter, Hit, Query};
 use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
@@ -34,13 +34,13 @@ impl<R: Real> Lattice<'_, R> {
         tmin: R,
         tmax: R,
         any: bool,
-        q: &mut Query<'_>,
+        (f, q): (&Filter, &mut Query<'_>),
     ) -> Option<Hit<R>> {
         let slack = slack(ray);
         let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
         // A window culls an object before its test for less than the box test costs.
-        let inv = Inverse::new(ray, q.box_tests() && !q.by_windows(), slack);
+        let inv = Inverse::new(ray, f.tests_boxes() && !f.by_windows(), slack);
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
@@ -55,7 +55,7 @@ impl<R: Real> Lattice<'_, R> {
                     Ok(i) => {
                         if q.first_visit(i)
                             && inv.may_meet(scene, i, tmin, reach(&best, tmax), q)
-                            && offer(scene, i, ray, tmin, tmax, &mut best, q)
+                            && offer(scene, i, ray, tmin, tmax, &mut best, (f, q))
                             && any
                         {
                             return best;
@@ -100,7 +100,7 @@ struct Inverse<R> {
     /// `1 / d` per axis (zero where the ray does not move along it): what [`Inverse::may_meet`]
     /// multiplies by, in every scalar.
     inv: Vec3<R>,
-    /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Query::box_tests`], and not
+    /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Filter::box_tests`], and not
     /// through windows; in fixed point only while no direction component reaches 64, so the
     /// reciprocal's rounding stays within the padding).
     boxes: bool,

@@ -12,6 +12,7 @@ use crate::sample::{Hits, Sampler, Sampling, Shot};
 use crate::scalar::Real;
 use crate::storage::Scratch;
 use crate::trace::Tracer;
+use crate::trace::Work;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
@@ -65,7 +66,7 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
     let grid = frame.grid();
     let culling = Culling::new(tracer.scene(), frame, scratch.cover);
     let need = Query::mailbox_len(tracer.scene()).min(scratch.mailbox.len());
-    let mut q = Query::new(&mut scratch.mailbox[..need]);
+    let mut work = Work::new(&mut scratch.mailbox[..need]);
     let ((tiles_x, _), (first, end)) = (grid.tiles(), grid.rows(frame.rows));
     let total = share.tiles_in(tiles_x, (first, end)) as u32;
     // Tiles of this share before the band range: their traced samples come first.
@@ -87,16 +88,16 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
         sampler.next_band();
         // Remembered occluders are forgotten at every band of tiles, so a band renders the same
         // whichever bands a core or thread rendered before it.
-        q.forget_occluders();
+        work.forget_occluders();
         for tx in (0..tiles_x).filter(|&tx| share.holds(tx, ty)) {
             let at = grid.at(tx, ty);
-            let candidates = culling.tile(tracer.scene(), &mut q, (tx, ty), at);
+            let candidates = culling.tile(tracer.scene(), &mut work, (tx, ty), at);
             let traced = pass.as_mut().map(|Pass { n, traced, whole_share }| {
                 let k = if *whole_share { skipped } else { 0 } + done as usize;
                 let per_tile = (at.t / 2) * (at.t / 2);
                 (*n, &mut traced[k * per_tile..(k + 1) * per_tile])
             });
-            let mut ray = Eye { tracer, q: &mut q, cache: &mut eyes };
+            let mut ray = Eye { tracer, work: &mut work, cache: &mut eyes };
             sample(&mut ray, &mut sampler, at, candidates, looks, traced, &mut tile);
             hooks.gray_tile(at.x0 as u16, at.y0 as u16, at.tw as u16, at.th as u16, &tile.levels[..at.tw * at.th]);
             finish(&mut ray, &sampler, at, frame, looks, &mut tile);
@@ -107,7 +108,7 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
             }
         }
     }
-    Ok(q.stats)
+    Ok(work.query.stats)
 }
 
 /// The dither and the sampler of a render, their rows cut from the scratch's.
@@ -143,21 +144,20 @@ struct TileWork {
     sides: KeptTile,
 }
 
-/// The eye rays of a render: each made by the camera's cache, its window position given to the
-/// query, and traced.
+/// The eye rays of a render: each made by the camera's cache and traced with its window
+/// position.
 struct Eye<'e, 'q, 'c, 'a, 'b, R, A: ?Sized, const E: u8> {
     tracer: &'e Tracer<'a, 'b, R, A, E>,
-    q: &'e mut Query<'q>,
+    work: &'e mut Work<'q>,
     cache: &'e mut crate::camera::EyeRayCache<'c, R>,
 }
 
 impl<R: Real, A: Accelerator<R> + ?Sized, const E: u8> Eye<'_, '_, '_, '_, '_, R, A, E> {
-    /// The eye ray through `(sx, sy)` (quarter pixels), its window position given to the query.
+    /// The eye ray through `(sx, sy)` (quarter pixels) and its window position.
     #[inline(always)]
-    fn ray(&mut self, sx: usize, sy: usize) -> crate::math::Ray<R> {
+    fn ray(&mut self, sx: usize, sy: usize) -> (crate::math::Ray<R>, Option<[i32; 2]>) {
         let (uv, ray) = self.cache.at(sx as i32, sy as i32);
-        self.q.set_eye_ray(Some(uv));
-        ray
+        (ray, Some(uv))
     }
 }
 
@@ -185,22 +185,22 @@ impl<'c> Culling<'c> {
         Culling { tiling, many, counted, cover, block, size: (4 * w as i32, 4 * h as i32) }
     }
 
-    /// Step one of a tile, cull: gives the query the objects the tile's eye rays can hit, and
+    /// Step one of a tile, cull: tells the tracer's work the objects the tile's eye rays can hit, and
     /// returns them as a mask (`u64::MAX`: listed, or past 64 objects).
     #[inline(always)]
     fn tile<R: Real>(
         &self,
         scene: &crate::scene::Scene<'_, R>,
-        q: &mut Query<'c>,
+        work: &mut Work<'c>,
         (tx, ty): (usize, usize),
         at: TileAt,
     ) -> u64 {
         if self.many {
-            q.set_eye_list(if self.counted { self.tiling.list(self.cover, (tx, ty)) } else { None });
+            work.set_eye_list(if self.counted { self.tiling.list(self.cover, (tx, ty)) } else { None });
             u64::MAX
         } else {
             let c = crate::cull::tiles::tile_candidates(scene, (at.x0, at.tw), (at.y0, at.th), self.block, self.size);
-            q.set_eye_candidates(c);
+            work.set_eye_candidates(c);
             c
         }
     }
@@ -224,8 +224,8 @@ fn sample<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
         crate::cull::block::alone(tracer, candidates, (at.x0, at.y0), (xs, ys), id, far, size)
     };
     let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
-        let ray = eye.ray(sx, sy);
-        let (v, id, depth) = tracer.eye_sample(ray, eye.q);
+        let (ray, uv) = eye.ray(sx, sy);
+        let (v, id, depth) = tracer.eye_sample(ray, uv, eye.work);
         (v, id as u16, if looks.keys { depth.depth_key() } else { u16::MAX })
     };
     let TileWork { levels, hits, .. } = tile;
@@ -259,8 +259,8 @@ fn finish<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     // The apron: what the eye rays through the column left of the tile and the row above it hit
     // (the tile's eye candidates cover them: they are a pixel away).
     let mut probe = |x: usize, y: usize| -> (u16, u16) {
-        let ray = eye.ray(4 * x + 2, 4 * y + 2);
-        let (id, depth) = eye.tracer.eye_hit(ray, eye.q);
+        let (ray, uv) = eye.ray(4 * x + 2, 4 * y + 2);
+        let (id, depth) = eye.tracer.eye_hit(ray, uv, eye.work);
         (id as u16, depth.depth_key())
     };
     if !looks.keep {

@@ -157,7 +157,7 @@ pub fn reference(text: &str, path: &Path, w: u16, h: u16, n: usize) -> Result<Ve
         |tracer| {
             let scene = tracer.scene();
             let mut mb = vec![0u32; lattice_rt::Query::mailbox_len(scene)];
-            let mut q = lattice_rt::Query::new(&mut mb);
+            let mut q = lattice_rt::trace::Work::new(&mut mb);
             let (ws, hs) = (2 * n * w as usize, 2 * n * h as usize);
             let mut out = Vec::with_capacity(w as usize * h as usize);
             for y in 0..h as usize {

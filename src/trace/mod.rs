@@ -18,7 +18,10 @@
 //! same. Fixed point, whose absolute precision is the same everywhere, uses
 //! `offset_eps * (1 + size)`.
 
-use crate::accel::{Accelerator, BruteForce, Hit, Query, RayKind};
+mod work;
+pub use work::Work;
+
+use crate::accel::{Accelerator, BruteForce, Filter, Hit, Query, RayKind};
 use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
@@ -252,7 +255,7 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     eye_rays: EyeRays,
     /// Whether a shadow ray first tries the object that last hid its light.
     coherence: bool,
-    /// Whether a lattice walk tests an object's box before the object ([`Query::set_box_tests`]).
+    /// Whether a lattice walk tests an object's box before the object ([`Filter::box_tests`]).
     box_tests: bool,
 }
 
@@ -317,21 +320,26 @@ impl EyeRays {
 }
 
 /// The nearest hit of an eye ray among the objects whose windows hold it: the tile's
-/// candidates ([`Query::eye_candidates`]) in index order, each window checked again for the ray
+/// `candidates` ([`Work::eye_candidates`]) in index order, each window checked again for the ray
 /// itself (as [`BruteForce`] would check every object's); objects that are no candidates are
 /// counted as culled, as their windows would have culled them.
-fn nearest_by_windows<R: Real>(scene: &Scene<'_, R>, ray: &Ray<R>, q: &mut Query<'_>) -> Option<Hit<R>> {
+fn nearest_by_windows<R: Real>(
+    scene: &Scene<'_, R>,
+    ray: &Ray<R>,
+    candidates_mask: u64,
+    (f, q): (&Filter, &mut Query<'_>),
+) -> Option<Hit<R>> {
     let n = scene.objects.len();
     if n > 64 {
-        return BruteForce.nearest(scene, ray, R::ZERO, R::MAX, q);
+        return BruteForce.nearest(scene, ray, R::ZERO, R::MAX, f, q);
     }
     let mut best = None;
     // The candidates are counted as they come (cheaper than a population count on a core
     // without one): the others are culled.
     let mut candidates = 0u32;
-    crate::cull::any_object(q.eye_candidates(), n, |i| {
+    crate::cull::any_object(candidates_mask, n, |i| {
         candidates += 1;
-        crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, q);
+        crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, (f, q));
         false
     });
     q.stats.culled += u64::from(n as u32 - candidates);
@@ -351,7 +359,7 @@ struct Meta<R> {
     depth: u8,
     kind: RayKind,
     /// The object the ray leaves from outside (a mirror ray off its surface), which it cannot
-    /// hit ([`Query::set_leaving`]), or [`NO_OBJECT`].
+    /// hit ([`Filter::leaving`]), or [`NO_OBJECT`].
     leaving: u32,
 }
 
@@ -418,7 +426,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         self.box_tests
     }
 
-    /// Switches the walk's box tests ([`Query::set_box_tests`]; the picture is the same either
+    /// Switches the walk's box tests ([`Filter::box_tests`]; the picture is the same either
     /// way; off is the paper's walk, which tests every object of every cell it enters).
     pub fn set_box_tests(&mut self, on: bool) {
         self.box_tests = on;
@@ -490,24 +498,24 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     }
 
     /// Brightness (0 black .. 1 white, clamped) seen along an eye ray.
-    pub fn radiance(&self, eye: Ray<R>, q: &mut Query<'_>) -> R {
-        self.radiance_and_object(eye, q).0
+    pub fn radiance(&self, eye: Ray<R>, w: &mut Work<'_>) -> R {
+        self.eye_sample(eye, None, w).0
     }
 
-    /// Brightness along an eye ray and the object the eye ray hits ([`NO_OBJECT`] if none).
-    pub fn radiance_and_object(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u32) {
-        let (v, object, _) = self.eye_sample(eye, q);
+    /// Brightness along an eye ray and the object the eye ray hits ([`NO_OBJECT`] if none);
+    /// `uv` as for [`Tracer::eye_sample`].
+    pub fn radiance_and_object(&self, eye: Ray<R>, uv: Option<[i32; 2]>, w: &mut Work<'_>) -> (R, u32) {
+        let (v, object, _) = self.eye_sample(eye, uv, w);
         (v, object)
     }
 
     /// The object an eye ray hits first ([`NO_OBJECT`] if none) and how far along the ray, as
     /// [`Tracer::eye_sample`] finds them, without shading or any further ray (counted as a
     /// primary ray): what the outline's apron needs.
-    pub fn eye_hit(&self, eye: Ray<R>, q: &mut Query<'_>) -> (u32, R) {
-        q.stats.rays[RayKind::Primary as usize] += 1;
-        let uv = q.eye_ray();
-        let found = self.nearest(&eye, uv, q);
-        q.stats.hit(RayKind::Primary, found.is_some());
+    pub fn eye_hit(&self, eye: Ray<R>, uv: Option<[i32; 2]>, w: &mut Work<'_>) -> (u32, R) {
+        w.query.stats.rays[RayKind::Primary as usize] += 1;
+        let found = self.nearest(&eye, uv, &self.filter(), w);
+        w.query.stats.hit(RayKind::Primary, found.is_some());
         found.map_or((NO_OBJECT, R::MAX), |hit| (hit.object, hit.t))
     }
 
@@ -518,46 +526,56 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         self.eye_rays == EyeRays::Windows && self.scene.objects.len() <= EyeRays::EVERY_OBJECT_UP_TO
     }
 
-    /// The nearest hit of `ray`; an eye ray's window position `uv` (when given) lets
-    /// [`EyeRays`] skip objects or the walk. Leaves the query with no eye ray set. Inlined on
-    /// x86-64: the hit would come back through memory, written field by field and read in wider
-    /// moves that wait for those stores to retire.
+    /// What every ray of this tracer may skip before its own: nothing, with the walk's box
+    /// tests as set ([`Tracer::set_box_tests`]).
+    #[inline(always)]
+    fn filter(&self) -> Filter {
+        Filter::NONE.box_tests(self.box_tests)
+    }
+
+    /// The nearest hit of `ray` skipping what `f` allows; an eye ray's window position `uv`
+    /// (when given) lets [`EyeRays`] skip objects or the walk. Inlined on x86-64: the hit would
+    /// come back through memory, written field by field and read in wider moves that wait for
+    /// those stores to retire.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
-    fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, q: &mut Query<'_>) -> Option<Hit<R>> {
-        let found = match uv {
+    fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, f: &Filter, w: &mut Work<'_>) -> Option<Hit<R>> {
+        match uv {
             Some(uv) if self.eye_rays != EyeRays::Plain => {
-                q.set_eye_ray(Some(uv));
+                let f = &f.eye(Some(uv));
                 match self.eye_rays {
-                    EyeRays::Windows => nearest_by_windows(self.scene, ray, q),
-                    _ => match q.eye_list() {
+                    EyeRays::Windows => nearest_by_windows(self.scene, ray, w.eye_candidates(), (f, &mut w.query)),
+                    _ => match w.eye_list() {
                         // The tile listed its objects: no walk (see `Scratch::with_cover`).
                         Some(list) => {
                             let mut best = None;
                             for &i in list {
-                                crate::accel::offer(self.scene, i as usize, ray, R::ZERO, R::MAX, &mut best, q);
+                                crate::accel::offer(
+                                    self.scene,
+                                    i as usize,
+                                    ray,
+                                    R::ZERO,
+                                    R::MAX,
+                                    &mut best,
+                                    (f, &mut w.query),
+                                );
                             }
                             best
                         }
-                        None => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, q),
+                        None => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, f, &mut w.query),
                     },
                 }
             }
-            _ => {
-                q.set_eye_ray(None);
-                if self.tests_every_object() {
-                    BruteForce.nearest(self.scene, ray, R::ZERO, R::MAX, q)
-                } else {
-                    self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, q)
-                }
-            }
-        };
-        q.set_eye_ray(None);
-        found
+            _ if self.tests_every_object() => BruteForce.nearest(self.scene, ray, R::ZERO, R::MAX, f, &mut w.query),
+            _ => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, f, &mut w.query),
+        }
     }
 
     /// Brightness along an eye ray, the object it hits ([`NO_OBJECT`] if none) and how far
-    /// along the ray (in units of its direction's length; `R::MAX` if it hits nothing).
-    pub fn eye_sample(&self, eye: Ray<R>, q: &mut Query<'_>) -> (R, u32, R) {
+    /// along the ray (in units of its direction's length; `R::MAX` if it hits nothing). `uv` is
+    /// the eye ray's window position when the caller knows it
+    /// ([`crate::camera::Camera::window_uv`]): objects whose eye region does not hold it are then
+    /// not tested.
+    pub fn eye_sample(&self, eye: Ray<R>, eye_uv: Option<[i32; 2]>, w: &mut Work<'_>) -> (R, u32, R) {
         let mut first = NO_OBJECT;
         let mut depth = R::MAX;
         let scene = self.scene;
@@ -565,9 +583,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         // most `MAX_DEPTH + 2` nodes wait: no push below can fail.
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
         let mut total = R::ZERO;
-        // The eye ray's window position (if the caller gave one) serves the eye ray alone.
-        let eye_uv = q.eye_ray();
-        q.set_box_tests(self.box_tests);
+        let f = self.filter();
         // The eye ray is traced first without a trip through the stack (the stack only holds
         // children).
         let mut primary = true;
@@ -591,20 +607,20 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             } else {
                 break;
             };
-            q.stats.rays[node.kind as usize] += 1;
-            q.set_leaving((node.leaving != NO_OBJECT).then_some(node.leaving));
-            let found = self.nearest(ray, if node.depth == 0 { eye_uv } else { None }, q);
-            q.set_leaving(None);
+            w.query.stats.rays[node.kind as usize] += 1;
+            // The eye ray's window position serves the eye ray alone.
+            let leaves = f.leaving((node.leaving != NO_OBJECT).then_some(node.leaving));
+            let found = self.nearest(ray, if node.depth == 0 { eye_uv } else { None }, &leaves, w);
             let Some(hit) = found else {
                 total += node.weight.weigh(scene.background);
                 continue;
             };
-            q.stats.hit(node.kind, true);
+            w.query.stats.hit(node.kind, true);
             if node.depth == 0 {
                 first = hit.object;
                 depth = hit.t;
             }
-            total += self.shade(ray, node, &hit, &mut stack, q);
+            total += self.shade(ray, node, &hit, &mut stack, w);
         }
         (total.max(R::ZERO).min(R::ONE), first, depth)
     }
@@ -619,7 +635,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         node: Meta<R>,
         hit: &Hit<R>,
         stack: &mut Vec<Node<R>, { MAX_DEPTH as usize + 2 }>,
-        q: &mut Query<'_>,
+        w: &mut Work<'_>,
     ) -> R {
         let scene = self.scene;
         let obj = at(scene.objects, hit.object as usize);
@@ -630,7 +646,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let (reflects, refracts) = self.branches(m);
         let children = node.depth < self.max_depth && (reflects || refracts);
         let d = if children { ray.dir.normalize() } else { ray.dir };
-        let side = facing(d, q.world_normal(scene, hit.object, hit.normal));
+        let side = facing(d, w.world_normal(scene, hit.object, hit.normal));
         let n = side.normal;
         // Rays off the outer side of the surface, towards where its normal points (shadow
         // rays to lights in front, the mirror ray), leave the object: every primitive is
@@ -641,11 +657,10 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let mut local = scene.ambient * m.ka;
         if m.kd > R::ZERO {
             // Lit from outside, the point's shadow rays leave its own (convex) object.
-            q.set_leaving((leaving != NO_OBJECT).then_some(leaving));
+            let f = self.filter().leaving((leaving != NO_OBJECT).then_some(leaving));
             for (l, light) in scene.lights.iter().enumerate() {
-                local += self.direct(l, light, outside, n, m.kd, node.weight, q);
+                local += self.direct(l, light, (outside, n), (m.kd, node.weight), &f, w);
             }
-            q.set_leaving(None);
         }
         let lit = node.weight.weigh(local);
         if children {
@@ -695,8 +710,17 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// (with shadows on) blocked. When the term, times the weight of the node, is below the
     /// cutoff, the shadow ray is not traced and the light counts as visible: either answer is
     /// within the cutoff of the other.
-    #[allow(clippy::too_many_arguments)]
-    fn direct(&self, l: usize, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, weight: R, q: &mut Query<'_>) -> R {
+    /// `f` is what the shadow ray may skip (the object the point lies on, when lit from
+    /// outside).
+    fn direct(
+        &self,
+        l: usize,
+        light: &Light<R>,
+        (from, n): (Vec3<R>, Vec3<R>),
+        (kd, weight): (R, R),
+        f: &Filter,
+        w: &mut Work<'_>,
+    ) -> R {
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
@@ -714,13 +738,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         }
         let term = ip * kd * cos;
         if self.simulates(Effects::SHADOWS) && weight.weigh(term) >= self.cutoff {
-            q.stats.rays[RayKind::Shadow as usize] += 1;
+            w.query.stats.rays[RayKind::Shadow as usize] += 1;
             let ray = Ray::new(from, to_light);
             // Shadow-ray coherence: the object that last hid this light from a point is tried
             // before the accelerator (the last shadow ray towards the light was hidden by it);
             // neighbouring points in a shadow share their occluder.
             // Occlusion is a yes-or-no question, so the answer is the accelerator's.
-            let last = if self.coherence { q.occluder(l) } else { None };
+            let last = if self.coherence { w.occluder(l) } else { None };
             // Towards the first light, when it is directional, every object holds the ray's
             // direction in its own space already.
             // The ray's position across it, which objects' shadow windows are in.
@@ -728,17 +752,14 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 Some((a, b)) if l == 0 => Some([from.dot(a), from.dot(b)]),
                 _ => None,
             };
-            let tried = last.filter(|&i| !q.skips(i) && (i as usize) < self.scene.objects.len());
-            if self.hides(tried, &ray, across, reach, q) {
-                q.stats.hit(RayKind::Shadow, true);
+            let tried = last.filter(|&i| !f.skips(i) && (i as usize) < self.scene.objects.len());
+            if self.hides(tried, &ray, across, reach, &mut w.query) {
+                w.query.stats.hit(RayKind::Shadow, true);
                 return R::ZERO;
             }
             // Missed: the search below need not test it again.
-            q.set_tried(tried);
-            let hidden = self.occluded(l, &ray, across, reach, q);
-            q.set_tried(None);
-            if hidden {
-                q.stats.hit(RayKind::Shadow, true);
+            if self.occluded(l, &ray, (across, reach), &f.tried(tried), w) {
+                w.query.stats.hit(RayKind::Shadow, true);
                 return R::ZERO;
             }
         }
@@ -770,40 +791,42 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// Whether anything hides light `l` along the shadow ray `ray` within `reach`: by the shadow
     /// windows, or by the accelerator (the occluder found remembered for the next point).
     #[inline(always)]
-    fn occluded(&self, l: usize, ray: &Ray<R>, across: Option<[R; 2]>, reach: R, q: &mut Query<'_>) -> bool {
-        match across {
-            // Towards the first light, when it is directional, a small scene's shadow rays
-            // test the objects whose shadow window holds the ray, with no walk.
-            Some(w) if self.eye_rays == EyeRays::Windows => {
-                let found = self.shadow_by_windows(ray, w, reach, q);
-                q.set_occluder(l, found);
-                found.is_some()
-            }
+    fn occluded(
+        &self,
+        l: usize,
+        ray: &Ray<R>,
+        (across, reach): (Option<[R; 2]>, R),
+        f: &Filter,
+        w: &mut Work<'_>,
+    ) -> bool {
+        // Towards the first light, when it is directional, a small scene's shadow rays test the
+        // objects whose shadow window holds the ray, with no walk.
+        let found = match across {
+            Some(at) if self.eye_rays == EyeRays::Windows => self.shadow_by_windows(ray, at, reach, f, &mut w.query),
             _ => {
-                q.set_first_light_ray(across);
-                let hidden = if self.tests_every_object() {
-                    BruteForce.occluded(self.scene, ray, R::ZERO, reach, q)
+                let f = &f.first_light(across);
+                if self.tests_every_object() {
+                    BruteForce.occluded(self.scene, ray, R::ZERO, reach, f, &mut w.query)
                 } else {
-                    self.accel.occluded(self.scene, ray, R::ZERO, reach, q)
-                };
-                q.set_first_light_ray::<R>(None);
-                // Remembered only while the light stays hidden: a lit point forgets it, so
-                // points in the light pay no extra test.
-                q.remember_occluder(l, hidden);
-                hidden
+                    self.accel.occluded(self.scene, ray, R::ZERO, reach, f, &mut w.query)
+                }
             }
-        }
+        };
+        // Remembered only while the light stays hidden: a lit point forgets it, so points in the
+        // light pay no extra test.
+        w.set_occluder(l, found);
+        found.is_some()
     }
 
     /// The first object (in index order) whose shadow window holds the shadow ray's position
     /// `w` across the first light (directional) and which the ray hits within `reach`.
-    fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, q: &mut Query<'_>) -> Option<u32> {
+    fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
         // Tests and culls are counted once the loop ends, not per object.
         let mut tested = 0u32;
         let mut found = None;
         let mut seen = self.scene.objects.len();
         for (i, o) in self.scene.objects.iter().enumerate() {
-            if !o.shadow_window_holds(w) || q.skips(i as u32) {
+            if !o.shadow_window_holds(w) || f.skips(i as u32) {
                 continue;
             }
             tested += 1;
