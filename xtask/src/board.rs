@@ -19,7 +19,6 @@ use board_frame::{Build, LADDER, ORBIT_FRAMES, PICO};
 use board_records::{FrameDone, Record};
 use host_sim::uf2::{build_image, build_pico, kept_image, pico_built, pico_elf, write_uf2, Scenes};
 use lattice_rt::BitFrame;
-use object::{Object, ObjectSymbol};
 use std::fmt::Write as _;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -275,18 +274,13 @@ fn run_emulator(
     work: &Path,
     models: &[&str],
 ) -> Result<BoardRun> {
-    let elf_bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-    let file = object::File::parse(&*elf_bytes)?;
-    let rtt = file
-        .symbols()
-        .find(|s| s.name() == Ok("_SEGGER_RTT"))
-        .context("the image has no _SEGGER_RTT symbol (defmt-rtt's control block)")?
-        .address();
-    let records_at = file
-        .symbols()
-        .find(|s| s.name() == Ok("BOARD_RECORDS"))
-        .context("the image has no BOARD_RECORDS symbol (its board_records::Channel)")?
-        .address();
+    let image = crate::elf::Elf::read(elf)?;
+    let rtt = image
+        .symbol_address("_SEGGER_RTT")?
+        .context("the image has no _SEGGER_RTT symbol (defmt-rtt's control block)")?;
+    let records_at = image
+        .symbol_address("BOARD_RECORDS")?
+        .context("the image has no BOARD_RECORDS symbol (its board_records::Channel)")?;
     let log_path = work.join(if display { "defmt.bin" } else { "defmt-no-display.bin" });
     let records_path = work.join(if display { "records.bin" } else { "records-no-display.bin" });
     let mut cmd = Command::new("node");
@@ -341,7 +335,7 @@ fn run_emulator(
     if run.reason.is_empty() {
         bail!("the emulator ended without a report ({status})");
     }
-    run.log = decode_log(&elf_bytes, &std::fs::read(&log_path).unwrap_or_default())?;
+    run.log = decode_log(image.bytes(), &std::fs::read(&log_path).unwrap_or_default())?;
     run.records = decode_records(&mut std::fs::read(&records_path).unwrap_or_default())?;
     Ok(run)
 }
@@ -391,10 +385,7 @@ fn decode_log(elf: &[u8], bytes: &[u8]) -> Result<Vec<LogLine>> {
 
 /// Bytes of the ELF section `name` (0 when there is none).
 fn section_size(elf: &Path, name: &str) -> Result<u64> {
-    use object::ObjectSection as _;
-    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-    let file = object::File::parse(&*bytes)?;
-    Ok(file.section_by_name(name).map_or(0, |s| s.size()))
+    crate::elf::Elf::read(elf)?.section_size(name)
 }
 
 /// Writes a panel frame (rows MSB first, lit = 1) as a PNG the way the OLED shows it.
@@ -866,18 +857,10 @@ const PROFILE_ROWS: usize = 16;
 /// largest first: the symbols of `elf` (demangled, hashes dropped), code below the flash
 /// `bootrom`, anything else `(no symbol)`.
 fn profile_shares(elf: &Path, samples: &Path) -> Result<Vec<(String, f64)>> {
-    use object::{Object as _, ObjectSymbol as _, SymbolKind};
     let text = std::fs::read_to_string(samples).with_context(|| format!("cannot read {}", samples.display()))?;
     let pairs: Vec<(u64, u64)> =
         serde_json::from_str(&text).with_context(|| format!("{} is not a profile", samples.display()))?;
-    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-    let file = object::File::parse(&*bytes)?;
-    let mut syms: Vec<(u64, u64, String)> = file
-        .symbols()
-        .filter(|s| s.kind() == SymbolKind::Text && s.size() > 0)
-        .filter_map(|s| Some(((s.address() & !1), s.size(), format!("{:#}", rustc_demangle::demangle(s.name().ok()?)))))
-        .collect();
-    syms.sort();
+    let syms = crate::elf::Elf::read(elf)?.code_symbols()?;
     let mut by_name: std::collections::HashMap<String, u64> = Default::default();
     let total: u64 = pairs.iter().map(|p| p.1).sum();
     for (pc, n) in pairs {

@@ -2,11 +2,11 @@
 //! `-icount shift=0`, checks every frame bit for bit against the same render on the host,
 //! measures flash, RAM and instructions per frame, and writes `docs/firmware.md`.
 
+use crate::elf::{demangled, Elf};
 use anyhow::{bail, Context, Result};
 use host_sim::load::read;
 use host_sim::run::render_text;
 use host_sim::uf2::Scenes;
-use object::{Object, ObjectSection, SectionFlags};
 use std::fmt::Write as _;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -221,24 +221,7 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
 /// Flash bytes (every allocated section with contents, `.data` counted at its load address)
 /// and static RAM bytes (`.data`, `.bss`, `.uninit`).
 pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
-    let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-    let file = object::File::parse(&*data)?;
-    let (mut flash, mut ram) = (0, 0);
-    for s in file.sections() {
-        let SectionFlags::Elf { sh_flags } = s.flags() else { continue };
-        if sh_flags & object::elf::SHF_ALLOC as u64 == 0 || s.size() == 0 {
-            continue;
-        }
-        let in_ram = (0x2000_0000..0x3000_0000).contains(&s.address());
-        let has_bytes = s.file_range().is_some();
-        if has_bytes {
-            flash += s.size();
-        }
-        if in_ram {
-            ram += s.size();
-        }
-    }
-    Ok((flash, ram))
+    Elf::read(elf)?.sizes()
 }
 
 /// What one QEMU run printed.
@@ -372,11 +355,11 @@ pub fn host_frame(scenes: &Path, name: &str, scalar: &str, build: board_frame::B
 /// compiler's built-ins (integer division, memcpy) and the rest (vector table, start-up).
 fn flash_parts(elf: &Path) -> Result<Vec<(&'static str, u64)>> {
     use object::{Object as _, ObjectSection as _, ObjectSymbol as _, SectionKind};
-    let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-    let file = object::File::parse(&*data)?;
+    let image = Elf::read(elf)?;
+    let file = image.file()?;
     let rodata: u64 =
         file.sections().filter(|s| s.name().is_ok_and(|n| n.starts_with(".rodata"))).map(|s| s.size()).sum();
-    let (flash, _) = elf_sizes(elf)?;
+    let (flash, _) = image.sizes()?;
     let mut parts: Vec<(&'static str, u64)> = vec![
         ("tracer and renderer (`lattice_rt`)", 0),
         ("the firmware's render loop (`firmware::app`)", 0),
@@ -389,7 +372,7 @@ fn flash_parts(elf: &Path) -> Result<Vec<(&'static str, u64)>> {
         if section.kind() != SectionKind::Text {
             continue;
         }
-        let name = format!("{:#}", rustc_demangle::demangle(sym.name().unwrap_or("")));
+        let name = demangled(sym.name().unwrap_or(""));
         // The render loop is inlined into the harness's `main`, which counts it there.
         let part = if name.contains("fmt") || name.starts_with("qemu::") || name.contains("semihosting") {
             2
@@ -412,16 +395,7 @@ fn flash_parts(elf: &Path) -> Result<Vec<(&'static str, u64)>> {
 
 /// Bytes of the baked scenes' `Baked` statics in an image (`firmware::app::baked::NAME`).
 fn baked_static_bytes(elf: &Path) -> Result<u64> {
-    use object::{Object as _, ObjectSymbol as _};
-    let data = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-    let file = object::File::parse(&*data)?;
-    Ok(file
-        .symbols()
-        .filter(|s| {
-            format!("{:#}", rustc_demangle::demangle(s.name().unwrap_or(""))).starts_with("firmware::app::baked::")
-        })
-        .map(|s| s.size())
-        .sum())
+    Elf::read(elf)?.symbol_bytes("firmware::app::baked::")
 }
 
 /// The `tiny` build's variant: the chair in the smallest parts' memory map.

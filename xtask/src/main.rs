@@ -9,6 +9,7 @@ mod bench;
 mod board;
 mod display;
 mod effects;
+mod elf;
 mod firmware;
 mod memory;
 mod motion;
