@@ -57,7 +57,7 @@ fn walk_and_tile(c: &mut Criterion) {
     c.bench_function("lattice nearest, desk eye ray", |b| {
         b.iter(|| {
             let mut q = Query::new(&mut mb);
-            lat.nearest(&scene, black_box(&ray), 0.0, f64::MAX, &lattice_rt::accel::Filter::NONE, &mut q)
+            lat.nearest(&scene, black_box(&ray), 0.0, f64::MAX, &mut q)
         })
     });
     let tracer = Tracer::new(&scene, &lat);

@@ -93,13 +93,22 @@ impl Stats {
     }
 }
 
-/// An accelerator's scratch for the rays it answers: statistics, and the mailbox (one stamp per
-/// object and per composite, so a ray tests each once). It holds nothing about the ray being
-/// traced: what a ray may skip comes with the ray ([`Filter`]).
+/// What an accelerator is asked with a ray: what that ray may skip ([`Filter`], set by the
+/// caller for each call), and the accelerator's own scratch, statistics and the mailbox (one
+/// stamp per object and per composite, so a ray tests each once). Nothing else: what the tracer
+/// remembers from ray to ray is its own ([`crate::trace::Work`]).
+///
+/// The filter rides in the query rather than beside it, so an accelerator's inner calls (the
+/// object test above all) take one pointer for both. Its layout is fixed, the counters and the
+/// filter first: a Cortex-M0+ loads and stores a word at most 124 bytes past a pointer in one
+/// instruction, and these are read on every test.
 #[derive(Debug)]
+#[repr(C)]
 pub struct Query<'m> {
     /// Counts so far.
     pub stats: Stats,
+    /// What the ray being asked about may skip ([`Filter::NONE`] until the caller says more).
+    pub filter: Filter,
     mailbox: &'m mut [u32],
     ray_id: u32,
 }
@@ -109,7 +118,7 @@ impl<'m> Query<'m> {
     /// mailbox is allowed: objects beyond it are simply re-tested (same answer, more work).
     pub fn new(mailbox: &'m mut [u32]) -> Self {
         mailbox.iter_mut().for_each(|m| *m = 0);
-        Query { stats: Stats::default(), mailbox, ray_id: 0 }
+        Query { stats: Stats::default(), filter: Filter::NONE, mailbox, ray_id: 0 }
     }
     /// Mailbox entries a scene needs: one per object and one per composite.
     pub fn mailbox_len<R: Real>(scene: &Scene<'_, R>) -> usize {
@@ -138,27 +147,29 @@ impl<'m> Query<'m> {
 }
 
 /// What one ray may skip, given with the ray to [`Accelerator::nearest`] and
-/// [`Accelerator::occluded`]: the objects it is known to miss, the objects whose regions it
+/// [`Accelerator::occluded`] in its query ([`Query::filter`]): the objects it is known to miss, the
+/// objects whose regions it
 /// passes outside ([`crate::cull`]: an eye ray's window position, a shadow ray's position across
 /// a directional first light), and whether a lattice walk tests an object's box before it. The
 /// answer is the same whatever the filter says; only the work differs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
 pub struct Filter {
-    /// Whether the ray is an eye ray with a window position.
-    eye_on: bool,
+    /// Objects the ray is known to miss ([`u32::MAX`]: none): the one it leaves and one already
+    /// tried.
+    skip: [u32; 2],
     /// Its window position, both coordinates packed in one word ([`pack_uv`]): written and read
     /// whole, so a read finds the write in the store buffer (two narrow stores read as one
     /// wide load stall until they retire, on x86).
     eye_uv: u64,
+    /// Whether the ray is an eye ray with a window position.
+    eye_on: bool,
+    /// Whether a lattice walk tests an object's box before the object.
+    box_tests: bool,
     /// A shadow ray towards the scene's first light, when that light is directional: its
     /// position across the light ([`Real::to_raw`] bits of the coordinates objects' shadow
     /// windows are in).
     first_light: Option<[u64; 2]>,
-    /// Objects the ray is known to miss ([`u32::MAX`]: none): the one it leaves and one already
-    /// tried.
-    skip: [u32; 2],
-    /// Whether a lattice walk tests an object's box before the object.
-    box_tests: bool,
 }
 
 impl Filter {
@@ -169,8 +180,9 @@ impl Filter {
     /// An eye ray through window position `uv` (from [`crate::camera::Camera::window_uv`]), or
     /// not one (`None`): objects whose eye region does not hold it are not tested.
     #[inline]
-    pub fn eye(self, uv: Option<[i32; 2]>) -> Self {
-        Filter { eye_on: uv.is_some(), eye_uv: uv.map_or(0, pack_uv), ..self }
+    pub fn eye(mut self, uv: Option<[i32; 2]>) -> Self {
+        self.set_eye(uv);
+        self
     }
     /// A shadow ray towards the scene's first light, when that light is directional (its
     /// direction the light's `to_light`), at position `at` across the light (the origin's
@@ -178,27 +190,60 @@ impl Filter {
     /// then take the direction's object-space image from the scene, and objects whose shadow
     /// window does not hold `at` are not tested.
     #[inline]
-    pub fn first_light<R: Real>(self, at: Option<[R; 2]>) -> Self {
-        Filter { first_light: at.map(|w| [w[0].to_raw(), w[1].to_raw()]), ..self }
+    pub fn first_light<R: Real>(mut self, at: Option<[R; 2]>) -> Self {
+        self.set_first_light(at);
+        self
     }
     /// The object the ray leaves (`None`: none): it starts outside it, on the side of the
     /// tangent plane its outward normal points to, and travels away from that plane. Every
     /// primitive is convex, so lies wholly behind that plane: the ray cannot hit it.
     #[inline]
-    pub fn leaving(self, object: Option<u32>) -> Self {
-        Filter { skip: [object.unwrap_or(u32::MAX), self.skip[1]], ..self }
+    pub fn leaving(mut self, object: Option<u32>) -> Self {
+        self.set_leaving(object.unwrap_or(u32::MAX));
+        self
     }
     /// An object the ray was already tested against and missed (`None`: none).
     #[inline]
-    pub fn tried(self, object: Option<u32>) -> Self {
-        Filter { skip: [self.skip[0], object.unwrap_or(u32::MAX)], ..self }
+    pub fn tried(mut self, object: Option<u32>) -> Self {
+        self.set_tried(object);
+        self
     }
     /// Switches a lattice walk's box test before each object's own (on by default): the same
     /// hits, fewer exact tests where objects are smaller than the cells that list them, at six
     /// crossings per object met.
     #[inline]
-    pub fn box_tests(self, on: bool) -> Self {
-        Filter { box_tests: on, ..self }
+    pub fn box_tests(mut self, on: bool) -> Self {
+        self.set_box_tests(on);
+        self
+    }
+    /// [`Filter::eye`] in place: the tracer keeps one filter per core and changes only what
+    /// changes from ray to ray (a few stores, where a new filter would be a copy of all of it).
+    #[inline]
+    pub(crate) fn set_eye(&mut self, uv: Option<[i32; 2]>) {
+        self.eye_on = uv.is_some();
+        if let Some(uv) = uv {
+            self.eye_uv = pack_uv(uv);
+        }
+    }
+    /// [`Filter::first_light`] in place.
+    #[inline]
+    pub(crate) fn set_first_light<R: Real>(&mut self, at: Option<[R; 2]>) {
+        self.first_light = at.map(|w| [w[0].to_raw(), w[1].to_raw()]);
+    }
+    /// [`Filter::leaving`] in place (`u32::MAX`: none).
+    #[inline]
+    pub(crate) fn set_leaving(&mut self, object: u32) {
+        self.skip[0] = object;
+    }
+    /// [`Filter::tried`] in place.
+    #[inline]
+    pub(crate) fn set_tried(&mut self, object: Option<u32>) {
+        self.skip[1] = object.unwrap_or(u32::MAX);
+    }
+    /// [`Filter::box_tests`] in place.
+    #[inline]
+    pub(crate) fn set_box_tests(&mut self, on: bool) {
+        self.box_tests = on;
     }
     /// Whether object `i` is known to be missed by the ray ([`Filter::leaving`],
     /// [`Filter::tried`]).
@@ -262,15 +307,15 @@ pub fn offer<R: Real>(
     tmin: R,
     tmax: R,
     best: &mut Option<Hit<R>>,
-    (f, q): (&Filter, &mut Query<'_>),
+    q: &mut Query<'_>,
 ) -> bool {
-    if f.skips(i as u32) {
+    if q.filter.skips(i as u32) {
         q.stats.culled += 1;
         return false;
     }
     let limit = reach(best, tmax);
     let o = at(scene.objects, i);
-    let hit = match f.eye_ray() {
+    let hit = match q.filter.eye_ray() {
         Some(uv) => match o.intersect_eye_ray(ray, uv, tmin, limit) {
             Ok(hit) => hit,
             Err(Culled) => {
@@ -278,7 +323,7 @@ pub fn offer<R: Real>(
                 return false;
             }
         },
-        None => match f.first_light {
+        None => match q.filter.first_light {
             Some(w) => {
                 if !o.shadow_window_holds([R::from_raw(w[0]), R::from_raw(w[1])]) {
                     q.stats.culled += 1;
@@ -312,11 +357,11 @@ pub fn offer<R: Real>(
 pub trait Accelerator<R: Real> {
     /// Short name for reports.
     fn name(&self) -> &'static str;
-    /// The nearest hit with `t0 < t <= t1`, skipping what `f` allows.
-    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>>;
-    /// An object hit with `t0 < t <= t1`, if any (shadow rays: the occluder), skipping what
-    /// `f` allows.
-    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32>;
+    /// The nearest hit with `t0 < t <= t1`, skipping what the query's filter allows.
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<Hit<R>>;
+    /// An object hit with `t0 < t <= t1`, if any (shadow rays: the occluder), skipping what the
+    /// query's filter allows.
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<u32>;
 }
 
 /// Tests every object for every ray.
@@ -327,16 +372,16 @@ impl<R: Real> Accelerator<R> for BruteForce {
     fn name(&self) -> &'static str {
         "brute"
     }
-    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>> {
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<Hit<R>> {
         let mut best = None;
         for i in 0..s.objects.len() {
-            offer(s, i, ray, t0, t1, &mut best, (f, q));
+            offer(s, i, ray, t0, t1, &mut best, q);
         }
         best
     }
-    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<u32> {
         let mut best = None;
-        (0..s.objects.len()).find(|&i| offer(s, i, ray, t0, t1, &mut best, (f, q))).map(|i| i as u32)
+        (0..s.objects.len()).find(|&i| offer(s, i, ray, t0, t1, &mut best, q)).map(|i| i as u32)
     }
 }
 
@@ -416,14 +461,14 @@ impl BoundingBox {
         tmin: R,
         tmax: R,
         any: bool,
-        (f, q): (&Filter, &mut Query<'_>),
+        q: &mut Query<'_>,
     ) -> Option<Hit<R>> {
         let frame = RayFrame::new(ray);
         let slack = slack(ray);
         let mut best = None;
         for (i, o) in scene.objects.iter().enumerate() {
             q.stats.inside_tests += 1;
-            if frame.passes(&o.bounds.padded(slack)) && offer(scene, i, ray, tmin, tmax, &mut best, (f, q)) && any {
+            if frame.passes(&o.bounds.padded(slack)) && offer(scene, i, ray, tmin, tmax, &mut best, q) && any {
                 return best;
             }
         }
@@ -435,10 +480,10 @@ impl<R: Real> Accelerator<R> for BoundingBox {
     fn name(&self) -> &'static str {
         "bbox"
     }
-    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>> {
-        Self::run(s, ray, t0, t1, false, (f, q))
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<Hit<R>> {
+        Self::run(s, ray, t0, t1, false, q)
     }
-    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
-        Self::run(s, ray, t0, t1, true, (f, q)).map(|h| h.object)
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<u32> {
+        Self::run(s, ray, t0, t1, true, q).map(|h| h.object)
     }
 }

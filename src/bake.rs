@@ -261,7 +261,11 @@ mod writer {
         lattice: Option<&Lattice<'_, R>>,
     ) -> String {
         let mut out = String::new();
-        let _ = write!(out, "/// The scene `{name}`, baked.\npub static {name}: Baked<{scalar}> = Baked {{\n    scene: Scene::from_tables(\n        &");
+        let _ = write!(
+            out,
+            "/// The scene `{name}`, baked.\n\
+             pub static {name}: Baked<{scalar}> = Baked {{\n    scene: Scene::from_tables(\n        &"
+        );
         list(scene.objects, &mut out);
         let arg = |out: &mut String, v: &dyn Literal| {
             out.push_str(",\n        ");
@@ -371,8 +375,7 @@ mod tests {
             let (a, b) = (p(), p());
             let ray = Ray::new(a, b - a);
             let hit = |s: &Scene<'_, Fx>, l: &Lattice<'_, Fx>, mb: &mut [u32]| {
-                l.nearest(s, &ray, Fx(0), Fx::MAX, &crate::accel::Filter::NONE, &mut Query::new(mb))
-                    .map(|h| (h.object, h.t))
+                l.nearest(s, &ray, Fx(0), Fx::MAX, &mut Query::new(mb)).map(|h| (h.object, h.t))
             };
             assert_eq!(hit(&scene, &lattice, &mut mb), hit(&tables, &copy, &mut mb));
         }

@@ -598,7 +598,9 @@ mod tests {
                         for x in [0, 1, 2, w - 3, w - 2, w - 1] {
                             assert!(
                                 dev(x).abs() <= texture,
-                                "{mode:?} {w}x{h} tiles {t} level {level}: column {x} lit {} times against a mean of {mean:.1} ({:.2} sd, the interior within {texture:.2}): first {:?}, last {:?}",
+                                "{mode:?} {w}x{h} tiles {t} level {level}: column {x} lit {} times against a \
+                                 mean of {mean:.1} ({:.2} sd, the interior within {texture:.2}): first {:?}, \
+                                 last {:?}",
                                 lit[x],
                                 dev(x),
                                 &lit[..4],

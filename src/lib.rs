@@ -64,7 +64,8 @@ extern crate alloc;
 extern crate std;
 
 // In the order the data flows: numbers, geometry, the scene (text in, validated scene out),
-// the lattice over it, the storage that holds both and the loading that fills it, then tracing, sampling, dithering and the
+// the lattice over it, the storage that holds both and the loading that fills it, then tracing,
+// sampling, dithering and the
 // tile loop that writes a display.
 mod bounds;
 pub mod scalar;

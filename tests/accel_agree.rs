@@ -142,22 +142,22 @@ fn check_rays<R: Real>(
     let mut mb = vec![0; Query::mailbox_len(scene)];
     let mut q = Query::new(&mut mb);
     for ray in &rays {
-        let want = BruteForce.nearest(scene, ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
-        let got_l = lat.nearest(scene, ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
-        let got_b = BoundingBox.nearest(scene, ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
+        let want = BruteForce.nearest(scene, ray, R::ZERO, R::MAX, &mut q);
+        let got_l = lat.nearest(scene, ray, R::ZERO, R::MAX, &mut q);
+        let got_b = BoundingBox.nearest(scene, ray, R::ZERO, R::MAX, &mut q);
         prop_assert_eq!(want, got_l, "lattice differs from brute force for {:?}", ray);
         prop_assert_eq!(want, got_b, "bbox differs from brute force for {:?}", ray);
         let reach = R::from_f64(3.0);
-        let occ = BruteForce.occluded(scene, ray, R::ZERO, reach, &lattice_rt::accel::Filter::NONE, &mut q).is_some();
+        let occ = BruteForce.occluded(scene, ray, R::ZERO, reach, &mut q).is_some();
         prop_assert_eq!(
             occ,
-            lat.occluded(scene, ray, R::ZERO, reach, &lattice_rt::accel::Filter::NONE, &mut q).is_some(),
+            lat.occluded(scene, ray, R::ZERO, reach, &mut q).is_some(),
             "lattice occlusion, {:?}",
             ray
         );
         prop_assert_eq!(
             occ,
-            BoundingBox.occluded(scene, ray, R::ZERO, reach, &lattice_rt::accel::Filter::NONE, &mut q).is_some(),
+            BoundingBox.occluded(scene, ray, R::ZERO, reach, &mut q).is_some(),
             "bbox occlusion, {:?}",
             ray
         );
@@ -340,11 +340,11 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
         let target = Vec3::new(at(0, &mut rng), at(1, &mut rng), at(2, &mut rng));
         let o = Vec3::new(R::from_f64(1.0), R::from_f64(2.0), R::from_f64(-5.0));
         let ray = Ray::new(o, target - o);
-        let want = BruteForce.nearest(&scene, &ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
+        let want = BruteForce.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q);
         hits += usize::from(want.is_some());
         prop_assert_eq!(
             want,
-            lat.nearest(&scene, &ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q),
+            lat.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q),
             "lattice, lead {} members {} ray {:?}",
             lead,
             members,
@@ -352,7 +352,7 @@ fn check_big_group<R: Real>(lead: usize, members: usize, seed: u64) -> Result<()
         );
         prop_assert_eq!(
             want,
-            BoundingBox.nearest(&scene, &ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q),
+            BoundingBox.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q),
             "bbox, lead {} members {} ray {:?}",
             lead,
             members,

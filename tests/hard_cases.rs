@@ -196,10 +196,8 @@ fn small_far_sphere<R: Real>() {
         for x in 0..n {
             let r = scene.camera().ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
             let r64 = s64.camera().ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
-            let hit =
-                BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q).is_some();
-            let hit64 =
-                BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &lattice_rt::accel::Filter::NONE, &mut q).is_some();
+            let hit = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q).is_some();
+            let hit64 = BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &mut q).is_some();
             if hit != hit64 {
                 // Only rays passing within half a pixel of the f64 silhouette may disagree.
                 let d = r64.dir.normalize();
@@ -294,7 +292,7 @@ fn signed_zero_parallel_rays<R: Real>() {
             let mut answers = Vec::new();
             for (sx, sy) in [(0.0, 0.0), (-0.0, 0.0), (0.0, -0.0), (-0.0, -0.0)] {
                 let r = Ray::new(v::<R>(x, y, -10.0), v::<R>(sx, sy, 1.0));
-                answers.push(a.nearest(&scene, &r, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q));
+                answers.push(a.nearest(&scene, &r, R::ZERO, R::MAX, &mut q));
             }
             assert!(answers.windows(2).all(|w| w[0] == w[1]), "{} {name}: +0 and -0 differ at {x},{y}", R::NAME);
             let want = BruteForce.nearest(
@@ -302,7 +300,6 @@ fn signed_zero_parallel_rays<R: Real>() {
                 &Ray::new(v::<R>(x, y, -10.0), v::<R>(0.0, 0.0, 1.0)),
                 R::ZERO,
                 R::MAX,
-                &lattice_rt::accel::Filter::NONE,
                 &mut q,
             );
             assert_eq!(answers[0], want, "{} {name}", R::NAME);
@@ -338,13 +335,8 @@ fn corners_faces_and_sub_lattices<R: Real>() {
         for r in &rays {
             for dir in [r.dir, -r.dir] {
                 let r = Ray::new(r.origin, dir);
-                let want = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
-                assert_eq!(
-                    a.nearest(&scene, &r, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q),
-                    want,
-                    "{} {name} {r:?}",
-                    R::NAME
-                );
+                let want = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q);
+                assert_eq!(a.nearest(&scene, &r, R::ZERO, R::MAX, &mut q), want, "{} {name} {r:?}", R::NAME);
             }
         }
     });
@@ -410,14 +402,7 @@ fn large_object_and_mailbox<R: Real>() {
         let mut mb = vec![0; 4];
         let mut q = Query::new(&mut mb);
         let hit = a
-            .nearest(
-                &scene,
-                &Ray::new(v::<R>(0.0, 0.5, -1.0), v::<R>(0.0, 0.0, 1.0)),
-                R::ZERO,
-                R::MAX,
-                &lattice_rt::accel::Filter::NONE,
-                &mut q,
-            )
+            .nearest(&scene, &Ray::new(v::<R>(0.0, 0.5, -1.0), v::<R>(0.0, 0.0, 1.0)), R::ZERO, R::MAX, &mut q)
             .unwrap();
         assert_eq!(hit.object, 1, "{} {name}: the sphere is nearer", R::NAME);
         if name != "bbox" {
@@ -499,8 +484,8 @@ fn boxes_under_extreme_transforms<R: Real>() {
             let d = [x * 0.04, y * 0.04, 1.0];
             let r = Ray::new(scene.camera().eye, v::<R>(d[0], d[1], d[2]));
             let r64 = Ray::new(s64.camera().eye, Vec3::new(d[0], d[1], d[2]));
-            let h = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
-            let h64 = BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
+            let h = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q);
+            let h64 = BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &mut q);
             match (h, h64) {
                 (Some(a), Some(b)) => {
                     let rel = (a.t.to_f64() - b.t).abs() / b.t;
@@ -535,26 +520,9 @@ fn fixed_point_far_spheres_are_right_and_tiny_ones_refused() {
     let (fx, f) = (parse::<Fx>(text, &mut a, &mut pa).unwrap(), parse::<f64>(text, &mut b, &mut pb).unwrap());
     let mut mb = vec![0; 2];
     let mut q = Query::new(&mut mb);
-    let h = BruteForce
-        .nearest(
-            &fx,
-            &Ray::new(fx.camera().eye, fx.camera().forward),
-            Fx::ZERO,
-            Fx::MAX,
-            &lattice_rt::accel::Filter::NONE,
-            &mut q,
-        )
-        .unwrap();
-    let h64 = BruteForce
-        .nearest(
-            &f,
-            &Ray::new(f.camera().eye, f.camera().forward),
-            0.0,
-            f64::MAX,
-            &lattice_rt::accel::Filter::NONE,
-            &mut q,
-        )
-        .unwrap();
+    let h =
+        BruteForce.nearest(&fx, &Ray::new(fx.camera().eye, fx.camera().forward), Fx::ZERO, Fx::MAX, &mut q).unwrap();
+    let h64 = BruteForce.nearest(&f, &Ray::new(f.camera().eye, f.camera().forward), 0.0, f64::MAX, &mut q).unwrap();
     // Right to 1e-4 of the distance (the saturating, unshifted quadratic would be off by far more).
     assert!((h.t.to_f64() - h64.t).abs() < 1e-4 * h64.t, "{} vs {}", h.t.to_f64(), h64.t);
     // A radius near the LSB in a scene of size 10 is refused, with the object's line.

@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use lattice_rt::accel::{Filter, Hit, Query};
+use lattice_rt::accel::{Hit, Query};
 use lattice_rt::render::Sampling;
 use lattice_rt::scene::Object;
 use lattice_rt::{Accelerator, BruteForce, Dither, EyeRays, Frame, Fx, LatticeConfig, Ray, Real, Scene, Tracer};
@@ -21,13 +21,13 @@ impl<R: Real> Accelerator<R> for Counting<'_, R> {
     fn name(&self) -> &'static str {
         "counting"
     }
-    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>> {
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<Hit<R>> {
         self.asked.fetch_add(1, Ordering::Relaxed);
-        self.lattice.nearest(s, ray, t0, t1, f, q)
+        self.lattice.nearest(s, ray, t0, t1, q)
     }
-    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<u32> {
         self.asked.fetch_add(1, Ordering::Relaxed);
-        self.lattice.occluded(s, ray, t0, t1, f, q)
+        self.lattice.occluded(s, ray, t0, t1, q)
     }
 }
 

@@ -30,8 +30,8 @@ fn check<R: Real>(text: &str) {
             let mut q = Query::new(&mut mb);
             for (x, y) in [(1, 1), (7, 3), (15, 9)] {
                 let ray = scene.camera().ray(x, y, 16, 10);
-                let a = lat.nearest(&scene, &ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
-                let b = BruteForce.nearest(&scene, &ray, R::ZERO, R::MAX, &lattice_rt::accel::Filter::NONE, &mut q);
+                let a = lat.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q);
+                let b = BruteForce.nearest(&scene, &ray, R::ZERO, R::MAX, &mut q);
                 assert_eq!(a, b);
             }
         }

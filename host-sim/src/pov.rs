@@ -271,9 +271,7 @@ mod tests {
         let ours: Vec<Option<usize>> = (0..(W * H) as i32)
             .map(|i| {
                 let r = scene.camera().ray(2 * (i % W as i32) + 1, 2 * (i / W as i32) + 1, 2 * W as i32, 2 * H as i32);
-                BruteForce
-                    .nearest(scene, &r, 0.0, f64::MAX, &lattice_rt::accel::Filter::NONE, &mut q)
-                    .map(|h| h.object as usize)
+                BruteForce.nearest(scene, &r, 0.0, f64::MAX, &mut q).map(|h| h.object as usize)
             })
             .collect();
         let agree = ours.iter().zip(&ids).filter(|(o, g)| **o == rgb_id(**g, n)).count() as f64 / ours.len() as f64;

@@ -168,7 +168,13 @@ fn objects_behind_a_block_s_object_show_in_none_of_its_pixels() {
                     for y in ys[0]..=ys[1] {
                         for x in xs[0]..=xs[1] {
                             let seen = pixels[y * w + x].0;
-                            assert!(seen == crate::trace::NO_OBJECT || hidden & (1 << seen) == 0, "{what}, {}: object {seen} counted hidden behind {id} over ({x0}, {y0}) + {size} shows at ({x}, {y})", R::NAME);
+                            let shown = seen == crate::trace::NO_OBJECT || hidden & (1 << seen) == 0;
+                            let name = R::NAME;
+                            assert!(
+                                shown,
+                                "{what}, {name}: object {seen} counted hidden behind {id} over ({x0}, {y0}) + {size} \
+                                 shows at ({x}, {y})"
+                            );
                         }
                     }
                 }

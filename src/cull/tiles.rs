@@ -152,7 +152,8 @@ pub(crate) const fn lists(objects: usize) -> bool {
 /// less than a walk through the cells in front of them.
 pub(crate) const LIST: usize = 16;
 
-/// The objects the eye rays of the tile at `x` (its first column and its width) and `y` can hit: those whose window meets the tile's
+/// The objects the eye rays of the tile at `x` (its first column and its width) and `y` can hit:
+/// those whose window meets the tile's
 /// (widened by a `block` on each side, beyond any ray the sampler shoots in the tile), on an
 /// image of `size` quarter pixels.
 pub(crate) fn tile_candidates<R: Real>(

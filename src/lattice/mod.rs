@@ -37,7 +37,7 @@ pub use build::{LatticeError, LatticeStorage};
 pub use config::{LatticeConfig, Resolution, Spacing, MAX_PER_AXIS};
 pub use plan::LatticeSizes;
 
-use crate::accel::{Accelerator, Filter, Hit, Query};
+use crate::accel::{Accelerator, Hit, Query};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::{Scene, NO_COMPOSITE};
@@ -213,11 +213,11 @@ impl<R: Real> Accelerator<R> for Lattice<'_, R> {
     fn name(&self) -> &'static str {
         "lattice"
     }
-    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<Hit<R>> {
-        self.run(s, ray, t0, t1, false, (f, q))
+    fn nearest(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<Hit<R>> {
+        self.run(s, ray, t0, t1, false, q)
     }
-    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
-        self.run(s, ray, t0, t1, true, (f, q)).map(|h| h.object)
+    fn occluded(&self, s: &Scene<'_, R>, ray: &Ray<R>, t0: R, t1: R, q: &mut Query<'_>) -> Option<u32> {
+        self.run(s, ray, t0, t1, true, q).map(|h| h.object)
     }
 }
 

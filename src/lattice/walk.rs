@@ -2,7 +2,7 @@
 //! explicit bounded stack of walkers for sub-lattices (the paper's steps 1-14).
 
 use super::{index, locate, Lattice, MAX_NESTING};
-use crate::accel::{offer, reach, slack, Filter, Hit, Query};
+use crate::accel::{offer, reach, slack, Hit, Query};
 use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
@@ -34,13 +34,13 @@ impl<R: Real> Lattice<'_, R> {
         tmin: R,
         tmax: R,
         any: bool,
-        (f, q): (&Filter, &mut Query<'_>),
+        q: &mut Query<'_>,
     ) -> Option<Hit<R>> {
         let slack = slack(ray);
         let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
         q.next_ray();
         // A window culls an object before its test for less than the box test costs.
-        let inv = Inverse::new(ray, f.tests_boxes() && !f.by_windows(), slack);
+        let inv = Inverse::new(ray, q.filter.tests_boxes() && !q.filter.by_windows(), slack);
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
@@ -55,7 +55,7 @@ impl<R: Real> Lattice<'_, R> {
                     Ok(i) => {
                         if q.first_visit(i)
                             && inv.may_meet(scene, i, tmin, reach(&best, tmax), q)
-                            && offer(scene, i, ray, tmin, tmax, &mut best, (f, q))
+                            && offer(scene, i, ray, tmin, tmax, &mut best, q)
                             && any
                         {
                             return best;

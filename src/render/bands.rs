@@ -44,7 +44,8 @@ pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 
 /// The second half of trace, then dither ([`trace_share`]): dithers tile row `ty` of `frame`
 /// from its kept tiles (`tile(tx)`: tile `tx` of the row) and draws it into `target`, tile by
-/// tile in the order [`render`](super::render) draws them, so bands dithered in order give [`render`](super::render)'s frame
+/// tile in the order [`render`](super::render) draws them, so bands dithered in order give
+/// [`render`](super::render)'s frame
 /// bit for bit. The band ends at the first tile `tile` has nothing for. With silhouette lines,
 /// `above` (the frame's width of entries) holds what the bottom row of the band above hit and
 /// is left holding this band's (shorter storage is refused: `ScratchTooSmall`). The band is

@@ -31,13 +31,15 @@ pub struct Frame {
     /// different objects is drawn black.
     pub outline: bool,
     /// `Some(k)`: branches of the intersection tree weighing less than 2^-k are not traced, as
-    /// with [`Tracer::set_cutoff`](crate::trace::Tracer::set_cutoff) (the larger of the two cutoffs holds; `k` above 14 counts as
+    /// with [`Tracer::set_cutoff`](crate::trace::Tracer::set_cutoff) (the larger of the two cutoffs
+    /// holds; `k` above 14 counts as
     /// 14, [`Real::div_pow2`]); `None`: the tracer's own. 7 is half of
     /// one of the 64 gray steps a pixel's level takes.
     pub cutoff: Option<u8>,
 }
 
-/// One core's share of a frame's tiles ([`render_share`](super::render_share)): tile `(tx, ty)` belongs to share `(tx + ty) % of`, a
+/// One core's share of a frame's tiles ([`render_share`](super::render_share)): tile `(tx, ty)`
+/// belongs to share `(tx + ty) % of`, a
 /// checkerboard for two, so each share holds as much of every part of the picture as the
 /// others. Shares rendered apart give the pixels of the whole frame when its bands are
 /// independent ([`Frame::bands_independent`]).
@@ -248,24 +250,44 @@ impl<E: fmt::Debug> fmt::Display for RenderError<E> {
             RenderError::BadTile => {
                 write!(f, "tile side must be 1..={MAX_TILE} and a multiple of the pattern block")
             }
-            RenderError::EdgesNotCompiled => write!(f, "this build leaves out edge sampling (the core's `edge-sampling` feature)"),
-            RenderError::CoarseNotCompiled => write!(f, "this build leaves out two-level adaptive sampling (the core's `coarse-sampling` feature)"),
-            RenderError::DiffusionNotCompiled => write!(f, "this build leaves out error diffusion (the core's `diffusion` feature)"),
+            RenderError::EdgesNotCompiled => {
+                write!(f, "this build leaves out edge sampling (the core's `edge-sampling` feature)")
+            }
+            RenderError::CoarseNotCompiled => {
+                write!(f, "this build leaves out two-level adaptive sampling (the core's `coarse-sampling` feature)")
+            }
+            RenderError::DiffusionNotCompiled => {
+                write!(f, "this build leaves out error diffusion (the core's `diffusion` feature)")
+            }
             RenderError::ScratchTooSmall { needed } => {
                 write!(f, "render scratch storage too small: {needed} entries needed")
             }
-            RenderError::BadShare => write!(f, "tile share out of range, or the frame carries state from tile to tile (error diffusion, edge sampling)"),
+            RenderError::BadShare => {
+                write!(
+                    f,
+                    "tile share out of range, or the frame carries state from tile to tile (error \
+                     diffusion, edge sampling)"
+                )
+            }
             RenderError::ViewTooNarrow { most, scalar } => write!(
                 f,
-                "the view is too narrow for {scalar} at this size: through it {scalar} resolves at most {}x{} pixels (widen the field of view, render fewer pixels, or trace in f64)",
+                "the view is too narrow for {scalar} at this size: through it {scalar} resolves at most {}x{} \
+                 pixels (widen the field of view, render fewer pixels, or trace in f64)",
                 most[0], most[1]
             ),
             RenderError::FrameShape { fitted, frame } => write!(
                 f,
-                "the scene's view was fitted to frames of shape {}:{}, not {}x{} (pixels would not be square): load the scene for this frame",
+                "the scene's view was fitted to frames of shape {}:{}, not {}x{} (pixels would not be square): \
+                 load the scene for this frame",
                 fitted[0], fitted[1], frame[0], frame[1]
             ),
-            RenderError::NotProgressive => write!(f, "progressive passes need tiles of a multiple of 8, one ray per pixel, a pass of 8, 4, 2 or 1 and room for the traced samples"),
+            RenderError::NotProgressive => {
+                write!(
+                    f,
+                    "progressive passes need tiles of a multiple of 8, one ray per pixel, a pass of 8, \
+                     4, 2 or 1 and room for the traced samples"
+                )
+            }
         }
     }
 }

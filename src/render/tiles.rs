@@ -333,7 +333,8 @@ fn outline_tile(
 /// [`dither_band`](super::dither_band)): its gray levels (tone curve and the silhouette lines inside it applied),
 /// and for the lines across its borders what its pixels hit (object and depth key) along its
 /// four sides: the left column and top row as sampled, and the right column and bottom row as
-/// the apron of the tiles right of it and below takes them ([`Sampler::side`](crate::sample::Sampler::side): the eye rays
+/// the apron of the tiles right of it and below takes them
+/// ([`Sampler::side`](crate::sample::Sampler::side): the eye rays
 /// through their centres, or with adaptive sampling the fill between two traced pixels that
 /// hit the same object).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

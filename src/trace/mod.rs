@@ -21,7 +21,7 @@
 mod work;
 pub use work::Work;
 
-use crate::accel::{Accelerator, BruteForce, Filter, Hit, Query, RayKind};
+use crate::accel::{Accelerator, BruteForce, Hit, Query, RayKind};
 use crate::bounds::at;
 use crate::math::{Ray, Vec3};
 use crate::scalar::Real;
@@ -255,7 +255,7 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     eye_rays: EyeRays,
     /// Whether a shadow ray first tries the object that last hid its light.
     coherence: bool,
-    /// Whether a lattice walk tests an object's box before the object ([`Filter::box_tests`]).
+    /// Whether a lattice walk tests an object's box before the object ([`crate::accel::Filter::box_tests`]).
     box_tests: bool,
 }
 
@@ -327,11 +327,11 @@ fn nearest_by_windows<R: Real>(
     scene: &Scene<'_, R>,
     ray: &Ray<R>,
     candidates_mask: u64,
-    (f, q): (&Filter, &mut Query<'_>),
+    q: &mut Query<'_>,
 ) -> Option<Hit<R>> {
     let n = scene.objects.len();
     if n > 64 {
-        return BruteForce.nearest(scene, ray, R::ZERO, R::MAX, f, q);
+        return BruteForce.nearest(scene, ray, R::ZERO, R::MAX, q);
     }
     let mut best = None;
     // The candidates are counted as they come (cheaper than a population count on a core
@@ -339,7 +339,7 @@ fn nearest_by_windows<R: Real>(
     let mut candidates = 0u32;
     crate::cull::any_object(candidates_mask, n, |i| {
         candidates += 1;
-        crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, (f, q));
+        crate::accel::offer(scene, i, ray, R::ZERO, R::MAX, &mut best, q);
         false
     });
     q.stats.culled += u64::from(n as u32 - candidates);
@@ -359,7 +359,7 @@ struct Meta<R> {
     depth: u8,
     kind: RayKind,
     /// The object the ray leaves from outside (a mirror ray off its surface), which it cannot
-    /// hit ([`Filter::leaving`]), or [`NO_OBJECT`].
+    /// hit ([`crate::accel::Filter::leaving`]), or [`NO_OBJECT`].
     leaving: u32,
 }
 
@@ -426,7 +426,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         self.box_tests
     }
 
-    /// Switches the walk's box tests ([`Filter::box_tests`]; the picture is the same either
+    /// Switches the walk's box tests ([`crate::accel::Filter::box_tests`]; the picture is the same either
     /// way; off is the paper's walk, which tests every object of every cell it enters).
     pub fn set_box_tests(&mut self, on: bool) {
         self.box_tests = on;
@@ -514,7 +514,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// primary ray): what the outline's apron needs.
     pub fn eye_hit(&self, eye: Ray<R>, uv: Option<[i32; 2]>, w: &mut Work<'_>) -> (u32, R) {
         w.query.stats.rays[RayKind::Primary as usize] += 1;
-        let found = self.nearest(&eye, uv, &self.filter(), w);
+        w.query.filter.set_box_tests(self.box_tests);
+        let found = self.nearest(&eye, uv, w);
         w.query.stats.hit(RayKind::Primary, found.is_some());
         found.map_or((NO_OBJECT, R::MAX), |hit| (hit.object, hit.t))
     }
@@ -526,47 +527,35 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         self.eye_rays == EyeRays::Windows && self.scene.objects.len() <= EyeRays::EVERY_OBJECT_UP_TO
     }
 
-    /// What every ray of this tracer may skip before its own: nothing, with the walk's box
-    /// tests as set ([`Tracer::set_box_tests`]).
-    #[inline(always)]
-    fn filter(&self) -> Filter {
-        Filter::NONE.box_tests(self.box_tests)
-    }
-
-    /// The nearest hit of `ray` skipping what `f` allows; an eye ray's window position `uv`
-    /// (when given) lets [`EyeRays`] skip objects or the walk. Inlined on x86-64: the hit would
-    /// come back through memory, written field by field and read in wider moves that wait for
-    /// those stores to retire.
+    /// The nearest hit of `ray`, skipping what the work's filter allows; an eye ray's window
+    /// position `uv` (when given) lets [`EyeRays`] skip objects or the walk. Inlined on x86-64:
+    /// the hit would come back through memory, written field by field and read in wider moves
+    /// that wait for those stores to retire.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
-    fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, f: &Filter, w: &mut Work<'_>) -> Option<Hit<R>> {
+    fn nearest(&self, ray: &Ray<R>, uv: Option<[i32; 2]>, w: &mut Work<'_>) -> Option<Hit<R>> {
+        let scene = self.scene;
         match uv {
             Some(uv) if self.eye_rays != EyeRays::Plain => {
-                let f = &f.eye(Some(uv));
-                match self.eye_rays {
-                    EyeRays::Windows => nearest_by_windows(self.scene, ray, w.eye_candidates(), (f, &mut w.query)),
-                    _ => match w.eye_list() {
-                        // The tile listed its objects: no walk (see `Scratch::with_cover`).
-                        Some(list) => {
-                            let mut best = None;
-                            for &i in list {
-                                crate::accel::offer(
-                                    self.scene,
-                                    i as usize,
-                                    ray,
-                                    R::ZERO,
-                                    R::MAX,
-                                    &mut best,
-                                    (f, &mut w.query),
-                                );
-                            }
-                            best
+                // The window position serves this ray alone.
+                w.query.filter.set_eye(Some(uv));
+                let q = &mut w.query;
+                let found = match (self.eye_rays, w.eye_list) {
+                    (EyeRays::Windows, _) => nearest_by_windows(scene, ray, w.eye_candidates, q),
+                    // The tile listed its objects: no walk (see `Scratch::with_cover`).
+                    (_, Some(list)) => {
+                        let mut best = None;
+                        for &i in list {
+                            crate::accel::offer(scene, i as usize, ray, R::ZERO, R::MAX, &mut best, q);
                         }
-                        None => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, f, &mut w.query),
-                    },
-                }
+                        best
+                    }
+                    _ => self.accel.nearest(scene, ray, R::ZERO, R::MAX, q),
+                };
+                w.query.filter.set_eye(None);
+                found
             }
-            _ if self.tests_every_object() => BruteForce.nearest(self.scene, ray, R::ZERO, R::MAX, f, &mut w.query),
-            _ => self.accel.nearest(self.scene, ray, R::ZERO, R::MAX, f, &mut w.query),
+            _ if self.tests_every_object() => BruteForce.nearest(scene, ray, R::ZERO, R::MAX, &mut w.query),
+            _ => self.accel.nearest(scene, ray, R::ZERO, R::MAX, &mut w.query),
         }
     }
 
@@ -583,7 +572,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         // most `MAX_DEPTH + 2` nodes wait: no push below can fail.
         let mut stack: Vec<Node<R>, { MAX_DEPTH as usize + 2 }> = Vec::new();
         let mut total = R::ZERO;
-        let f = self.filter();
+        w.query.filter.set_box_tests(self.box_tests);
         // The eye ray is traced first without a trip through the stack (the stack only holds
         // children).
         let mut primary = true;
@@ -609,8 +598,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             };
             w.query.stats.rays[node.kind as usize] += 1;
             // The eye ray's window position serves the eye ray alone.
-            let leaves = f.leaving((node.leaving != NO_OBJECT).then_some(node.leaving));
-            let found = self.nearest(ray, if node.depth == 0 { eye_uv } else { None }, &leaves, w);
+            w.query.filter.set_leaving(node.leaving);
+            let found = self.nearest(ray, if node.depth == 0 { eye_uv } else { None }, w);
+            w.query.filter.set_leaving(NO_OBJECT);
             let Some(hit) = found else {
                 total += node.weight.weigh(scene.background);
                 continue;
@@ -657,10 +647,11 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let mut local = scene.ambient * m.ka;
         if m.kd > R::ZERO {
             // Lit from outside, the point's shadow rays leave its own (convex) object.
-            let f = self.filter().leaving((leaving != NO_OBJECT).then_some(leaving));
+            w.query.filter.set_leaving(leaving);
             for (l, light) in scene.lights.iter().enumerate() {
-                local += self.direct(l, light, (outside, n), (m.kd, node.weight), &f, w);
+                local += self.direct(l, light, outside, n, m.kd, node.weight, w);
             }
+            w.query.filter.set_leaving(NO_OBJECT);
         }
         let lit = node.weight.weigh(local);
         if children {
@@ -710,17 +701,10 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// (with shadows on) blocked. When the term, times the weight of the node, is below the
     /// cutoff, the shadow ray is not traced and the light counts as visible: either answer is
     /// within the cutoff of the other.
-    /// `f` is what the shadow ray may skip (the object the point lies on, when lit from
-    /// outside).
-    fn direct(
-        &self,
-        l: usize,
-        light: &Light<R>,
-        (from, n): (Vec3<R>, Vec3<R>),
-        (kd, weight): (R, R),
-        f: &Filter,
-        w: &mut Work<'_>,
-    ) -> R {
+    /// The work's filter says what the shadow ray may skip (the object the point lies on, when
+    /// lit from outside).
+    #[allow(clippy::too_many_arguments)]
+    fn direct(&self, l: usize, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, weight: R, w: &mut Work<'_>) -> R {
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
@@ -752,13 +736,16 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 Some((a, b)) if l == 0 => Some([from.dot(a), from.dot(b)]),
                 _ => None,
             };
-            let tried = last.filter(|&i| !f.skips(i) && (i as usize) < self.scene.objects.len());
+            let tried = last.filter(|&i| !w.query.filter.skips(i) && (i as usize) < self.scene.objects.len());
             if self.hides(tried, &ray, across, reach, &mut w.query) {
                 w.query.stats.hit(RayKind::Shadow, true);
                 return R::ZERO;
             }
             // Missed: the search below need not test it again.
-            if self.occluded(l, &ray, (across, reach), &f.tried(tried), w) {
+            w.query.filter.set_tried(tried);
+            let hidden = self.occluded(l, &ray, across, reach, w);
+            w.query.filter.set_tried(None);
+            if hidden {
                 w.query.stats.hit(RayKind::Shadow, true);
                 return R::ZERO;
             }
@@ -791,25 +778,20 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// Whether anything hides light `l` along the shadow ray `ray` within `reach`: by the shadow
     /// windows, or by the accelerator (the occluder found remembered for the next point).
     #[inline(always)]
-    fn occluded(
-        &self,
-        l: usize,
-        ray: &Ray<R>,
-        (across, reach): (Option<[R; 2]>, R),
-        f: &Filter,
-        w: &mut Work<'_>,
-    ) -> bool {
+    fn occluded(&self, l: usize, ray: &Ray<R>, across: Option<[R; 2]>, reach: R, w: &mut Work<'_>) -> bool {
         // Towards the first light, when it is directional, a small scene's shadow rays test the
         // objects whose shadow window holds the ray, with no walk.
         let found = match across {
-            Some(at) if self.eye_rays == EyeRays::Windows => self.shadow_by_windows(ray, at, reach, f, &mut w.query),
+            Some(at) if self.eye_rays == EyeRays::Windows => self.shadow_by_windows(ray, at, reach, &mut w.query),
             _ => {
-                let f = &f.first_light(across);
-                if self.tests_every_object() {
-                    BruteForce.occluded(self.scene, ray, R::ZERO, reach, f, &mut w.query)
+                w.query.filter.set_first_light(across);
+                let found = if self.tests_every_object() {
+                    BruteForce.occluded(self.scene, ray, R::ZERO, reach, &mut w.query)
                 } else {
-                    self.accel.occluded(self.scene, ray, R::ZERO, reach, f, &mut w.query)
-                }
+                    self.accel.occluded(self.scene, ray, R::ZERO, reach, &mut w.query)
+                };
+                w.query.filter.set_first_light::<R>(None);
+                found
             }
         };
         // Remembered only while the light stays hidden: a lit point forgets it, so points in the
@@ -820,13 +802,13 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
 
     /// The first object (in index order) whose shadow window holds the shadow ray's position
     /// `w` across the first light (directional) and which the ray hits within `reach`.
-    fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, f: &Filter, q: &mut Query<'_>) -> Option<u32> {
+    fn shadow_by_windows(&self, ray: &Ray<R>, w: [R; 2], reach: R, q: &mut Query<'_>) -> Option<u32> {
         // Tests and culls are counted once the loop ends, not per object.
         let mut tested = 0u32;
         let mut found = None;
         let mut seen = self.scene.objects.len();
         for (i, o) in self.scene.objects.iter().enumerate() {
-            if !o.shadow_window_holds(w) || f.skips(i as u32) {
+            if !o.shadow_window_holds(w) || q.filter.skips(i as u32) {
                 continue;
             }
             tested += 1;

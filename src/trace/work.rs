@@ -12,7 +12,10 @@ use crate::scene::{axis_normal, Scene, MAX_LIGHTS};
 /// tile being rendered can hit (set by the render, per tile), each light's last occluder (shadow
 /// coherence; forgotten per band of tiles, so a band renders the same whichever band came
 /// before it) and the last unit normal mapped to the world.
+///
+/// Its layout is fixed, the query first (see [`Query`]'s).
 #[derive(Debug)]
+#[repr(C)]
 pub struct Work<'m> {
     /// The accelerator's scratch: mailbox and statistics.
     pub query: Query<'m>,
@@ -23,10 +26,10 @@ pub struct Work<'m> {
     axis_normal: Option<(u32, u8, [u64; 3])>,
     /// The objects (bit `i`: object `i`) whose eye region meets the current tile; the others
     /// cannot be hit by its eye rays (see [`Work::set_eye_candidates`]).
-    eye_candidates: u64,
+    pub(crate) eye_candidates: u64,
     /// The objects whose eye window meets the current tile, when a render listed them (see
     /// [`Work::set_eye_list`]); `None`: not listed.
-    eye_list: Option<&'m [u32]>,
+    pub(crate) eye_list: Option<&'m [u32]>,
 }
 
 impl<'m> Work<'m> {

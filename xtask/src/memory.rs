@@ -68,11 +68,7 @@ fn measure(scene: &Scene<'_, f64>, methods: &[Method<'_>], rays: &[Ray<f64>], ru
             let mut hits = Vec::with_capacity(rays.len());
             let t0 = Instant::now();
             for r in rays {
-                hits.push(
-                    m.accel
-                        .nearest(scene, r, 0.0, f64::MAX, &lattice_rt::accel::Filter::NONE, &mut q)
-                        .map(|h| (h.object as usize, h.t)),
-                );
+                hits.push(m.accel.nearest(scene, r, 0.0, f64::MAX, &mut q).map(|h| (h.object as usize, h.t)));
             }
             times[i].push(t0.elapsed() / rays.len().max(1) as u32);
             let n = rays.len().max(1) as f64;
