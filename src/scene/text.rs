@@ -846,7 +846,19 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
 }
 
 /// Parses scene text into a validated scene whose objects live in `storage` and whose
-/// composites, materials and lights live in `parts`.
+/// composites, materials and lights live in `parts`. A mistake is an error that says where:
+///
+/// ```
+/// use lattice_rt::{parse, scene::Object, Parts};
+///
+/// let (mut storage, mut parts) = ([Object::<f32>::default(); 4], Parts::default());
+/// let scene = parse::<f32>("light directional dir -1 -1 1\nsphere radius 1\n", &mut storage, &mut parts);
+/// assert_eq!(scene.map(|s| s.objects().len()), Ok(1));
+///
+/// let (mut storage, mut parts) = ([Object::<f32>::default(); 4], Parts::default());
+/// let err = parse::<f32>("sphere raduis 1\n", &mut storage, &mut parts).unwrap_err();
+/// assert_eq!((err.line, err.col, err.token), (1, 8, "raduis"));
+/// ```
 ///
 /// Kept out of line so that on a microcontroller the parser's frame is released before the
 /// render that follows it needs the stack.
