@@ -155,8 +155,9 @@ impl<'m> Query<'m> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(C)]
 pub struct Filter {
-    /// Objects the ray is known to miss ([`u32::MAX`]: none): the one it leaves and one already
-    /// tried.
+    /// Objects the ray is known to miss, each stored plus one (0: none): the one it leaves and
+    /// one already tried. With `no_box_tests`, a filter that skips nothing is all zeros, so
+    /// making one takes no table of its bytes (the tiny image's 16 KiB counts them).
     skip: [u32; 2],
     /// Its window position, both coordinates packed in one word ([`pack_uv`]): written and read
     /// whole, so a read finds the write in the store buffer (two narrow stores read as one
@@ -164,8 +165,8 @@ pub struct Filter {
     eye_uv: u64,
     /// Whether the ray is an eye ray with a window position.
     eye_on: bool,
-    /// Whether a lattice walk tests an object's box before the object.
-    box_tests: bool,
+    /// Whether a lattice walk leaves out its test of an object's box before the object.
+    no_box_tests: bool,
     /// A shadow ray towards the scene's first light, when that light is directional: its
     /// position across the light ([`Real::to_raw`] bits of the coordinates objects' shadow
     /// windows are in).
@@ -174,8 +175,7 @@ pub struct Filter {
 
 impl Filter {
     /// A ray that skips nothing, with box tests on.
-    pub const NONE: Filter =
-        Filter { eye_on: false, eye_uv: 0, first_light: None, skip: [u32::MAX; 2], box_tests: true };
+    pub const NONE: Filter = Filter { eye_on: false, eye_uv: 0, first_light: None, skip: [0; 2], no_box_tests: false };
 
     /// An eye ray through window position `uv` (from [`crate::camera::Camera::window_uv`]), or
     /// not one (`None`): objects whose eye region does not hold it are not tested.
@@ -233,23 +233,24 @@ impl Filter {
     /// [`Filter::leaving`] in place (`u32::MAX`: none).
     #[inline]
     pub(crate) fn set_leaving(&mut self, object: u32) {
-        self.skip[0] = object;
+        self.skip[0] = object.wrapping_add(1);
     }
     /// [`Filter::tried`] in place.
     #[inline]
     pub(crate) fn set_tried(&mut self, object: Option<u32>) {
-        self.skip[1] = object.unwrap_or(u32::MAX);
+        self.skip[1] = object.unwrap_or(u32::MAX).wrapping_add(1);
     }
     /// [`Filter::box_tests`] in place.
     #[inline]
     pub(crate) fn set_box_tests(&mut self, on: bool) {
-        self.box_tests = on;
+        self.no_box_tests = !on;
     }
     /// Whether object `i` is known to be missed by the ray ([`Filter::leaving`],
     /// [`Filter::tried`]).
     #[inline]
     pub fn skips(&self, i: u32) -> bool {
-        self.skip[0] == i || self.skip[1] == i
+        let stored = i.wrapping_add(1);
+        self.skip[0] == stored || self.skip[1] == stored
     }
     /// The eye ray's window position, if the ray is an eye ray with one.
     #[inline]
@@ -259,7 +260,7 @@ impl Filter {
     /// Whether a lattice walk tests boxes before objects ([`Filter::box_tests`]).
     #[inline]
     pub fn tests_boxes(&self) -> bool {
-        self.box_tests
+        !self.no_box_tests
     }
     /// Whether the ray is tested through regions: an eye ray, or a shadow ray towards the first
     /// light.

@@ -406,12 +406,12 @@ impl<'c> Ditherer<'c> {
             Some(c) => c.tile(self.mode, (x0, y0), w, h, levels, out),
             None if self.mode == Dither::BlueNoise => {
                 // Row by row against the mask's row (the same pixels as `blue_noise`).
-                let (levels, out) = (&levels[..w * h], &mut out[..w * h]);
                 for y in 0..h {
                     let mask = &BLUE_NOISE[(y0 + y) % 16];
-                    let (row, px) = (&levels[y * w..(y + 1) * w], &mut out[y * w..(y + 1) * w]);
                     for x in 0..w {
-                        px[x] = BinaryColor::from((mask[(x0 + x) % 16] as u32) < row[x].min(LEVELS) as u32 * 4);
+                        let l = *crate::bounds::at(levels, y * w + x);
+                        *crate::bounds::at_mut(out, y * w + x) =
+                            BinaryColor::from((mask[(x0 + x) % 16] as u32) < l.min(LEVELS) as u32 * 4);
                     }
                 }
             }

@@ -144,6 +144,7 @@ impl Frame {
     }
 
     /// The frame's grid of tiles.
+    #[inline(always)]
     pub const fn grid(&self) -> TileGrid {
         TileGrid::new(self.tile as usize, self.width as usize, self.height as usize)
     }
@@ -350,14 +351,17 @@ pub struct TileGrid {
 
 impl TileGrid {
     /// The grid of a frame `w x h` pixels in tiles of side `t` (0 counts as 1).
+    #[inline(always)]
     pub const fn new(t: usize, w: usize, h: usize) -> Self {
         TileGrid { t: if t == 0 { 1 } else { t }, w, h }
     }
     /// Tiles across and down.
+    #[inline(always)]
     pub const fn tiles(&self) -> (usize, usize) {
         (self.w.div_ceil(self.t), self.h.div_ceil(self.t))
     }
     /// The band of tile rows `rows` (`[first, end)`) cut to the grid: `first <= end <= tiles down`.
+    #[inline(always)]
     pub const fn rows(&self, rows: (u16, u16)) -> (usize, usize) {
         let down = self.tiles().1;
         let end = if (rows.1 as usize) < down { rows.1 as usize } else { down };
@@ -365,7 +369,7 @@ impl TileGrid {
         (first, end)
     }
     /// Where tile `(tx, ty)` lies (it must be on the grid).
-    #[inline]
+    #[inline(always)]
     pub fn at(&self, tx: usize, ty: usize) -> TileAt {
         let (x0, y0) = (tx * self.t, ty * self.t);
         TileAt { x0, y0, tw: self.t.min(self.w - x0), th: self.t.min(self.h - y0), t: self.t }

@@ -81,7 +81,8 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
     };
     let (w4, h4) = (4 * grid.w as i32, 4 * grid.h as i32);
     let mut eyes = crate::camera::EyeRayCache::<R>::new(tracer.scene().camera(), w4, h4);
-    let mut tile = TileWork { levels: [0; MAX_TILE * MAX_TILE], hits: Hits::new(), sides: KeptTile::EMPTY };
+    let mut tile =
+        TileWork { levels: [0; MAX_TILE * MAX_TILE], hits: Hits::new(), bits: [BinaryColor::Off; MAX_TILE * MAX_TILE] };
     let (mut done, mut kept) = (0, 0);
     for ty in first..end {
         dither.next_band();
@@ -100,8 +101,10 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
             let mut ray = Eye { tracer, work: &mut work, cache: &mut eyes };
             sample(&mut ray, &mut sampler, at, candidates, looks, traced, &mut tile);
             hooks.gray_tile(at.x0 as u16, at.y0 as u16, at.tw as u16, at.th as u16, &tile.levels[..at.tw * at.th]);
-            finish(&mut ray, &sampler, at, frame, looks, &mut tile);
-            emit(&mut out, &mut dither, at, &tile, &mut kept)?;
+            // What a kept tile keeps of its sides (a drawn one keeps none: the compiler leaves it out).
+            let mut sides = KeptTile::EMPTY;
+            finish(&mut ray, &sampler, at, (frame, looks), (&mut tile, &mut sides));
+            emit(&mut out, &mut dither, at, (&mut tile, &sides), &mut kept)?;
             done += 1;
             if !hooks.progress(done, total) {
                 return Err(RenderError::Cancelled);
@@ -111,7 +114,9 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
     Ok(work.query.stats)
 }
 
-/// The dither and the sampler of a render, their rows cut from the scratch's.
+/// The dither and the sampler of a render, their rows cut from the scratch's. Inlined, so a
+/// firmware's constant frame folds its modes into the tile loop (the code of the others left out).
+#[inline(always)]
 fn rows<'s, E>(
     frame: &Frame,
     mode: Dither,
@@ -137,11 +142,11 @@ struct Looks {
     keep: bool,
 }
 
-/// A tile's working buffers: its gray levels, what its pixels hit, and its kept sides.
+/// A tile's working buffers: its gray levels, what its pixels hit, and its pixels once dithered.
 struct TileWork {
     levels: [u8; MAX_TILE * MAX_TILE],
     hits: Hits,
-    sides: KeptTile,
+    bits: [BinaryColor; MAX_TILE * MAX_TILE],
 }
 
 /// The eye rays of a render: each made by the camera's cache and traced with its window
@@ -242,17 +247,15 @@ fn finish<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     eye: &mut Eye<'_, '_, '_, '_, '_, R, A, E>,
     sampler: &Sampler<'_>,
     at: TileAt,
-    frame: &Frame,
-    looks: Looks,
-    tile: &mut TileWork,
+    (frame, looks): (&Frame, Looks),
+    (tile, sides): (&mut TileWork, &mut KeptTile),
 ) {
     let TileAt { x0, y0, tw, th, .. } = at;
-    let TileWork { levels, hits, sides } = tile;
+    let TileWork { levels, hits, .. } = tile;
     let levels = &mut levels[..tw * th];
     if !frame.tone.is_linear() {
         levels.iter_mut().for_each(|l| *l = frame.tone.apply(*l));
     }
-    *sides = KeptTile::EMPTY;
     if !looks.outline {
         return;
     }
@@ -286,22 +289,23 @@ fn emit<D: DrawTarget<Color = BinaryColor>>(
     out: &mut Out<'_, D>,
     dither: &mut Ditherer<'_>,
     at: TileAt,
-    tile: &TileWork,
+    (tile, sides): (&mut TileWork, &KeptTile),
     kept: &mut usize,
 ) -> Result<(), RenderError<D::Error>> {
     let TileAt { x0, y0, tw, th, .. } = at;
+    let n = tw * th;
     match out {
         Out::Keep(store) => {
             let stored = &mut store[*kept];
-            *stored = tile.sides;
-            stored.levels[..tw * th].copy_from_slice(&tile.levels[..tw * th]);
+            *stored = *sides;
+            stored.levels[..n].copy_from_slice(&tile.levels[..n]);
             *kept += 1;
         }
         Out::Draw(target) => {
-            let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
-            dither.tile(x0, y0, tw, th, &tile.levels[..tw * th], &mut bits);
+            let TileWork { levels, bits, .. } = tile;
+            dither.tile(x0, y0, tw, th, &levels[..n], bits);
             let area = Rectangle::new(Point::new(x0 as i32, y0 as i32), Size::new(tw as u32, th as u32));
-            target.fill_contiguous(&area, bits[..tw * th].iter().copied()).map_err(RenderError::Draw)?;
+            target.fill_contiguous(&area, bits[..n].iter().copied()).map_err(RenderError::Draw)?;
         }
     }
     Ok(())

@@ -538,8 +538,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             Some(uv) if self.eye_rays != EyeRays::Plain => {
                 // The window position serves this ray alone.
                 w.query.filter.set_eye(Some(uv));
+                let list = w.eye_list();
                 let q = &mut w.query;
-                let found = match (self.eye_rays, w.eye_list) {
+                let found = match (self.eye_rays, list) {
                     (EyeRays::Windows, _) => nearest_by_windows(scene, ray, w.eye_candidates, q),
                     // The tile listed its objects: no walk (see `Scratch::with_cover`).
                     (_, Some(list)) => {

@@ -28,8 +28,12 @@ pub struct Work<'m> {
     /// cannot be hit by its eye rays (see [`Work::set_eye_candidates`]).
     pub(crate) eye_candidates: u64,
     /// The objects whose eye window meets the current tile, when a render listed them (see
-    /// [`Work::set_eye_list`]); `None`: not listed.
+    /// [`Work::set_eye_list`]); `None`: not listed. Only with the `tile-lists` feature.
+    #[cfg(feature = "tile-lists")]
     pub(crate) eye_list: Option<&'m [u32]>,
+    /// Without the `tile-lists` feature nothing is listed.
+    #[cfg(not(feature = "tile-lists"))]
+    pub(crate) eye_list: core::marker::PhantomData<&'m [u32]>,
 }
 
 impl<'m> Work<'m> {
@@ -41,7 +45,7 @@ impl<'m> Work<'m> {
             occluders: [u32::MAX; MAX_LIGHTS],
             axis_normal: None,
             eye_candidates: u64::MAX,
-            eye_list: None,
+            eye_list: Default::default(),
         }
     }
     /// The work counted so far.
@@ -63,11 +67,19 @@ impl<'m> Work<'m> {
     /// window meets the tile being rendered), or that they are not listed (`None`): eye rays
     /// through an accelerator then test the listed objects instead of asking it.
     pub fn set_eye_list(&mut self, objects: Option<&'m [u32]>) {
-        self.eye_list = objects;
+        #[cfg(feature = "tile-lists")]
+        {
+            self.eye_list = objects;
+        }
+        #[cfg(not(feature = "tile-lists"))]
+        let _ = objects;
     }
     /// The objects eye rays can hit, if listed (see [`Work::set_eye_list`]).
     pub fn eye_list(&self) -> Option<&'m [u32]> {
-        self.eye_list
+        #[cfg(feature = "tile-lists")]
+        return self.eye_list;
+        #[cfg(not(feature = "tile-lists"))]
+        None
     }
     /// The object that last hid light `l` from a shaded point, if any.
     pub fn occluder(&self, l: usize) -> Option<u32> {
@@ -82,7 +94,7 @@ impl<'m> Work<'m> {
     /// Forgets the remembered occluders (the render does so at every band of tiles, so a band's
     /// work does not depend on the bands rendered before it, on whichever core or thread).
     pub fn forget_occluders(&mut self) {
-        self.occluders = [u32::MAX; MAX_LIGHTS];
+        self.occluders.fill(u32::MAX);
     }
     /// [`crate::scene::Object::world_normal`] of object `i` of `scene`: a unit-axis normal (a
     /// box's face, a cap) that is the last one asked for is given again without mapping it anew
