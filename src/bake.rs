@@ -144,6 +144,8 @@ mod writer {
                 Shape::Cylinder => out.push_str("Shape::Cylinder"),
                 Shape::Cone { top } => record(out, "Shape::Cone", &[("top", top)]),
                 Shape::Box => out.push_str("Shape::Box"),
+                Shape::Open { top } => record(out, "Shape::Open", &[("top", top)]),
+                Shape::Triangle => out.push_str("Shape::Triangle"),
             }
         }
     }
@@ -152,7 +154,14 @@ mod writer {
             record(
                 out,
                 "Material",
-                &[("ka", &self.ka), ("kd", &self.kd), ("ks", &self.ks), ("kt", &self.kt), ("ior", &self.ior)],
+                &[
+                    ("ka", &self.ka),
+                    ("kd", &self.kd),
+                    ("ks", &self.ks),
+                    ("kt", &self.kt),
+                    ("ior", &self.ior),
+                    ("shine", &self.shine),
+                ],
             );
         }
     }

@@ -74,9 +74,9 @@ pub fn random_object(rng: &mut Rng, center: Vec3<f64>, size: f64) -> (Shape<f64>
 pub fn random_scene<R: Real>(b: &mut SceneBuilder<'_, R>, p: &RandomScene) -> Result<(), SceneError> {
     let mut rng = Rng::new(p.seed);
     let side = if p.spread > 0.0 { p.spread } else { 4.0 * libm::cbrt(p.objects.max(1) as f64) };
-    let matte = b.add_material(Material { ka: 0.2, kd: 0.8, ks: 0.0, kt: 0.0, ior: 1.0 })?;
-    let mirror = b.add_material(Material { ka: 0.1, kd: 0.5, ks: 0.4, kt: 0.0, ior: 1.0 })?;
-    let glass = b.add_material(Material { ka: 0.05, kd: 0.1, ks: 0.1, kt: 0.7, ior: 1.5 })?;
+    let matte = b.add_material(Material { ka: 0.2, kd: 0.8, ks: 0.0, kt: 0.0, ior: 1.0, shine: 0 })?;
+    let mirror = b.add_material(Material { ka: 0.1, kd: 0.5, ks: 0.4, kt: 0.0, ior: 1.0, shine: 0 })?;
+    let glass = b.add_material(Material { ka: 0.05, kd: 0.1, ks: 0.1, kt: 0.7, ior: 1.5, shine: 0 })?;
     b.add_light(Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 })?;
     let mut in_composite = 0;
     for i in 0..p.objects {

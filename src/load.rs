@@ -5,7 +5,8 @@
 use crate::lattice::{Lattice, LatticeConfig, LatticeError};
 use crate::render::Scratch;
 use crate::scalar::Real;
-use crate::scene::text::{parse_with, ParseError};
+use crate::scene::parse_with;
+use crate::scene::text::ParseError;
 use crate::scene::{CameraDesc, Scene};
 use crate::storage::StorageView;
 use core::fmt;

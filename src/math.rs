@@ -369,6 +369,10 @@ impl<R: Real> Affine<R> {
 }
 
 impl Affine<f64> {
+    /// The map taking the unit axes to `x`, `y`, `z` and the origin to `at`.
+    pub fn from_columns(x: Vec3<f64>, y: Vec3<f64>, z: Vec3<f64>, at: Vec3<f64>) -> Self {
+        Affine { m: [[x.x, y.x, z.x, at.x], [x.y, y.y, z.y, at.y], [x.z, y.z, z.z, at.z]] }
+    }
     /// Translation by `v`.
     pub fn translate(v: Vec3<f64>) -> Self {
         let mut t = Self::identity();

@@ -3,7 +3,14 @@
 //! * sphere: unit sphere at the origin;
 //! * cylinder: radius 1 about the y axis, `0 <= y <= 1`, capped;
 //! * cone: radius 1 at `y = 0`, radius `top` at `y = 1` (`top = 0` is a pointed cone), capped;
-//! * box: the unit cube `[0,1]^3`.
+//! * box: the unit cube `[0,1]^3`;
+//! * open: the side of the cone (or cylinder, `top = 1`) above, without its caps: NFF's `c`;
+//! * triangle: corners `(0,0,0)`, `(1,0,0)` and `(0,0,1)` in the plane `y = 0`, normal `+y`.
+//!
+//! The open side and the triangle are not solids: a ray can meet an open side twice from
+//! within, and a triangle has no inside. [`Shape::is_solid`] says which are; the tracer's
+//! rules that rest on convex solids (a ray leaving a surface cannot meet it again, a ray
+//! inside is refracted out) ask it (see `docs/scene-format.md`, *Open shapes and triangles*).
 //!
 //! A scene object places one of these with an affine transform. This module knows nothing of
 //! transforms, materials or lattices: it answers "where does this object-space ray first meet
@@ -26,6 +33,14 @@ pub enum Shape<R> {
     },
     /// The unit cube `[0,1]^3`.
     Box,
+    /// The side of [`Shape::Cone`] (a cylinder's for `top = 1`) without its caps.
+    Open {
+        /// Radius at y = 1, relative to the base radius.
+        top: R,
+    },
+    /// The triangle `(0,0,0)`, `(1,0,0)`, `(0,0,1)` in the plane `y = 0`, a surface of no
+    /// thickness; its object-space normal is `+y`.
+    Triangle,
 }
 
 /// Where a ray meets a primitive, in object space.
@@ -41,7 +56,7 @@ pub struct ShapeHit<R> {
 }
 
 /// Which primitive a shape is, without parameters (for names and statistics).
-pub const SHAPE_NAMES: [&str; 4] = ["sphere", "cylinder", "cone", "box"];
+pub const SHAPE_NAMES: [&str; 6] = ["sphere", "cylinder", "cone", "box", "open side", "triangle"];
 
 impl<R: Real> Shape<R> {
     /// Index into [`SHAPE_NAMES`].
@@ -51,7 +66,16 @@ impl<R: Real> Shape<R> {
             Shape::Cylinder => 1,
             Shape::Cone { .. } => 2,
             Shape::Box => 3,
+            Shape::Open { .. } => 4,
+            Shape::Triangle => 5,
         }
+    }
+
+    /// Whether the shape bounds a convex solid (sphere, capped cylinder and cone, box): a ray
+    /// leaving its surface cannot meet it again, and a ray inside it is refracted out. The open
+    /// side (seen from within) and the triangle (no inside) are not.
+    pub fn is_solid(&self) -> bool {
+        !matches!(self, Shape::Open { .. } | Shape::Triangle)
     }
 
     /// The Cargo feature that has the shape's intersection code (`spheres`, `cones`); `None`
@@ -59,7 +83,8 @@ impl<R: Real> Shape<R> {
     pub fn feature(&self) -> Option<&'static str> {
         match self {
             Shape::Sphere => Some("spheres"),
-            Shape::Cone { .. } => Some("cones"),
+            Shape::Cone { .. } | Shape::Open { .. } => Some("cones"),
+            Shape::Triangle => Some("triangles"),
             _ => None,
         }
     }
@@ -68,7 +93,8 @@ impl<R: Real> Shape<R> {
     pub fn left_out(&self) -> Option<&'static str> {
         match self {
             Shape::Sphere if !cfg!(feature = "spheres") => self.feature(),
-            Shape::Cone { .. } if !cfg!(feature = "cones") => self.feature(),
+            Shape::Cone { .. } | Shape::Open { .. } if !cfg!(feature = "cones") => self.feature(),
+            Shape::Triangle if !cfg!(feature = "triangles") => self.feature(),
             _ => None,
         }
     }
@@ -85,6 +111,10 @@ impl<R: Real> Shape<R> {
     // the stores to retire.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
+        if let Shape::Triangle = self {
+            // A plane and three sides: no square to keep small, so no clip first.
+            return if cfg!(feature = "triangles") { triangle(r, tmin, tmax) } else { None };
+        }
         let (t0, t1) = self.clip(r, tmin, tmax)?;
         if let Shape::Box = self {
             // The clip is the whole box test.
@@ -95,8 +125,9 @@ impl<R: Real> Shape<R> {
         match *self {
             // A shape a build leaves out is refused when the scene is built.
             Shape::Sphere if cfg!(feature = "spheres") => sphere(&local, &mut best),
-            Shape::Cylinder => cone_side_and_caps(&local, R::ONE, &mut best),
-            Shape::Cone { top } if cfg!(feature = "cones") => cone_side_and_caps(&local, top, &mut best),
+            Shape::Cylinder => cone_side_and_caps(&local, R::ONE, true, &mut best),
+            Shape::Cone { top } if cfg!(feature = "cones") => cone_side_and_caps(&local, top, true, &mut best),
+            Shape::Open { top } if cfg!(feature = "cones") => cone_side_and_caps(&local, top, false, &mut best),
             _ => {}
         }
         best.hit.map(|(normal, point)| ShapeHit { t: best.t + t0, normal, point })
@@ -128,12 +159,17 @@ impl<R: Real> Shape<R> {
     pub fn on_surface(&self, p: Vec3<R>, n: Vec3<R>) -> Vec3<R> {
         match self {
             Shape::Box => Vec3::new(onto_face(p.x, n.x), onto_face(p.y, n.y), onto_face(p.z, n.z)),
+            Shape::Triangle => Vec3::new(p.x, R::ZERO, p.z),
             _ => p,
         }
     }
 
-    /// Corners of an object-space box that holds the shape.
+    /// Corners of an object-space box that holds the shape (a triangle's is flat in y).
     pub fn bounds(&self) -> (Vec3<R>, Vec3<R>) {
+        if let Shape::Triangle = self {
+            let z = R::ZERO;
+            return (Vec3::new(z, z, z), Vec3::new(R::ONE, z, R::ONE));
+        }
         let (round, flat) = self.sides_below();
         let side = |below: bool| if below { -R::ONE } else { R::ZERO };
         (Vec3::new(side(round), side(flat), side(round)), Vec3::new(R::ONE, R::ONE, R::ONE))
@@ -145,8 +181,8 @@ impl<R: Real> Shape<R> {
     fn sides_below(&self) -> (bool, bool) {
         match self {
             Shape::Sphere => (true, true),
-            Shape::Cylinder | Shape::Cone { .. } => (true, false),
-            Shape::Box => (false, false),
+            Shape::Cylinder | Shape::Cone { .. } | Shape::Open { .. } => (true, false),
+            Shape::Box | Shape::Triangle => (false, false),
         }
     }
 }
@@ -240,10 +276,10 @@ fn sphere<R: Real>(r: &Ray<R>, best: &mut Closest<R>) {
 }
 
 /// Side of the cone `x^2 + z^2 = (1 + k y)^2` with `k = top - 1` (k = 0 is the cylinder) for
-/// `0 <= y <= 1`, plus the caps. The mirror cone beyond a pointed apex has `y > 1` and is
-/// rejected by the same `y` range test.
+/// `0 <= y <= 1`, plus the caps when `capped`. The mirror cone beyond a pointed apex has
+/// `y > 1` and is rejected by the same `y` range test.
 #[cfg_attr(target_arch = "x86_64", inline(always))]
-fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
+fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, capped: bool, best: &mut Closest<R>) {
     let (o, d) = (r.origin, r.dir);
     let k = top - R::ONE;
     let w = R::ONE + k * o.y;
@@ -273,7 +309,7 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
             }
         }
     }
-    if d.y != R::ZERO {
+    if capped && d.y != R::ZERO {
         for (y, radius, ny) in [(R::ZERO, R::ONE, -R::ONE), (R::ONE, top, R::ONE)] {
             if radius <= R::ZERO {
                 continue;
@@ -285,6 +321,30 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, best: &mut Closest<R>) {
             }
         }
     }
+}
+
+/// The triangle `(0,0,0)`, `(1,0,0)`, `(0,0,1)` in `y = 0`: where the ray crosses the plane
+/// in `(tmin, tmax]`, if that point's `x` and `z` lie in the triangle. The three side tests
+/// are widened by the scalar's box padding ([`Real::pad_eps`]), so the triangles a polygon is
+/// fanned into overlap by a rounding's width along their shared sides and no ray slips
+/// between them.
+#[cfg_attr(target_arch = "x86_64", inline(always))]
+fn triangle<R: Real>(r: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
+    let (o, d) = (r.origin, r.dir);
+    if d.y == R::ZERO {
+        return None;
+    }
+    let t = -o.y / d.y;
+    if !(t > tmin && t <= tmax) {
+        return None;
+    }
+    let (u, v) = (o.x + d.x * t, o.z + d.z * t);
+    let slack = R::pad_eps();
+    if u < -slack || v < -slack || u + v > R::ONE + slack {
+        return None;
+    }
+    let z = R::ZERO;
+    Some(ShapeHit { t, normal: Vec3::new(z, R::ONE, z), point: Vec3::new(u, z, v) })
 }
 
 /// The unit cube, given the ray's parameter range inside it `[t0, t1]` from the slab clip:
@@ -349,6 +409,33 @@ mod tests {
         // At y = 0.5 the radius is 0.5.
         let ShapeHit { t, .. } = s.intersect(&ray([-5.0, 0.5, 0.0], [1.0, 0.0, 0.0]), 0.0, 100.0).unwrap();
         assert!((t - 4.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_open_side_has_no_caps_and_is_met_from_within() {
+        let s = Shape::<f64>::Open { top: 1.0 };
+        // Along the axis: through both open ends, nothing.
+        assert!(s.intersect(&ray([0.5, -1.0, 0.0], [0.0, 1.0, 0.0]), 0.0, 100.0).is_none());
+        // From the axis outwards: the inside of the side, its outward normal pointing away.
+        let ShapeHit { t, normal: n, .. } = s.intersect(&ray([0.0, 0.5, 0.0], [1.0, 0.0, 0.0]), 0.0, 100.0).unwrap();
+        assert_eq!(t, 1.0);
+        assert!(n.x > 0.0);
+        // A slanted ray into the open end meets the far inner wall.
+        let ShapeHit { t, .. } = s.intersect(&ray([0.0, 2.0, 0.0], [1.0, -2.0, 0.0]), 0.0, 100.0).unwrap();
+        assert!((t - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_triangle_is_hit_inside_its_three_sides_from_either_side() {
+        let s = Shape::<f64>::Triangle;
+        let ShapeHit { t, normal: n, point: p } =
+            s.intersect(&ray([0.25, 2.0, 0.25], [0.0, -1.0, 0.0]), 0.0, 100.0).unwrap();
+        assert_eq!((t, n, p), (2.0, Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.25, 0.0, 0.25)));
+        assert!(s.intersect(&ray([0.25, -2.0, 0.25], [0.0, 1.0, 0.0]), 0.0, 100.0).is_some());
+        // Past the hypotenuse, behind the start, and parallel to the plane: no hit.
+        assert!(s.intersect(&ray([0.6, 2.0, 0.6], [0.0, -1.0, 0.0]), 0.0, 100.0).is_none());
+        assert!(s.intersect(&ray([0.25, 2.0, 0.25], [0.0, 1.0, 0.0]), 0.0, 100.0).is_none());
+        assert!(s.intersect(&ray([0.25, 0.0, 0.25], [1.0, 0.0, 0.0]), 0.0, 100.0).is_none());
     }
 
     #[test]

@@ -18,7 +18,7 @@ fn check(text: &str, want: &str) {
 
 #[test]
 fn unknown_statement() {
-    check("sphere\nteapot size 3", "line 2, column 1 at `teapot`: unknown statement (expected camera, ambient, background, depth, light, material, sphere, cylinder, cone, box, group or end)");
+    check("sphere\nteapot size 3", "line 2, column 1 at `teapot`: unknown statement (expected camera, ambient, background, depth, light, material, sphere, cylinder, cone, box, triangle, group or end)");
 }
 
 #[test]
@@ -169,10 +169,13 @@ fn too_many_objects_names_the_capacity() {
 
 #[test]
 fn too_many_materials_and_lights() {
-    let mats: String = (0..17).map(|i| format!("material m{i}\n")).collect();
-    check(&mats, "line 17, column 10 at `m16`: too many materials (at most 16)");
-    let lights = "light directional dir 0 -1 0\n".repeat(5);
-    check(&lights, "line 5, column 1 at `light`: too many lights (at most 4)");
+    // The capacities of this build (the host's, with `alloc`; a microcontroller's are 16 and 4).
+    use lattice_rt::scene::{MAX_LIGHTS, MAX_MATERIALS};
+    let (m, l) = (MAX_MATERIALS, MAX_LIGHTS);
+    let mats: String = (0..=m).map(|i| format!("material m{i}\n")).collect();
+    check(&mats, &format!("line {}, column 10 at `m{m}`: too many materials (at most {m})", m + 1));
+    let lights = "light directional dir 0 -1 0\n".repeat(l + 1);
+    check(&lights, &format!("line {}, column 1 at `light`: too many lights (at most {l})", l + 1));
 }
 
 #[test]

@@ -3,8 +3,9 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use lattice_rt::lattice::LatticeSizes;
-use lattice_rt::scene::text::parse_with;
-use lattice_rt::scene::text::{object_count, text_from_bytes};
+use lattice_rt::scene::object_count;
+use lattice_rt::scene::parse_with;
+use lattice_rt::scene::text::text_from_bytes;
 use lattice_rt::scene::Object;
 use lattice_rt::{Frame, HeapStorage, Lattice, LatticeConfig, Parts, Real, Scene, SceneBuilder, Sizes};
 use std::io::Read;

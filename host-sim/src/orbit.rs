@@ -6,7 +6,7 @@ use crate::output::write_atomic;
 use crate::progress;
 use anyhow::{anyhow, bail, Context, Result};
 use board_records::frame as board_frame;
-use lattice_rt::scene::text::parse_with;
+use lattice_rt::scene::parse_with;
 use lattice_rt::{BitFrame, Frame, LatticeConfig, Real, Tracer};
 use std::borrow::Cow;
 use std::path::Path;

@@ -134,6 +134,9 @@ fn object(s: &mut String, scene: &Scene<'_, f64>, i: usize, mode: PovMode) -> Re
         Shape::Cylinder => "cylinder { <0, 0, 0>, <0, 1, 0>, 1".to_string(),
         Shape::Cone { top } => format!("cone {{ <0, 0, 0>, 1, <0, 1, 0>, {top}"),
         Shape::Box => "box { <0, 0, 0>, <1, 1, 1>".to_string(),
+        Shape::Open { top: 1.0 } => "cylinder { <0, 0, 0>, <0, 1, 0>, 1 open".to_string(),
+        Shape::Open { top } => format!("cone {{ <0, 0, 0>, 1, <0, 1, 0>, {top} open"),
+        Shape::Triangle => "triangle { <0, 0, 0>, <1, 0, 0>, <0, 0, 1>".to_string(),
     };
     let mat = &scene.materials()[o.material() as usize];
     let look = match mode {

@@ -8,8 +8,8 @@
 
 use board_records::frame::{self as board_frame, Build, PICO};
 use lattice_rt::render::{RenderError, Sampling};
-use lattice_rt::scene::text::{object_count, parse_with};
 use lattice_rt::scene::Object;
+use lattice_rt::scene::{object_count, parse_with};
 use lattice_rt::trace::Effects;
 use lattice_rt::{
     render, BitFrame, Dither, Frame, Fx, HeapScratch, HeapStorage, LatticeConfig, NoHooks, Real, Sizes, Tone, Tracer,

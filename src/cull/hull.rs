@@ -147,9 +147,9 @@ fn outline_discs<R: Real>(o: &Object<R>, place: &Affine<f64>, projection: &Proje
     };
     let (x, z) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0));
     match o.shape {
-        Shape::Box => [None, None],
+        Shape::Box | Shape::Triangle => [None, None],
         Shape::Cylinder => [disc(Vec3::new(0.0, 0.0, 0.0), x, z), disc(Vec3::new(0.0, 1.0, 0.0), x, z)],
-        Shape::Cone { top } => {
+        Shape::Cone { top } | Shape::Open { top } => {
             let top = top.to_f64();
             [disc(Vec3::new(0.0, 0.0, 0.0), x, z), disc(Vec3::new(0.0, 1.0, 0.0), x * top, z * top)]
         }

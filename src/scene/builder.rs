@@ -115,7 +115,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         }
         check_value::<R>(IOR, m.ior)?;
         let f = R::from_f64;
-        let conv = Material { ka: f(m.ka), kd: f(m.kd), ks: f(m.ks), kt: f(m.kt), ior: f(m.ior) };
+        let conv = Material { ka: f(m.ka), kd: f(m.kd), ks: f(m.ks), kt: f(m.kt), ior: f(m.ior), shine: m.shine };
         self.parts.materials.push(conv).map_err(|_| SceneError::TooManyMaterials)?;
         Ok((self.parts.materials.len() - 1) as u8)
     }
@@ -141,6 +141,34 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             }
         };
         self.parts.lights.push(conv).map_err(|_| SceneError::TooManyLights)
+    }
+
+    /// Adds the triangle `a`, `b`, `c` (world or composite coordinates, as
+    /// [`SceneBuilder::add_object`] places objects): [`Shape::Triangle`] placed by the map whose
+    /// x and z columns are its sides `b - a` and `c - a` and whose y column is its unit normal
+    /// times the square root of its sides' cross product (about the triangle's size, so the map
+    /// is as well conditioned as the triangle). A triangle of no area is refused.
+    pub fn add_triangle(&mut self, [a, b, c]: [Vec3<f64>; 3], material: u8) -> Result<(), SceneError> {
+        check_range::<R>(a)?;
+        check_range::<R>(b)?;
+        check_range::<R>(c)?;
+        let (e1, e2) = (b - a, c - a);
+        let cross = e1.cross(e2);
+        let area2 = cross.length();
+        if !(area2 > 0.0)
+            || !area2.is_finite()
+            || area2
+                < 1e-12 * {
+                    let l = e1.length().max(e2.length());
+                    l * l
+                }
+        {
+            return Err(SceneError::DegenerateTriangle);
+        }
+        // y = n * sqrt(|e1 x e2|) with n the unit normal: `cross / sqrt(|cross|)`.
+        let y = cross * (1.0 / libm::sqrt(area2));
+        let place = Affine::from_columns(e1, y, e2, a);
+        self.add_object(Shape::Triangle, place, material)
     }
 
     /// Opens a composite object placed by `t`; objects until [`SceneBuilder::end_composite`] belong to it.
@@ -205,6 +233,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             Shape::Cylinder => Shape::Cylinder,
             Shape::Cone { top } => Shape::Cone { top: R::from_f64(top) },
             Shape::Box => Shape::Box,
+            Shape::Open { top } => Shape::Open { top: R::from_f64(top) },
+            Shape::Triangle => Shape::Triangle,
         };
         let (dir_scale, unscale) = scales::<R>(&inv, self.len)?;
         let mut scaled = inv;
@@ -334,7 +364,9 @@ fn check_objects<R: Real>(objects: &[Object<R>], world: &Aabb<R>) -> Result<(), 
             return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
         }
     }
-    for (i, o) in objects.iter().enumerate() {
+    // A triangle has no inside for a secondary ray to start in (every ray off it leaves it):
+    // the rule is for solids.
+    for (i, o) in objects.iter().enumerate().filter(|(_, o)| o.shape.is_solid()) {
         let (size, smallest) = thickness(o);
         if size < smallest {
             return Err(SceneError::ObjectTooThin { object: i, size, smallest, scalar: R::NAME });
@@ -350,7 +382,7 @@ type Placed = (Shape<f64>, Affine<f64>, Affine<f64>);
 /// radius checked, and a cone wider at its top than at its base turned over onto its top.
 fn upright(shape: Shape<f64>, place: Affine<f64>, inv: Affine<f64>) -> Result<Placed, SceneError> {
     let top = match shape {
-        Shape::Cone { top } => top,
+        Shape::Cone { top } | Shape::Open { top } => top,
         _ => 0.0,
     };
     check_finite(&[top])?;
@@ -364,7 +396,12 @@ fn upright(shape: Shape<f64>, place: Affine<f64>, inv: Affine<f64>) -> Result<Pl
             .after(&Affine::rotate(0, 180.0))
             .after(&Affine::scale(Vec3::new(top, 1.0, top)));
         let place = place.after(&over);
-        (Shape::Cone { top: 1.0 / top }, place, checked_inverse(&place)?)
+        let turned = if let Shape::Open { .. } = shape {
+            Shape::Open { top: 1.0 / top }
+        } else {
+            Shape::Cone { top: 1.0 / top }
+        };
+        (turned, place, checked_inverse(&place)?)
     } else {
         (shape, place, inv)
     })
@@ -431,12 +468,14 @@ fn brightness_bound<R: Real>(materials: &[Material<R>], lights: &[Light<R>], amb
         })
         .sum();
     let bg = background.abs();
-    let mut below = materials.iter().map(|m| ambient.abs() * m.ka.to_f64() + m.kd.to_f64() * ip).fold(bg, f64::max);
+    // A highlight adds at most `Ks * Ip` per light.
+    let local = |m: &Material<R>| {
+        let highlight = if m.shine > 0 { m.ks.to_f64() } else { 0.0 };
+        ambient.abs() * m.ka.to_f64() + (m.kd.to_f64() + highlight) * ip
+    };
+    let mut below = materials.iter().map(local).fold(bg, f64::max);
     for _ in 0..crate::trace::MAX_DEPTH {
-        below = materials
-            .iter()
-            .map(|m| ambient.abs() * m.ka.to_f64() + m.kd.to_f64() * ip + (m.ks.to_f64() + m.kt.to_f64()) * below)
-            .fold(bg, f64::max);
+        below = materials.iter().map(|m| local(m) + (m.ks.to_f64() + m.kt.to_f64()) * below).fold(bg, f64::max);
     }
     below
 }
@@ -458,6 +497,13 @@ fn pow2_at_least(x: f64) -> f64 {
 /// is the length of row `i` of the linear part), the transformed corners otherwise.
 fn world_bounds(shape: &Shape<f64>, place: &Affine<f64>) -> Aabb<f64> {
     let m = &place.m;
+    if let Shape::Triangle = shape {
+        let mut b = Aabb::empty();
+        for p in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0)] {
+            b.include(place.point(p));
+        }
+        return b;
+    }
     if let Shape::Sphere = shape {
         let c = Vec3::new(m[0][3], m[1][3], m[2][3]);
         let e = |i: usize| libm::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2]);

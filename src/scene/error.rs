@@ -90,6 +90,10 @@ pub enum SceneError {
     BadFieldOfView,
     /// A light with a zero direction.
     DegenerateLight,
+    /// A `triangle` statement without one of its corners `a`, `b`, `c`.
+    MissingCorner,
+    /// A triangle (or polygon) whose corners lie on one line: it has no area and no normal.
+    DegenerateTriangle,
     /// The scene has no objects.
     NoObjects,
     /// Inside the world box, an object's own coordinates grow beyond what the scalar holds
@@ -159,6 +163,8 @@ impl fmt::Display for SceneError {
             }
             SceneError::BadFieldOfView => write!(f, "field of view must be between 0 and 180 degrees"),
             SceneError::DegenerateLight => write!(f, "light direction is zero"),
+            SceneError::MissingCorner => write!(f, "a triangle needs its three corners: a X Y Z b X Y Z c X Y Z"),
+            SceneError::DegenerateTriangle => write!(f, "the polygon's corners lie on one line: it has no area"),
             SceneError::NoObjects => write!(f, "scene has no objects"),
             SceneError::ObjectOutOfRange { object, reach, limit, scalar } => write!(
                 f,

@@ -14,6 +14,7 @@
 pub mod builder;
 pub mod error;
 pub mod model;
+pub mod nff;
 pub mod text;
 
 pub use crate::camera::{lowest_terms, Camera, CameraDesc, FieldOfView, DEFAULT_FRAME, VIEW_MARGIN};
@@ -24,3 +25,49 @@ pub use model::{
     axis_normal, Composite, Light, Material, Object, Parts, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS,
     NO_COMPOSITE,
 };
+
+use crate::scalar::Real;
+use text::ParseError;
+
+/// The scene formats read: our own text ([`text`]) and NFF ([`nff`]), told apart by the first
+/// word ([`nff::is_nff`]), so every reader of scene text takes both.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// The plain-text scene format (`docs/scene-format.md`).
+    Text,
+    /// Eric Haines' Neutral File Format, the SPD's.
+    Nff,
+}
+
+impl Format {
+    /// The format of `text`.
+    pub fn of(text: &str) -> Self {
+        if nff::is_nff(text) {
+            Format::Nff
+        } else {
+            Format::Text
+        }
+    }
+}
+
+/// The object storage `text` (either [`Format`]) needs.
+pub fn object_count(text: &str) -> usize {
+    match Format::of(text) {
+        Format::Text => text::object_count(text),
+        Format::Nff => nff::object_count(text),
+    }
+}
+
+/// Parses `text` (either [`Format`]) into a [`Scene`], the camera changed by `camera` before
+/// the scene is validated ([`text::parse_with`], [`nff::parse_with`]).
+pub fn parse_with<'a, 't, R: Real>(
+    text: &'t str,
+    storage: &'a mut [Object<R>],
+    parts: &'a mut Parts<R>,
+    camera: impl FnOnce(&mut CameraDesc),
+) -> Result<Scene<'a, R>, ParseError<'t>> {
+    match Format::of(text) {
+        Format::Text => text::parse_with(text, storage, parts, camera),
+        Format::Nff => nff::parse_with(text, storage, parts, camera),
+    }
+}

@@ -7,10 +7,24 @@ use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
 use heapless::Vec;
 
-/// Most materials a scene may define.
+/// Most materials a scene may define: 16 in a build without `alloc` (a microcontroller's),
+/// 256 with it (the host's, where NFF scenes give objects dozens of colours; a material index
+/// is a byte).
+#[cfg(not(feature = "alloc"))]
 pub const MAX_MATERIALS: usize = 16;
-/// Most lights a scene may define.
+/// Most materials a scene may define: 16 in a build without `alloc` (a microcontroller's),
+/// 256 with it (the host's, where NFF scenes give objects dozens of colours; a material index
+/// is a byte).
+#[cfg(feature = "alloc")]
+pub const MAX_MATERIALS: usize = 256;
+/// Most lights a scene may define: 4 in a build without `alloc`, 16 with it (the SPD's `tree`
+/// has 7). Each core's work remembers an occluder per light, for at most this many lights.
+#[cfg(not(feature = "alloc"))]
 pub const MAX_LIGHTS: usize = 4;
+/// Most lights a scene may define: 4 in a build without `alloc`, 16 with it (the SPD's `tree`
+/// has 7). Each core's work remembers an occluder per light, for at most this many lights.
+#[cfg(feature = "alloc")]
+pub const MAX_LIGHTS: usize = 16;
 /// Most composite objects (each gets a sub-lattice).
 pub const MAX_COMPOSITES: usize = 16;
 /// The composite index of an object that belongs to no composite.
@@ -29,11 +43,26 @@ pub struct Material<R> {
     pub kt: R,
     /// Index of refraction of the inside.
     pub ior: R,
+    /// The Phong power of a highlight of weight `Ks` at each light (NFF's `Shine`), as a whole
+    /// number (raised by squaring in every scalar: no `pow` table in the firmware); 0 for none.
+    pub shine: u16,
+}
+
+impl Material<f64> {
+    /// A Phong power as [`Material::shine`] holds it: `p >= 0` rounded to the nearest whole
+    /// number, at most 65,535 (a cosine below 1 raised that far is as good as 0 beside 1).
+    pub fn power(p: f64) -> u16 {
+        if p >= 65_535.0 {
+            u16::MAX
+        } else {
+            (p + 0.5) as u16
+        }
+    }
 }
 
 impl Material<f64> {
     /// The material objects get when none is named: matte gray.
-    pub const DEFAULT: Self = Material { ka: 0.2, kd: 0.8, ks: 0.0, kt: 0.0, ior: 1.0 };
+    pub const DEFAULT: Self = Material { ka: 0.2, kd: 0.8, ks: 0.0, kt: 0.0, ior: 1.0, shine: 0 };
 }
 
 /// A light source.

@@ -55,6 +55,17 @@ pub enum ParseErrorKind {
         /// The offending byte.
         byte: u8,
     },
+    /// NFF: the word starts no NFF entity.
+    UnknownEntity,
+    /// NFF: a view (`v`) without one of its lines (`from`, `at`, `up`, `angle`).
+    ExpectedWord(&'static str),
+    /// NFF: a negative radius, NFF's surface visible from inside only, which the tracer does not
+    /// draw.
+    InsideOnly,
+    /// NFF: a polygon's vertex count is not a whole number of at least 3.
+    BadVertexCount,
+    /// NFF: a cone or cylinder whose base and apex are the same point.
+    CoincidentEnds,
     /// The scene itself is invalid.
     Scene(SceneError),
 }
@@ -79,7 +90,7 @@ impl fmt::Display for ParseErrorKind {
             ParseErrorKind::UnknownStatement => write!(
                 f,
                 "unknown statement (expected camera, ambient, background, depth, light, material, \
-                 sphere, cylinder, cone, box, group or end)"
+                 sphere, cylinder, cone, box, triangle, group or end)"
             ),
             ParseErrorKind::UnknownAttribute { valid, near } => {
                 write!(f, "not an attribute of this statement")?;
@@ -119,6 +130,16 @@ impl fmt::Display for ParseErrorKind {
                 write!(f, "a shear needs two different axes (`shear x y K`: x gains K times y)")
             }
             ParseErrorKind::InvalidUtf8 { byte } => write!(f, "not UTF-8 text (byte 0x{byte:02x})"),
+            ParseErrorKind::UnknownEntity => {
+                write!(f, "unknown NFF entity (expected v, b, l, f, c, s, p, pp or a # comment)")
+            }
+            ParseErrorKind::ExpectedWord(w) => write!(f, "the view needs its `{w}` line"),
+            ParseErrorKind::InsideOnly => write!(
+                f,
+                "a negative radius (NFF's inside-only surface): not drawn by this tracer; give the radius as positive"
+            ),
+            ParseErrorKind::BadVertexCount => write!(f, "a polygon's vertex count must be a whole number, at least 3"),
+            ParseErrorKind::CoincidentEnds => write!(f, "the cone's base and apex are the same point"),
             ParseErrorKind::Scene(e) => write!(f, "{e}"),
         }
     }
@@ -405,6 +426,15 @@ impl<'t> Words<'t> {
         Ok((v, col, tok))
     }
 
+    /// A Phong power: a number at least 0, rounded to a whole one ([`Material::power`]).
+    fn shine(&mut self) -> Result<u16, ParseError<'t>> {
+        let (v, col, tok) = self.number_at()?;
+        if v < 0.0 {
+            return Err(self.err(col, tok, ParseErrorKind::Scene(SceneError::BadCoefficient)));
+        }
+        Ok(Material::power(v))
+    }
+
     fn positive(&mut self) -> Result<f64, ParseError<'t>> {
         let save = self.pos;
         let v = self.coord()?;
@@ -492,12 +522,13 @@ impl<'t> Words<'t> {
     }
 }
 
-/// The number of object statements (`sphere`, `cylinder`, `cone`, `box`) in scene text: the
+/// The keywords of the statements that add one object.
+pub const OBJECT_KEYWORDS: [&str; 5] = ["sphere", "cylinder", "cone", "box", "triangle"];
+
+/// The number of object statements ([`OBJECT_KEYWORDS`]) in scene text: the
 /// object storage [`parse`] needs for it (line endings and comments as [`parse`] reads them).
 pub fn object_count(text: &str) -> usize {
-    lines(text)
-        .filter(|line| matches!(Words::new(line, 0).next(), Some((_, "sphere" | "cylinder" | "cone" | "box"))))
-        .count()
+    lines(text).filter(|line| Words::new(line, 0).next().is_some_and(|(_, k)| OBJECT_KEYWORDS.contains(&k))).count()
 }
 
 /// Line, column and keyword of the `index`-th object statement (for errors found after
@@ -507,7 +538,7 @@ pub fn object_statement(text: &str, index: usize) -> (u32, u32, &str) {
     for (i, line) in lines(text).enumerate() {
         let mut w = Words::new(line, i as u32 + 1);
         if let Some((col, key)) = w.next() {
-            if matches!(key, "sphere" | "cylinder" | "cone" | "box") {
+            if OBJECT_KEYWORDS.contains(&key) {
                 if seen == index {
                     return (i as u32 + 1, col, key);
                 }
@@ -570,14 +601,32 @@ fn attributes(key: &str, light: Option<&str>) -> &'static [&'static str] {
         ("camera", _) => &["eye", "look", "up", "fov"],
         ("light", Some("directional")) => &["dir", "intensity"],
         ("light", Some("point")) => &["pos", "intensity"],
-        ("material", _) => &["ka", "kd", "ks", "kt", "ior"],
+        ("material", _) => &["ka", "kd", "ks", "kt", "ior", "shine"],
         ("sphere", _) => &["center", "radius", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
-        ("cylinder", _) => {
-            &["base", "radius", "height", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]]
-        }
-        ("cone", _) => {
-            &["base", "radius", "height", "top", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]]
-        }
+        ("cylinder", _) => &[
+            "base",
+            "radius",
+            "height",
+            "open",
+            "material",
+            TRANSFORMS[0],
+            TRANSFORMS[1],
+            TRANSFORMS[2],
+            TRANSFORMS[3],
+        ],
+        ("cone", _) => &[
+            "base",
+            "radius",
+            "height",
+            "top",
+            "open",
+            "material",
+            TRANSFORMS[0],
+            TRANSFORMS[1],
+            TRANSFORMS[2],
+            TRANSFORMS[3],
+        ],
+        ("triangle", _) => &["a", "b", "c", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
         ("box", _) => &["min", "max", "material", TRANSFORMS[0], TRANSFORMS[1], TRANSFORMS[2], TRANSFORMS[3]],
         ("group", _) => &TRANSFORMS,
         _ => &[],
@@ -695,7 +744,7 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
         self.b.add_light(light).map_err(|e| self.scene_err(st, e))
     }
 
-    /// `material NAME [ka K] [kd K] [ks K] [kt K] [ior N]`
+    /// `material NAME [ka K] [kd K] [ks K] [kt K] [ior N] [shine P]`
     fn material(&mut self, st: &mut Statement<'t>) -> Result<(), ParseError<'t>> {
         let (ncol, name) = st.w.word()?;
         if self.names.iter().any(|(n, _)| *n == name) {
@@ -704,6 +753,10 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
         let mut m = Material::DEFAULT;
         while let Some((col, attr)) = st.w.next() {
             st.once(col, attr)?;
+            if attr == "shine" {
+                m.shine = st.w.shine()?;
+                continue;
+            }
             let (slot, what) = match attr {
                 "ka" => (&mut m.ka, "coefficient"),
                 "kd" => (&mut m.kd, "coefficient"),
@@ -725,10 +778,11 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
         Ok(())
     }
 
-    /// `sphere`, `cylinder`, `cone` or `box` with its size, material and transforms.
+    /// `sphere`, `cylinder`, `cone`, `box` or `triangle` with its size, material and transforms.
     fn object(&mut self, st: &mut Statement<'t>) -> Result<(), ParseError<'t>> {
         let key = st.key;
         let (mut pos, mut radius, mut height, mut top) = (Vec3::zero(), 1.0, 1.0, 0.0);
+        let (mut open, mut corners) = (false, [None; 3]);
         let (mut lo, mut hi) = (Vec3::zero(), Vec3::new(1.0, 1.0, 1.0));
         let mut material = 0u8;
         let mut t = Affine::identity();
@@ -747,6 +801,10 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
                         return Err(w.err(col, attr, ParseErrorKind::Scene(SceneError::NonPositiveSize)));
                     }
                 }
+                ("cylinder" | "cone", "open") => open = true,
+                ("triangle", "a") => corners[0] = Some(w.point()?),
+                ("triangle", "b") => corners[1] = Some(w.point()?),
+                ("triangle", "c") => corners[2] = Some(w.point()?),
                 ("box", "min") => lo = w.point()?,
                 ("box", "max") => hi = w.point()?,
                 (_, "material") => {
@@ -765,6 +823,13 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
                 }
             }
         }
+        if key == "triangle" {
+            let [Some(a), Some(b), Some(c)] = corners else {
+                return Err(self.scene_err(st, SceneError::MissingCorner));
+            };
+            let corners = [a, b, c].map(|p| t.point(p));
+            return self.b.add_triangle(corners, material).map_err(|e| self.scene_err(st, e));
+        }
         let (shape, placement) = match key {
             "sphere" => {
                 (Shape::Sphere, Affine::translate(pos).after(&Affine::scale(Vec3::new(radius, radius, radius))))
@@ -777,7 +842,12 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
                 (Shape::Box, Affine::translate(lo).after(&Affine::scale(size)))
             }
             _ => {
-                let shape = if key == "cone" { Shape::Cone { top: top / radius } } else { Shape::Cylinder };
+                let shape = match (key, open) {
+                    ("cone", false) => Shape::Cone { top: top / radius },
+                    ("cone", true) => Shape::Open { top: top / radius },
+                    (_, false) => Shape::Cylinder,
+                    (_, true) => Shape::Open { top: 1.0 },
+                };
                 (shape, Affine::translate(pos).after(&Affine::scale(Vec3::new(radius, height, radius))))
             }
         };
@@ -812,7 +882,7 @@ impl<'a, 't, R: Real> Parser<'a, 't, R> {
             "depth" => self.depth(st)?,
             "light" => self.light(st)?,
             "material" => self.material(st)?,
-            "sphere" | "cylinder" | "cone" | "box" => self.object(st)?,
+            "sphere" | "cylinder" | "cone" | "box" | "triangle" => self.object(st)?,
             "group" => self.group(st)?,
             "end" => self.b.end_composite().map_err(|e| self.scene_err(st, e))?,
             _ => return Err(st.w.err(st.kcol, st.key, ParseErrorKind::UnknownStatement)),

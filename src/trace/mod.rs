@@ -53,10 +53,13 @@ impl Effects {
     pub const POINT_LIGHTS: Self = Effects(8);
     /// Composite objects, walked as sub-lattices.
     pub const COMPOSITES: Self = Effects(16);
+    /// Phong highlights (a material with `Ks > 0` and a `shine` power).
+    pub const HIGHLIGHTS: Self = Effects(32);
     /// Every effect.
-    pub const ALL: Self = Effects(31);
+    pub const ALL: Self = Effects(63);
     /// Names of the effects, lowest bit first.
-    pub const NAMES: [&'static str; 5] = ["shadows", "reflection", "refraction", "point lights", "composites"];
+    pub const NAMES: [&'static str; 6] =
+        ["shadows", "reflection", "refraction", "point lights", "composites", "highlights"];
 
     /// The set as bits (for a [`Tracer`]'s const parameter).
     pub const fn bits(self) -> u8 {
@@ -88,16 +91,24 @@ impl Effects {
         Effects(self.0 & !other.0)
     }
 
-    /// The effects a scene calls for. Shadows need a light and at least two objects (every
-    /// primitive is convex, so a lone object never shadows itself); reflection needs a
-    /// material with `Ks > 0` on some object, refraction one with `Kt > 0`.
+    /// The effects a scene calls for. Shadows need a light and at least two objects (a lone
+    /// convex solid never shadows itself; a lone open side can); reflection needs a
+    /// material with `Ks > 0` on some object, refraction one with `Kt > 0`, highlights one with
+    /// `Ks > 0` and a `shine` power.
     pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
         let used = |f: fn(&Material<R>) -> R| {
             scene.objects.iter().any(|o| f(at(scene.materials, o.material as usize)) > R::ZERO)
         };
         let mut e = Self::NONE;
-        if !scene.lights.is_empty() && scene.objects.len() > 1 {
+        let self_shadowing = scene.objects.iter().any(|o| matches!(o.shape, crate::shape::Shape::Open { .. }));
+        if !scene.lights.is_empty() && (scene.objects.len() > 1 || self_shadowing) {
             e = e | Self::SHADOWS;
+        }
+        if scene.objects.iter().any(|o| {
+            let m = at(scene.materials, o.material as usize);
+            m.ks > R::ZERO && m.shine > 0
+        }) {
+            e = e | Self::HIGHLIGHTS;
         }
         if used(|m| m.ks) {
             e = e | Self::REFLECTION;
@@ -636,27 +647,41 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         // the side the ray meets is asked, which the direction as traced gives.
         let (reflects, refracts) = self.branches(m);
         let children = node.depth < self.max_depth && (reflects || refracts);
-        let d = if children { ray.dir.normalize() } else { ray.dir };
+        let shiny = self.simulates(Effects::HIGHLIGHTS) && m.shine > 0 && m.ks > R::ZERO;
+        let d = if children || shiny { ray.dir.normalize() } else { ray.dir };
         let side = facing(d, w.world_normal(scene, hit.object, hit.normal));
         let n = side.normal;
         // Rays off the outer side of the surface, towards where its normal points (shadow
-        // rays to lights in front, the mirror ray), leave the object: every primitive is
-        // convex, so they cannot meet it again.
-        let leaving = if side.entering { hit.object } else { NO_OBJECT };
+        // rays to lights in front, the mirror ray), leave the object: a convex solid (and the
+        // outside of an open side, part of one's boundary) cannot be met again; a triangle
+        // cannot be met again from either side.
+        let flat = matches!(obj.shape, crate::shape::Shape::Triangle);
+        let leaving = if side.entering || flat { hit.object } else { NO_OBJECT };
         let eps = R::offset(p.max_abs(), obj.size());
         let outside = p + n * eps;
         let mut local = scene.ambient * m.ka;
-        if m.kd > R::ZERO {
+        if m.kd > R::ZERO || shiny {
             // Lit from outside, the point's shadow rays leave its own (convex) object.
             w.query.filter.set_leaving(leaving);
+            let cos_i = -d.dot(n);
+            let mirror = d + n * (cos_i + cos_i);
+            let surface = Surface {
+                from: outside,
+                normal: n,
+                kd: m.kd,
+                mirror,
+                highlight: if shiny { m.ks } else { R::ZERO },
+                shine: m.shine,
+            };
             for (l, light) in scene.lights.iter().enumerate() {
-                local += self.direct(l, light, outside, n, m.kd, node.weight, w);
+                local += self.direct(l, light, &surface, node.weight, w);
             }
             w.query.filter.set_leaving(NO_OBJECT);
         }
         let lit = node.weight.weigh(local);
         if children {
-            self.push_children(node, (d, &side, p), (eps, outside, leaving), (reflects, refracts, m), stack);
+            let solid = obj.shape.is_solid();
+            self.push_children(node, (d, &side, p), (eps, outside, leaving), (reflects, refracts, m, solid), stack);
         }
         lit
     }
@@ -672,7 +697,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         node: Meta<R>,
         (d, side, p): (Vec3<R>, &Side<R>, Vec3<R>),
         (eps, outside, leaving): (R, Vec3<R>, u32),
-        (reflects, refracts, m): (bool, bool, &Material<R>),
+        (reflects, refracts, m, solid): (bool, bool, &Material<R>, bool),
         stack: &mut Vec<Node<R>, { MAX_DEPTH as usize + 2 }>,
     ) {
         let n = side.normal;
@@ -683,7 +708,12 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let cos_i = -d.dot(n);
         let mirror = d + n * (cos_i + cos_i);
         let mut reflect_w = if reflects { m.ks } else { R::ZERO };
-        if refracts {
+        if refracts && !solid {
+            // A sheet (a triangle, an open side): straight through, leaving it.
+            if node.weight * m.kt > self.cutoff {
+                let _ = stack.push(child(Ray::new(p - n * eps, d), m.kt, RayKind::Refraction, leaving));
+            }
+        } else if refracts {
             match refract(d, n, side.eta(m.ior)) {
                 // Total internal reflection: the transmitted share is reflected.
                 None => reflect_w += m.kt,
@@ -704,8 +734,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// within the cutoff of the other.
     /// The work's filter says what the shadow ray may skip (the object the point lies on, when
     /// lit from outside).
-    #[allow(clippy::too_many_arguments)]
-    fn direct(&self, l: usize, light: &Light<R>, from: Vec3<R>, n: Vec3<R>, kd: R, weight: R, w: &mut Work<'_>) -> R {
+    fn direct(&self, l: usize, light: &Light<R>, s: &Surface<R>, weight: R, w: &mut Work<'_>) -> R {
+        let (from, n) = (s.from, s.normal);
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
@@ -721,7 +751,14 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         if cos <= R::ZERO {
             return R::ZERO;
         }
-        let term = ip * kd * cos;
+        let mut term = ip * s.kd * cos;
+        if s.highlight > R::ZERO {
+            // Phong: the mirror direction's cosine to the light, raised to the power.
+            let c = s.mirror.dot(to_light);
+            if c > R::ZERO {
+                term += ip * s.highlight * power(c, s.shine);
+            }
+        }
         if self.simulates(Effects::SHADOWS) && weight.weigh(term) >= self.cutoff {
             w.query.stats.rays[RayKind::Shadow as usize] += 1;
             let ray = Ray::new(from, to_light);
@@ -822,4 +859,31 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         q.stats.culled += (seen as u64) - u64::from(tested);
         found
     }
+}
+
+/// What [`Tracer::direct`] needs of a lit point: where its shadow rays start, its unit normal
+/// (facing the ray that came), its diffuse coefficient, and for a highlight the mirror
+/// direction of the incoming ray, the highlight's weight (0: none) and its Phong power.
+struct Surface<R> {
+    from: Vec3<R>,
+    normal: Vec3<R>,
+    kd: R,
+    mirror: Vec3<R>,
+    highlight: R,
+    shine: u16,
+}
+
+/// `c^n` for `0 <= c <= 1` by squaring (a whole power: every scalar, no `pow` table).
+fn power<R: Real>(c: R, n: u16) -> R {
+    let (mut acc, mut base, mut k) = (R::ONE, c, n);
+    while k > 0 {
+        if k & 1 == 1 {
+            acc *= base;
+        }
+        k >>= 1;
+        if k > 0 {
+            base = base * base;
+        }
+    }
+    acc
 }

@@ -1,0 +1,411 @@
+//! NFF, the Neutral File Format of Eric Haines' Standard Procedural Databases (SPD), read into
+//! a [`Scene`] as [`super::text`] reads our own format: every entity of `NFF.TXT`.
+//!
+//! * `v` (`from`, `at`, `up`, `angle`, `hither`, `resolution`): the camera. `angle` is measured
+//!   between the centres of the edge pixels of a `resolution` frame (aspect 1), so the view
+//!   from edge to edge is a little wider: `tan(a'/2) = tan(a/2) n / (n - 1)` for `n` pixels
+//!   (the smaller of the two). `hither` is read and not used (rays start at the eye).
+//! * `b R G B`: the background, as a gray ([`luminance`]).
+//! * `l X Y Z [R G B]`: a point light. NFF gives no intensity; each of `n` lights gets the SPD
+//!   Readme's `sqrt(n) / (2 n)` (times the gray of its colour, when one is given), and so does
+//!   the ambient light.
+//! * `f R G B Kd Ks Shine T ior`: the material of the objects that follow: diffuse and ambient
+//!   `Kd` times the colour's gray, mirror and highlight `Ks`, the Phong power `Shine`
+//!   ([`Material::power`]), transmission `T`, and the index of refraction (used only when
+//!   `T > 0`). Equal materials are stored once.
+//! * `s X Y Z r`: a sphere. `c` with base point and radius, apex point and radius: the side of
+//!   a cylinder or cone without end caps ([`Shape::Open`]).
+//! * `p n` and `n` vertices: a planar convex polygon, fanned into `n - 2` triangles from its
+//!   first vertex. `pp n` and `n` vertices with normals: the same polygon; the normals are read
+//!   and the patch is shaded flat (its plane's normal).
+//! * `#` starts a comment that runs to the end of the line.
+//!
+//! What the tracer cannot draw is refused by name, never ignored: a negative radius (NFF's
+//! inside-only surface), a polygon of fewer than three vertices or of no area, a cone whose
+//! base and apex coincide. Every error says where (line and column), which word, and why.
+
+use super::builder::SceneBuilder;
+use super::error::SceneError;
+use super::model::{Light, Material, Object, Parts, Scene, MAX_LIGHTS, MAX_MATERIALS};
+use super::text::{parse_number, ParseError, ParseErrorKind};
+use crate::camera::{CameraDesc, FieldOfView};
+use crate::math::{Affine, Vec3};
+use crate::scalar::Real;
+use crate::shape::Shape;
+use heapless::Vec;
+
+/// The words that start an NFF entity.
+pub const ENTITIES: [&str; 8] = ["v", "b", "l", "f", "c", "s", "p", "pp"];
+
+/// Whether `text` reads as NFF: its first word (after comments) starts an NFF entity. Our own
+/// format has no statement of those names, so the two never meet.
+pub fn is_nff(text: &str) -> bool {
+    Tokens::new(text).next().is_some_and(|(_, _, w)| ENTITIES.contains(&w))
+}
+
+/// The number of objects NFF text makes ([`parse_with`]'s storage): one per sphere and cone or
+/// cylinder, `n - 2` triangles per polygon of `n` vertices. A count that does not read as a
+/// number counts nothing (the parser reports it).
+pub fn object_count(text: &str) -> usize {
+    let mut t = Tokens::new(text);
+    let mut n = 0usize;
+    while let Some((_, _, w)) = t.next() {
+        match w {
+            "s" | "c" => n += 1,
+            "p" | "pp" => {
+                if let Some(k) = t.next().and_then(|(_, _, c)| c.parse::<usize>().ok()) {
+                    n = n.saturating_add(k.saturating_sub(2));
+                }
+            }
+            _ => {}
+        }
+    }
+    n
+}
+
+/// The gray of an RGB colour: its luminance by the Rec. 709 weights.
+pub fn luminance(r: f64, g: f64, b: f64) -> f64 {
+    0.2126 * r + 0.7152 * g + 0.0722 * b
+}
+
+/// Parses NFF text into a [`Scene`], storing objects in `storage` (at least [`object_count`]
+/// long) and the materials and lights in `parts`; the camera the text describes is changed by
+/// `camera` before the scene is validated (a frame's shape, the frames of an orbit).
+pub fn parse_with<'a, 't, R: Real>(
+    text: &'t str,
+    storage: &'a mut [Object<R>],
+    parts: &'a mut Parts<R>,
+    camera: impl FnOnce(&mut CameraDesc),
+) -> Result<Scene<'a, R>, ParseError<'t>> {
+    let mut p = Reader {
+        t: Tokens::new(text),
+        b: SceneBuilder::<R>::new(storage, parts),
+        materials: Vec::new(),
+        material: None,
+        lights: Vec::new(),
+        last: (1, 1, ""),
+    };
+    p.b.background = 0.0;
+    while let Some(at) = p.t.next() {
+        p.last = at;
+        p.entity(at)?;
+    }
+    p.finish(camera)
+}
+
+/// A word of the text with its line and column (1-based).
+type At<'t> = (u32, u32, &'t str);
+
+/// The words of NFF text, with their lines and columns; `#` comments skipped.
+struct Tokens<'t> {
+    text: &'t str,
+    pos: usize,
+    line: u32,
+    line_start: usize,
+}
+
+impl<'t> Tokens<'t> {
+    fn new(text: &'t str) -> Self {
+        Tokens { text, pos: 0, line: 1, line_start: 0 }
+    }
+
+    fn next(&mut self) -> Option<At<'t>> {
+        let b = self.text.as_bytes();
+        loop {
+            let c = *b.get(self.pos)?;
+            if c == b'\n' {
+                self.pos += 1;
+                self.line += 1;
+                self.line_start = self.pos;
+            } else if c.is_ascii_whitespace() {
+                self.pos += 1;
+            } else if c == b'#' {
+                while b.get(self.pos).is_some_and(|&c| c != b'\n') {
+                    self.pos += 1;
+                }
+            } else {
+                break;
+            }
+        }
+        let start = self.pos;
+        while b.get(self.pos).is_some_and(|&c| !c.is_ascii_whitespace() && c != b'#') {
+            self.pos += 1;
+        }
+        let col = self.text[self.line_start..start].chars().count() as u32 + 1;
+        Some((self.line, col, &self.text[start..self.pos]))
+    }
+
+    /// The next word without taking it.
+    fn peek(&self) -> Option<At<'t>> {
+        Tokens { ..*self }.next()
+    }
+}
+
+/// The reader's state: the builder, the materials so far (to store each once), the current
+/// one, the lights (added at the end, when their number, which sets their intensity, is known).
+struct Reader<'a, 't, R> {
+    t: Tokens<'t>,
+    b: SceneBuilder<'a, R>,
+    materials: Vec<(Material<f64>, u8), MAX_MATERIALS>,
+    material: Option<u8>,
+    lights: Vec<(Vec3<f64>, f64, At<'t>), MAX_LIGHTS>,
+    /// The entity being read (what a scene-wide error is blamed on).
+    last: At<'t>,
+}
+
+fn error(at: At<'_>, kind: ParseErrorKind) -> ParseError<'_> {
+    ParseError { line: at.0, col: at.1, token: at.2, kind }
+}
+
+impl<'a, 't, R: Real> Reader<'a, 't, R> {
+    fn entity(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
+        match at.2 {
+            "v" => self.view(at),
+            "b" => {
+                let [r, g, b] = self.numbers()?;
+                self.b.background = luminance(r, g, b);
+                Ok(())
+            }
+            "l" => self.light(at),
+            "f" => self.fill(at),
+            "s" => self.sphere(at),
+            "c" => self.cone(at),
+            "p" => self.polygon(at, false),
+            "pp" => self.polygon(at, true),
+            _ => Err(error(at, ParseErrorKind::UnknownEntity)),
+        }
+    }
+
+    /// The next word, or an error at the end of the text.
+    fn word(&mut self) -> Result<At<'t>, ParseError<'t>> {
+        match self.t.next() {
+            Some(at) => Ok(at),
+            None => Err(ParseError { line: self.t.line, col: 1, token: "", kind: ParseErrorKind::MissingValue }),
+        }
+    }
+
+    /// A finite number.
+    fn number(&mut self) -> Result<f64, ParseError<'t>> {
+        let at = self.word()?;
+        match parse_number(at.2) {
+            Some(v) if v.is_finite() => Ok(v),
+            Some(_) => Err(error(at, ParseErrorKind::NumberOutOfRange)),
+            None => Err(error(at, ParseErrorKind::ExpectedNumber)),
+        }
+    }
+
+    fn numbers<const N: usize>(&mut self) -> Result<[f64; N], ParseError<'t>> {
+        let mut v = [0.0; N];
+        for x in v.iter_mut() {
+            *x = self.number()?;
+        }
+        Ok(v)
+    }
+
+    fn point(&mut self) -> Result<Vec3<f64>, ParseError<'t>> {
+        let [x, y, z] = self.numbers()?;
+        Ok(Vec3::new(x, y, z))
+    }
+
+    /// A radius: a number at least 0 (a negative one is NFF's inside-only surface).
+    fn radius(&mut self) -> Result<f64, ParseError<'t>> {
+        let at = self.t.peek();
+        let r = self.number()?;
+        match at {
+            Some(at) if r < 0.0 => Err(error(at, ParseErrorKind::InsideOnly)),
+            _ => Ok(r),
+        }
+    }
+
+    /// `v` and its lines: `from`, `at`, `up` and `angle` needed, `hither` and `resolution`
+    /// optional, in any order.
+    fn view(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
+        let (mut from, mut look, mut up, mut angle, mut res) = (None, None, None, None, None);
+        while let Some(next) = self.t.peek() {
+            match next.2 {
+                "from" | "at" | "up" | "angle" | "hither" | "resolution" => {
+                    self.t.next();
+                }
+                _ => break,
+            }
+            match next.2 {
+                "from" => from = Some(self.point()?),
+                "at" => look = Some(self.point()?),
+                "up" => up = Some(self.point()?),
+                "angle" => {
+                    let a = self.number()?;
+                    if !(a > 0.0 && a < 180.0) {
+                        return Err(error(next, ParseErrorKind::Scene(SceneError::BadFieldOfView)));
+                    }
+                    angle = Some(a);
+                }
+                "hither" => {
+                    self.number()?;
+                }
+                _ => {
+                    let [w, h] = self.numbers()?;
+                    if !(w >= 1.0 && h >= 1.0) {
+                        return Err(error(next, ParseErrorKind::Scene(SceneError::BadFieldOfView)));
+                    }
+                    res = Some(w.min(h));
+                }
+            }
+        }
+        let missing = |what| error(at, ParseErrorKind::ExpectedWord(what));
+        let angle = angle.ok_or(missing("angle"))?;
+        let c = &mut self.b.camera;
+        (c.eye, c.look, c.up) = (from.ok_or(missing("from"))?, look.ok_or(missing("at"))?, up.ok_or(missing("up"))?);
+        // From the centres of the edge pixels to the frame's edges: n pixels' centres span
+        // n - 1 pixels.
+        let widen = match res {
+            Some(n) if n > 1.0 => n / (n - 1.0),
+            _ => 1.0,
+        };
+        let half = libm::tan(angle.to_radians() / 2.0) * widen;
+        let edges = 2.0 * libm::atan(half).to_degrees();
+        if !(edges < 180.0) {
+            return Err(error(at, ParseErrorKind::Scene(SceneError::BadFieldOfView)));
+        }
+        c.fov = FieldOfView::Within(edges, edges);
+        Ok(())
+    }
+
+    /// `l X Y Z [R G B]`: kept until the end, when the number of lights is known.
+    fn light(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
+        let pos = self.point()?;
+        // A colour follows when the next word is a number.
+        let gray = if self.t.peek().is_some_and(|(_, _, w)| parse_number(w).is_some()) {
+            let [r, g, b] = self.numbers()?;
+            luminance(r, g, b)
+        } else {
+            1.0
+        };
+        self.lights.push((pos, gray, at)).map_err(|_| error(at, ParseErrorKind::Scene(SceneError::TooManyLights)))
+    }
+
+    /// `f R G B Kd Ks Shine T ior`: the material of the objects that follow.
+    fn fill(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
+        let [r, g, b, kd, ks, shine] = self.numbers()?;
+        let t_at = self.t.peek();
+        let [t, ior] = self.numbers()?;
+        let gray = luminance(r, g, b);
+        let m = Material {
+            ka: kd * gray,
+            kd: kd * gray,
+            ks,
+            kt: t,
+            ior: if t > 0.0 { ior } else { 1.0 },
+            shine: if shine >= 0.0 { Material::power(shine) } else { 0 },
+        };
+        if m.ka < 0.0 || ks < 0.0 || t < 0.0 || shine < 0.0 || m.ior < 1.0 {
+            return Err(error(t_at.unwrap_or(at), ParseErrorKind::Scene(SceneError::BadCoefficient)));
+        }
+        if let Some(&(_, id)) = self.materials.iter().find(|(known, _)| *known == m) {
+            self.material = Some(id);
+            return Ok(());
+        }
+        let id = self.b.add_material(m).map_err(|e| error(at, ParseErrorKind::Scene(e)))?;
+        let _ = self.materials.push((m, id));
+        self.material = Some(id);
+        Ok(())
+    }
+
+    /// The material for the next object: the last `f`'s, or the default before any.
+    fn material(&mut self, at: At<'t>) -> Result<u8, ParseError<'t>> {
+        match self.material {
+            Some(id) => Ok(id),
+            None => {
+                let id = self.b.add_material(Material::DEFAULT).map_err(|e| error(at, ParseErrorKind::Scene(e)))?;
+                self.material = Some(id);
+                Ok(id)
+            }
+        }
+    }
+
+    /// `s X Y Z r`.
+    fn sphere(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
+        let c = self.point()?;
+        let r = self.radius()?;
+        if r == 0.0 {
+            return Err(error(at, ParseErrorKind::Scene(SceneError::NonPositiveSize)));
+        }
+        let m = self.material(at)?;
+        let place = Affine::translate(c).after(&Affine::scale(Vec3::new(r, r, r)));
+        self.b.add_object(Shape::Sphere, place, m).map_err(|e| error(at, ParseErrorKind::Scene(e)))
+    }
+
+    /// `c`, base point and radius, apex point and radius: an open side.
+    fn cone(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
+        let (mut base, mut r0) = (self.point()?, self.radius()?);
+        let (mut apex, mut r1) = (self.point()?, self.radius()?);
+        if r1 > r0 {
+            // The wider end is the canonical cone's base.
+            (base, r0, apex, r1) = (apex, r1, base, r0);
+        }
+        if r0 == 0.0 {
+            return Err(error(at, ParseErrorKind::Scene(SceneError::NonPositiveSize)));
+        }
+        let axis = apex - base;
+        if axis.max_abs() == 0.0 {
+            return Err(error(at, ParseErrorKind::CoincidentEnds));
+        }
+        // Two unit vectors across the axis, from the axis of the world least along it.
+        let a = axis.normalize();
+        let helper = if a.x.abs() < 0.6 { Vec3::new(1.0, 0.0, 0.0) } else { Vec3::new(0.0, 1.0, 0.0) };
+        let u = a.cross(helper).normalize();
+        let w = a.cross(u).normalize();
+        let place = Affine::from_columns(u * r0, axis, w * r0, base);
+        let m = self.material(at)?;
+        self.b.add_object(Shape::Open { top: r1 / r0 }, place, m).map_err(|e| error(at, ParseErrorKind::Scene(e)))
+    }
+
+    /// `p n` or `pp n` and the vertices (with normals for `pp`, read and not used): fanned into
+    /// triangles from the first vertex. A fan triangle of no area (three vertices in a line,
+    /// a vertex repeated) adds nothing and is left out; a polygon left with none is refused.
+    fn polygon(&mut self, at: At<'t>, patch: bool) -> Result<(), ParseError<'t>> {
+        let n_at = self.word()?;
+        let n = match n_at.2.parse::<usize>() {
+            Ok(n) if n >= 3 => n,
+            _ => return Err(error(n_at, ParseErrorKind::BadVertexCount)),
+        };
+        let m = self.material(at)?;
+        let mut first = [Vec3::zero(); 2];
+        let mut added = 0usize;
+        for k in 0..n {
+            let v = self.point()?;
+            if patch {
+                self.point()?;
+            }
+            match k {
+                0 | 1 => first[k] = v,
+                _ => {
+                    match self.b.add_triangle([first[0], first[1], v], m) {
+                        Ok(()) => added += 1,
+                        Err(SceneError::DegenerateTriangle) => {}
+                        Err(e) => return Err(error(at, ParseErrorKind::Scene(e))),
+                    }
+                    first[1] = v;
+                }
+            }
+        }
+        if added == 0 {
+            return Err(error(at, ParseErrorKind::Scene(SceneError::DegenerateTriangle)));
+        }
+        Ok(())
+    }
+
+    /// Adds the lights and ambient light (`sqrt(n) / (2 n)` each) and validates the scene.
+    fn finish(mut self, camera: impl FnOnce(&mut CameraDesc)) -> Result<Scene<'a, R>, ParseError<'t>> {
+        let n = self.lights.len() as f64;
+        let each = if n > 0.0 { libm::sqrt(n) / (2.0 * n) } else { 0.0 };
+        self.b.ambient = if n > 0.0 { each } else { 0.5 };
+        for &(pos, gray, at) in &self.lights {
+            self.b
+                .add_light(Light::Point { pos, intensity: each * gray })
+                .map_err(|e| error(at, ParseErrorKind::Scene(e)))?;
+        }
+        camera(&mut self.b.camera);
+        let last = self.last;
+        self.b.finish().map_err(|e| error(last, ParseErrorKind::Scene(e)))
+    }
+}

@@ -1,0 +1,142 @@
+//! NFF in: every entity of `NFF.TXT` read, what the tracer cannot draw refused by name, and
+//! every error placed at its line and column.
+
+use lattice_rt::scene::nff;
+use lattice_rt::scene::{Format, Light, Object, Parts};
+use lattice_rt::Shape;
+
+const SCENE: &str = "\
+# a comment, then every entity
+v
+from 0 -10 2
+at 0 0 0
+up 0 0 1
+angle 45
+hither 0.01
+resolution 512 512
+b 0.2 0.4 0.6
+l 5 -5 5
+l -5 -5 5 1 0.5 0.5
+f 1 0 0 0.8 0.2 30 0 1
+s 0 0 1 1
+c 2 0 0 0.5 2 0 2 0.5
+c -2 0 0 0.8 -2 0 1.5 0.2   # a cone
+p 4
+-5 -5 0
+5 -5 0
+5 5 0
+-5 5 0
+f 0.5 0.5 0.5 0.5 0.5 0 0.5 1.5
+pp 3
+0 3 0 0 0 1
+1 3 0 0 0 1
+0 4 0 0 0 1
+";
+
+fn read(text: &str) -> Result<(Vec<Object<f64>>, usize), String> {
+    let mut storage = vec![Object::<f64>::default(); nff::object_count(text).max(1)];
+    let mut parts = Parts::default();
+    let scene = nff::parse_with::<f64>(text, &mut storage, &mut parts, |_| {}).map_err(|e| e.to_string())?;
+    Ok((scene.objects().to_vec(), scene.lights().len()))
+}
+
+fn err(text: &str) -> String {
+    read(text).err().unwrap_or_else(|| panic!("accepted:\n{text}"))
+}
+
+#[test]
+fn every_entity_is_read() {
+    assert_eq!(Format::of(SCENE), Format::Nff);
+    assert_eq!(Format::of("sphere radius 1"), Format::Text);
+    assert_eq!(nff::object_count(SCENE), 1 + 2 + 2 + 1);
+    let mut storage = vec![Object::<f64>::default(); 6];
+    let mut parts = Parts::default();
+    let scene = nff::parse_with::<f64>(SCENE, &mut storage, &mut parts, |_| {}).unwrap();
+    let kinds: Vec<usize> = scene.objects().iter().map(|o| o.shape().kind()).collect();
+    let (sphere, open, triangle) =
+        (Shape::<f64>::Sphere.kind(), Shape::Open { top: 1.0 }.kind(), Shape::<f64>::Triangle.kind());
+    assert_eq!(kinds, [sphere, open, open, triangle, triangle, triangle]);
+    assert_eq!(scene.objects()[1].shape(), Shape::Open { top: 1.0 });
+    assert_eq!(scene.objects()[2].shape(), Shape::Open { top: 0.25 });
+    // Two lights of sqrt(2) / 4 each, the second times its colour's gray; the ambient too.
+    let each = 2f64.sqrt() / 4.0;
+    let gray = nff::luminance(1.0, 0.5, 0.5);
+    let intensities: Vec<f64> = scene
+        .lights()
+        .iter()
+        .map(|l| match *l {
+            Light::Point { intensity, .. } | Light::Directional { intensity, .. } => intensity,
+        })
+        .collect();
+    assert_eq!(intensities, [each, each * gray]);
+    assert_eq!(scene.ambient(), each);
+    assert_eq!(scene.background(), nff::luminance(0.2, 0.4, 0.6));
+    // Two materials: the red one's Kd times its gray, Ks, the power; the glass's T and index.
+    let m = scene.materials();
+    assert_eq!(m.len(), 2);
+    assert_eq!((m[0].kd, m[0].ks, m[0].shine, m[0].kt), (0.8 * nff::luminance(1.0, 0.0, 0.0), 0.2, 30, 0.0));
+    assert_eq!((m[1].kt, m[1].ior), (0.5, 1.5));
+}
+
+#[test]
+fn equal_materials_are_stored_once() {
+    let text = "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 40\nl 0 -5 5\nf 1 1 1 1 0 0 0 1\ns 0 0 0 1\nf 1 1 1 1 0 0 0 1\ns 2 0 0 1\n";
+    let mut storage = vec![Object::<f64>::default(); 2];
+    let mut parts = Parts::default();
+    let scene = nff::parse_with::<f64>(text, &mut storage, &mut parts, |_| {}).unwrap();
+    assert_eq!(scene.materials().len(), 1);
+}
+
+#[test]
+fn what_cannot_be_drawn_is_refused_by_name_at_its_place() {
+    let view = "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 40\n";
+    assert_eq!(
+        err(&format!("{view}s 0 0 0 -1\n")),
+        "line 2, column 9 at `-1`: a negative radius (NFF's inside-only surface): not drawn by this tracer; give the radius as positive"
+    );
+    assert_eq!(
+        err(&format!("{view}c 0 0 0 -1\n0 0 1 -1\n")),
+        "line 2, column 9 at `-1`: a negative radius (NFF's inside-only surface): not drawn by this tracer; give the radius as positive"
+    );
+    assert_eq!(
+        err(&format!("{view}p 2\n0 0 0\n1 0 0\n")),
+        "line 2, column 3 at `2`: a polygon's vertex count must be a whole number, at least 3"
+    );
+    assert_eq!(
+        err(&format!("{view}p 3\n0 0 0\n1 0 0\n2 0 0\n")),
+        "line 2, column 1 at `p`: the polygon's corners lie on one line: it has no area"
+    );
+    assert_eq!(
+        err(&format!("{view}c 1 1 1 1\n1 1 1 1\n")),
+        "line 2, column 1 at `c`: the cone's base and apex are the same point"
+    );
+    assert_eq!(
+        err(&format!("{view}t 0 0 0\n")),
+        "line 2, column 1 at `t`: unknown NFF entity (expected v, b, l, f, c, s, p, pp or a # comment)"
+    );
+    assert_eq!(err(&format!("{view}s 0 0 zero 1\n")), "line 2, column 7 at `zero`: expected a number");
+    assert_eq!(err(&format!("{view}s 0 0 0\n")), "line 3, column 1: a value is missing at the end of the line");
+    assert_eq!(
+        err("v from 0 -5 0 at 0 0 0 angle 40\ns 0 0 0 1\n"),
+        "line 1, column 1 at `v`: the view needs its `up` line"
+    );
+    assert_eq!(
+        err(&format!("{view}f 1 1 1 1 0 0 0.5 0.5\ns 0 0 0 1\n")),
+        "line 2, column 15 at `0.5`: coefficients must be >= 0 and the index of refraction >= 1"
+    );
+}
+
+#[test]
+fn the_view_angle_spans_the_edge_pixels_centres() {
+    // 45 degrees between the centres of the edge pixels of 512: the frame's edges are half a
+    // pixel further out on each side.
+    let text = "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 45 resolution 512 512\ns 0 0 0 1\n";
+    let mut storage = vec![Object::<f64>::default(); 1];
+    let mut parts = Parts::default();
+    let scene = nff::parse_with::<f64>(text, &mut storage, &mut parts, |_| {}).unwrap();
+    let c = scene.camera();
+    // The default frame is 2:1, so the view's limit is its height.
+    let half = c.up.length();
+    let want = (22.5f64).to_radians().tan() * 512.0 / 511.0;
+    assert!((half - want).abs() < 1e-12, "{half} {want}");
+}
