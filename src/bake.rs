@@ -149,6 +149,11 @@ mod writer {
             }
         }
     }
+    impl Literal for crate::Effects {
+        fn literal(&self, out: &mut String) {
+            let _ = write!(out, "Effects::from_bits({})", self.bits());
+        }
+    }
     impl<R: Literal> Literal for Material<R> {
         fn literal(&self, out: &mut String) {
             record(
@@ -289,6 +294,7 @@ mod writer {
         arg(&mut out, &scene.max_depth);
         arg(&mut out, &scene.world);
         arg(&mut out, &scene.shadow_basis);
+        arg(&mut out, &scene.effects);
         out.push_str(",\n    ),\n    lattice: Lattice::from_tables(\n        ");
         let empty = Lattice::from_tables(&[], &[], (&[], &[]), (0, 0), true, scene.objects.len());
         let (lattices, coords, (cells, refs), entries, narrow) = lattice.unwrap_or(&empty).tables();
@@ -333,6 +339,7 @@ pub mod prelude {
     pub use crate::scene::Scene;
     pub use crate::scene::{Camera, Composite, Light, Material, Object};
     pub use crate::shape::Shape;
+    pub use crate::trace::Effects;
     pub use crate::{F32Micro, F32MicroNewton, Fx};
 }
 
@@ -372,6 +379,7 @@ mod tests {
             scene.max_depth,
             scene.world,
             scene.shadow_basis,
+            scene.effects,
         );
         let mut mb = vec![0; Query::mailbox_len(&scene)];
         let mut rng = Rng::new(4);

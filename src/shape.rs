@@ -75,7 +75,8 @@ impl<R: Real> Shape<R> {
     /// leaving its surface cannot meet it again, and a ray inside it is refracted out. The open
     /// side (seen from within) and the triangle (no inside) are not.
     pub fn is_solid(&self) -> bool {
-        !matches!(self, Shape::Open { .. } | Shape::Triangle)
+        // A build without cones and triangles holds only solids (scenes with others are refused).
+        !(cfg!(any(feature = "cones", feature = "triangles")) && matches!(self, Shape::Open { .. } | Shape::Triangle))
     }
 
     /// The Cargo feature that has the shape's intersection code (`spheres`, `cones`); `None`
@@ -111,9 +112,10 @@ impl<R: Real> Shape<R> {
     // the stores to retire.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn intersect(&self, r: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        if let Shape::Triangle = self {
-            // A plane and three sides: no square to keep small, so no clip first.
-            return if cfg!(feature = "triangles") { triangle(r, tmin, tmax) } else { None };
+        if let (true, Shape::Triangle) = (cfg!(feature = "triangles"), self) {
+            // A plane and three sides: no square to keep small, so no clip first. (A build
+            // without triangles holds none: the scene was refused.)
+            return triangle(r, tmin, tmax);
         }
         let (t0, t1) = self.clip(r, tmin, tmax)?;
         if let Shape::Box = self {

@@ -8,6 +8,7 @@ use crate::cull::Region;
 use crate::math::{Aabb, Affine, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
+use crate::trace::Effects;
 
 /// Builds and validates a [`Scene`] into caller-provided object storage.
 #[derive(Debug)]
@@ -302,7 +303,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         if !(bound < R::LIMIT) {
             return Err(SceneError::TooBright { bound, limit: R::LIMIT, scalar: R::NAME });
         }
-        Ok(Scene {
+        let mut scene = Scene {
             objects,
             composites: &parts.composites,
             materials: &parts.materials,
@@ -313,7 +314,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             max_depth,
             world,
             shadow_basis,
-        })
+            effects: Effects::NONE,
+        };
+        scene.effects = Effects::called_for(&scene);
+        Ok(scene)
     }
 }
 

@@ -5,6 +5,7 @@ use crate::cull::{any_object, Culled, EyeHull, EyeWindow, Region, ShadowWindow};
 use crate::math::{Aabb, Affine, Linear, Ray, Vec3};
 use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
+use crate::trace::Effects;
 use heapless::Vec;
 
 /// Most materials a scene may define: 16 in a build without `alloc` (a microcontroller's),
@@ -418,6 +419,8 @@ pub struct Scene<'a, R> {
     pub(crate) world: Aabb<R>,
     /// Two unit vectors across the first light, when it is directional (see [`ShadowWindow`]).
     pub(crate) shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
+    /// The effects the scene calls for ([`Effects::of`]).
+    pub(crate) effects: Effects,
 }
 
 impl<'a, R> Scene<'a, R> {
@@ -436,8 +439,21 @@ impl<'a, R> Scene<'a, R> {
         max_depth: u8,
         world: Aabb<R>,
         shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
+        effects: Effects,
     ) -> Self {
-        Scene { objects, composites, materials, lights, ambient, background, camera, max_depth, world, shadow_basis }
+        Scene {
+            objects,
+            composites,
+            materials,
+            lights,
+            ambient,
+            background,
+            camera,
+            max_depth,
+            world,
+            shadow_basis,
+            effects,
+        }
     }
 }
 

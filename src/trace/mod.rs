@@ -96,18 +96,21 @@ impl Effects {
     /// material with `Ks > 0` on some object, refraction one with `Kt > 0`, highlights one with
     /// `Ks > 0` and a `shine` power.
     pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
+        scene.effects
+    }
+
+    /// [`Effects::of`] worked out from the scene's objects, materials and lights (when the scene
+    /// is validated, so a baked scene carries it as a literal).
+    pub(crate) fn called_for<R: Real>(scene: &Scene<'_, R>) -> Self {
         let used = |f: fn(&Material<R>) -> R| {
             scene.objects.iter().any(|o| f(at(scene.materials, o.material as usize)) > R::ZERO)
         };
         let mut e = Self::NONE;
-        let self_shadowing = scene.objects.iter().any(|o| matches!(o.shape, crate::shape::Shape::Open { .. }));
-        if !scene.lights.is_empty() && (scene.objects.len() > 1 || self_shadowing) {
+        let self_shadowing = || scene.objects.iter().any(|o| !o.shape.is_solid());
+        if !scene.lights.is_empty() && (scene.objects.len() > 1 || self_shadowing()) {
             e = e | Self::SHADOWS;
         }
-        if scene.objects.iter().any(|o| {
-            let m = at(scene.materials, o.material as usize);
-            m.ks > R::ZERO && m.shine > 0
-        }) {
+        if used(|m| if m.shine > 0 { m.ks } else { R::ZERO }) {
             e = e | Self::HIGHLIGHTS;
         }
         if used(|m| m.ks) {
@@ -655,7 +658,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         // rays to lights in front, the mirror ray), leave the object: a convex solid (and the
         // outside of an open side, part of one's boundary) cannot be met again; a triangle
         // cannot be met again from either side.
-        let flat = matches!(obj.shape, crate::shape::Shape::Triangle);
+        let flat = cfg!(feature = "triangles") && matches!(obj.shape, crate::shape::Shape::Triangle);
         let leaving = if side.entering || flat { hit.object } else { NO_OBJECT };
         let eps = R::offset(p.max_abs(), obj.size());
         let outside = p + n * eps;
@@ -663,18 +666,10 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         if m.kd > R::ZERO || shiny {
             // Lit from outside, the point's shadow rays leave its own (convex) object.
             w.query.filter.set_leaving(leaving);
-            let cos_i = -d.dot(n);
-            let mirror = d + n * (cos_i + cos_i);
-            let surface = Surface {
-                from: outside,
-                normal: n,
-                kd: m.kd,
-                mirror,
-                highlight: if shiny { m.ks } else { R::ZERO },
-                shine: m.shine,
-            };
+            // The highlight's mirror direction, weight and power.
+            let highlight = if shiny { Some((mirror(d, n), m.ks, m.shine)) } else { None };
             for (l, light) in scene.lights.iter().enumerate() {
-                local += self.direct(l, light, &surface, node.weight, w);
+                local += self.direct(l, light, (outside, n, m.kd), highlight, node.weight, w);
             }
             w.query.filter.set_leaving(NO_OBJECT);
         }
@@ -705,8 +700,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             ray,
             meta: Meta { weight: node.weight * w, depth: node.depth + 1, kind, leaving },
         };
-        let cos_i = -d.dot(n);
-        let mirror = d + n * (cos_i + cos_i);
+        let mirror = mirror(d, n);
         let mut reflect_w = if reflects { m.ks } else { R::ZERO };
         if refracts && !solid {
             // A sheet (a triangle, an open side): straight through, leaving it.
@@ -734,8 +728,16 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// within the cutoff of the other.
     /// The work's filter says what the shadow ray may skip (the object the point lies on, when
     /// lit from outside).
-    fn direct(&self, l: usize, light: &Light<R>, s: &Surface<R>, weight: R, w: &mut Work<'_>) -> R {
-        let (from, n) = (s.from, s.normal);
+    #[allow(clippy::too_many_arguments)]
+    fn direct(
+        &self,
+        l: usize,
+        light: &Light<R>,
+        (from, n, kd): (Vec3<R>, Vec3<R>, R),
+        highlight: Option<(Vec3<R>, R, u16)>,
+        weight: R,
+        w: &mut Work<'_>,
+    ) -> R {
         let (to_light, reach, ip) = match *light {
             Light::Directional { to_light, intensity } => (to_light, R::MAX, intensity),
             // Unit direction, so every ray the tracer casts has a direction of length about 1.
@@ -751,12 +753,12 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         if cos <= R::ZERO {
             return R::ZERO;
         }
-        let mut term = ip * s.kd * cos;
-        if s.highlight > R::ZERO {
+        let mut term = ip * kd * cos;
+        if let Some((mirror, ks, shine)) = highlight {
             // Phong: the mirror direction's cosine to the light, raised to the power.
-            let c = s.mirror.dot(to_light);
+            let c = mirror.dot(to_light);
             if c > R::ZERO {
-                term += ip * s.highlight * power(c, s.shine);
+                term += ip * ks * power(c, shine);
             }
         }
         if self.simulates(Effects::SHADOWS) && weight.weigh(term) >= self.cutoff {
@@ -861,16 +863,11 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     }
 }
 
-/// What [`Tracer::direct`] needs of a lit point: where its shadow rays start, its unit normal
-/// (facing the ray that came), its diffuse coefficient, and for a highlight the mirror
-/// direction of the incoming ray, the highlight's weight (0: none) and its Phong power.
-struct Surface<R> {
-    from: Vec3<R>,
-    normal: Vec3<R>,
-    kd: R,
-    mirror: Vec3<R>,
-    highlight: R,
-    shine: u16,
+/// The mirror direction of `d` at a surface of unit normal `n` (facing `d`).
+#[inline(always)]
+fn mirror<R: Real>(d: Vec3<R>, n: Vec3<R>) -> Vec3<R> {
+    let cos_i = -d.dot(n);
+    d + n * (cos_i + cos_i)
 }
 
 /// `c^n` for `0 <= c <= 1` by squaring (a whole power: every scalar, no `pow` table).
