@@ -11,4 +11,5 @@ pub mod progress;
 pub mod report;
 pub mod run;
 pub mod shared;
+pub mod spd;
 pub mod uf2;

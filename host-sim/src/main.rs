@@ -70,6 +70,20 @@ enum Command {
         #[arg(long, default_value_t = board_records::frame::ORBIT_FRAMES)]
         frames: u32,
     },
+    /// Generate a scene of Eric Haines' Standard Procedural Databases as NFF, as the SPD's own
+    /// program does (`balls -s 4` ...): the field's benchmark scenes, for `render`, `stats` and
+    /// `export` (which read NFF as they read scene files).
+    Spd {
+        /// The SPD generator.
+        #[arg(value_enum)]
+        generator: host_sim::spd::Generator,
+        /// Size factor [default: the SPD's own for that scene, the published figures' size].
+        #[arg(short, long)]
+        size: Option<u32>,
+        /// NFF file to write (`-`: standard output) [default: out/spd/<generator>-<size>.nff].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Build the Pico (or Pico 2) image and write it as a UF2 file, for flashing without a
     /// probe: hold BOOTSEL while plugging the board in and copy the file onto the drive it
     /// shows (RPI-RP2 for the Pico, RP2350 for the Pico 2). With --scene, no build: the scene
@@ -135,6 +149,20 @@ fn real_main() -> Result<()> {
             })?;
             output::write_atomic(&output, out.as_bytes())?;
             println!("wrote {}", output.display());
+            Ok(())
+        }
+        Some(Command::Spd { generator, size, output }) => {
+            let size = size.unwrap_or(generator.default_size());
+            let text = generator.nff(size)?;
+            match output {
+                Some(p) if p.as_os_str() == "-" => print!("{text}"),
+                _ => {
+                    let path = output.unwrap_or_else(|| format!("out/spd/{}-{size}.nff", generator.name()).into());
+                    output::write_atomic(&path, text.as_bytes())?;
+                    let objects = lattice_rt::scene::object_count(&text);
+                    println!("wrote {} ({objects} objects)", path.display());
+                }
+            }
             Ok(())
         }
         Some(Command::Orbit { scene, output, frames }) => orbit::orbit_cmd(&scene, &output, frames),

@@ -1,0 +1,87 @@
+//! Eric Haines' Standard Procedural Databases (SPD), generated here as the SPD's own programs
+//! generate them (`host-sim spd NAME --size N`), written as NFF: the field's benchmark scenes
+//! at any size factor, without the C sources. `tests/spd.rs` holds their output to
+//! the original programs' for a few sizes (fixtures in `tests/spd/`, CC0 like the SPD).
+
+pub mod curves;
+pub mod nff;
+
+/// An SPD generator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Generator {
+    /// The sphereflake: 1 + 9 + ... + 9^size spheres and a floor (default 4: 7,382 objects).
+    Balls,
+    /// Pyramids of rings of pentagons (cylinders and spheres) before a wall (default 7: 8,401).
+    Rings,
+    /// A tree of cones and spheres on a field, seven lights (default 11: 8,191).
+    Tree,
+    /// A cubic lattice of spheres and cylinders, six lights (default 12: 8,281).
+    Lattice,
+    /// A jack with smaller jacks in its octants (default 1: 9).
+    Jacks,
+    /// Spheres along a logarithmic spiral (default 5: 5,761).
+    Shells,
+}
+
+impl Generator {
+    /// Every generator, in the order the SPD's Readme lists them.
+    pub const ALL: [Generator; 6] =
+        [Generator::Balls, Generator::Rings, Generator::Tree, Generator::Lattice, Generator::Jacks, Generator::Shells];
+
+    /// The generator's name (its program's).
+    pub fn name(self) -> &'static str {
+        match self {
+            Generator::Balls => "balls",
+            Generator::Rings => "rings",
+            Generator::Tree => "tree",
+            Generator::Lattice => "lattice",
+            Generator::Jacks => "jacks",
+            Generator::Shells => "shells",
+        }
+    }
+
+    /// The size factor the SPD's program uses when none is given (the published figures').
+    pub fn default_size(self) -> u32 {
+        match self {
+            Generator::Balls => 4,
+            Generator::Rings => 7,
+            Generator::Tree => 11,
+            Generator::Lattice => 12,
+            Generator::Jacks => 1,
+            Generator::Shells => 5,
+        }
+    }
+
+    /// The largest size factor accepted: about ten million objects (the host's limits refuse
+    /// more when the scene is read).
+    pub fn max_size(self) -> u32 {
+        match self {
+            Generator::Balls => 7,
+            Generator::Rings => 90,
+            Generator::Tree => 22,
+            Generator::Lattice => 140,
+            Generator::Jacks => 8,
+            Generator::Shells => 14,
+        }
+    }
+
+    /// The scene as NFF text at size factor `size` (at least 1, at most [`Generator::max_size`]).
+    pub fn nff(self, size: u32) -> anyhow::Result<String> {
+        if size < 1 || size > self.max_size() {
+            anyhow::bail!(
+                "{}: the size factor must be from 1 to {} (the SPD's default is {})",
+                self.name(),
+                self.max_size(),
+                self.default_size()
+            );
+        }
+        Ok(match self {
+            Generator::Balls => curves::balls(size),
+            Generator::Rings => curves::rings(size),
+            Generator::Tree => curves::tree(size),
+            Generator::Lattice => curves::lattice(size),
+            Generator::Jacks => curves::jacks(size),
+            Generator::Shells => curves::shells(size),
+        })
+    }
+}
