@@ -265,6 +265,12 @@ pub struct StatsArgs {
     /// Print the statistics as JSON instead of text (fields: docs/json.md).
     #[arg(long)]
     pub json: bool,
+    /// Count rays under the Standard Procedural Databases' testing protocol instead (512x512,
+    /// eye rays through the 513x513 pixel corners, depth 5 counting the eye ray, no cutoff): the
+    /// ray invariants Havran and Sixta published, and object tests and cell steps per ray with
+    /// the lattice alone (as Havran measured) and with the tracer's defaults. `--size` is not used.
+    #[arg(long)]
+    pub spd: bool,
 }
 
 /// The scenes given, or the paper's four and the Whitted showcase.

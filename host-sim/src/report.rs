@@ -169,3 +169,18 @@ pub fn print_json(v: &impl Serialize) -> anyhow::Result<()> {
     println!("{}", serde_json::to_string_pretty(v)?);
     Ok(())
 }
+
+/// `stats --spd --json`: the SPD protocol's counts (`crate::spd::protocol`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SpdReport {
+    /// Scene file.
+    pub scene: String,
+    /// Numeric type.
+    pub scalar: &'static str,
+    /// Objects (a polygon counts its triangles).
+    pub objects: usize,
+    /// The lattice's shape and memory.
+    pub lattice: LatticeSize,
+    /// One count with the lattice alone (as Havran measured), one with the tracer's defaults.
+    pub counts: Vec<crate::spd::protocol::Count>,
+}

@@ -370,6 +370,9 @@ fn outputs(a: &RenderArgs) -> Result<Vec<(&Path, Output)>> {
 
 /// `host-sim stats`.
 pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
+    if a.spd {
+        return spd_stats::<R>(a);
+    }
     let text = read(&a.scene)?;
     let frame = Frame::new(a.size.0, a.size.1);
     let mut storage = object_storage::<R>(&text)?;
@@ -576,6 +579,50 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
         }
     }
     println!("wrote {} scenes to {}/ (each as `render` draws it by default)", files.len(), out.display());
+    Ok(())
+}
+
+/// `stats --spd`: the SPD protocol's counts ([`crate::spd::protocol`]) with the lattice alone
+/// and with the tracer's defaults.
+fn spd_stats<R: Real>(a: &StatsArgs) -> Result<()> {
+    use crate::spd::protocol::{count, Setup, RESOLUTION};
+    let text = read(&a.scene)?;
+    let frame = Frame::new(RESOLUTION, RESOLUTION);
+    let mut storage = object_storage::<R>(&text)?;
+    let scene = parse_scene::<R>(&a.scene, &text, &mut storage, &frame)?;
+    let cfg = crate::cli::lattice_config(a.cells, a.budget);
+    let mut bufs = lattice_storage(&scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+    let counts = [Setup::AsHavran, Setup::Defaults].map(|s| count(&scene, &lattice, s));
+    let report = crate::report::SpdReport {
+        scene: a.scene.display().to_string(),
+        scalar: R::NAME,
+        objects: scene.objects().len(),
+        lattice: LatticeSize::of(&lattice),
+        counts: counts.to_vec(),
+    };
+    if a.json {
+        return print_json(&report);
+    }
+    println!(
+        "scene {} ({}): {} objects, SPD protocol (513x513 eye rays at the pixel corners, depth 5)",
+        report.scene,
+        R::NAME,
+        report.objects
+    );
+    println!(
+        "  lattice: {} cells, {} references, {} bytes",
+        report.lattice.cells, report.lattice.references, report.lattice.bytes
+    );
+    for (name, v) in counts[0].invariants.named() {
+        println!("  {name:<24}{v:>10}");
+    }
+    for c in &counts {
+        println!(
+            "  {:?}: {:.2} object tests per ray, {:.2} cell steps per ray, {:.0} ms",
+            c.setup, c.tests_per_ray, c.steps_per_ray, c.ms
+        );
+    }
     Ok(())
 }
 

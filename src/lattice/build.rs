@@ -2,11 +2,12 @@
 //! in two passes (count, then fill).
 
 use super::config::uniform_coord;
+use super::oriented::{self, Oriented};
 use super::plan::{axis_planes, lattice_bounds, lattice_resolution};
 use super::{cluster, for_each_item, index, Lattice, LatticeConfig, SubLattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
-use crate::scene::Scene;
+use crate::scene::{Object, Scene};
 use core::fmt;
 
 /// Caller-provided storage for a lattice.
@@ -225,10 +226,11 @@ fn for_each_ref<R: Real>(
     let find = |c: usize| dense.binary_search_by_key(&(c as u32), |d| d.dense_cell).ok();
     let world = &lattices[0];
     let wp = planes_of(coords, world);
+    let object = |item: u32| (item & index::SUB_FLAG == 0).then(|| &scene.objects[item as usize]);
     for_each_item(scene, cfg, 0, |item, ib| {
-        visit_cells(coords, world, ib, |c| match find(c) {
+        visit_cells(coords, world, ib, object(item), |c| match find(c) {
             Some(k) if item & index::SUB_FLAG == 0 && cluster::moves(&cluster::cell_box(&wp, c), ib) => {
-                visit_cells(coords, &dense[k], ib, |c| f(item, c))
+                visit_cells(coords, &dense[k], ib, object(item), |c| f(item, c))
             }
             _ => f(item, c),
         })
@@ -237,19 +239,21 @@ fn for_each_ref<R: Real>(
         f(index::SUB_FLAG | (base - 1 + k) as u32, d.dense_cell as usize);
     }
     for (g, sub) in lattices.iter().enumerate().take(base).skip(1) {
-        for_each_item(scene, cfg, g, |item, ib| visit_cells(coords, sub, ib, |c| f(item, c)));
+        for_each_item(scene, cfg, g, |item, ib| visit_cells(coords, sub, ib, None, |c| f(item, c)));
     }
 }
 
-/// Calls `f` with the global cell index of every cell of `sub` a box overlaps.
-fn visit_cells<R: Real>(coords: &[R], sub: &SubLattice<R>, b: &Aabb<R>, mut f: impl FnMut(usize)) {
-    let r = cluster::span(&planes_of(coords, sub), b);
+/// Calls `f` with the global cell index of every cell of `sub` a box overlaps; for an object
+/// given, only the cells its own box meets ([`Oriented`]).
+fn visit_cells<R: Real>(
+    coords: &[R],
+    sub: &SubLattice<R>,
+    b: &Aabb<R>,
+    object: Option<&Object<R>>,
+    mut f: impl FnMut(usize),
+) {
     let (nx, ny) = (sub.n[0] as usize, sub.n[1] as usize);
-    for z in r[2].0..=r[2].1 {
-        for y in r[1].0..=r[1].1 {
-            for x in r[0].0..=r[0].1 {
-                f(sub.cell_start as usize + x + nx * (y + ny * z));
-            }
-        }
-    }
+    oriented::for_each_cell(&planes_of(coords, sub), b, object.and_then(Oriented::of).as_ref(), |[x, y, z]| {
+        f(sub.cell_start as usize + x + nx * (y + ny * z))
+    });
 }

@@ -9,6 +9,7 @@
 //! a pass or two over the free objects per 4096 world cells and no storage.
 
 use super::config::{resolution, uniform_coord};
+use super::oriented::{count_cells, Oriented};
 use super::{locate_by, LatticeConfig, NO_COMPOSITE};
 use crate::math::{Aabb, Vec3};
 use crate::scalar::Real;
@@ -81,11 +82,6 @@ pub(super) fn span<R: Real>(planes: &(impl Planes<R> + ?Sized), b: &Aabb<R>) -> 
 /// The cell of axis `a` that coordinate `x` falls in.
 fn locate_on<R: Real>(planes: &(impl Planes<R> + ?Sized), a: usize, x: R) -> usize {
     locate_by(planes.cells(a), x, |i| planes.plane(a, i))
-}
-
-/// Cells a box overlaps in a range from [`span`].
-pub(super) fn cells_in(r: &[(usize, usize); 3]) -> usize {
-    r.iter().map(|&(lo, hi)| hi - lo + 1).product()
 }
 
 /// The free objects: index and box.
@@ -193,8 +189,9 @@ impl Occupied {
     }
 }
 
-/// What [`scan`] calls per object and cell: the cell's number in its chunk, its box, the object's box.
-type Visit<'v, R> = dyn FnMut(usize, &Aabb<R>, &Aabb<R>) + 'v;
+/// What [`scan`] calls per object and cell: the cell's number in its chunk, its box, the object's
+/// box, the object's index.
+type Visit<'v, R> = dyn FnMut(usize, &Aabb<R>, &Aabb<R>, usize) + 'v;
 
 /// [`for_each_dense`]'s work, out of line so that its counters are on the stack only when a
 /// scene can have a dense cell.
@@ -221,11 +218,13 @@ fn scan<R: Real>(
         // Calls `visit(cell - base, cell box, object box)` for every cell of the chunk each free
         // object overlaps and would move to, were the cell dense.
         let each = |visit: &mut Visit<'_, R>| {
-            for (_, b) in free_objects(scene) {
+            for (o, b) in free_objects(scene) {
                 let (lz, hz) = (locate_on(planes, 2, b.min.z), locate_on(planes, 2, b.max.z));
                 if hz < z0 || lz > z1 {
                     continue;
                 }
+                // Only the cells the object's own box meets, as the build lists it.
+                let oriented = scene.objects.get(o).and_then(Oriented::of);
                 let r = span(planes, b);
                 for z in lz.max(z0)..=hz.min(z1) {
                     for y in r[1].0..=r[1].1 {
@@ -233,8 +232,8 @@ fn scan<R: Real>(
                             let c = x + n[0] * (y + n[1] * z);
                             if (base..end).contains(&c) {
                                 let cell = cell_box(planes, c);
-                                if moves(&cell, b) {
-                                    visit(c - base, &cell, b);
+                                if moves(&cell, b) && oriented.as_ref().is_none_or(|k| k.meets(planes, [x, y, z])) {
+                                    visit(c - base, &cell, b, o);
                                 }
                             }
                         }
@@ -243,13 +242,13 @@ fn scan<R: Real>(
             }
         };
         counts.iter_mut().for_each(|k| *k = 0);
-        each(&mut |i, _, _| counts[i] += 1);
+        each(&mut |i, _, _, _| counts[i] += 1);
         if !counts.iter().any(|&k| k as usize > split) {
             continue;
         }
         centred.iter_mut().chain(refs.iter_mut()).for_each(|k| *k = 0);
         occupied.iter_mut().for_each(|k| *k = NOTHING);
-        each(&mut |i, cell, b| {
+        each(&mut |i, cell, b, _| {
             if counts[i] as usize > split {
                 occupied[i] = Occupied::union(occupied[i], Occupied::of(cell, b));
                 let centre = (b.min + b.max) * R::HALF;
@@ -257,10 +256,11 @@ fn scan<R: Real>(
                     u32::from((0..3).all(|a| centre.axis(a) >= cell.min.axis(a) && centre.axis(a) < cell.max.axis(a)));
             }
         });
-        each(&mut |i, _, b| {
+        each(&mut |i, _, b, o| {
             if counts[i] as usize > split {
                 let d = dense(base + i, counts[i] as usize, occupied[i]);
-                refs[i] += cells_in(&span(&Uniform { bounds: &d.bounds, n: d.n }, b)) as u32;
+                let oriented = scene.objects.get(o).and_then(Oriented::of);
+                refs[i] += count_cells(&Uniform { bounds: &d.bounds, n: d.n }, b, oriented.as_ref()) as u32;
             }
         });
         for i in 0..end - base {

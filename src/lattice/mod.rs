@@ -28,6 +28,7 @@ mod build;
 mod cluster;
 mod config;
 mod index;
+mod oriented;
 mod plan;
 mod walk;
 

@@ -1,6 +1,7 @@
 //! Planning a lattice: its resolution, where its planes go, and how much storage it needs.
 
 use super::config::{resolution, uniform_coord, LatticeConfig, Resolution, Spacing, MAX_PER_AXIS};
+use super::oriented::{count_cells, Oriented};
 use super::{cluster, for_each_item, Lattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
@@ -221,7 +222,12 @@ fn adaptive_planes<R: Real>(
 fn plan_refs<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig, g: usize, b: &Aabb<R>, n: [u16; 3]) -> usize {
     with_planes(scene, cfg, g, b, n, |planes| {
         let mut refs = 0;
-        for_each_item(scene, cfg, g, |_, ib| refs += cluster::cells_in(&cluster::span(planes, ib)));
+        // The world lattice lists an object only in the cells its own box meets (module
+        // `oriented`); a composite's lattice in every cell of its world box.
+        for_each_item(scene, cfg, g, |item, ib| {
+            let object = (g == 0 && item & super::index::SUB_FLAG == 0).then(|| &scene.objects[item as usize]);
+            refs += count_cells(planes, ib, object.and_then(Oriented::of).as_ref());
+        });
         refs
     })
 }

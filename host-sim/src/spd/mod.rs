@@ -5,6 +5,7 @@
 
 pub mod curves;
 pub mod nff;
+pub mod protocol;
 
 /// An SPD generator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
