@@ -147,8 +147,15 @@ fn object(s: &mut String, scene: &Scene<'_, f64>, i: usize, mode: PovMode) -> Re
         PovMode::Full => {
             let pig = if mat.kt > 0.0 { format!("rgbt <1, 1, 1, {}>", mat.kt) } else { "rgb 1".into() };
             let interior = if mat.kt > 0.0 { format!(" interior {{ ior {} }}", mat.ior) } else { String::new() };
+            // A highlight: POV-Ray's Phong of weight Ks and size the power (its phong_size is
+            // the cosine's power, as ours).
+            let phong = if mat.shine > 0 && mat.ks > 0.0 {
+                format!("phong {} phong_size {}", mat.ks, mat.shine)
+            } else {
+                "phong 0".into()
+            };
             format!(
-                "pigment {{ {pig} }} finish {{ ambient {} diffuse {} specular 0 phong 0 reflection {{ {} }} }}{interior}",
+                "pigment {{ {pig} }} finish {{ ambient {} diffuse {} specular 0 {phong} reflection {{ {} }} }}{interior}",
                 mat.ka, mat.kd, mat.ks
             )
         }

@@ -16,6 +16,7 @@ mod motion;
 mod playground;
 mod plot;
 mod profile;
+mod spd;
 mod tradeoff;
 mod versus;
 
@@ -103,6 +104,20 @@ enum Command {
     },
     /// host-sim against POV-Ray on chosen scenes of `bench`'s comparison, printed as a table
     /// (nothing written): for measuring one scene while working on it.
+    /// The Standard Procedural Databases at their default sizes: the ray invariants against
+    /// Havran's and the SPD Readme's, object tests and cell steps per ray against the published
+    /// structures, and the time against POV-Ray 3.7. Writes docs/spd.md.
+    Spd {
+        /// Report to write.
+        #[arg(long, default_value = "docs/spd.md")]
+        out: PathBuf,
+        /// Timed runs per scene against POV-Ray (the median is used).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Leave POV-Ray's column out.
+        #[arg(long)]
+        no_povray: bool,
+    },
     Versus {
         /// Scenes by name or name prefix (`chair`, `loose clustered 1000`, `random`); all when none.
         scenes: Vec<String>,
@@ -234,6 +249,7 @@ fn real_main() -> Result<()> {
         }
         Command::Firmware { out, no_build } => firmware::firmware_cmd(&root, &out, no_build),
         Command::Bench { quick, runs, out, plot } => bench::bench_cmd(quick, runs, &out, &plot),
+        Command::Spd { out, runs, no_povray } => spd::spd_cmd(&out, runs, !no_povray),
         Command::Versus { scenes, runs, no_povray } => bench::versus_cmd(&scenes, runs, !no_povray),
         Command::Memory { quick, runs, out, plot, tests_plot } => {
             memory::memory_cmd(&memory::MemoryArgs { runs, quick, out, plot, tests_plot })

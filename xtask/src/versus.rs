@@ -68,12 +68,12 @@ fn trace_time(stderr: &str) -> Option<Duration> {
 
 /// Renders `pov` with POV-Ray (one thread, no anti-aliasing, no file written) and returns its
 /// trace time.
-fn povray(pov: &str, work: &Path, name: &str) -> Result<Duration> {
+fn povray(pov: &str, work: &Path, name: &str, size: (u16, u16)) -> Result<Duration> {
     let src = work.join(format!("{}.pov", name.replace(' ', "-")));
     std::fs::write(&src, pov).with_context(|| format!("cannot write {}", src.display()))?;
     let out = Command::new("povray")
         .arg(format!("+I{}", src.display()))
-        .args([format!("+W{}", SIZE.0), format!("+H{}", SIZE.1), "-D".into(), "-F".into(), "-A".into(), "+WT1".into()])
+        .args([format!("+W{}", size.0), format!("+H{}", size.1), "-D".into(), "-F".into(), "-A".into(), "+WT1".into()])
         .env("HOME", work)
         .output()
         .context("cannot run povray (Debian package povray)")?;
@@ -86,7 +86,7 @@ fn povray(pov: &str, work: &Path, name: &str) -> Result<Duration> {
 
 /// Times `scene` in host-sim (its default tracer over `accel`, one core) and, given a work
 /// folder, in POV-Ray, interleaved `runs` times, with and without shadows (POV-Ray's time is
-/// zero without one).
+/// zero without one), at [`SIZE`].
 pub fn compare(
     name: &str,
     scene: &Scene<'_, f64>,
@@ -94,13 +94,25 @@ pub fn compare(
     runs: usize,
     work: Option<&Path>,
 ) -> Result<Vec<Row>> {
+    compare_at(name, scene, accel, (runs, SIZE, true), work)
+}
+
+/// [`compare`] at `size`, `runs` times, also without shadows when `unshadowed` (the scene's
+/// camera must be fitted to the size's shape).
+pub fn compare_at(
+    name: &str,
+    scene: &Scene<'_, f64>,
+    accel: &(dyn Accelerator<f64> + Sync),
+    (runs, size, unshadowed): (usize, (u16, u16), bool),
+    work: Option<&Path>,
+) -> Result<Vec<Row>> {
     if let Some(work) = work {
         std::fs::create_dir_all(work).with_context(|| format!("cannot create {}", work.display()))?;
     }
     let full = export(scene, PovMode::Full)?;
-    let frame = Frame::new(SIZE.0, SIZE.1);
+    let frame = Frame::new(size.0, size.1);
     let mut rows = Vec::new();
-    for shadows in [true, false] {
+    for shadows in [true, false].into_iter().take(if unshadowed { 2 } else { 1 }) {
         let pov_text = if shadows { full.clone() } else { shadowless(&full) };
         let mut tracer = Tracer::new(scene, accel);
         if !shadows {
@@ -112,7 +124,7 @@ pub fn compare(
             ours.push(r.elapsed);
             tests = r.stats.object_tests as f64 / r.stats.total_rays().max(1) as f64;
             if let Some(work) = work {
-                pov.push(povray(&pov_text, work, name)?);
+                pov.push(povray(&pov_text, work, name, size)?);
             }
         }
         rows.push(Row {
