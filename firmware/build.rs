@@ -210,7 +210,7 @@ fn plan<R: Real + Literal>(
     text: &str,
     bake: Option<(&str, bool, &mut String)>,
 ) -> (Sizes, u8, bool) {
-    let mut storage = vec![Object::<R>::default(); text.lines().count().max(1)];
+    let mut storage = vec![Object::<R>::default(); lattice_rt::object_count(text).max(1)];
     let mut parts = lattice_rt::Parts::default();
     let scene =
         lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));

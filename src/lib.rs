@@ -79,7 +79,8 @@ pub mod shape;
 pub use shape::{Shape, ShapeHit};
 pub mod cull;
 pub mod scene;
-pub use scene::text::{parse, ParseError};
+pub use scene::text::ParseError;
+pub use scene::{object_count, parse};
 pub use scene::{Parts, Scene, SceneBuilder, SceneError};
 pub mod accel;
 #[cfg(any(test, feature = "generate"))]

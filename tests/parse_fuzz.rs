@@ -42,7 +42,7 @@ const WORDS: [&str; 30] = [
 ];
 
 fn check<R: Real>(text: &str) -> Result<(), TestCaseError> {
-    let mut storage = vec![Object::<R>::default(); 48];
+    let mut storage = vec![Object::<R>::default(); lattice_rt::object_count(text).clamp(48, 512)];
     let mut parts = lattice_rt::Parts::default();
     match parse::<R>(text, &mut storage, &mut parts) {
         Err(e) => {
@@ -69,6 +69,44 @@ fn check<R: Real>(text: &str) -> Result<(), TestCaseError> {
         }
     }
     Ok(())
+}
+
+/// NFF's words and a few numbers, for random NFF text.
+const NFF_WORDS: [&str; 24] = [
+    "v",
+    "from",
+    "at",
+    "up",
+    "angle",
+    "hither",
+    "resolution",
+    "b",
+    "l",
+    "f",
+    "c",
+    "s",
+    "p",
+    "pp",
+    "#",
+    "\n",
+    "0",
+    "1",
+    "-1",
+    "0.5",
+    "3",
+    "1e300",
+    "nan",
+    "-0",
+];
+
+/// Small NFF scenes to mutate: the SPD's jacks and rings at size 1 (as its programs write them)
+/// and every entity in a few lines.
+fn nff_scene(pick: usize) -> String {
+    match pick {
+        0 => include_str!("../host-sim/tests/spd/rings-1.nff").to_string(),
+        1 => "v\nfrom 0 -10 2\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0.01\nresolution 64 64\nb 0.2 0.4 0.6\nl 5 -5 5\nl -5 -5 5 1 0.5 0.5\nf 1 0 0 0.8 0.2 30 0 1\ns 0 0 1 1\nc 2 0 0 0.5 2 0 2 0.5\nc -2 0 0 0.8 -2 0 1.5 0.2\np 4\n-5 -5 0\n5 -5 0\n5 5 0\n-5 5 0\nf 0.5 0.5 0.5 0.5 0.5 0 0.5 1.5\npp 3\n0 3 0 0 0 1\n1 3 0 0 0 1\n0 4 0 0 0 1\n".to_string(),
+        _ => include_str!("../host-sim/tests/spd/tree-2.nff").to_string(),
+    }
 }
 
 fn mutate(base: &str, ops: &[(u8, usize, usize)]) -> String {
@@ -119,6 +157,21 @@ proptest! {
         let text = mutate(&base, &ops);
         check::<f64>(&text)?;
         check::<f32>(&text)?;
+        check::<Fx>(&text)?;
+    }
+
+    #[test]
+    fn mutated_nff_never_panics(pick in 0usize..3, ops in prop::collection::vec((any::<u8>(), any::<usize>(), any::<usize>()), 1..6)) {
+        let text = mutate(&nff_scene(pick), &ops);
+        check::<f64>(&text)?;
+        check::<f32>(&text)?;
+        check::<Fx>(&text)?;
+    }
+
+    #[test]
+    fn random_nff_never_panics(words in prop::collection::vec(0usize..24, 0..60)) {
+        let text: String = words.iter().map(|&w| NFF_WORDS[w]).collect::<Vec<_>>().join(" ");
+        check::<f64>(&text)?;
         check::<Fx>(&text)?;
     }
 

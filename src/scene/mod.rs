@@ -58,6 +58,17 @@ pub fn object_count(text: &str) -> usize {
     }
 }
 
+/// Parses `text` (either [`Format`]) into a [`Scene`], storing objects in `storage` (at least
+/// [`object_count`] long) and the composites, materials and lights in `parts`: [`text::parse`]
+/// or NFF's reader.
+pub fn parse<'a, 't, R: Real>(
+    text: &'t str,
+    storage: &'a mut [Object<R>],
+    parts: &'a mut Parts<R>,
+) -> Result<Scene<'a, R>, ParseError<'t>> {
+    parse_with(text, storage, parts, |_| {})
+}
+
 /// Parses `text` (either [`Format`]) into a [`Scene`], the camera changed by `camera` before
 /// the scene is validated ([`text::parse_with`], [`nff::parse_with`]).
 pub fn parse_with<'a, 't, R: Real>(
