@@ -84,6 +84,25 @@ fn povray(pov: &str, work: &Path, name: &str, size: (u16, u16)) -> Result<Durati
     trace_time(&stderr).with_context(|| format!("povray printed no Trace Time for {}", src.display()))
 }
 
+/// Renders `pov` with POV-Ray at `size` into the PNG `png` (one thread, no anti-aliasing).
+pub fn povray_picture(pov: &str, png: &Path, size: (u16, u16)) -> Result<()> {
+    let work = std::env::temp_dir().join("lattice-rt-pov-picture");
+    std::fs::create_dir_all(&work)?;
+    let src = work.join("scene.pov");
+    std::fs::write(&src, pov).with_context(|| format!("cannot write {}", src.display()))?;
+    let out = Command::new("povray")
+        .arg(format!("+I{}", src.display()))
+        .arg(format!("+O{}", png.display()))
+        .args([format!("+W{}", size.0), format!("+H{}", size.1), "-D".into(), "+FN".into(), "-A".into(), "+WT1".into()])
+        .env("HOME", &work)
+        .output()
+        .context("cannot run povray (Debian package povray)")?;
+    if !out.status.success() {
+        bail!("povray failed on {}", src.display());
+    }
+    Ok(())
+}
+
 /// Times `scene` in host-sim (its default tracer over `accel`, one core) and, given a work
 /// folder, in POV-Ray, interleaved `runs` times, with and without shadows (POV-Ray's time is
 /// zero without one), at [`SIZE`].
