@@ -328,7 +328,7 @@ fn cone_side_and_caps<R: Real>(r: &Ray<R>, top: R, capped: bool, best: &mut Clos
 /// The triangle `(0,0,0)`, `(1,0,0)`, `(0,0,1)` in `y = 0`: where the ray crosses the plane
 /// in `(tmin, tmax]`, if that point's `x` and `z` lie in the triangle. The three side tests
 /// are widened by the scalar's box padding ([`Real::pad_eps`]), so the triangles a polygon is
-/// fanned into overlap by a rounding's width along their shared sides and no ray slips
+/// cut into overlap by a rounding's width along their shared sides and no ray slips
 /// between them.
 #[cfg_attr(target_arch = "x86_64", inline(always))]
 fn triangle<R: Real>(r: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {

@@ -21,7 +21,7 @@ fn generated_scenes_are_the_original_programs_output() {
         assert!(got == want, "{stem}: the generated NFF differs from the SPD program's");
         checked += 1;
     }
-    assert_eq!(checked, 7);
+    assert_eq!(checked, 10);
 }
 
 #[test]
@@ -34,10 +34,13 @@ fn every_generator_at_its_default_size_makes_the_published_object_count_and_read
         (Generator::Lattice, 8281),
         (Generator::Jacks, 9),
         (Generator::Shells, 5761),
+        (Generator::Tetra, 4096),
+        (Generator::Gears, 9345),
+        (Generator::Mount, 8196),
     ];
     for (g, want) in published {
         let text = g.nff(g.default_size()).unwrap();
-        // NFF primitives (a polygon is one; it becomes two triangles here).
+        // NFF primitives (a polygon is one; here it is its triangles).
         let primitives =
             text.lines().filter(|l| l.starts_with("s ") || l.starts_with("c ") || l.starts_with("p ")).count();
         assert_eq!(primitives, want, "{}", g.name());
@@ -100,6 +103,9 @@ fn the_lattice_agrees_with_brute_force_on_spd_scenes() {
         (Generator::Balls, 2),
         (Generator::Lattice, 3),
         (Generator::Jacks, 2),
+        (Generator::Tetra, 4),
+        (Generator::Gears, 1),
+        (Generator::Mount, 3),
     ] {
         let text = g.nff(size).unwrap();
         for cfg in [lattice_rt::LatticeConfig::default(), crowded] {

@@ -15,6 +15,7 @@ pub mod builder;
 pub mod error;
 pub mod model;
 pub mod nff;
+pub mod polygon;
 pub mod text;
 
 pub use crate::camera::{lowest_terms, Camera, CameraDesc, FieldOfView, DEFAULT_FRAME, VIEW_MARGIN};

@@ -15,8 +15,8 @@
 //!   `T > 0`). Equal materials are stored once.
 //! * `s X Y Z r`: a sphere. `c` with base point and radius, apex point and radius: the side of
 //!   a cylinder or cone without end caps ([`Shape::Open`]).
-//! * `p n` and `n` vertices: a planar convex polygon, fanned into `n - 2` triangles from its
-//!   first vertex. `pp n` and `n` vertices with normals: the same polygon; the normals are read
+//! * `p n` and `n` vertices: a planar polygon, convex or not, cut into `n - 2` triangles
+//!   ([`triangulate`]). `pp n` and `n` vertices with normals: the same polygon; the normals are read
 //!   and the patch is shaded flat (its plane's normal).
 //! * `#` starts a comment that runs to the end of the line.
 //!
@@ -27,6 +27,7 @@
 use super::builder::SceneBuilder;
 use super::error::SceneError;
 use super::model::{Light, Material, Object, Parts, Scene, MAX_LIGHTS, MAX_MATERIALS};
+use super::polygon::{triangulate, MAX_VERTICES};
 use super::text::{parse_number, ParseError, ParseErrorKind};
 use crate::camera::{CameraDesc, FieldOfView};
 use crate::math::{Affine, Vec3};
@@ -359,39 +360,38 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
         self.b.add_object(Shape::Open { top: r1 / r0 }, place, m).map_err(|e| error(at, ParseErrorKind::Scene(e)))
     }
 
-    /// `p n` or `pp n` and the vertices (with normals for `pp`, read and not used): fanned into
-    /// triangles from the first vertex. A fan triangle of no area (three vertices in a line,
-    /// a vertex repeated) adds nothing and is left out; a polygon left with none is refused.
+    /// `p n` or `pp n` and the vertices (with normals for `pp`, read and not used): cut into
+    /// triangles ([`triangulate`]). A triangle of no area (three vertices in a line, a vertex
+    /// repeated) adds nothing and is left out; a polygon left with none is refused.
     fn polygon(&mut self, at: At<'t>, patch: bool) -> Result<(), ParseError<'t>> {
         let n_at = self.word()?;
         let n = match n_at.2.parse::<usize>() {
             Ok(n) if n >= 3 => n,
             _ => return Err(error(n_at, ParseErrorKind::BadVertexCount)),
         };
+        if n > MAX_VERTICES {
+            return Err(error(n_at, ParseErrorKind::PolygonTooLarge { most: MAX_VERTICES }));
+        }
         let m = self.material(at)?;
-        let mut first = [Vec3::zero(); 2];
-        let mut added = 0usize;
-        for k in 0..n {
-            let v = self.point()?;
+        let mut v: Vec<Vec3<f64>, MAX_VERTICES> = Vec::new();
+        for _ in 0..n {
+            let _ = v.push(self.point()?);
             if patch {
                 self.point()?;
             }
-            match k {
-                0 | 1 => first[k] = v,
-                _ => {
-                    match self.b.add_triangle([first[0], first[1], v], m) {
-                        Ok(()) => added += 1,
-                        Err(SceneError::DegenerateTriangle) => {}
-                        Err(e) => return Err(error(at, ParseErrorKind::Scene(e))),
-                    }
-                    first[1] = v;
-                }
-            }
         }
-        if added == 0 {
-            return Err(error(at, ParseErrorKind::Scene(SceneError::DegenerateTriangle)));
+        let (mut added, mut failed) = (0usize, None);
+        triangulate(&v, |[a, b, c]| match (failed, self.b.add_triangle([v[a], v[b], v[c]], m)) {
+            (None, Ok(())) => added += 1,
+            (None, Err(SceneError::DegenerateTriangle)) => {}
+            (None, Err(e)) => failed = Some(e),
+            (Some(_), _) => {}
+        });
+        match failed {
+            Some(e) => Err(error(at, ParseErrorKind::Scene(e))),
+            None if added == 0 => Err(error(at, ParseErrorKind::Scene(SceneError::DegenerateTriangle))),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// Adds the lights and ambient light (`sqrt(n) / (2 n)` each) and validates the scene.

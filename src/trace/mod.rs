@@ -271,6 +271,8 @@ pub struct Tracer<'s, 'a, R, A: ?Sized, const E: u8 = { Effects::ALL.bits() }> {
     coherence: bool,
     /// Whether a lattice walk tests an object's box before the object ([`crate::accel::Filter::box_tests`]).
     box_tests: bool,
+    /// Whether every ray the SPD's testing protocol asks for is spawned ([`Tracer::set_every_ray`]).
+    every_ray: bool,
 }
 
 /// How eye rays find their nearest hit. Every eye ray starts at the eye, and each object knows
@@ -390,6 +392,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized> Tracer<'s, 'a, R, A> {
             eye_rays: EyeRays::for_scene(scene),
             coherence: true,
             box_tests: true,
+            every_ray: false,
         }
     }
 }
@@ -411,7 +414,16 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
             eye_rays: EyeRays::for_scene(scene),
             coherence: true,
             box_tests: true,
+            every_ray: false,
         })
+    }
+
+    /// Spawns every ray the Standard Procedural Databases' testing protocol asks for (its
+    /// Readme, rules 8 and 9): a mirror ray from every transmitting surface too (its `Ks` may be
+    /// 0), and every mirror and refracted ray whatever its weight. The picture is the same (the
+    /// rays added weigh nothing); the ray counts become comparable with the published ones.
+    pub fn set_every_ray(&mut self, on: bool) {
+        self.every_ray = on;
     }
 
     /// How eye rays find their nearest hit.
@@ -508,7 +520,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
     /// the effects simulated (each ray also needs the tree's depth left).
     #[inline(always)]
     pub fn branches(&self, m: &Material<R>) -> (bool, bool) {
-        (self.simulates(Effects::REFLECTION) && m.ks > R::ZERO, self.simulates(Effects::REFRACTION) && m.kt > R::ZERO)
+        let refracts = self.simulates(Effects::REFRACTION) && m.kt > R::ZERO;
+        (self.simulates(Effects::REFLECTION) && (m.ks > R::ZERO || (self.every_ray && refracts)), refracts)
     }
 
     /// Brightness (0 black .. 1 white, clamped) seen along an eye ray.
@@ -675,8 +688,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         }
         let lit = node.weight.weigh(local);
         if children {
-            let solid = obj.shape.is_solid();
-            self.push_children(node, (d, &side, p), (eps, outside, leaving), (reflects, refracts, m, solid), stack);
+            self.push_children(node, (d, &side, p), (eps, outside, leaving), (reflects, refracts, m), stack);
         }
         lit
     }
@@ -692,7 +704,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         node: Meta<R>,
         (d, side, p): (Vec3<R>, &Side<R>, Vec3<R>),
         (eps, outside, leaving): (R, Vec3<R>, u32),
-        (reflects, refracts, m, solid): (bool, bool, &Material<R>, bool),
+        (reflects, refracts, m): (bool, bool, &Material<R>),
         stack: &mut Vec<Node<R>, { MAX_DEPTH as usize + 2 }>,
     ) {
         let n = side.normal;
@@ -702,22 +714,18 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         };
         let mirror = mirror(d, n);
         let mut reflect_w = if reflects { m.ks } else { R::ZERO };
-        if refracts && !solid {
-            // A sheet (a triangle, an open side): straight through, leaving it.
-            if node.weight * m.kt > self.cutoff {
-                let _ = stack.push(child(Ray::new(p - n * eps, d), m.kt, RayKind::Refraction, leaving));
-            }
-        } else if refracts {
+        if refracts {
             match refract(d, n, side.eta(m.ior)) {
                 // Total internal reflection: the transmitted share is reflected.
                 None => reflect_w += m.kt,
-                Some(dir) if node.weight * m.kt > self.cutoff => {
+                Some(dir) if self.every_ray || node.weight * m.kt > self.cutoff => {
                     let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction, NO_OBJECT));
                 }
                 Some(_) => {}
             }
         }
-        if reflect_w > R::ZERO && node.weight * reflect_w > self.cutoff {
+        let spawn = self.every_ray && reflects;
+        if spawn || (reflect_w > R::ZERO && node.weight * reflect_w > self.cutoff) {
             let _ = stack.push(child(Ray::new(outside, mirror), reflect_w, RayKind::Reflection, leaving));
         }
     }

@@ -5,6 +5,7 @@
 
 pub mod curves;
 pub mod nff;
+pub mod polygons;
 pub mod protocol;
 
 /// An SPD generator.
@@ -22,12 +23,27 @@ pub enum Generator {
     Jacks,
     /// Spheres along a logarithmic spiral (default 5: 5,761).
     Shells,
+    /// Sierpinski's tetrahedron of triangles (default 6: 4,096).
+    Tetra,
+    /// Meshing gears, some of glass, on a floor: concave polygons (default 4: 9,345).
+    Gears,
+    /// A fractal mountain of triangles under four glass spheres (default 6: 8,196).
+    Mount,
 }
 
 impl Generator {
     /// Every generator, in the order the SPD's Readme lists them.
-    pub const ALL: [Generator; 6] =
-        [Generator::Balls, Generator::Rings, Generator::Tree, Generator::Lattice, Generator::Jacks, Generator::Shells];
+    pub const ALL: [Generator; 9] = [
+        Generator::Balls,
+        Generator::Rings,
+        Generator::Tree,
+        Generator::Lattice,
+        Generator::Jacks,
+        Generator::Shells,
+        Generator::Tetra,
+        Generator::Gears,
+        Generator::Mount,
+    ];
 
     /// The generator's name (its program's).
     pub fn name(self) -> &'static str {
@@ -38,6 +54,9 @@ impl Generator {
             Generator::Lattice => "lattice",
             Generator::Jacks => "jacks",
             Generator::Shells => "shells",
+            Generator::Tetra => "tetra",
+            Generator::Gears => "gears",
+            Generator::Mount => "mount",
         }
     }
 
@@ -50,6 +69,9 @@ impl Generator {
             Generator::Lattice => 12,
             Generator::Jacks => 1,
             Generator::Shells => 5,
+            Generator::Tetra => 6,
+            Generator::Gears => 4,
+            Generator::Mount => 6,
         }
     }
 
@@ -63,6 +85,9 @@ impl Generator {
             Generator::Lattice => 140,
             Generator::Jacks => 8,
             Generator::Shells => 14,
+            Generator::Tetra => 11,
+            Generator::Gears => 10,
+            Generator::Mount => 7,
         }
     }
 
@@ -83,6 +108,9 @@ impl Generator {
             Generator::Lattice => curves::lattice(size),
             Generator::Jacks => curves::jacks(size),
             Generator::Shells => curves::shells(size),
+            Generator::Tetra => polygons::tetra(size),
+            Generator::Gears => polygons::gears(size),
+            Generator::Mount => polygons::mount(size),
         })
     }
 }

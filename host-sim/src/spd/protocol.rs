@@ -106,6 +106,7 @@ pub fn count<R: Real, A: Accelerator<R>>(scene: &Scene<'_, R>, accel: &A, setup:
     // DEPTH is below the tracer's deepest (MAX_DEPTH): this cannot fail.
     let _ = tracer.set_max_depth(DEPTH);
     tracer.set_cutoff(R::ZERO);
+    tracer.set_every_ray(true);
     tracer.set_eye_rays(EyeRays::Plain);
     let as_havran = setup == Setup::AsHavran;
     tracer.set_shadow_coherence(!as_havran);
