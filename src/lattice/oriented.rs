@@ -52,6 +52,9 @@ pub(super) struct Oriented {
     lo: [f64; 3],
     hi: [f64; 3],
     margin: f64,
+    /// For a triangle, how far past its long side (`x + z = 1` in its space) a cell may lie and
+    /// still be listed: the widening of its own test ([`crate::shape::Shape::intersect`]), twice.
+    hypotenuse: Option<f64>,
 }
 
 impl Oriented {
@@ -75,6 +78,7 @@ impl Oriented {
             lo: [lo.x.to_f64(), lo.y.to_f64(), lo.z.to_f64()],
             hi: [hi.x.to_f64(), hi.y.to_f64(), hi.z.to_f64()],
             margin: 2.0 * o.bounds.pad_for::<R>(),
+            hypotenuse: matches!(o.shape, Shape::Triangle).then(|| 2.0 * R::pad_eps().to_f64()),
         })
     }
 
@@ -87,13 +91,23 @@ impl Oriented {
         let hi = [0, 1, 2].map(|a| side(a, cell[a] + 1) + self.margin);
         let centre = [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a]) - self.origin[a]);
         let half = [0, 1, 2].map(|a| 0.5 * (hi[a] - lo[a]));
-        (0..3).all(|i| {
-            let row = &self.to_object[i];
+        // The cell's range along a direction `row` of the object's space: centre and half width.
+        let range = |row: [f64; 3]| {
             let c = row[0] * centre[0] + row[1] * centre[1] + row[2] * centre[2];
             let h = row[0].abs() * half[0] + row[1].abs() * half[1] + row[2].abs() * half[2];
             // f64's own rounding of these sums, far below the margin, allowed for all the same.
-            let slack = 1e-9 * (c.abs() + h);
-            c + h + slack >= self.lo[i] && c - h - slack <= self.hi[i]
-        })
+            (c, h + 1e-9 * (c.abs() + h))
+        };
+        let boxed = (0..3).all(|i| {
+            let (c, h) = range(self.to_object[i]);
+            c + h >= self.lo[i] && c - h <= self.hi[i]
+        });
+        // A triangle's third side: the cell's least x + z in the triangle's space at most 1.
+        boxed
+            && self.hypotenuse.is_none_or(|slack| {
+                let (x, z) = (self.to_object[0], self.to_object[2]);
+                let (c, h) = range([x[0] + z[0], x[1] + z[1], x[2] + z[2]]);
+                c - h <= 1.0 + slack
+            })
     }
 }

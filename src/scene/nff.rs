@@ -190,7 +190,11 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
         let at = self.word()?;
         match parse_number(at.2) {
             Some(v) if v.is_finite() => Ok(v),
-            Some(_) => Err(error(at, ParseErrorKind::NumberOutOfRange)),
+            // Digits beyond f64 (`1e999`) are out of range; `nan` and `inf` are not finite.
+            Some(_) if at.2.trim_start_matches(['+', '-']).starts_with(|c: char| c.is_ascii_digit() || c == '.') => {
+                Err(error(at, ParseErrorKind::NumberOutOfRange))
+            }
+            Some(_) => Err(error(at, ParseErrorKind::Scene(SceneError::NotFinite))),
             None => Err(error(at, ParseErrorKind::ExpectedNumber)),
         }
     }

@@ -117,7 +117,8 @@ pub fn compare(
 }
 
 /// [`compare`] at `size`, `runs` times, also without shadows when `unshadowed` (the scene's
-/// camera must be fitted to the size's shape).
+/// camera must be fitted to the size's shape). host-sim's frame is `Frame::new`'s: one ray per
+/// pixel, no silhouette lines (POV-Ray draws none).
 pub fn compare_at(
     name: &str,
     scene: &Scene<'_, f64>,
