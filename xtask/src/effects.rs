@@ -140,7 +140,13 @@ fn highlights_section(md: &mut String, runs: usize) -> Result<()> {
     writeln!(md, "\n## Highlights\n")?;
     writeln!(md, "A material with `ks` above 0 and a `shine` power gets a Phong highlight at each light (NFF's `Shine`); scenes without one do not compile it in. The SPD's sphereflake at size 2 (`host-sim spd balls --size 2`: 91 mirror spheres of `Shine` 3.08, rounded to 3), 128x64, with the highlights and without (`set_effects` without `highlights`):\n")?;
     writeln!(md, "| | rays | host ms | pixels differing from without |\n|---|---|---|---|")?;
-    writeln!(md, "| with highlights | {} | {:.2} | {} |", kinds(&a.stats), median(with).as_secs_f64() * 1e3, differ(&a.bits, &b.bits))?;
+    writeln!(
+        md,
+        "| with highlights | {} | {:.2} | {} |",
+        kinds(&a.stats),
+        median(with).as_secs_f64() * 1e3,
+        differ(&a.bits, &b.bits)
+    )?;
     writeln!(md, "| without | {} | {:.2} | 0 |\n", kinds(&b.stats), median(without).as_secs_f64() * 1e3)?;
     writeln!(md, "The same rays: a highlight is a term of each light's shadow-ray answer, no ray of its own.\n")?;
     Ok(())
