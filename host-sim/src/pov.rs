@@ -239,6 +239,7 @@ mod tests {
     use super::*;
     use crate::load::{build_lattice, lattice_storage, object_storage, parse_scene, read};
     use crate::run::render_with;
+    use crate::spd::Generator;
     use lattice_rt::generate::{random_scene, RandomScene};
     use lattice_rt::scene::Object;
     use lattice_rt::{Accelerator, BruteForce, Frame, LatticeConfig, Query, SceneBuilder, Tracer};
@@ -332,6 +333,33 @@ mod tests {
             let text = read(path).unwrap();
             let mut storage = object_storage::<f64>(&text).unwrap();
             let scene = parse_scene::<f64>(path, &text, &mut storage, &Frame::new(W as u16, H as u16)).unwrap();
+            let (agree, mean, far) = compare(&name, &scene);
+            report.push_str(&format!(
+                "{name}: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n",
+                agree * 100.0,
+                far * 100.0
+            ));
+            if agree < 0.995 || mean > 2.0 || far > 0.01 {
+                failures.push(name);
+            }
+        }
+        // The Standard Procedural Databases' scenes, small sizes, as `host-sim spd` writes them.
+        for (g, size) in [
+            (Generator::Balls, 2),
+            (Generator::Rings, 1),
+            (Generator::Tree, 5),
+            (Generator::Lattice, 2),
+            (Generator::Jacks, 1),
+            (Generator::Shells, 1),
+            (Generator::Tetra, 3),
+            (Generator::Gears, 1),
+            (Generator::Mount, 3),
+        ] {
+            let name = format!("spd-{}-{size}", g.name());
+            let text = g.nff(size).unwrap();
+            let mut storage = object_storage::<f64>(&text).unwrap();
+            let path = PathBuf::from(&name);
+            let scene = parse_scene::<f64>(&path, &text, &mut storage, &Frame::new(W as u16, H as u16)).unwrap();
             let (agree, mean, far) = compare(&name, &scene);
             report.push_str(&format!(
                 "{name}: coverage {:.2} %, mean |gray diff| {mean:.2} levels, {:.2} % off by > 8\n",
