@@ -14,7 +14,9 @@
 pub mod builder;
 pub mod error;
 pub mod model;
+#[cfg(feature = "nff")]
 pub mod nff;
+#[cfg(feature = "nff")]
 pub mod polygon;
 pub mod text;
 
@@ -43,7 +45,14 @@ pub enum Format {
 impl Format {
     /// The format of `text`.
     pub fn of(text: &str) -> Self {
-        if nff::is_nff(text) {
+        #[cfg(not(feature = "nff"))]
+        let is_nff = |text: &str| {
+            let first = text.lines().map(|l| l.split('#').next().unwrap_or("")).flat_map(str::split_whitespace).next();
+            first.is_some_and(|w| ["v", "b", "l", "f", "c", "s", "p", "pp"].contains(&w))
+        };
+        #[cfg(feature = "nff")]
+        let is_nff = nff::is_nff;
+        if is_nff(text) {
             Format::Nff
         } else {
             Format::Text
@@ -54,8 +63,9 @@ impl Format {
 /// The object storage `text` (either [`Format`]) needs.
 pub fn object_count(text: &str) -> usize {
     match Format::of(text) {
-        Format::Text => text::object_count(text),
+        #[cfg(feature = "nff")]
         Format::Nff => nff::object_count(text),
+        _ => text::object_count(text),
     }
 }
 
@@ -79,7 +89,10 @@ pub fn parse_with<'a, 't, R: Real>(
     camera: impl FnOnce(&mut CameraDesc),
 ) -> Result<Scene<'a, R>, ParseError<'t>> {
     match Format::of(text) {
-        Format::Text => text::parse_with(text, storage, parts, camera),
+        #[cfg(feature = "nff")]
         Format::Nff => nff::parse_with(text, storage, parts, camera),
+        #[cfg(not(feature = "nff"))]
+        Format::Nff => Err(ParseError { line: 1, col: 1, token: "", kind: text::ParseErrorKind::NffLeftOut }),
+        Format::Text => text::parse_with(text, storage, parts, camera),
     }
 }

@@ -72,6 +72,10 @@ pub fn luminance(r: f64, g: f64, b: f64) -> f64 {
 /// Parses NFF text into a [`Scene`], storing objects in `storage` (at least [`object_count`]
 /// long) and the materials and lights in `parts`; the camera the text describes is changed by
 /// `camera` before the scene is validated (a frame's shape, the frames of an orbit).
+// Out of line: its reader's tables (and a polygon's vertices, in `polygon`) are on the stack
+// only while NFF is read, not in the frame of a caller that reads the other format (the Pico's
+// run-time parsing has a few KiB of stack).
+#[inline(never)]
 pub fn parse_with<'a, 't, R: Real>(
     text: &'t str,
     storage: &'a mut [Object<R>],
@@ -367,6 +371,7 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
     /// `p n` or `pp n` and the vertices (with normals for `pp`, read and not used): cut into
     /// triangles ([`triangulate`]). A triangle of no area (three vertices in a line, a vertex
     /// repeated) adds nothing and is left out; a polygon left with none is refused.
+    #[inline(never)]
     fn polygon(&mut self, at: At<'t>, patch: bool) -> Result<(), ParseError<'t>> {
         let n_at = self.word()?;
         let n = match n_at.2.parse::<usize>() {

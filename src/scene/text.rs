@@ -66,9 +66,11 @@ pub enum ParseErrorKind {
     BadVertexCount,
     /// NFF: a cone or cylinder whose base and apex are the same point.
     CoincidentEnds,
+    /// NFF text given to a build without the `nff` feature (the firmware's).
+    NffLeftOut,
     /// NFF: a polygon of more vertices than this build reads.
     PolygonTooLarge {
-        /// The most it reads ([`crate::scene::polygon::MAX_VERTICES`]).
+        /// The most it reads (`scene::polygon::MAX_VERTICES`).
         most: usize,
     },
     /// The scene itself is invalid.
@@ -145,6 +147,9 @@ impl fmt::Display for ParseErrorKind {
             ),
             ParseErrorKind::BadVertexCount => write!(f, "a polygon's vertex count must be a whole number, at least 3"),
             ParseErrorKind::CoincidentEnds => write!(f, "the cone's base and apex are the same point"),
+            ParseErrorKind::NffLeftOut => {
+                write!(f, "NFF, which this build does not read (its lattice-rt lacks the feature `nff`)")
+            }
             ParseErrorKind::PolygonTooLarge { most } => {
                 write!(f, "a polygon of more vertices than this build reads (at most {most})")
             }
