@@ -149,6 +149,19 @@ mod writer {
             }
         }
     }
+    impl<R: Literal> Literal for crate::scene::Smooth<R> {
+        fn literal(&self, out: &mut String) {
+            let [a, b, c] = &self.normals;
+            let _ = write!(out, "Smooth {{ object: {}, normals: [", self.object);
+            for (k, n) in [a, b, c].into_iter().enumerate() {
+                if k > 0 {
+                    out.push_str(", ");
+                }
+                n.literal(out);
+            }
+            out.push_str("] }");
+        }
+    }
     impl Literal for crate::Effects {
         fn literal(&self, out: &mut String) {
             let _ = write!(out, "Effects::from_bits({})", self.bits());
@@ -295,6 +308,7 @@ mod writer {
         arg(&mut out, &scene.world);
         arg(&mut out, &scene.shadow_basis);
         arg(&mut out, &scene.effects);
+        arg(&mut out, &Slice(scene.smooth));
         out.push_str(",\n    ),\n    lattice: Lattice::from_tables(\n        ");
         let empty = Lattice::from_tables(&[], &[], (&[], &[]), (0, 0), true, scene.objects.len());
         let (lattices, coords, (cells, refs), entries, narrow) = lattice.unwrap_or(&empty).tables();
@@ -337,7 +351,7 @@ pub mod prelude {
     pub use crate::math::{Aabb, Affine, Linear, Vec3};
     pub use crate::scalar::Pow2;
     pub use crate::scene::Scene;
-    pub use crate::scene::{Camera, Composite, Light, Material, Object};
+    pub use crate::scene::{Camera, Composite, Light, Material, Object, Smooth};
     pub use crate::shape::Shape;
     pub use crate::trace::Effects;
     pub use crate::{F32Micro, F32MicroNewton, Fx};
@@ -380,6 +394,7 @@ mod tests {
             scene.world,
             scene.shadow_basis,
             scene.effects,
+            scene.smooth,
         );
         let mut mb = vec![0; Query::mailbox_len(&scene)];
         let mut rng = Rng::new(4);

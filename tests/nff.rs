@@ -1,6 +1,8 @@
 //! NFF in: every entity of `NFF.TXT` read, what the tracer cannot draw refused by name, and
 //! every error placed at its line and column.
 
+mod common;
+use common::{build_lattice, gray_of, lattice_storage};
 use lattice_rt::scene::nff;
 use lattice_rt::scene::{Format, Light, Object, Parts};
 use lattice_rt::Shape;
@@ -141,4 +143,71 @@ fn the_view_angle_spans_the_edge_pixels_centres() {
     let half = c.up.length();
     let want = (22.5f64).to_radians().tan() * 512.0 / 511.0;
     assert!((half - want).abs() < 1e-12, "{half} {want}");
+}
+
+/// A triangle facing the eye (normal -z), lit head-on, as `p` or as `pp` with the normals
+/// given for its corners (0 0), (4 0), (0 4).
+fn facing_triangle(normals: Option<[[f64; 3]; 3]>) -> String {
+    let corners = [[-2.0, -2.0, 0.0], [2.0, -2.0, 0.0], [-2.0, 2.0, 0.0]];
+    let mut t = String::from("v\nfrom 0 0 -10\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 32 32\n");
+    t.push_str("l 0 0 -20\nf 1 1 1 1 0 0 0 1\n");
+    t.push_str(if normals.is_some() { "pp 3\n" } else { "p 3\n" });
+    for (k, c) in corners.iter().enumerate() {
+        let n = normals.map(|n| format!(" {} {} {}", n[k][0], n[k][1], n[k][2])).unwrap_or_default();
+        t.push_str(&format!("{} {} {}{n}\n", c[0], c[1], c[2]));
+    }
+    t
+}
+
+fn gray(text: &str) -> Vec<u8> {
+    let frame = lattice_rt::Frame::new(32, 32);
+    let mut storage = vec![Object::<f64>::default(); 4];
+    let mut parts = Parts::default();
+    let scene = lattice_rt::scene::parse_with::<f64>(text, &mut storage, &mut parts, |c| c.frame = [32, 32]).unwrap();
+    let cfg = lattice_rt::LatticeConfig::default();
+    let mut bufs = lattice_storage(&scene, &cfg);
+    let lat = build_lattice(&scene, &cfg, &mut bufs);
+    gray_of(&lattice_rt::Tracer::new(&scene, &lat), &frame)
+}
+
+#[test]
+fn patch_normals_shade_smoothly() {
+    let flat = gray(&facing_triangle(None));
+    // Normals equal to the face's (either way round) shade as the flat triangle does.
+    assert_eq!(gray(&facing_triangle(Some([[0.0, 0.0, -1.0]; 3]))), flat);
+    assert_eq!(gray(&facing_triangle(Some([[0.0, 0.0, 2.0]; 3]))), flat);
+    // Tilted at two corners: darker towards them, as bright as flat where the normal is the
+    // face's, and the same pixels covered (the outline stays the flat triangle's).
+    let tilted = gray(&facing_triangle(Some([[0.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 1.0, -1.0]])));
+    let background = flat[0];
+    let covered = |g: &[u8]| g.iter().map(|&v| v != background).collect::<Vec<_>>();
+    assert_eq!(covered(&tilted), covered(&flat));
+    let lit: Vec<(usize, u8, u8)> =
+        (0..flat.len()).filter(|&i| flat[i] != background).map(|i| (i, flat[i], tilted[i])).collect();
+    assert!(lit.len() > 50, "{} pixels", lit.len());
+    assert!(lit.iter().all(|&(_, f, t)| t <= f), "no pixel brighter than flat");
+    // Row 31 - y, column x: the corner (-2, -2) is at the bottom left, (2, -2) bottom right.
+    let at = |x: usize, y: usize| lit.iter().find(|p| p.0 == y * 32 + x).map(|p| (p.1, p.2));
+    let near_a = at(9, 22).expect("the pixel near the corner a is covered");
+    let near_b = at(22, 24).expect("the pixel near the corner b is covered");
+    assert!(near_a.1 + 2 >= near_a.0, "near a {near_a:?}");
+    assert!(near_b.1 + 8 < near_b.0, "near b {near_b:?}");
+}
+
+#[test]
+fn smooth_normals_interpolate_and_face_the_ray() {
+    use lattice_rt::scene::Smooth;
+    use lattice_rt::Vec3;
+    let n = [Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0)];
+    let s = Smooth { object: 0, normals: n };
+    let up = Vec3::new(0.0, 1.0, 0.0);
+    let close = |a: Vec3<f64>, b: Vec3<f64>| (a - b).length() < 1e-12;
+    assert!(close(s.normal(Vec3::new(0.0, 0.0, 0.0), up), n[0]));
+    assert!(close(s.normal(Vec3::new(1.0, 0.0, 0.0), up), n[1]));
+    assert!(close(s.normal(Vec3::new(0.0, 0.0, 1.0), up), n[2]));
+    let third = 1.0 / 3.0;
+    let mid = s.normal(Vec3::new(third, 0.0, third), up);
+    assert!(close(mid, Vec3::new(1.0, 1.0, 1.0).normalize()), "{mid:?}");
+    // Met from the other side: turned round.
+    assert!(close(s.normal(Vec3::new(third, 0.0, third), -up), -mid));
 }

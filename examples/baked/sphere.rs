@@ -13,6 +13,7 @@ pub static SPHERE: Baked<f32> = Baked {
         Aabb { min: Vec3 { x: f32::from_bits(0xc0400150), y: f32::from_bits(0xbdccf6be), z: f32::from_bits(0xc0a00000) }, max: Vec3 { x: f32::from_bits(0x40400150), y: f32::from_bits(0x3fccce81), z: f32::from_bits(0x40400150) } },
         Some((Vec3 { x: f32::from_bits(0x0), y: f32::from_bits(0xbee4f92e), z: f32::from_bits(0xbf64f92e) }, Vec3 { x: f32::from_bits(0xbf69b1e9), y: f32::from_bits(0x3ebaf4ba), z: f32::from_bits(0xbe3af4ba) })),
         Effects::from_bits(7),
+        &[],
     ),
     lattice: Lattice::from_tables(
         &[SubLattice { bounds: Aabb { min: Vec3 { x: f32::from_bits(0xc0400150), y: f32::from_bits(0xbdccf6be), z: f32::from_bits(0xc0400150) }, max: Vec3 { x: f32::from_bits(0x40400150), y: f32::from_bits(0x3fccce81), z: f32::from_bits(0x40400150) } }, n: [2, 1, 2], coord_start: [0, 3, 5], cell_start: 0, dense_cell: 4294967295 }],

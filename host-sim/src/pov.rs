@@ -136,7 +136,18 @@ fn object(s: &mut String, scene: &Scene<'_, f64>, i: usize, mode: PovMode) -> Re
         Shape::Box => "box { <0, 0, 0>, <1, 1, 1>".to_string(),
         Shape::Open { top: 1.0 } => "cylinder { <0, 0, 0>, <0, 1, 0>, 1 open".to_string(),
         Shape::Open { top } => format!("cone {{ <0, 0, 0>, 1, <0, 1, 0>, {top} open"),
-        Shape::Triangle => "triangle { <0, 0, 0>, <1, 0, 0>, <0, 0, 1>".to_string(),
+        Shape::Triangle => match scene.smooth_of(i as u32) {
+            // The world normals in canonical space (the placement's transpose), which POV-Ray's
+            // matrix maps back by its inverse transpose.
+            Some(sm) => {
+                let n = sm.normals.map(|n| {
+                    let c = |j: usize| m.m[0][j] * n.x + m.m[1][j] * n.y + m.m[2][j] * n.z;
+                    format!("<{:e}, {:e}, {:e}>", c(0), c(1), c(2))
+                });
+                format!("smooth_triangle {{ <0, 0, 0>, {}, <1, 0, 0>, {}, <0, 0, 1>, {}", n[0], n[1], n[2])
+            }
+            None => "triangle { <0, 0, 0>, <1, 0, 0>, <0, 0, 1>".to_string(),
+        },
     };
     let mat = &scene.materials()[o.material() as usize];
     let look = match mode {

@@ -21,7 +21,7 @@ fn generated_scenes_are_the_original_programs_output() {
         assert!(got == want, "{stem}: the generated NFF differs from the SPD program's");
         checked += 1;
     }
-    assert_eq!(checked, 10);
+    assert_eq!(checked, 11);
 }
 
 #[test]
@@ -37,12 +37,12 @@ fn every_generator_at_its_default_size_makes_the_published_object_count_and_read
         (Generator::Tetra, 4096),
         (Generator::Gears, 9345),
         (Generator::Mount, 8196),
+        (Generator::Teapot, 9264),
     ];
     for (g, want) in published {
         let text = g.nff(g.default_size()).unwrap();
         // NFF primitives (a polygon is one; here it is its triangles).
-        let primitives =
-            text.lines().filter(|l| l.starts_with("s ") || l.starts_with("c ") || l.starts_with("p ")).count();
+        let primitives = text.lines().filter(|l| ["s ", "c ", "p ", "pp "].iter().any(|w| l.starts_with(w))).count();
         assert_eq!(primitives, want, "{}", g.name());
         let n = object_count(&text);
         let mut storage = vec![Object::<f64>::default(); n];
@@ -106,6 +106,7 @@ fn the_lattice_agrees_with_brute_force_on_spd_scenes() {
         (Generator::Tetra, 4),
         (Generator::Gears, 1),
         (Generator::Mount, 3),
+        (Generator::Teapot, 3),
     ] {
         let text = g.nff(size).unwrap();
         for cfg in [lattice_rt::LatticeConfig::default(), crowded] {

@@ -1,7 +1,7 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
 use super::error::SceneError;
-use super::model::{Composite, Light, Material, Object, Parts, Scene, NO_COMPOSITE};
+use super::model::{Composite, Light, Material, Object, Parts, Scene, Smooth, NO_COMPOSITE};
 use crate::camera::{lowest_terms, resolvable_pixels, Camera, CameraDesc};
 use crate::cull::build::{shadow_basis, Regions};
 use crate::cull::Region;
@@ -172,6 +172,61 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         self.add_object(Shape::Triangle, place, material)
     }
 
+    /// Adds a smooth triangle: [`SceneBuilder::add_triangle`] with a normal at each corner
+    /// (NFF's `pp`), interpolated across it for shading ([`Smooth`]). A corner's normal of no
+    /// length (or not finite) takes the flat one; normals need not face the triangle's side.
+    pub fn add_smooth_triangle(
+        &mut self,
+        corners: [Vec3<f64>; 3],
+        normals: [Vec3<f64>; 3],
+        material: u8,
+    ) -> Result<(), SceneError> {
+        if crate::scene::MAX_SMOOTH == 0 {
+            return Err(SceneError::SmoothLeftOut);
+        }
+        self.add_triangle(corners, material)?;
+        let [a, b, c] = corners;
+        let flat = (b - a).cross(c - a).normalize();
+        let unit = |n: Vec3<f64>| {
+            let l = n.length();
+            if l > 0.0 && l.is_finite() {
+                n * (1.0 / l)
+            } else {
+                flat
+            }
+        };
+        // Inside a composite the corners are the group's: its normals map by the inverse
+        // transpose of the group's transform.
+        let group = match &self.open_composite {
+            Some((_, g, _)) => Some(checked_inverse(g)?),
+            None => None,
+        };
+        let to_world = |n: Vec3<f64>| match &group {
+            Some(inv) => {
+                let m = &inv.m;
+                Vec3::new(
+                    m[0][0] * n.x + m[1][0] * n.y + m[2][0] * n.z,
+                    m[0][1] * n.x + m[1][1] * n.y + m[2][1] * n.z,
+                    m[0][2] * n.x + m[1][2] * n.y + m[2][2] * n.z,
+                )
+            }
+            None => n,
+        };
+        let object = (self.len - 1) as u32;
+        self.push_smooth(Smooth { object, normals: normals.map(|n| unit(to_world(unit(n))).cast()) })
+    }
+
+    #[cfg(feature = "alloc")]
+    fn push_smooth(&mut self, s: Smooth<R>) -> Result<(), SceneError> {
+        self.parts.smooth.push(s);
+        Ok(())
+    }
+
+    #[cfg(not(feature = "alloc"))]
+    fn push_smooth(&mut self, s: Smooth<R>) -> Result<(), SceneError> {
+        self.parts.smooth.push(s).map_err(|_| SceneError::SmoothLeftOut)
+    }
+
     /// Opens a composite object placed by `t`; objects until [`SceneBuilder::end_composite`] belong to it.
     pub fn begin_composite(&mut self, t: Affine<f64>) -> Result<(), SceneError> {
         if self.open_composite.is_some() {
@@ -315,6 +370,7 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             world,
             shadow_basis,
             effects: Effects::NONE,
+            smooth: &parts.smooth,
         };
         scene.effects = Effects::called_for(&scene);
         Ok(scene)

@@ -94,6 +94,9 @@ pub enum SceneError {
     MissingCorner,
     /// A triangle (or polygon) whose corners lie on one line: it has no area and no normal.
     DegenerateTriangle,
+    /// A smooth triangle (vertex normals, NFF's `pp`) in a build without `alloc`, whose parts
+    /// keep no room for their normals.
+    SmoothLeftOut,
     /// The scene has no objects.
     NoObjects,
     /// Inside the world box, an object's own coordinates grow beyond what the scalar holds
@@ -165,6 +168,9 @@ impl fmt::Display for SceneError {
             SceneError::DegenerateLight => write!(f, "light direction is zero"),
             SceneError::MissingCorner => write!(f, "a triangle needs its three corners: a X Y Z b X Y Z c X Y Z"),
             SceneError::DegenerateTriangle => write!(f, "the polygon's corners lie on one line: it has no area"),
+            SceneError::SmoothLeftOut => {
+                write!(f, "vertex normals (a smooth patch) need lattice-rt's Cargo feature `alloc`, which this build leaves out")
+            }
             SceneError::NoObjects => write!(f, "scene has no objects"),
             SceneError::ObjectOutOfRange { object, reach, limit, scalar } => write!(
                 f,

@@ -25,8 +25,8 @@ pub use crate::cull::{Culled, EyeHull, EyeWindow, ShadowWindow, EYE_MARGIN, HULL
 pub use builder::{check_value, SceneBuilder, IOR};
 pub use error::SceneError;
 pub use model::{
-    axis_normal, Composite, Light, Material, Object, Parts, Scene, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS,
-    NO_COMPOSITE,
+    axis_normal, Composite, Light, Material, Object, Parts, Scene, Smooth, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS,
+    MAX_SMOOTH, NO_COMPOSITE,
 };
 
 use crate::scalar::Real;

@@ -26,6 +26,9 @@ pub const MAX_LIGHTS: usize = 4;
 /// has 7). Each core's work remembers an occluder per light, for at most this many lights.
 #[cfg(feature = "alloc")]
 pub const MAX_LIGHTS: usize = 16;
+/// Most smooth triangles (NFF's `pp` patches, [`Smooth`]): none in a build without `alloc`
+/// (whose parts keep no room for them), as many as there are objects with it.
+pub const MAX_SMOOTH: usize = if cfg!(feature = "alloc") { usize::MAX } else { 0 };
 /// Most composite objects (each gets a sub-lattice).
 pub const MAX_COMPOSITES: usize = 16;
 /// The composite index of an object that belongs to no composite.
@@ -373,6 +376,43 @@ pub struct Composite<R> {
     pub bounds: Aabb<R>,
 }
 
+/// The vertex normals of a smooth triangle (an NFF `pp` patch): its shading normal at a hit is
+/// theirs interpolated by the hit's barycentric weights, as Phong shading does, while its
+/// intersection, its offsets and the side a ray meets stay the flat triangle's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Smooth<R> {
+    /// The triangle's index among the scene's objects.
+    pub object: u32,
+    /// Unit world normals at its corners `a`, `b`, `c` (as given to
+    /// [`SceneBuilder::add_smooth_triangle`](crate::SceneBuilder::add_smooth_triangle)).
+    pub normals: [Vec3<R>; 3],
+}
+
+impl<R: Real> Smooth<R> {
+    /// The shading normal at the canonical point `p` of the triangle ((0,0,0), (1,0,0), (0,0,1)
+    /// in y = 0: `p.x` and `p.z` are the weights of `b` and `c`), unit, turned to the side of
+    /// `face` (the flat normal the ray meets).
+    pub fn normal(&self, p: Vec3<R>, face: Vec3<R>) -> Vec3<R> {
+        let [a, b, c] = self.normals;
+        let (u, w) = (p.x.max(R::ZERO).min(R::ONE), p.z.max(R::ZERO).min(R::ONE));
+        let n = (a * (R::ONE - u - w).max(R::ZERO) + b * u + c * w).normalize();
+        if !(n.dot(n) > R::ZERO) {
+            face
+        } else if n.dot(face) < R::ZERO {
+            -n
+        } else {
+            n
+        }
+    }
+}
+
+/// The smooth triangles' normals a [`Parts`] holds: on the heap with `alloc`, none without.
+#[cfg(feature = "alloc")]
+pub(crate) type SmoothList<R> = alloc::vec::Vec<Smooth<R>>;
+/// The smooth triangles' normals a [`Parts`] holds: on the heap with `alloc`, none without.
+#[cfg(not(feature = "alloc"))]
+pub(crate) type SmoothList<R> = Vec<Smooth<R>, 0>;
+
 /// Where a parsed scene's composites, materials and lights are kept, beside the object storage
 /// (lists of fixed capacity; a [`Scene`] holds exact slices of them, as a baked scene holds
 /// slices of its tables, so that neither carries the unused capacity).
@@ -381,12 +421,13 @@ pub struct Parts<R> {
     pub(crate) composites: Vec<Composite<R>, MAX_COMPOSITES>,
     pub(crate) materials: Vec<Material<R>, MAX_MATERIALS>,
     pub(crate) lights: Vec<Light<R>, MAX_LIGHTS>,
+    pub(crate) smooth: SmoothList<R>,
 }
 
 impl<R> Parts<R> {
     /// Empty lists.
     pub const fn new() -> Self {
-        Parts { composites: Vec::new(), materials: Vec::new(), lights: Vec::new() }
+        Parts { composites: Vec::new(), materials: Vec::new(), lights: Vec::new(), smooth: SmoothList::new() }
     }
 }
 
@@ -421,6 +462,8 @@ pub struct Scene<'a, R> {
     pub(crate) shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
     /// The effects the scene calls for ([`Effects::of`]).
     pub(crate) effects: Effects,
+    /// The smooth triangles' vertex normals, by object index.
+    pub(crate) smooth: &'a [Smooth<R>],
 }
 
 impl<'a, R> Scene<'a, R> {
@@ -440,6 +483,7 @@ impl<'a, R> Scene<'a, R> {
         world: Aabb<R>,
         shadow_basis: Option<(Vec3<R>, Vec3<R>)>,
         effects: Effects,
+        smooth: &'a [Smooth<R>],
     ) -> Self {
         Scene {
             objects,
@@ -453,6 +497,7 @@ impl<'a, R> Scene<'a, R> {
             world,
             shadow_basis,
             effects,
+            smooth,
         }
     }
 }
@@ -515,5 +560,15 @@ impl<'a, R: Real> Scene<'a, R> {
     /// Box holding the viewpoint and every object (the paper's world range).
     pub fn world(&self) -> Aabb<R> {
         self.world
+    }
+    /// The smooth triangles' vertex normals, in object order.
+    pub fn smooth(&self) -> &'a [Smooth<R>] {
+        self.smooth
+    }
+    /// The vertex normals of object `i`, when it is a smooth triangle.
+    #[inline]
+    pub fn smooth_of(&self, i: u32) -> Option<&'a Smooth<R>> {
+        let k = self.smooth.binary_search_by_key(&i, |s| s.object).ok()?;
+        self.smooth.get(k)
     }
 }

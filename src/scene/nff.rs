@@ -16,8 +16,9 @@
 //! * `s X Y Z r`: a sphere. `c` with base point and radius, apex point and radius: the side of
 //!   a cylinder or cone without end caps ([`Shape::Open`]).
 //! * `p n` and `n` vertices: a planar polygon, convex or not, cut into `n - 2` triangles
-//!   ([`triangulate`]). `pp n` and `n` vertices with normals: the same polygon; the normals are read
-//!   and the patch is shaded flat (its plane's normal).
+//!   ([`triangulate`]). `pp n` and `n` vertices with normals: the same polygon, its triangles shaded by
+//!   the normals interpolated across them ([`crate::scene::Smooth`]; a build without `alloc`
+//!   refuses them).
 //! * `#` starts a comment that runs to the end of the line.
 //!
 //! What the tracer cannot draw is refused by name, never ignored: a negative radius (NFF's
@@ -368,8 +369,8 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
         self.b.add_object(Shape::Open { top: r1 / r0 }, place, m).map_err(|e| error(at, ParseErrorKind::Scene(e)))
     }
 
-    /// `p n` or `pp n` and the vertices (with normals for `pp`, read and not used): cut into
-    /// triangles ([`triangulate`]). A triangle of no area (three vertices in a line, a vertex
+    /// `p n` or `pp n` and the vertices (with normals for `pp`, which shade the triangles
+    /// smoothly: [`crate::scene::Smooth`]): cut into triangles ([`triangulate`]). A triangle of no area (three vertices in a line, a vertex
     /// repeated) adds nothing and is left out; a polygon left with none is refused.
     #[inline(never)]
     fn polygon(&mut self, at: At<'t>, patch: bool) -> Result<(), ParseError<'t>> {
@@ -383,18 +384,25 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
         }
         let m = self.material(at)?;
         let mut v: Vec<Vec3<f64>, MAX_VERTICES> = Vec::new();
+        let mut normals: Vec<Vec3<f64>, MAX_VERTICES> = Vec::new();
         for _ in 0..n {
             let _ = v.push(self.point()?);
             if patch {
-                self.point()?;
+                let _ = normals.push(self.point()?);
             }
         }
         let (mut added, mut failed) = (0usize, None);
-        triangulate(&v, |[a, b, c]| match (failed, self.b.add_triangle([v[a], v[b], v[c]], m)) {
-            (None, Ok(())) => added += 1,
-            (None, Err(SceneError::DegenerateTriangle)) => {}
-            (None, Err(e)) => failed = Some(e),
-            (Some(_), _) => {}
+        triangulate(&v, |[a, b, c]| {
+            let added_one = match normals.get(a).zip(normals.get(b)).zip(normals.get(c)) {
+                Some(((&na, &nb), &nc)) => self.b.add_smooth_triangle([v[a], v[b], v[c]], [na, nb, nc], m),
+                None => self.b.add_triangle([v[a], v[b], v[c]], m),
+            };
+            match (failed, added_one) {
+                (None, Ok(())) => added += 1,
+                (None, Err(SceneError::DegenerateTriangle)) => {}
+                (None, Err(e)) => failed = Some(e),
+                (Some(_), _) => {}
+            }
         });
         match failed {
             Some(e) => Err(error(at, ParseErrorKind::Scene(e))),

@@ -665,8 +665,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let children = node.depth < self.max_depth && (reflects || refracts);
         let shiny = self.simulates(Effects::HIGHLIGHTS) && m.shine > 0 && m.ks > R::ZERO;
         let d = if children || shiny { ray.dir.normalize() } else { ray.dir };
-        let side = facing(d, w.world_normal(scene, hit.object, hit.normal));
-        let n = side.normal;
+        let mut side = facing(d, w.world_normal(scene, hit.object, hit.normal));
         // Rays off the outer side of the surface, towards where its normal points (shadow
         // rays to lights in front, the mirror ray), leave the object: a convex solid (and the
         // outside of an open side, part of one's boundary) cannot be met again; a triangle
@@ -674,7 +673,15 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let flat = cfg!(feature = "triangles") && matches!(obj.shape, crate::shape::Shape::Triangle);
         let leaving = if side.entering || flat { hit.object } else { NO_OBJECT };
         let eps = R::offset(p.max_abs(), obj.size());
-        let outside = p + n * eps;
+        // Secondary rays start off the flat surface; a smooth triangle shades (lights, mirrors,
+        // refracts) by its interpolated normal.
+        let (outside, inside) = (p + side.normal * eps, p - side.normal * eps);
+        if flat && !scene.smooth.is_empty() {
+            if let Some(s) = scene.smooth_of(hit.object) {
+                side.normal = s.normal(hit.point, side.normal);
+            }
+        }
+        let n = side.normal;
         let mut local = scene.ambient * m.ka;
         if m.kd > R::ZERO || shiny {
             // Lit from outside, the point's shadow rays leave its own (convex) object.
@@ -688,22 +695,21 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         }
         let lit = node.weight.weigh(local);
         if children {
-            self.push_children(node, (d, &side, p), (eps, outside, leaving), (reflects, refracts, m), stack);
+            self.push_children(node, (d, &side), (inside, outside, leaving), (reflects, refracts, m), stack);
         }
         lit
     }
 
-    /// The children of a hit node at point `p` (the `side` of the surface the ray's direction `d`
-    /// meets):
-    /// the refracted ray from just inside, the mirror ray from `outside` (leaving `leaving`),
+    /// The children of a hit node (the `side` of the surface the ray's direction `d` meets):
+    /// the refracted ray from `inside`, the mirror ray from `outside` (leaving `leaving`),
     /// each pushed when its weight passes the cutoff; total internal reflection adds the
     /// transmitted share to the mirror ray's.
     #[inline(always)]
     fn push_children(
         &self,
         node: Meta<R>,
-        (d, side, p): (Vec3<R>, &Side<R>, Vec3<R>),
-        (eps, outside, leaving): (R, Vec3<R>, u32),
+        (d, side): (Vec3<R>, &Side<R>),
+        (inside, outside, leaving): (Vec3<R>, Vec3<R>, u32),
         (reflects, refracts, m): (bool, bool, &Material<R>),
         stack: &mut Vec<Node<R>, { MAX_DEPTH as usize + 2 }>,
     ) {
@@ -719,7 +725,7 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
                 // Total internal reflection: the transmitted share is reflected.
                 None => reflect_w += m.kt,
                 Some(dir) if self.every_ray || node.weight * m.kt > self.cutoff => {
-                    let _ = stack.push(child(Ray::new(p - n * eps, dir), m.kt, RayKind::Refraction, NO_OBJECT));
+                    let _ = stack.push(child(Ray::new(inside, dir), m.kt, RayKind::Refraction, NO_OBJECT));
                 }
                 Some(_) => {}
             }

@@ -217,6 +217,15 @@ impl Writer {
         }
     }
 
+    /// `pp 3` and the triangle's corners, each with its normal (`lib_output_polypatch` of a
+    /// triangle, untransformed).
+    pub fn patch(&mut self, corners: &[([f64; 3], [f64; 3]); 3]) {
+        self.out.push_str("pp 3\n");
+        for (v, n) in corners {
+            self.line(&[v[0], v[1], v[2], n[0], n[1], n[2]]);
+        }
+    }
+
     /// `lib_tx_push`.
     pub fn push(&mut self) {
         let top = *self.tx.last().unwrap_or(&IDENTITY);
