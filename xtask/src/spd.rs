@@ -28,7 +28,7 @@ struct Published {
     readme: Option<[u64; 3]>,
 }
 
-const PUBLISHED: [Published; 7] = [
+const PUBLISHED: [Published; 8] = [
     Published {
         name: "balls",
         invariants: [263_169, 263_169, 959_244, 285_178, 179_884, 134_368],
@@ -86,6 +86,14 @@ const PUBLISHED: [Published; 7] = [
         grid: (13.32, 15.01),
         // Reflection rays 354,769 and refraction rays 354,769.
         readme: Some([173_125, 709_538, 412_922]),
+    },
+    Published {
+        name: "teapot",
+        invariants: [263_169, 161_546, 406_340, 34_757, 226_235, 67_688],
+        best_nit: 13.30,
+        best_by: "uniform grid",
+        grid: (13.30, 41.24),
+        readme: Some([161_120, 225_248, 407_656]),
     },
 ];
 
