@@ -217,6 +217,11 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     writeln!(md, "\n![time per ray against N]({})\n", plot_link(out, plot))?;
     md.push_str(&against_povray(quick, runs)?);
     crate::plot::loglog(plot, "Time per ray against scene size", "primitives N", "microseconds per ray", &series)?;
+    // The SPD's tables are `cargo xtask spd`'s: carried over as they are.
+    let old = std::fs::read_to_string(out).unwrap_or_default();
+    if let Some(spd) = crate::spd::section(&old, crate::spd::SECTION) {
+        md = format!("{}\n{spd}", md.trim_end());
+    }
     write_atomic(out, md.as_bytes())?;
     println!("wrote {} and {}", out.display(), plot.display());
     Ok(())
