@@ -33,7 +33,7 @@ use crate::scalar::Real;
 use text::ParseError;
 
 /// The scene formats read: our own text ([`text`]) and NFF ([`nff`]), told apart by the first
-/// word ([`nff::is_nff`]), so every reader of scene text takes both.
+/// word ([`Format::of`]), so every reader of scene text takes both.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
     /// The plain-text scene format (`docs/scene-format.md`).
@@ -42,17 +42,15 @@ pub enum Format {
     Nff,
 }
 
+/// NFF's entity words: text whose first word (after `#` comments) is one of them is NFF.
+pub const NFF_ENTITIES: [&str; 8] = ["v", "b", "l", "f", "c", "s", "p", "pp"];
+
 impl Format {
-    /// The format of `text`.
+    /// The format of `text`: NFF when its first word is one of [`NFF_ENTITIES`] (a build
+    /// without the `nff` feature tells them apart too, to refuse NFF by name).
     pub fn of(text: &str) -> Self {
-        #[cfg(not(feature = "nff"))]
-        let is_nff = |text: &str| {
-            let first = text.lines().map(|l| l.split('#').next().unwrap_or("")).flat_map(str::split_whitespace).next();
-            first.is_some_and(|w| ["v", "b", "l", "f", "c", "s", "p", "pp"].contains(&w))
-        };
-        #[cfg(feature = "nff")]
-        let is_nff = nff::is_nff;
-        if is_nff(text) {
+        let first = text.lines().map(|l| l.split('#').next().unwrap_or("")).flat_map(str::split_whitespace).next();
+        if first.is_some_and(|w| NFF_ENTITIES.contains(&w)) {
             Format::Nff
         } else {
             Format::Text

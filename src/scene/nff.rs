@@ -36,15 +36,6 @@ use crate::scalar::Real;
 use crate::shape::Shape;
 use heapless::Vec;
 
-/// The words that start an NFF entity.
-pub const ENTITIES: [&str; 8] = ["v", "b", "l", "f", "c", "s", "p", "pp"];
-
-/// Whether `text` reads as NFF: its first word (after comments) starts an NFF entity. Our own
-/// format has no statement of those names, so the two never meet.
-pub fn is_nff(text: &str) -> bool {
-    Tokens::new(text).next().is_some_and(|(_, _, w)| ENTITIES.contains(&w))
-}
-
 /// The number of objects NFF text makes ([`parse_with`]'s storage): one per sphere and cone or
 /// cylinder, `n - 2` triangles per polygon of `n` vertices. A count that does not read as a
 /// number counts nothing (the parser reports it).
