@@ -22,6 +22,10 @@
 //
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
+// --panel-off START_MS:LEN_MS (repeatable) cuts the display's power at START_MS of emulated
+// time for LEN_MS: it answers nothing meanwhile (every I2C address NACKs, SPI bytes are lost)
+// and comes back as a freshly powered panel (registers reset, GDDRAM cleared, display off). A
+// frame the panel cannot show then is reported with its reason and the run goes on.
 // --pass-bytes N shows a picture every N GDDRAM bytes the display receives while the LED is lit
 // (1024: a progressive frame's passes, each a whole panel), instead of when the LED goes out.
 // With --profile FILE it also samples core 0's program counter every 97th instruction of the
@@ -32,7 +36,7 @@
 //                     [--records ADDR --records-log FILE] [--frames N] [--max-cycles N]
 //                     [--no-display] [--until-ms T] [--profile FILE]
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
-//                     [--pass-bytes N]
+//                     [--pass-bytes N] [--panel-off START_MS:LEN_MS]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
@@ -45,7 +49,7 @@ const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [] };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -68,6 +72,12 @@ function parseArgs(argv) {
     else if (a === '--no-cache') o.cache = false;
     else if (a === '--pass-bytes') o.passBytes = Number(next());
     else if (a === '--untimed-bus') o.timedBus = false;
+    else if (a === '--panel-off') {
+      const v = next();
+      const m = /^(\d+(?:\.\d+)?):(\d+(?:\.\d+)?)$/.exec(v);
+      if (!m) throw new Error(`--panel-off ${v}: START_MS:LEN_MS expected`);
+      o.panelOff.push({ startMs: Number(m[1]), lenMs: Number(m[2]) });
+    }
     else throw new Error(`unknown argument ${a}`);
   }
   for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
@@ -232,7 +242,7 @@ function main() {
     emit(frame);
     frameStart = opt.passBytes ? end : null;
     firstByteOfFrame = null;
-    if (why) board.stop = `display: ${why}`;
+    if (why && opt.panelOff.length === 0) board.stop = `display: ${why}`;
     else if (frames.length >= opt.frames && !opt.passBytes) draining = true;
   };
   let passData = 0; // GDDRAM bytes since the LED went on (--pass-bytes)
@@ -261,6 +271,12 @@ function main() {
     else if (frames.length >= opt.frames) draining = true;
     frameStart = null;
   });
+
+  // The display's power cuts, as alarms on the emulated clock (a sleeping board wakes for them).
+  for (const { startMs, lenMs } of display ? opt.panelOff : []) {
+    mcu.clock.createAlarm(() => display.powerOff()).schedule(startMs * 1e6);
+    mcu.clock.createAlarm(() => display.powerOn()).schedule((startMs + lenMs) * 1e6);
+  }
 
   // Core 0 at boot2 with the stack pointer the bootrom would leave; core 1 in the bootrom.
   board.start(FLASH, mcu.readUint32(0));

@@ -123,3 +123,29 @@ test('I2C TX_EMPTY follows the FIFO level and reaches the NVIC when IC_INTR_MASK
   board.mcu.writeUint32(base + 0x30, 0);
   assert.equal(i2c.intStatus, 0);
 });
+
+test('a panel that loses power answers nothing, and comes back dark with its settings and RAM lost', async () => {
+  const { Ssd1306 } = await import('./ssd1306.mjs');
+  const d = new Ssd1306(0x3c);
+  const send = (bytes) => {
+    d.start();
+    assert.equal(d.connect(0x3c, false), true);
+    for (const b of bytes) assert.equal(d.write(b), true);
+    d.stop();
+  };
+  // Charge pump on, horizontal addressing, display on; then a data byte.
+  send([0x00, 0x8d, 0x14, 0x20, 0x00, 0xaf]);
+  send([0x40, 0xff]);
+  assert.equal(d.notShowable(), null);
+  d.start();
+  assert.equal(d.connect(0x3c, false), true);
+  d.powerOff();
+  assert.equal(d.write(0x40), false, 'a byte after the power went NACKs');
+  d.stop();
+  d.start();
+  assert.equal(d.connect(0x3c, false), false, 'no power: the address NACKs');
+  d.powerOn();
+  assert.match(d.notShowable(), /never switched on/, 'back dark, its set-up lost');
+  assert.equal(d.gddram.every((b) => b === 0), true, 'its RAM lost');
+  assert.equal(d.connect(0x3c, false), true, 'power back: it answers');
+});

@@ -65,6 +65,24 @@ export class Ssd1306 {
     this.transfers = 0;
     this.everOn = false; // the display has been switched on with its charge pump
     this.error = null; // the first protocol error
+    this.absent = false; // without power: the panel answers nothing (powerOff, powerOn)
+    this.reset();
+  }
+
+  /** Power lost (a loose wire): the panel answers nothing until `powerOn`. */
+  powerOff() {
+    this.absent = true;
+    this.endTransfer();
+  }
+
+  /**
+   * Power back: a freshly powered panel, its registers at their reset values, its GDDRAM
+   * cleared and the display off until it is set up again (charge pump, 0xAF).
+   */
+  powerOn() {
+    this.absent = false;
+    this.gddram.fill(0);
+    this.everOn = false;
     this.reset();
   }
 
@@ -112,7 +130,7 @@ export class Ssd1306 {
 
   /** The address phase: whether the display ACKs. */
   connect(address, read) {
-    if (address !== this.address) return false;
+    if (address !== this.address || this.absent) return false;
     if (read) {
       this.fail('a read from the display (the SSD1306 on I2C is write-only)');
       return false;
@@ -144,6 +162,7 @@ export class Ssd1306 {
    * command or command argument when it is low (no control bytes on SPI).
    */
   spiByte(byte, isData) {
+    if (this.absent) return;
     this.bytes++;
     if (isData) {
       if (this.cmd !== null) this.fail(`data byte while command ${hex(this.cmd)} waits for ${argumentCount(this.cmd) - this.args.length} more argument bytes`);

@@ -11,6 +11,7 @@
 //! `host-sim uf2` is the first half alone: the UF2 file to drag onto a Pico (or, with
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
 
+mod faults;
 mod slot;
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
@@ -172,6 +173,11 @@ struct PanelFrame {
     setup_cycles: u64,
     /// Bytes the display heard.
     bus_bytes: u64,
+    /// When the LED went on and out, in emulated milliseconds from boot.
+    #[serde(default)]
+    start_ms: f64,
+    #[serde(default)]
+    end_ms: f64,
     error: Option<String>,
     /// The panel's pixels (rows MSB first, lit = 1), sent as hex.
     #[serde(deserialize_with = "hex_pixels")]
@@ -475,6 +481,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
             save_frame(&r.frame.pixels, &images.join(format!("board-{}.png", r.name)))?;
         }
     }
+    let fault_rows = s.fault_runs(&rows)?;
     let bare = s.no_display_run()?;
     let (models, (alone, levers)) = (s.model_runs()?, s.lever_runs()?);
     let (orun, orbit_same) = s.orbit_run()?;
@@ -518,6 +525,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         md.push_str(&outline_report(f, rays, same, lined, run.clk_sys_hz)?);
     }
     md.push_str(&slot::slot_report(&slot_rows)?);
+    md.push_str(&faults::fault_report(&fault_rows)?);
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     let Checks { passed, failures } = s.checks;

@@ -22,6 +22,29 @@ use firmware::app::{HEIGHT, RENDERED, WIDTH};
 use ssd1306::mode::BasicMode;
 use ssd1306::prelude::*;
 
+/// A panel the modes set up before every frame: a panel that lost power (a loose wire) comes
+/// back dark, with its settings lost, and a write-only bus cannot tell, so no frame may count
+/// on an earlier set-up.
+pub trait SetUp {
+    /// Sends the panel's whole set-up (display off, its configuration, charge pump, display on)
+    /// and waits until it has left the bus; an error when the panel does not answer.
+    fn set_up(&mut self) -> Result<(), display_interface::DisplayError>;
+    /// Whether the panel answers a command that changes nothing it shows (normal, not inverted,
+    /// display): a probe while the board waits between frames.
+    fn answers(&mut self) -> bool;
+}
+
+impl<DI: WriteOnlyDataCommand> SetUp for PageTiles<DI> {
+    fn set_up(&mut self) -> Result<(), display_interface::DisplayError> {
+        self.display.init()?;
+        flush().map_err(|_| display_interface::DisplayError::BusWriteError)
+    }
+
+    fn answers(&mut self) -> bool {
+        self.display.set_invert(false).is_ok() && flush().is_ok()
+    }
+}
+
 /// The most rows drawn at once: a band of tiles.
 const BAND_ROWS: usize = RENDERED.tile as usize;
 

@@ -26,6 +26,7 @@ mod sleep;
 mod wiring;
 
 use defmt_rtt as _;
+use display::SetUp;
 use firmware::app::{SceneMemory, ShareMemory, HEIGHT, SCENES, WIDTH};
 use hal::pac;
 use hal::Clock;
@@ -64,10 +65,17 @@ pub static PICOTOOL_ENTRIES: [hal::binary_info::EntryAddr; 4] = [
 ];
 
 /// What tells the slot image's UF2 file from another's (`board_records::slot::IMAGE_MARK`),
-/// which `host-sim uf2 --scene` looks for before writing a scene beside it.
+/// which `host-sim uf2 --scene` looks for in each 256-byte block before writing a scene beside
+/// it: aligned to its 16 bytes, so it never straddles two blocks (it did, once the code before
+/// it grew).
 #[cfg(feature = "slot")]
 #[used]
-pub static SLOT_IMAGE: [u8; 16] = board_records::slot::IMAGE_MARK;
+pub static SLOT_IMAGE: SlotMark = SlotMark(board_records::slot::IMAGE_MARK);
+
+/// The slot image's mark, aligned to its size.
+#[cfg(feature = "slot")]
+#[repr(C, align(16))]
+pub struct SlotMark(pub [u8; 16]);
 
 /// The board's name in the log.
 #[cfg(feature = "pico")]
@@ -107,7 +115,8 @@ fn main() -> ! {
 
     let mut display = ssd1306::Ssd1306::new(interface, DisplaySize128x64, DisplayRotation::Rotate0);
     display::reset(&mut display, &mut reset, &mut { timer });
-    while display.init().is_err() || display::flush().is_err() {
+    let mut target = display::PageTiles { display };
+    while target.set_up().is_err() {
         defmt::error!(
             "no SSD1306 answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
             Wiring::SDA,
@@ -147,6 +156,5 @@ fn main() -> ! {
     let Some(second) = cortex_m::singleton!(: ShareMemory = ShareMemory::new()) else {
         defmt::panic!("the second share's memory is taken")
     };
-    let target = display::PageTiles { display };
     modes::run(modes::Panel { target, led, timer, alarm, cores, st: &mut st, second })
 }

@@ -2,6 +2,7 @@
 //! orbit around each (`orbit`), or the ladder of levers on the first scene (`ladder`).
 
 use crate::cores::TwoCores;
+use crate::display::SetUp;
 use crate::sleep::{sleep_ms, Alarm0, Timer};
 #[cfg(any(feature = "ladder", not(feature = "orbit")))]
 use board_records::FrameDone;
@@ -19,6 +20,13 @@ use lattice_rt::render::RenderError;
 
 /// The pause between two scenes.
 const PAUSE_MS: u32 = 3000;
+
+/// How often a panel that does not answer is set up again.
+const RETRY_MS: u32 = 100;
+
+/// How often the board asks the panel whether it answers while it waits between frames
+/// ([`Panel::pause`]).
+const PROBE_MS: u32 = 20;
 
 /// The records this board reports (`board_records`): `cargo xtask board` finds the channel by this
 /// symbol in the emulated board's RAM and decodes them into the same types.
@@ -70,13 +78,14 @@ pub struct Panel<'m, T, L> {
     pub second: &'m mut ShareMemory,
 }
 
-impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin> Panel<'_, T, L> {
+impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin> Panel<'_, T, L> {
     /// One frame, with the LED lit while it renders; its report and its microseconds, whole and
     /// up to the first tile (the set-up). The passes of
     /// a progressive frame (the `progressive` feature) follow each other without waiting for the
     /// bus: each reaches the panel as its bytes do, while the cores trace the next, and the LED
     /// goes out when the last is on the panel.
     pub fn show(&mut self, scene: Embedded, shot: &Shot) -> Result<(Report, Micros), AppError<'static, T::Error>> {
+        self.set_up_panel();
         let timer = self.timer;
         let t0 = timer.get_counter();
         let _ = self.led.set_high();
@@ -105,6 +114,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         use lattice_rt::BitFrame;
         const BYTES: usize = BitFrame::bytes(WIDTH as u32, HEIGHT as u32);
         let (w, h) = (WIDTH as u32, HEIGHT as u32);
+        self.set_up_panel();
         let _ = self.led.set_high();
         let mut bits = [0u8; BYTES];
         let Some(mut frame) = BitFrame::new(w, h, &mut bits) else { return Err(DisplayError::OutOfBoundsError) };
@@ -123,9 +133,36 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
         sent.map_err(|_| DisplayError::BusWriteError)
     }
 
-    /// Sleeps between scenes.
-    pub fn pause(&mut self) {
-        sleep_ms(&mut self.alarm, PAUSE_MS);
+    /// Sets the panel up for the next frame ([`SetUp`]), again every [`RETRY_MS`] while it does
+    /// not answer (a loose wire): logged when it stops and when it starts answering again.
+    fn set_up_panel(&mut self) {
+        if self.target.set_up().is_ok() {
+            return;
+        }
+        defmt::warn!("the display does not answer: setting it up again every {} ms", RETRY_MS);
+        while self.target.set_up().is_err() {
+            sleep_ms(&mut self.alarm, RETRY_MS);
+        }
+        defmt::info!("the display answers again");
+    }
+
+    /// Sleeps between scenes, asking the panel every [`PROBE_MS`] whether it answers. True, at
+    /// once, when it stopped answering and answers again: it lost power and shows nothing, so
+    /// the frame is to be drawn again.
+    pub fn pause(&mut self) -> bool {
+        let mut lost = false;
+        for _ in 0..PAUSE_MS / PROBE_MS {
+            sleep_ms(&mut self.alarm, PROBE_MS);
+            match (self.target.answers(), lost) {
+                (false, _) => lost = true,
+                (true, true) => {
+                    defmt::warn!("the display lost power and answers again: drawing the frame again");
+                    return true;
+                }
+                (true, false) => {}
+            }
+        }
+        false
     }
 }
 
@@ -133,7 +170,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputP
 /// panel that says why there is none (the slot empty or corrupt, the scene refused at its line
 /// and column or too big for the image's storage), also logged.
 #[cfg(feature = "slot")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     use firmware::slot::Message;
@@ -161,40 +198,55 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
                 defmt::error!("the display did not take the message");
             }
         }
-        panel.pause();
+        let _ = panel.pause();
     }
 }
 
 /// The embedded scenes in turn, each frame's time and statistics logged.
 #[cfg(not(any(feature = "orbit", feature = "ladder", feature = "slot")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     loop {
         for (i, (name, scene)) in EMBEDDED.iter().copied().enumerate() {
-            match panel.show(scene, &Shot::default()) {
-                Ok((r, (us, setup_us))) => {
-                    report(Record::Frame(frame_done(i, &r, (us, setup_us))));
-                    let (s, shares) = (r.stats, r.share_us);
-                    defmt::info!(
-                        "{}: {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
-                        name, us / 1000, shares[0], shares[1], s.total_rays(), s.rays[1], s.rays[2], s.rays[3], s.object_tests, s.cells_visited,
-                        r.lattice_bytes, stack::high_water()
-                    );
-                }
-                Err(e) => {
-                    report(Record::Failed { scene: i as u8 });
-                    defmt::error!("{}: {}", name, e)
-                }
-            }
-            panel.pause();
+            // A frame the display did not take, or lost with its power, is drawn again once the
+            // panel answers.
+            while show_scene(&mut panel, i, name, scene) {}
         }
     }
 }
 
+/// Scene `i`'s frame, drawn again while the display does not take it, then the pause after it:
+/// true when the panel lost it in the pause ([`Panel::pause`]).
+#[cfg(not(any(feature = "orbit", feature = "ladder", feature = "slot")))]
+fn show_scene<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
+    panel: &mut Panel<'_, T, L>,
+    i: usize,
+    name: &str,
+    scene: Embedded,
+) -> bool {
+    while let Err(e) = panel.show(scene, &Shot::default()).map(|(r, (us, setup_us))| {
+        report(Record::Frame(frame_done(i, &r, (us, setup_us))));
+        let (s, shares) = (r.stats, r.share_us);
+        defmt::info!(
+            "{}: {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
+            name, us / 1000, shares[0], shares[1], s.total_rays(), s.rays[1], s.rays[2], s.rays[3], s.object_tests, s.cells_visited,
+            r.lattice_bytes, stack::high_water()
+        );
+    }) {
+        report(Record::Failed { scene: i as u8 });
+        defmt::error!("{}: {}", name, e);
+        // Only a display that did not take the frame is worth another try.
+        if !matches!(e, AppError::Render(RenderError::Draw(_))) {
+            break;
+        }
+    }
+    panel.pause()
+}
+
 /// Orbit mode: the camera circles each scene, frame after frame, for one turn.
 #[cfg(all(feature = "orbit", not(feature = "ladder")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     use firmware::app::ORBIT_FRAMES;
@@ -220,14 +272,14 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
                 centi_fps % 100,
                 stack::high_water()
             );
-            panel.pause();
+            let _ = panel.pause();
         }
     }
 }
 
 /// The ladder: the first scene once per rung, from the paper's method to the default.
 #[cfg(feature = "ladder")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     use firmware::app::{EMBEDDED, LADDER};
@@ -255,6 +307,6 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + Send, L: O
                 }
             }
         }
-        panel.pause();
+        let _ = panel.pause();
     }
 }
