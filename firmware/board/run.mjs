@@ -26,6 +26,11 @@
 // time for LEN_MS: it answers nothing meanwhile (every I2C address NACKs, SPI bytes are lost)
 // and comes back as a freshly powered panel (registers reset, GDDRAM cleared, display off). A
 // frame the panel cannot show then is reported with its reason and the run goes on.
+// --reset-at MS (repeatable) resets the chip at MS of emulated time, as the RUN pin does, and
+// --hang-core1-at MS stops core 1 for good (it makes no more progress): either way the board
+// boots again (SRAM and the watchdog's scratch registers kept, as on silicon; the watchdog's
+// REASON says TIMER after its own reset, nothing after the RUN pin) and the run goes on, with an
+// {"event":"reset"} line and the emulated time running on.
 // --pass-bytes N shows a picture every N GDDRAM bytes the display receives while the LED is lit
 // (1024: a progressive frame's passes, each a whole panel), instead of when the LED goes out.
 // With --profile FILE it also samples core 0's program counter every 97th instruction of the
@@ -36,7 +41,8 @@
 //                     [--records ADDR --records-log FILE] [--frames N] [--max-cycles N]
 //                     [--no-display] [--until-ms T] [--profile FILE]
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
-//                     [--pass-bytes N] [--panel-off START_MS:LEN_MS]
+//                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
+//                     [--hang-core1-at MS]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
@@ -49,7 +55,7 @@ const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [] };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [] };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -77,7 +83,8 @@ function parseArgs(argv) {
       const m = /^(\d+(?:\.\d+)?):(\d+(?:\.\d+)?)$/.exec(v);
       if (!m) throw new Error(`--panel-off ${v}: START_MS:LEN_MS expected`);
       o.panelOff.push({ startMs: Number(m[1]), lenMs: Number(m[2]) });
-    }
+    } else if (a === '--reset-at') o.resetAt.push(Number(next()));
+    else if (a === '--hang-core1-at') o.hangAt.push(Number(next()));
     else throw new Error(`unknown argument ${a}`);
   }
   for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
@@ -164,14 +171,20 @@ const toHex = (bytes) => Buffer.from(bytes).toString('hex');
 
 function main() {
   const opt = parseArgs(process.argv);
-  const board = new SiliconBoard({ cache: opt.cache, dualCore: opt.core1 });
-  const mcu = board.mcu;
+  let board = null;
+  let mcu = null;
+  let core = null;
   const bootrom = readFileSync(opt.bootrom);
   if (bootrom.length !== 16384) throw new Error(`${opt.bootrom}: ${bootrom.length} bytes, a bootrom is 16384`);
-  board.loadBootrom(new Uint32Array(bootrom.buffer, bootrom.byteOffset, 4096));
-  const flashBytes = loadUf2(mcu, readFileSync(opt.uf2));
+  const bootWords = new Uint32Array(bootrom.buffer, bootrom.byteOffset, 4096);
+  const uf2 = readFileSync(opt.uf2);
+  let flashBytes = 0;
   const warnings = [];
-  mcu.logger = { debug() {}, info() {}, warn() {}, error: (c, m) => warnings.push(`${c}: ${m}`) };
+  const logger = { debug() {}, info() {}, warn() {}, error: (c, m) => warnings.push(`${c}: ${m}`) };
+  // Cycles and nanoseconds of the boots before this one (a reset starts a new board at 0).
+  let epoch = { cycles: 0, nanos: 0 };
+  let resets = 0;
+  let pendingReset = null; // why the chip resets after this step ('watchdog', 'reset pin')
 
   // The display model on I2C0 and SPI0 (or nothing: every I2C address NACKs), bytes delivered
   // when the bus would deliver them.
@@ -181,25 +194,16 @@ function main() {
   let naks = 0;
   let ledOn = false;
   let firstByteOfFrame = null;
-  const snapshot = () => ({ ...board.snapshot(), busBytes, i2cTransfers });
+  const snapshot = () => {
+    const s = board.snapshot();
+    return { ...s, cycles: s.cycles + epoch.cycles, nanos: s.nanos + epoch.nanos, busBytes, i2cTransfers };
+  };
   const byte = () => {
     if (ledOn && firstByteOfFrame === null) firstByteOfFrame = snapshot();
     busBytes++;
   };
-  board.attachI2c(0, display, {
-    timed: opt.timedBus,
-    listen: {
-      connect: (ack) => {
-        i2cTransfers++;
-        if (!ack) naks++;
-      },
-      byte,
-    },
-  });
-  board.attachSpi(0, display, { ...SPI_DISPLAY, timed: opt.timedBus, listen: { byte } });
-
-  const rtt = new RttReader(mcu, opt.rtt);
-  const records = opt.records === undefined ? null : new RecordReader(mcu, opt.records);
+  const rtt = new RttReader(null, opt.rtt);
+  const records = opt.records === undefined ? null : new RecordReader(null, opt.records);
   const frames = [];
   let frameStart = null;
   let ledToggles = 0;
@@ -242,7 +246,7 @@ function main() {
     emit(frame);
     frameStart = opt.passBytes ? end : null;
     firstByteOfFrame = null;
-    if (why && opt.panelOff.length === 0) board.stop = `display: ${why}`;
+    if (why && opt.panelOff.length + opt.resetAt.length + opt.hangAt.length === 0) board.stop = `display: ${why}`;
     else if (frames.length >= opt.frames && !opt.passBytes) draining = true;
   };
   let passData = 0; // GDDRAM bytes since the LED went on (--pass-bytes)
@@ -254,7 +258,7 @@ function main() {
     };
   }
 
-  board.gpio(LED_PIN).addListener((state) => {
+  const onLed = (state) => {
     const on = state === GPIOPinState.High;
     if (on === ledOn) return;
     ledOn = on;
@@ -270,18 +274,81 @@ function main() {
     if (!opt.passBytes) capture();
     else if (frames.length >= opt.frames) draining = true;
     frameStart = null;
-  });
+  };
 
-  // The display's power cuts, as alarms on the emulated clock (a sleeping board wakes for them).
+  // What happens at a moment of emulated time (from the first boot): the display's power cuts,
+  // resets, core 1 stopping. Scheduled on each boot's clock as alarms (a sleeping board wakes
+  // for them).
+  const moments = [];
   for (const { startMs, lenMs } of display ? opt.panelOff : []) {
-    mcu.clock.createAlarm(() => display.powerOff()).schedule(startMs * 1e6);
-    mcu.clock.createAlarm(() => display.powerOn()).schedule((startMs + lenMs) * 1e6);
+    moments.push({ nanos: startMs * 1e6, fn: () => display.powerOff() });
+    moments.push({ nanos: (startMs + lenMs) * 1e6, fn: () => display.powerOn() });
   }
+  for (const ms of opt.resetAt) moments.push({ nanos: ms * 1e6, fn: () => (pendingReset ??= 'reset pin') });
+  for (const ms of opt.hangAt) moments.push({ nanos: ms * 1e6, fn: () => (board.held[1] = true) });
 
-  // Core 0 at boot2 with the stack pointer the bootrom would leave; core 1 in the bootrom.
-  board.start(FLASH, mcu.readUint32(0));
+  /** A board from power-on (or, with `kept`, after a reset: SRAM and the watchdog's scratch and reason). */
+  const boot = (kept) => {
+    board = new SiliconBoard({ cache: opt.cache, dualCore: opt.core1 });
+    mcu = board.mcu;
+    board.loadBootrom(bootWords);
+    flashBytes = loadUf2(mcu, uf2);
+    mcu.logger = logger;
+    board.attachI2c(0, display, {
+      timed: opt.timedBus,
+      listen: {
+        connect: (ack) => {
+          i2cTransfers++;
+          if (!ack) naks++;
+        },
+        byte,
+      },
+    });
+    board.attachSpi(0, display, { ...SPI_DISPLAY, timed: opt.timedBus, listen: { byte } });
+    board.gpio(LED_PIN).addListener(onLed);
+    const watchdog = mcu.peripherals[0x40058];
+    // The watchdog resets the chip: its timer stops here (rp2040js would re-arm it at 0 and
+    // fire again at once), and the board boots again after this step.
+    watchdog.onWatchdogTrigger = () => {
+      watchdog.alarm.enable = false;
+      watchdog.timer.enable = false;
+      pendingReset ??= 'watchdog';
+    };
+    if (kept) {
+      mcu.sram.set(kept.sram);
+      watchdog.scratchData.set(kept.scratch);
+      watchdog.reason = kept.reason;
+    }
+    rtt.mcu = mcu;
+    if (records) records.mcu = mcu;
+    for (const m of moments) {
+      if (m.nanos >= epoch.nanos) mcu.clock.createAlarm(m.fn).schedule(m.nanos - epoch.nanos);
+    }
+    // Core 0 at boot2 with the stack pointer the bootrom would leave; core 1 in the bootrom.
+    board.start(FLASH, mcu.readUint32(0));
+    core = board.cores[0];
+  };
 
-  const core = board.cores[0];
+  /** The chip resets (`why`): what the logs hold so far is read, and the board boots again. */
+  const reboot = (why) => {
+    rtt.poll();
+    records?.poll();
+    const s = board.snapshot();
+    epoch = { cycles: epoch.cycles + s.cycles, nanos: epoch.nanos + s.nanos };
+    const watchdog = mcu.peripherals[0x40058];
+    const kept = { sram: mcu.sram.slice(), scratch: watchdog.scratchData.slice(), reason: why === 'watchdog' ? watchdog.reason : 0 };
+    emit({ event: 'reset', reason: why, ms: epoch.nanos / 1e6, frames: frames.length });
+    resets++;
+    // A frame under way is lost; the display sees its transfer cut off (no STOP).
+    ledOn = false;
+    frameStart = null;
+    firstByteOfFrame = null;
+    display?.endTransfer();
+    boot(kept);
+  };
+
+  boot(null);
+
   const profile = opt.profile ? new Map() : null;
   const untilNanos = opt.untilMs === null ? Infinity : opt.untilMs * 1e6;
   let steps = 0;
@@ -301,7 +368,13 @@ function main() {
         board.stop = 'both cores sleep (wfi/wfe) with no timer alarm to wake them';
         break;
       }
-      if (mcu.clock.nanos >= untilNanos) nextPoll = 0; // time is up while asleep: check now
+      if (mcu.clock.nanos + epoch.nanos >= untilNanos) nextPoll = 0; // time is up while asleep: check now
+    }
+    if (pendingReset) {
+      const why = pendingReset;
+      pendingReset = null;
+      reboot(why);
+      continue;
     }
     steps++;
     if (steps >= nextPoll) {
@@ -309,9 +382,9 @@ function main() {
       rtt.poll();
       records?.poll();
       board.stop ??= board.fault();
-      if (board.time > opt.maxCycles) board.stop ??= `no result within ${opt.maxCycles} cycles`;
+      if (board.time + epoch.cycles > opt.maxCycles) board.stop ??= `no result within ${opt.maxCycles} cycles`;
       else if (display?.error) board.stop ??= `display: ${display.error}`;
-      if (mcu.clock.nanos >= untilNanos && board.stop === null) {
+      if (mcu.clock.nanos + epoch.nanos >= untilNanos && board.stop === null) {
         board.stop = `${opt.untilMs} ms of emulated time`;
         ok = true;
       }
@@ -338,7 +411,8 @@ function main() {
     sclPeriodCycles: board.sclPeriod(0),
     spiByteCycles: board.spiFrameCycles(0),
     models: { core1: opt.core1, cache: opt.cache, timedBus: opt.timedBus },
-    emulatedMs: mcu.clock.nanos / 1e6,
+    emulatedMs: (mcu.clock.nanos + epoch.nanos) / 1e6,
+    resets,
     idleMs: (Math.min(...total.idle.slice(0, opt.core1 ? 2 : 1)) * 1e3) / mcu.clkSys,
     clkSysHz: mcu.clkSys,
     flashBytes,

@@ -216,6 +216,8 @@ struct RunEnd {
 #[derive(Debug)]
 enum Event {
     Frame(PanelFrame),
+    /// The chip reset (run.mjs's `reset` event: why, and when in emulated milliseconds).
+    Reset(String, f64),
     End(RunEnd),
 }
 
@@ -226,6 +228,9 @@ impl Event {
         let event = match v["event"].as_str() {
             Some("frame") => Event::Frame(serde_json::from_value(v)?),
             Some("end") => Event::End(serde_json::from_value(v)?),
+            Some("reset") => {
+                Event::Reset(v["reason"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0))
+            }
             _ => bail!("emulator printed an unknown event: {line}"),
         };
         Ok(event)
@@ -258,6 +263,8 @@ struct BoardRun {
     log: Vec<LogLine>,
     /// What the board reported on its record channel, in order.
     records: Vec<Record>,
+    /// The chip's resets: why, and when (emulated milliseconds from the first boot).
+    resets: Vec<(String, f64)>,
 }
 
 /// One decoded defmt log line.
@@ -321,6 +328,10 @@ fn run_emulator(
             Event::Frame(f) => {
                 eprintln!("  frame {} shown: {:.1} M cycles", run.frames.len() + 1, f.cycles as f64 / 1e6);
                 run.frames.push(f);
+            }
+            Event::Reset(why, ms) => {
+                eprintln!("  reset ({why}) at {ms:.1} ms");
+                run.resets.push((why, ms));
             }
             Event::End(e) => {
                 run.ok = e.ok;
@@ -1442,7 +1453,7 @@ mod tests {
                 assert_eq!((e.xip_miss_cycles, e.scl_period_cycles, e.led_toggles), (56, 332, 10));
                 assert_eq!(e.clk_sys_hz, 125e6);
             }
-            Event::Frame(_) => panic!("an end event read as a frame"),
+            other => panic!("an end event read as {other:?}"),
         }
         let frame = r#"{"event":"frame","index":0,"cycles":31447325,"instructions":39300000,"busy":[31447325,26591316],"idle":[0,4856009],"coreInstructions":[1,2],"xipHits":5,"xipMisses":519,"xipStallCycles":29104,"setupCycles":3594371,"setupInstructions":1,"busBytes":2176,"busCycles":7900000,"i2cTransfers":384,"startMs":1,"endMs":2,"error":null,"pixels":"00ff"}"#;
         match Event::parse(frame).unwrap() {
@@ -1454,7 +1465,12 @@ mod tests {
                 assert_eq!(f.pixels, vec![0x00, 0xff]);
                 assert!(f.error.is_none());
             }
-            Event::End(_) => panic!("a frame read as an end event"),
+            other => panic!("a frame read as {other:?}"),
+        }
+        let reset = r#"{"event":"reset","reason":"watchdog","ms":4181.2,"frames":1}"#;
+        match Event::parse(reset).unwrap() {
+            Event::Reset(why, ms) => assert_eq!((why.as_str(), ms), ("watchdog", 4181.2)),
+            other => panic!("a reset read as {other:?}"),
         }
     }
 }

@@ -1,8 +1,10 @@
-//! The display losing power on the emulated board (run.mjs `--panel-off`): the panel stops
-//! answering, then comes back as a freshly powered one (its settings and RAM lost, dark). Each
-//! scenario cuts the power at a moment taken from the clean run's frames, for a while, and
-//! checks what the board did: every frame it reported as shown is on the panel, bit-identical
-//! to host-sim's, and a good frame follows within a second of the power's return.
+//! Faults on the emulated board, each at a moment taken from the clean run's frames: the
+//! display losing power (run.mjs `--panel-off`: the panel stops answering, then comes back as a
+//! freshly powered one, its settings and RAM lost, dark), the chip reset mid-frame (`--reset-at`,
+//! the RUN pin) and core 1 stopping for good (`--hang-core1-at`, which the watchdog must turn
+//! into a reset). Each run checks what the board did: every frame it reported as shown is on
+//! the panel, bit-identical to host-sim's, and a good frame follows within a second of the
+//! fault's end (the power's return, the reset).
 
 use super::{host_frame, run_emulator, PanelFrame, SceneRow, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
@@ -12,35 +14,82 @@ use std::fmt::Write as _;
 /// The most time from the power's return to the next good frame (1 s: 125 M cycles).
 const RECOVERY_MS: f64 = 1000.0;
 
+/// The firmware's watchdog timeout (`firmware/src/bin/pico/guard.rs`).
+const WATCHDOG_MS: f64 = 1000.0;
+
 /// Frames each scenario runs for: the first scenes and the frames drawn again.
 const FRAMES: usize = 4;
 
-/// One scenario: its name, what it does, and when it cuts the power (from boot, in emulated
-/// milliseconds) and for how long, from the clean run's first two frames.
+/// A fault and when (emulated milliseconds from boot).
+#[derive(Clone, Copy)]
+enum Fault {
+    /// The display's power cut at the first time for the second's milliseconds.
+    PanelOff(f64, f64),
+    /// The chip reset (the RUN pin).
+    Reset(f64),
+    /// Core 1 stops making progress for good.
+    HangCore1(f64),
+}
+
+impl Fault {
+    /// run.mjs's switch for it.
+    fn args(self) -> [String; 2] {
+        match self {
+            Fault::PanelOff(start, len) => ["--panel-off".into(), format!("{start:.3}:{len:.3}")],
+            Fault::Reset(at) => ["--reset-at".into(), format!("{at:.3}")],
+            Fault::HangCore1(at) => ["--hang-core1-at".into(), format!("{at:.3}")],
+        }
+    }
+    /// When it starts.
+    fn start(self) -> f64 {
+        match self {
+            Fault::PanelOff(start, _) | Fault::Reset(start) | Fault::HangCore1(start) => start,
+        }
+    }
+}
+
+/// One scenario: its name, what it does, and its fault, placed by the clean run's first two
+/// frames.
 struct Scenario {
     name: &'static str,
     what: &'static str,
-    cut: fn(&PanelFrame, &PanelFrame) -> (f64, f64),
+    fault: fn(&PanelFrame, &PanelFrame) -> Fault,
 }
 
-/// The scenarios: a cut in the middle of a frame (the bus sees it), one inside the pause after
-/// a frame (no transfer sees it: the board's probes do), and a long one that spans the start of
-/// the next frame (its set-up waits for the panel).
-const SCENARIOS: [Scenario; 3] = [
+/// The middle of frame `f`.
+fn mid(f: &PanelFrame) -> f64 {
+    f.start_ms + (f.end_ms - f.start_ms) / 2.0
+}
+
+/// The scenarios: a power cut in the middle of a frame (the bus sees it), one inside the pause
+/// after a frame (no transfer sees it: the board's probes do), a long one that spans the start
+/// of the next frame (its set-up waits for the panel); a reset in the middle of a frame; core 1
+/// stopping in the middle of a frame.
+const SCENARIOS: [Scenario; 5] = [
     Scenario {
-        name: "mid-frame",
-        what: "the second frame half sent, power back after 300 ms",
-        cut: |_, f1| (f1.start_ms + (f1.end_ms - f1.start_ms) / 2.0, 300.0),
+        name: "power cut mid-frame",
+        what: "the display's power, the second frame half sent, back after 300 ms",
+        fault: |_, f1| Fault::PanelOff(mid(f1), 300.0),
     },
     Scenario {
-        name: "in the pause",
-        what: "0.7 s into the pause after the first frame, for 600 ms",
-        cut: |f0, _| (f0.end_ms + 700.0, 600.0),
+        name: "power cut in the pause",
+        what: "the display's power, 0.7 s into the pause after the first frame, for 600 ms",
+        fault: |f0, _| Fault::PanelOff(f0.end_ms + 700.0, 600.0),
     },
     Scenario {
-        name: "across a frame's start",
-        what: "2 s into the pause after the first frame, for 2.5 s",
-        cut: |f0, _| (f0.end_ms + 2000.0, 2500.0),
+        name: "power cut across a frame's start",
+        what: "the display's power, 2 s into the pause after the first frame, for 2.5 s",
+        fault: |f0, _| Fault::PanelOff(f0.end_ms + 2000.0, 2500.0),
+    },
+    Scenario {
+        name: "reset mid-frame",
+        what: "the RUN pin, the second frame half traced",
+        fault: |_, f1| Fault::Reset(mid(f1)),
+    },
+    Scenario {
+        name: "core 1 stops",
+        what: "core 1 makes no more progress, the second frame half traced",
+        fault: |_, f1| Fault::HangCore1(mid(f1)),
     },
 ];
 
@@ -48,7 +97,11 @@ const SCENARIOS: [Scenario; 3] = [
 pub(super) struct FaultRow {
     name: &'static str,
     what: &'static str,
-    cut: (f64, f64),
+    /// When the fault started and ended (emulated ms from boot; a stopped core ends with the
+    /// watchdog's reset).
+    span: (f64, Option<f64>),
+    /// The resets the run saw, and why.
+    resets: Vec<String>,
     /// Frames the board reported as not taken by the display.
     failed: usize,
     /// Milliseconds from the power's return to the end of the next good frame.
@@ -67,9 +120,9 @@ impl Session<'_> {
         std::fs::create_dir_all(&dir)?;
         let mut rows = Vec::new();
         for sc in &SCENARIOS {
-            let (start, len) = (sc.cut)(&f0.frame, &f1.frame);
-            eprintln!("power cut {}: at {start:.1} ms for {len:.0} ms", sc.name);
-            let arg = format!("{start:.3}:{len:.3}");
+            let fault = (sc.fault)(&f0.frame, &f1.frame);
+            let args = fault.args();
+            eprintln!("fault {}: {} {}", sc.name, args[0], args[1]);
             let run = run_emulator(
                 self.root,
                 &self.elf,
@@ -78,8 +131,28 @@ impl Session<'_> {
                 FRAMES,
                 true,
                 &dir,
-                &["--panel-off", &arg],
+                &[args[0].as_str(), args[1].as_str()],
             )?;
+            let start = fault.start();
+            // When the fault ended: the power's return, the reset; for a stopped core, the
+            // watchdog's reset, which must come within its timeout (and a tile's time).
+            let end = match fault {
+                Fault::PanelOff(start, len) => Some(start + len),
+                Fault::Reset(at) => {
+                    let seen = run.resets.iter().any(|(why, ms)| why == "reset pin" && (ms - at).abs() < 1.0);
+                    self.checks.check(seen, || format!("{}: no reset at {at:.1} ms", sc.name));
+                    Some(at)
+                }
+                Fault::HangCore1(at) => {
+                    let reset = run.resets.iter().find(|(why, _)| why == "watchdog").map(|(_, ms)| *ms);
+                    self.checks.check(reset.is_some_and(|ms| ms - at <= WATCHDOG_MS + 100.0), || {
+                        format!("{}: the watchdog reset {reset:?} ms, core 1 stopped at {at:.1} ms (at most {WATCHDOG_MS} ms later)", sc.name)
+                    });
+                    let said = run.log.iter().any(|l| l.text.contains("the watchdog reset the board"));
+                    self.checks.check(said, || format!("{}: the next boot did not log why it reset", sc.name));
+                    reset
+                }
+            };
             let outcomes: Vec<Option<u8>> = run
                 .records
                 .iter()
@@ -89,8 +162,7 @@ impl Session<'_> {
                     _ => None,
                 })
                 .collect();
-            let mut ok =
-                self.checks.check(run.ok, || format!("power cut {}: the run did not finish: {}", sc.name, run.reason));
+            let mut ok = self.checks.check(run.ok, || format!("{}: the run did not finish: {}", sc.name, run.reason));
             let mut recovery_ms = None;
             for (k, (frame, outcome)) in run.frames.iter().zip(&outcomes).enumerate() {
                 let Some(scene) = outcome else { continue };
@@ -99,51 +171,55 @@ impl Session<'_> {
                 let same = frame.error.is_none() && frame.pixels == want;
                 ok &= self.checks.check(same, || {
                     let why = frame.error.clone().unwrap_or_else(|| "it differs from host-sim's".into());
-                    format!("power cut {}: frame {k} ({name}) was reported shown, but the panel: {why}", sc.name)
+                    format!("{}: frame {k} ({name}) was reported shown, but the panel: {why}", sc.name)
                 });
-                if same && frame.end_ms > start + len && recovery_ms.is_none() {
-                    recovery_ms = Some(frame.end_ms - (start + len));
+                if let Some(end) = end {
+                    if same && frame.end_ms > end && recovery_ms.is_none() {
+                        recovery_ms = Some(frame.end_ms - end);
+                    }
                 }
             }
             ok &= self.checks.check(outcomes.len() >= run.frames.len(), || {
-                format!("power cut {}: {} frames on the panel, {} reported", sc.name, run.frames.len(), outcomes.len())
+                format!("{}: {} frames on the panel, {} reported", sc.name, run.frames.len(), outcomes.len())
             });
             ok &= self.checks.check(recovery_ms.is_some_and(|ms| ms <= RECOVERY_MS), || {
                 format!(
-                    "power cut {}: the next good frame came {recovery_ms:?} ms after the power (at most {RECOVERY_MS})",
+                    "{}: the next good frame came {recovery_ms:?} ms after the fault ended (at most {RECOVERY_MS})",
                     sc.name
                 )
             });
             let failed = outcomes.iter().filter(|o| o.is_none()).count();
-            rows.push(FaultRow { name: sc.name, what: sc.what, cut: (start, len), failed, recovery_ms, ok });
+            let resets = run.resets.iter().map(|(why, ms)| format!("{why} at {ms:.0} ms")).collect();
+            rows.push(FaultRow { name: sc.name, what: sc.what, span: (start, end), resets, failed, recovery_ms, ok });
         }
         Ok(rows)
     }
 }
 
-/// The report's section on the power cuts.
+/// The report's section on the faults.
 pub(super) fn fault_report(rows: &[FaultRow]) -> Result<String> {
     let mut md = String::new();
-    writeln!(md, "\n## The display losing power\n")?;
+    writeln!(md, "\n## Faults on the desk: power cuts, resets, a core that stops\n")?;
     writeln!(
         md,
-        "A loose wire: the emulated panel stops answering (every I2C address NACKs) and comes back as a freshly powered SSD1306, its settings and RAM lost and its display off (`run.mjs --panel-off START:LEN`). The firmware sets the panel up before every frame (a write-only bus cannot tell that it lost power), draws again a frame the display did not take once it answers (set up again every 100 ms), and asks the panel every 20 ms while it waits between frames whether it answers, drawing the frame again when it stopped and answers again. Each run: {FRAMES} frames of the default image; every frame the board reported as shown must be on the panel, bit-identical to host-sim's, and a good frame must end within {RECOVERY_MS:.0} ms of the power's return.\n"
+        "Written by `cargo xtask board`: each fault is one run of the default image on the emulated board ({FRAMES} frames), placed by the clean run's first two frames. *Power cut*: the emulated panel stops answering (every I2C address NACKs) and comes back as a freshly powered SSD1306, its settings and RAM lost and its display off (`run.mjs --panel-off START:LEN`). *Reset*: the chip resets as the RUN pin resets it (`--reset-at`); SRAM is kept, as on silicon. *Core 1 stops*: it makes no more progress (`--hang-core1-at`).\n\nWhat the firmware does: it sets the panel up before every frame (a write-only bus cannot tell that it lost power); it draws again a frame the display did not take once the panel answers (set up again every 100 ms); while it waits between frames it asks the panel every 20 ms whether it answers, and draws the frame again when it stopped and answers again. The watchdog ({WATCHDOG_MS:.0} ms) is fed by core 0 after each tile it traces, between frames and while it waits for the panel, never while it waits for core 1: a core that stops resets the board, and the next boot logs why. Checked in each run: every frame the board reported as shown is on the panel, bit-identical to host-sim's; a good frame ends within {RECOVERY_MS:.0} ms of the fault's end (the power's return, the reset); the run ends with no hard fault and no lock-up.\n"
     )?;
-    writeln!(md, "| scenario | power cut | from boot (ms) | length (ms) | frames not taken | power back to the next good frame | passed |")?;
-    writeln!(md, "|---|---|---:|---:|---:|---:|---|")?;
+    writeln!(md, "| scenario | fault | starts (ms from boot) | ends (ms) | resets | frames not taken | fault's end to the next good frame | passed |")?;
+    writeln!(md, "|---|---|---:|---:|---|---:|---:|---|")?;
     for r in rows {
         let rec = r.recovery_ms.map_or("none".into(), |ms| format!("{ms:.0} ms"));
+        let end = r.span.1.map_or("-".into(), |ms| format!("{ms:.1}"));
+        let resets = if r.resets.is_empty() { "none".into() } else { r.resets.join(", ") };
         writeln!(
             md,
-            "| {} | {} | {:.1} | {:.0} | {} | {rec} | {} |",
+            "| {} | {} | {:.1} | {end} | {resets} | {} | {rec} | {} |",
             r.name,
             r.what,
-            r.cut.0,
-            r.cut.1,
+            r.span.0,
             r.failed,
             if r.ok { "yes" } else { "**no**" }
         )?;
     }
-    writeln!(md, "\nNot survived yet: a cut shorter than the gaps between one frame's transfers (the bus idles while the cores trace) that ends before the frame's last byte. No transfer fails, the board reports the frame shown, and the panel stays dark until the next frame sets it up: an SSD1306 on I2C cannot be read back. The SPI image sees no cut at all (SPI has no acknowledge); its frames still set the panel up, so the next frame after the power's return is good.")?;
+    writeln!(md, "\nNot survived yet: a power cut shorter than the gaps between one frame's transfers (the bus idles while the cores trace) that ends before the frame's last byte. No transfer fails, the board reports the frame shown, and the panel stays dark until the next frame sets it up: an SSD1306 on I2C cannot be read back. The SPI image sees no cut at all (SPI has no acknowledge); its frames still set the panel up, so the next frame after the power's return is good. Not yet emulated: SDA held low by the panel (and the bus clear it needs), a panic without a probe.")?;
     Ok(md)
 }

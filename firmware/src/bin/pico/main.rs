@@ -13,13 +13,14 @@
 //!
 //! The rooms: [`wiring`] (the pins, address and bus clock: the one place to change them),
 //! [`display`] (the SSD1306 as a draw target), [`cores`] (core 1), [`sleep`] (the timer alarm),
-//! [`modes`] (what is shown: scenes, orbit or ladder), [`ram_code`] (the hot code copied to SRAM). The two boards differ only in what their
+//! [`modes`] (what is shown: scenes, orbit or ladder), [`guard`] (the watchdog), [`ram_code`] (the hot code copied to SRAM). The two boards differ only in what their
 //! HALs name differently (boot block, timer, its interrupt); each difference is one `cfg`.
 #![no_std]
 #![no_main]
 
 mod cores;
 mod display;
+mod guard;
 mod modes;
 mod ram_code;
 mod sleep;
@@ -91,6 +92,7 @@ const XTAL_FREQ_HZ: u32 = 12_000_000;
 fn main() -> ! {
     ram_code::load();
     let mut pac = pac::Peripherals::take().unwrap();
+    guard::reset_reason(&pac.WATCHDOG);
     let mut watchdog = hal::Watchdog::new(pac.WATCHDOG);
     let Ok(clocks) = hal::clocks::init_clocks_and_plls(
         XTAL_FREQ_HZ,
@@ -135,6 +137,7 @@ fn main() -> ! {
         Wiring::RES
     );
     let cores = cores::TwoCores::start(&mut pac.PSM, &mut pac.PPB, sio.fifo);
+    guard::start(watchdog);
     modes::report(board_records::Record::Started {
         scenes: SCENES.len() as u8,
         clk_mhz: clocks.system_clock.freq().to_MHz() as u16,

@@ -85,6 +85,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
     /// bus: each reaches the panel as its bytes do, while the cores trace the next, and the LED
     /// goes out when the last is on the panel.
     pub fn show(&mut self, scene: Embedded, shot: &Shot) -> Result<(Report, Micros), AppError<'static, T::Error>> {
+        crate::guard::feed();
         self.set_up_panel();
         let timer = self.timer;
         let t0 = timer.get_counter();
@@ -142,6 +143,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
         defmt::warn!("the display does not answer: setting it up again every {} ms", RETRY_MS);
         while self.target.set_up().is_err() {
             sleep_ms(&mut self.alarm, RETRY_MS);
+            crate::guard::feed();
         }
         defmt::info!("the display answers again");
     }
@@ -153,6 +155,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
         let mut lost = false;
         for _ in 0..PAUSE_MS / PROBE_MS {
             sleep_ms(&mut self.alarm, PROBE_MS);
+            crate::guard::feed();
             match (self.target.answers(), lost) {
                 (false, _) => lost = true,
                 (true, true) => {

@@ -127,12 +127,13 @@ pub fn flush() -> Result<(), hal::i2c::Error> {
 }
 
 /// The render's hooks on the Pico: after each tile core 0 traces, the display's queue moves on
-/// to the bus ([`pump`]).
+/// to the bus ([`pump`]) and the watchdog is fed (`guard`).
 pub struct Pump;
 
 impl lattice_rt::render::Hooks for Pump {
     fn progress(&mut self, _done: u32, _total: u32) -> bool {
         pump();
+        crate::guard::feed();
         true
     }
 }
