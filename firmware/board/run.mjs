@@ -31,6 +31,8 @@
 // boots again (SRAM and the watchdog's scratch registers kept, as on silicon; the watchdog's
 // REASON says TIMER after its own reset, nothing after the RUN pin) and the run goes on, with an
 // {"event":"reset"} line and the emulated time running on.
+// --panic-at MS with --panic-request ADDR writes 1 to the word at ADDR (the firmware's
+// PANIC_REQUEST) at MS: the firmware panics at its next check between frames.
 // --pass-bytes N shows a picture every N GDDRAM bytes the display receives while the LED is lit
 // (1024: a progressive frame's passes, each a whole panel), instead of when the LED goes out.
 // With --profile FILE it also samples core 0's program counter every 97th instruction of the
@@ -42,7 +44,7 @@
 //                     [--no-display] [--until-ms T] [--profile FILE]
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
-//                     [--hang-core1-at MS]
+//                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
@@ -55,7 +57,7 @@ const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [] };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [] };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -85,11 +87,14 @@ function parseArgs(argv) {
       o.panelOff.push({ startMs: Number(m[1]), lenMs: Number(m[2]) });
     } else if (a === '--reset-at') o.resetAt.push(Number(next()));
     else if (a === '--hang-core1-at') o.hangAt.push(Number(next()));
+    else if (a === '--panic-at') o.panicAt.push(Number(next()));
+    else if (a === '--panic-request') o.panicRequest = Number(next());
     else throw new Error(`unknown argument ${a}`);
   }
   for (const k of ['uf2', 'bootrom', 'log']) if (!o[k]) throw new Error(`--${k} is required`);
   if ((o.records === undefined) !== (o.recordsLog === undefined)) throw new Error('--records ADDR and --records-log FILE go together');
   if (!Number.isInteger(o.rtt)) throw new Error('--rtt ADDR (the _SEGGER_RTT symbol) is required');
+  if (o.panicAt.length > 0 && !Number.isInteger(o.panicRequest)) throw new Error('--panic-at needs --panic-request ADDR');
   return o;
 }
 
@@ -246,7 +251,7 @@ function main() {
     emit(frame);
     frameStart = opt.passBytes ? end : null;
     firstByteOfFrame = null;
-    if (why && opt.panelOff.length + opt.resetAt.length + opt.hangAt.length === 0) board.stop = `display: ${why}`;
+    if (why && opt.panelOff.length + opt.resetAt.length + opt.hangAt.length + opt.panicAt.length === 0) board.stop = `display: ${why}`;
     else if (frames.length >= opt.frames && !opt.passBytes) draining = true;
   };
   let passData = 0; // GDDRAM bytes since the LED went on (--pass-bytes)
@@ -286,6 +291,7 @@ function main() {
   }
   for (const ms of opt.resetAt) moments.push({ nanos: ms * 1e6, fn: () => (pendingReset ??= 'reset pin') });
   for (const ms of opt.hangAt) moments.push({ nanos: ms * 1e6, fn: () => (board.held[1] = true) });
+  for (const ms of opt.panicAt) moments.push({ nanos: ms * 1e6, fn: () => mcu.writeUint32(opt.panicRequest, 1) });
 
   /** A board from power-on (or, with `kept`, after a reset: SRAM and the watchdog's scratch and reason). */
   const boot = (kept) => {

@@ -72,6 +72,9 @@ pub enum Record {
         /// Index of the scene.
         scene: u8,
     },
+    /// The last boot ended in a panic: its reason is on the panel (drawn by [`crate::message`])
+    /// and in the log.
+    Panicked,
 }
 
 /// Bytes of a [`Channel`]'s ring buffer.

@@ -29,21 +29,26 @@ enum Fault {
     Reset(f64),
     /// Core 1 stops making progress for good.
     HangCore1(f64),
+    /// The firmware panics (asked through its `PANIC_REQUEST` word at this address).
+    Panic(f64, u64),
 }
 
 impl Fault {
-    /// run.mjs's switch for it.
-    fn args(self) -> [String; 2] {
+    /// run.mjs's switches for it.
+    fn args(self) -> Vec<String> {
         match self {
-            Fault::PanelOff(start, len) => ["--panel-off".into(), format!("{start:.3}:{len:.3}")],
-            Fault::Reset(at) => ["--reset-at".into(), format!("{at:.3}")],
-            Fault::HangCore1(at) => ["--hang-core1-at".into(), format!("{at:.3}")],
+            Fault::PanelOff(start, len) => vec!["--panel-off".into(), format!("{start:.3}:{len:.3}")],
+            Fault::Reset(at) => vec!["--reset-at".into(), format!("{at:.3}")],
+            Fault::HangCore1(at) => vec!["--hang-core1-at".into(), format!("{at:.3}")],
+            Fault::Panic(at, request) => {
+                vec!["--panic-at".into(), format!("{at:.3}"), "--panic-request".into(), format!("{request:#x}")]
+            }
         }
     }
     /// When it starts.
     fn start(self) -> f64 {
         match self {
-            Fault::PanelOff(start, _) | Fault::Reset(start) | Fault::HangCore1(start) => start,
+            Fault::PanelOff(start, _) | Fault::Reset(start) | Fault::HangCore1(start) | Fault::Panic(start, _) => start,
         }
     }
 }
@@ -53,7 +58,8 @@ impl Fault {
 struct Scenario {
     name: &'static str,
     what: &'static str,
-    fault: fn(&PanelFrame, &PanelFrame) -> Fault,
+    /// The fault, from the first two frames and the address of the firmware's `PANIC_REQUEST`.
+    fault: fn(&PanelFrame, &PanelFrame, u64) -> Fault,
 }
 
 /// The middle of frame `f`.
@@ -64,34 +70,49 @@ fn mid(f: &PanelFrame) -> f64 {
 /// The scenarios: a power cut in the middle of a frame (the bus sees it), one inside the pause
 /// after a frame (no transfer sees it: the board's probes do), a long one that spans the start
 /// of the next frame (its set-up waits for the panel); a reset in the middle of a frame; core 1
-/// stopping in the middle of a frame.
-const SCENARIOS: [Scenario; 5] = [
+/// stopping in the middle of a frame; a panic between frames.
+const SCENARIOS: [Scenario; 6] = [
     Scenario {
         name: "power cut mid-frame",
         what: "the display's power, the second frame half sent, back after 300 ms",
-        fault: |_, f1| Fault::PanelOff(mid(f1), 300.0),
+        fault: |_, f1, _| Fault::PanelOff(mid(f1), 300.0),
     },
     Scenario {
         name: "power cut in the pause",
         what: "the display's power, 0.7 s into the pause after the first frame, for 600 ms",
-        fault: |f0, _| Fault::PanelOff(f0.end_ms + 700.0, 600.0),
+        fault: |f0, _, _| Fault::PanelOff(f0.end_ms + 700.0, 600.0),
     },
     Scenario {
         name: "power cut across a frame's start",
         what: "the display's power, 2 s into the pause after the first frame, for 2.5 s",
-        fault: |f0, _| Fault::PanelOff(f0.end_ms + 2000.0, 2500.0),
+        fault: |f0, _, _| Fault::PanelOff(f0.end_ms + 2000.0, 2500.0),
     },
     Scenario {
         name: "reset mid-frame",
         what: "the RUN pin, the second frame half traced",
-        fault: |_, f1| Fault::Reset(mid(f1)),
+        fault: |_, f1, _| Fault::Reset(mid(f1)),
     },
     Scenario {
         name: "core 1 stops",
         what: "core 1 makes no more progress, the second frame half traced",
-        fault: |_, f1| Fault::HangCore1(mid(f1)),
+        fault: |_, f1, _| Fault::HangCore1(mid(f1)),
+    },
+    Scenario {
+        name: "panic",
+        what: "the firmware panics, 0.5 s into the pause after the first frame",
+        fault: |f0, _, request| Fault::Panic(f0.end_ms + 500.0, request),
     },
 ];
+
+/// What the board reported for a frame the panel showed.
+enum Outcome {
+    /// Scene `.0`'s frame, shown.
+    Frame(u8),
+    /// A frame the display did not take.
+    Failed,
+    /// The line saying why the last boot panicked.
+    Message,
+}
 
 /// What a scenario did, for the report.
 pub(super) struct FaultRow {
@@ -116,13 +137,14 @@ impl Session<'_> {
             self.checks.fail("the power cuts need the clean run's first two frames".into());
             return Ok(Vec::new());
         };
+        let request = crate::elf::Elf::read(&self.elf)?.symbol_address("PANIC_REQUEST")?.unwrap_or(0);
         let dir = self.frames_dir.join("faults");
         std::fs::create_dir_all(&dir)?;
         let mut rows = Vec::new();
         for sc in &SCENARIOS {
-            let fault = (sc.fault)(&f0.frame, &f1.frame);
+            let fault = (sc.fault)(&f0.frame, &f1.frame, request);
             let args = fault.args();
-            eprintln!("fault {}: {} {}", sc.name, args[0], args[1]);
+            eprintln!("fault {}: {}", sc.name, args.join(" "));
             let run = run_emulator(
                 self.root,
                 &self.elf,
@@ -131,54 +153,31 @@ impl Session<'_> {
                 FRAMES,
                 true,
                 &dir,
-                &[args[0].as_str(), args[1].as_str()],
+                &args.iter().map(String::as_str).collect::<Vec<_>>(),
             )?;
             let start = fault.start();
-            // When the fault ended: the power's return, the reset; for a stopped core, the
-            // watchdog's reset, which must come within its timeout (and a tile's time).
-            let end = match fault {
-                Fault::PanelOff(start, len) => Some(start + len),
-                Fault::Reset(at) => {
-                    let seen = run.resets.iter().any(|(why, ms)| why == "reset pin" && (ms - at).abs() < 1.0);
-                    self.checks.check(seen, || format!("{}: no reset at {at:.1} ms", sc.name));
-                    Some(at)
-                }
-                Fault::HangCore1(at) => {
-                    let reset = run.resets.iter().find(|(why, _)| why == "watchdog").map(|(_, ms)| *ms);
-                    self.checks.check(reset.is_some_and(|ms| ms - at <= WATCHDOG_MS + 100.0), || {
-                        format!("{}: the watchdog reset {reset:?} ms, core 1 stopped at {at:.1} ms (at most {WATCHDOG_MS} ms later)", sc.name)
-                    });
-                    let said = run.log.iter().any(|l| l.text.contains("the watchdog reset the board"));
-                    self.checks.check(said, || format!("{}: the next boot did not log why it reset", sc.name));
-                    reset
-                }
-            };
-            let outcomes: Vec<Option<u8>> = run
+            let end = self.fault_end(sc.name, fault, &run);
+            // A panic's reason: in the log of the next boot, and on the panel (checked below).
+            let panicked =
+                run.log.iter().find_map(|l| l.text.strip_prefix("the last boot panicked: ").map(str::to_string));
+            if let Fault::Panic(..) = fault {
+                self.checks.check(
+                    panicked.as_deref().is_some_and(|w| w.starts_with("a panic the test harness asked for")),
+                    || format!("{}: the next boot did not log the panic's reason ({panicked:?})", sc.name),
+                );
+            }
+            let outcomes: Vec<Outcome> = run
                 .records
                 .iter()
                 .filter_map(|r| match r {
-                    Record::Frame(f) => Some(Some(f.scene)),
-                    Record::Failed { .. } => Some(None),
+                    Record::Frame(f) => Some(Outcome::Frame(f.scene)),
+                    Record::Failed { .. } => Some(Outcome::Failed),
+                    Record::Panicked => Some(Outcome::Message),
                     _ => None,
                 })
                 .collect();
             let mut ok = self.checks.check(run.ok, || format!("{}: the run did not finish: {}", sc.name, run.reason));
-            let mut recovery_ms = None;
-            for (k, (frame, outcome)) in run.frames.iter().zip(&outcomes).enumerate() {
-                let Some(scene) = outcome else { continue };
-                let name = self.scenes.get(usize::from(*scene)).cloned().unwrap_or_default();
-                let want = host_frame(&self.scenes_dir, &name, PICO_SCALAR, PICO)?;
-                let same = frame.error.is_none() && frame.pixels == want;
-                ok &= self.checks.check(same, || {
-                    let why = frame.error.clone().unwrap_or_else(|| "it differs from host-sim's".into());
-                    format!("{}: frame {k} ({name}) was reported shown, but the panel: {why}", sc.name)
-                });
-                if let Some(end) = end {
-                    if same && frame.end_ms > end && recovery_ms.is_none() {
-                        recovery_ms = Some(frame.end_ms - end);
-                    }
-                }
-            }
+            let recovery_ms = self.check_frames(sc.name, &run, &outcomes, (end, panicked.as_deref()), &mut ok)?;
             ok &= self.checks.check(outcomes.len() >= run.frames.len(), || {
                 format!("{}: {} frames on the panel, {} reported", sc.name, run.frames.len(), outcomes.len())
             });
@@ -188,11 +187,85 @@ impl Session<'_> {
                     sc.name
                 )
             });
-            let failed = outcomes.iter().filter(|o| o.is_none()).count();
+            let failed = outcomes.iter().filter(|o| matches!(o, Outcome::Failed)).count();
             let resets = run.resets.iter().map(|(why, ms)| format!("{why} at {ms:.0} ms")).collect();
             rows.push(FaultRow { name: sc.name, what: sc.what, span: (start, end), resets, failed, recovery_ms, ok });
         }
         Ok(rows)
+    }
+
+    /// When `fault` ended in `run`: the power's return, the reset; for a stopped core and a
+    /// panic, the reset they cause, which must come in time (checked here, with the log's
+    /// reason for a stopped core).
+    fn fault_end(&mut self, name: &str, fault: Fault, run: &super::BoardRun) -> Option<f64> {
+        match fault {
+            Fault::PanelOff(start, len) => Some(start + len),
+            Fault::Reset(at) => {
+                let seen = run.resets.iter().any(|(why, ms)| why == "reset pin" && (ms - at).abs() < 1.0);
+                self.checks.check(seen, || format!("{name}: no reset at {at:.1} ms"));
+                Some(at)
+            }
+            Fault::HangCore1(at) => {
+                let reset = run.resets.iter().find(|(why, _)| why == "watchdog").map(|(_, ms)| *ms);
+                self.checks.check(reset.is_some_and(|ms| ms - at <= WATCHDOG_MS + 100.0), || {
+                    format!("{name}: the watchdog reset {reset:?} ms, core 1 stopped at {at:.1} ms (at most {WATCHDOG_MS} ms later)")
+                });
+                let said = run.log.iter().any(|l| l.text.contains("the watchdog reset the board"));
+                self.checks.check(said, || format!("{name}: the next boot did not log why it reset"));
+                reset
+            }
+            Fault::Panic(at, _) => {
+                let reset = run.resets.iter().find(|(why, ms)| why == "watchdog" && *ms >= at).map(|(_, ms)| *ms);
+                self.checks.check(reset.is_some_and(|ms| ms - at <= 100.0), || {
+                    format!("{name}: the panic at {at:.1} ms reset the board at {reset:?} ms")
+                });
+                reset
+            }
+        }
+    }
+
+    /// Each frame of `run` against what the board reported for it (`outcomes`, in order): a
+    /// frame it reported shown must be host-sim's, the panic's line must be the host's drawing
+    /// of it. Returns the time from the fault's `end` to the end of the next good frame.
+    fn check_frames(
+        &mut self,
+        name: &str,
+        run: &super::BoardRun,
+        outcomes: &[Outcome],
+        (end, panicked): (Option<f64>, Option<&str>),
+        ok: &mut bool,
+    ) -> Result<Option<f64>> {
+        let mut recovery_ms = None;
+        for (k, (frame, outcome)) in run.frames.iter().zip(outcomes).enumerate() {
+            let (scene, want) = match outcome {
+                Outcome::Failed => continue,
+                Outcome::Frame(scene) => {
+                    let scene = self.scenes.get(usize::from(*scene)).cloned().unwrap_or_default();
+                    let want = host_frame(&self.scenes_dir, &scene, PICO_SCALAR, PICO)?;
+                    (scene, want)
+                }
+                // The panic's line, drawn as the host draws messages.
+                Outcome::Message => {
+                    let line = format!("Panicked: {}", panicked.unwrap_or_default());
+                    let want = super::slot::message_frame(&line);
+                    *ok &= self.checks.check(frame.error.is_none() && frame.pixels == want, || {
+                        format!("{name}: the panel does not show \"{line}\"")
+                    });
+                    continue;
+                }
+            };
+            let same = frame.error.is_none() && frame.pixels == want;
+            *ok &= self.checks.check(same, || {
+                let why = frame.error.clone().unwrap_or_else(|| "it differs from host-sim's".into());
+                format!("{name}: frame {k} ({scene}) was reported shown, but the panel: {why}")
+            });
+            if let Some(end) = end {
+                if same && frame.end_ms > end && recovery_ms.is_none() {
+                    recovery_ms = Some(frame.end_ms - end);
+                }
+            }
+        }
+        Ok(recovery_ms)
     }
 }
 
@@ -202,7 +275,7 @@ pub(super) fn fault_report(rows: &[FaultRow]) -> Result<String> {
     writeln!(md, "\n## Faults on the desk: power cuts, resets, a core that stops\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask board`: each fault is one run of the default image on the emulated board ({FRAMES} frames), placed by the clean run's first two frames. *Power cut*: the emulated panel stops answering (every I2C address NACKs) and comes back as a freshly powered SSD1306, its settings and RAM lost and its display off (`run.mjs --panel-off START:LEN`). *Reset*: the chip resets as the RUN pin resets it (`--reset-at`); SRAM is kept, as on silicon. *Core 1 stops*: it makes no more progress (`--hang-core1-at`).\n\nWhat the firmware does: it sets the panel up before every frame (a write-only bus cannot tell that it lost power); it draws again a frame the display did not take once the panel answers (set up again every 100 ms); while it waits between frames it asks the panel every 20 ms whether it answers, and draws the frame again when it stopped and answers again. The watchdog ({WATCHDOG_MS:.0} ms) is fed by core 0 after each tile it traces, between frames and while it waits for the panel, never while it waits for core 1: a core that stops resets the board, and the next boot logs why. Checked in each run: every frame the board reported as shown is on the panel, bit-identical to host-sim's; a good frame ends within {RECOVERY_MS:.0} ms of the fault's end (the power's return, the reset); the run ends with no hard fault and no lock-up.\n"
+        "Written by `cargo xtask board`: each fault is one run of the default image on the emulated board ({FRAMES} frames), placed by the clean run's first two frames. *Power cut*: the emulated panel stops answering (every I2C address NACKs) and comes back as a freshly powered SSD1306, its settings and RAM lost and its display off (`run.mjs --panel-off START:LEN`). *Reset*: the chip resets as the RUN pin resets it (`--reset-at`); SRAM is kept, as on silicon. *Core 1 stops*: it makes no more progress (`--hang-core1-at`). *Panic*: the firmware panics between frames (`--panic-at`, through its `PANIC_REQUEST` word, the one way the harness can reach the panic handler).\n\nWhat the firmware does: it sets the panel up before every frame (a write-only bus cannot tell that it lost power); it draws again a frame the display did not take once the panel answers (set up again every 100 ms); while it waits between frames it asks the panel every 20 ms whether it answers, and draws the frame again when it stopped and answers again. The watchdog ({WATCHDOG_MS:.0} ms) is fed by core 0 after each tile it traces, between frames and while it waits for the panel, never while it waits for core 1: a core that stops resets the board, and the next boot logs why. Without a probe (the UF2 images; `cargo pico` keeps panic-probe), a panic writes its reason into RAM that a reset keeps, resets the board through the watchdog, and the next boot logs it and shows `Panicked: REASON` on the panel for 0.8 s before the scenes. Checked in each run: every frame the board reported as shown is on the panel, bit-identical to host-sim's; a good frame ends within {RECOVERY_MS:.0} ms of the fault's end (the power's return, the reset); the run ends with no hard fault and no lock-up.\n"
     )?;
     writeln!(md, "| scenario | fault | starts (ms from boot) | ends (ms) | resets | frames not taken | fault's end to the next good frame | passed |")?;
     writeln!(md, "|---|---|---:|---:|---|---:|---:|---|")?;
@@ -220,6 +293,6 @@ pub(super) fn fault_report(rows: &[FaultRow]) -> Result<String> {
             if r.ok { "yes" } else { "**no**" }
         )?;
     }
-    writeln!(md, "\nNot survived yet: a power cut shorter than the gaps between one frame's transfers (the bus idles while the cores trace) that ends before the frame's last byte. No transfer fails, the board reports the frame shown, and the panel stays dark until the next frame sets it up: an SSD1306 on I2C cannot be read back. The SPI image sees no cut at all (SPI has no acknowledge); its frames still set the panel up, so the next frame after the power's return is good. Not yet emulated: SDA held low by the panel (and the bus clear it needs), a panic without a probe.")?;
+    writeln!(md, "\nNot survived yet: a power cut shorter than the gaps between one frame's transfers (the bus idles while the cores trace) that ends before the frame's last byte. No transfer fails, the board reports the frame shown, and the panel stays dark until the next frame sets it up: an SSD1306 on I2C cannot be read back. The SPI image sees no cut at all (SPI has no acknowledge); its frames still set the panel up, so the next frame after the power's return is good. Not yet emulated: SDA held low by the panel (and the bus clear it needs).")?;
     Ok(md)
 }

@@ -61,7 +61,7 @@ fn cut(text: &str) -> String {
 }
 
 /// The panel's bits of `message` as the board draws it.
-fn message_frame(message: &str) -> Vec<u8> {
+pub(super) fn message_frame(message: &str) -> Vec<u8> {
     let mut bits = vec![0u8; BitFrame::bytes(PANEL.0, PANEL.1)];
     let mut frame = BitFrame::new(PANEL.0, PANEL.1, &mut bits).expect("sized");
     let Ok(()) = board_records::message::draw(&mut frame, PANEL.0, PANEL.1, message);

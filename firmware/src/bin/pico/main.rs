@@ -31,6 +31,7 @@ use display::SetUp;
 use firmware::app::{SceneMemory, ShareMemory, HEIGHT, SCENES, WIDTH};
 use hal::pac;
 use hal::Clock;
+#[cfg(feature = "probe")]
 use panic_probe as _;
 #[cfg(feature = "pico")]
 use rp2040_hal as hal;
@@ -159,5 +160,9 @@ fn main() -> ! {
     let Some(second) = cortex_m::singleton!(: ShareMemory = ShareMemory::new()) else {
         defmt::panic!("the second share's memory is taken")
     };
-    modes::run(modes::Panel { target, led, timer, alarm, cores, st: &mut st, second })
+    let mut panel = modes::Panel { target, led, timer, alarm, cores, st: &mut st, second };
+    if let Some(why) = guard::last_panic() {
+        panel.report_panic(why.as_str());
+    }
+    modes::run(panel)
 }

@@ -21,6 +21,9 @@ use lattice_rt::render::RenderError;
 /// The pause between two scenes.
 const PAUSE_MS: u32 = 3000;
 
+/// How long the line that says why the last boot panicked stays on the panel.
+const PANIC_LINE_MS: u32 = 800;
+
 /// How often a panel that does not answer is set up again.
 const RETRY_MS: u32 = 100;
 
@@ -105,9 +108,34 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
         })
     }
 
+    /// Reports why the last boot panicked: in the log, as a record, and on the panel for
+    /// [`PANIC_LINE_MS`]. Out of line: its buffers (and the message's 1 KiB frame) take stack
+    /// only when a boot has something to report.
+    #[inline(never)]
+    pub fn report_panic(&mut self, why: &str) {
+        defmt::error!("the last boot panicked: {}", why);
+        report(Record::Panicked);
+        const HEAD: &str = "Panicked: ";
+        // The note holds at most 120 bytes of whole characters: the line fits.
+        let mut bytes = [0u8; 160];
+        let n = (HEAD.len() + why.len()).min(bytes.len());
+        for (b, c) in bytes.iter_mut().zip(HEAD.bytes().chain(why.bytes())) {
+            *b = c;
+        }
+        let text = core::str::from_utf8(&bytes[..n]).unwrap_or(HEAD);
+        if self.message(text).is_err() {
+            defmt::error!("the display did not take the message");
+        }
+        // Long enough to read the line, short enough that a picture follows within a second.
+        for _ in 0..PANIC_LINE_MS / PROBE_MS {
+            sleep_ms(&mut self.alarm, PROBE_MS);
+            crate::guard::feed();
+        }
+    }
+
     /// Shows `text` on the panel in place of a picture (`board_records::message`, as the host
     /// draws it), with the LED lit until it is on the panel, as for a frame.
-    #[cfg(feature = "slot")]
+    #[inline(never)]
     pub fn message(&mut self, text: &str) -> Result<(), DisplayError> {
         use embedded_graphics_core::geometry::{Point, Size};
         use embedded_graphics_core::primitives::Rectangle;
@@ -156,6 +184,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
         for _ in 0..PAUSE_MS / PROBE_MS {
             sleep_ms(&mut self.alarm, PROBE_MS);
             crate::guard::feed();
+            crate::guard::check_requests();
             match (self.target.answers(), lost) {
                 (false, _) => lost = true,
                 (true, true) => {
