@@ -675,7 +675,8 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         let eps = R::offset(p.max_abs(), obj.size());
         // Secondary rays start off the flat surface; a smooth triangle shades (lights, mirrors,
         // refracts) by its interpolated normal.
-        let (outside, inside) = (p + side.normal * eps, p - side.normal * eps);
+        let flat_normal = side.normal;
+        let outside = p + flat_normal * eps;
         if flat && !scene.smooth.is_empty() {
             if let Some(s) = scene.smooth_of(hit.object) {
                 side.normal = s.normal(hit.point, side.normal);
@@ -695,6 +696,9 @@ impl<'s, 'a, R: Real, A: Accelerator<R> + ?Sized, const E: u8> Tracer<'s, 'a, R,
         }
         let lit = node.weight.weigh(local);
         if children {
+            // Only a refracted child starts inside: computed here, off the path of hits
+            // without children.
+            let inside = p - flat_normal * eps;
             self.push_children(node, (d, &side), (inside, outside, leaving), (reflects, refracts, m), stack);
         }
         lit
