@@ -31,6 +31,12 @@
 // boots again (SRAM and the watchdog's scratch registers kept, as on silicon; the watchdog's
 // REASON says TIMER after its own reset, nothing after the RUN pin) and the run goes on, with an
 // {"event":"reset"} line and the emulated time running on.
+// --sda-stuck START_MS:PULSES (repeatable) has the display hold SDA low at START_MS, as a panel
+// whose transfer was cut off in the middle of a byte does, until it has seen PULSES (1 to 9)
+// falling SCL edges: the controller sees a busy bus and sends nothing until the firmware clears
+// it through the pins (I2C0's SDA on GP4, SCL on GP5). --nack-at MS (repeatable): the display
+// does not acknowledge the first byte written to it after MS. Each gives an {"event":"bus"}
+// line when it happens (what: "sda held", "sda released", "nack").
 // --panic-at MS with --panic-request ADDR writes 1 to the word at ADDR (the firmware's
 // PANIC_REQUEST) at MS: the firmware panics at its next check between frames.
 // --pass-bytes N shows a picture every N GDDRAM bytes the display receives while the LED is lit
@@ -45,6 +51,7 @@
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
 //                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
+//                     [--sda-stuck START_MS:PULSES] [--nack-at MS]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
@@ -52,12 +59,14 @@ import { Ssd1306 } from './ssd1306.mjs';
 const LED_PIN = 25;
 /** The SPI display's control pins (firmware/src/bin/pico/wiring.rs, `spi`). */
 const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
+/** The I2C display's pins (wiring.rs): I2C0's SDA and SCL. */
+const I2C_PINS = { sda: 4, scl: 5 };
 // Every how many instructions --profile samples the program counter (a prime, so no loop of
 // the renderer beats in step with it).
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [] };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [], sdaStuck: [], nackAt: [] };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -85,7 +94,13 @@ function parseArgs(argv) {
       const m = /^(\d+(?:\.\d+)?):(\d+(?:\.\d+)?)$/.exec(v);
       if (!m) throw new Error(`--panel-off ${v}: START_MS:LEN_MS expected`);
       o.panelOff.push({ startMs: Number(m[1]), lenMs: Number(m[2]) });
-    } else if (a === '--reset-at') o.resetAt.push(Number(next()));
+    } else if (a === '--sda-stuck') {
+      const v = next();
+      const m = /^(\d+(?:\.\d+)?):([1-9])$/.exec(v);
+      if (!m) throw new Error(`--sda-stuck ${v}: START_MS:PULSES expected (PULSES 1 to 9)`);
+      o.sdaStuck.push({ startMs: Number(m[1]), pulses: Number(m[2]) });
+    } else if (a === '--nack-at') o.nackAt.push(Number(next()));
+    else if (a === '--reset-at') o.resetAt.push(Number(next()));
     else if (a === '--hang-core1-at') o.hangAt.push(Number(next()));
     else if (a === '--panic-at') o.panicAt.push(Number(next()));
     else if (a === '--panic-request') o.panicRequest = Number(next());
@@ -251,7 +266,8 @@ function main() {
     emit(frame);
     frameStart = opt.passBytes ? end : null;
     firstByteOfFrame = null;
-    if (why && opt.panelOff.length + opt.resetAt.length + opt.hangAt.length + opt.panicAt.length === 0) board.stop = `display: ${why}`;
+    const faults = [opt.panelOff, opt.resetAt, opt.hangAt, opt.panicAt, opt.sdaStuck, opt.nackAt];
+    if (why && faults.every((f) => f.length === 0)) board.stop = `display: ${why}`;
     else if (frames.length >= opt.frames && !opt.passBytes) draining = true;
   };
   let passData = 0; // GDDRAM bytes since the LED went on (--pass-bytes)
@@ -292,6 +308,11 @@ function main() {
   for (const ms of opt.resetAt) moments.push({ nanos: ms * 1e6, fn: () => (pendingReset ??= 'reset pin') });
   for (const ms of opt.hangAt) moments.push({ nanos: ms * 1e6, fn: () => (board.held[1] = true) });
   for (const ms of opt.panicAt) moments.push({ nanos: ms * 1e6, fn: () => mcu.writeUint32(opt.panicRequest, 1) });
+  const busEvent = (what) => emit({ event: 'bus', what, ms: (mcu.clock.nanos + epoch.nanos) / 1e6 });
+  for (const { startMs, pulses } of display ? opt.sdaStuck : []) {
+    moments.push({ nanos: startMs * 1e6, fn: () => (board.holdSda(0, pulses), busEvent('sda held')) });
+  }
+  for (const ms of display ? opt.nackAt : []) moments.push({ nanos: ms * 1e6, fn: () => board.nackNext(0) });
 
   /** A board from power-on (or, with `kept`, after a reset: SRAM and the watchdog's scratch and reason). */
   const boot = (kept) => {
@@ -308,7 +329,10 @@ function main() {
           if (!ack) naks++;
         },
         byte,
+        nack: () => busEvent('nack'),
+        released: () => busEvent('sda released'),
       },
+      pins: I2C_PINS,
     });
     board.attachSpi(0, display, { ...SPI_DISPLAY, timed: opt.timedBus, listen: { byte } });
     board.gpio(LED_PIN).addListener(onLed);
@@ -324,6 +348,7 @@ function main() {
       mcu.sram.set(kept.sram);
       watchdog.scratchData.set(kept.scratch);
       watchdog.reason = kept.reason;
+      if (kept.sdaStuck) board.holdSda(0, kept.sdaStuck);
     }
     rtt.mcu = mcu;
     if (records) records.mcu = mcu;
@@ -342,7 +367,12 @@ function main() {
     const s = board.snapshot();
     epoch = { cycles: epoch.cycles + s.cycles, nanos: epoch.nanos + s.nanos };
     const watchdog = mcu.peripherals[0x40058];
-    const kept = { sram: mcu.sram.slice(), scratch: watchdog.scratchData.slice(), reason: why === 'watchdog' ? watchdog.reason : 0 };
+    const kept = {
+      sram: mcu.sram.slice(),
+      scratch: watchdog.scratchData.slice(),
+      reason: why === 'watchdog' ? watchdog.reason : 0,
+      sdaStuck: board.i2cBuses[0]?.stuck ?? 0, // the panel does not reset with the chip
+    };
     emit({ event: 'reset', reason: why, ms: epoch.nanos / 1e6, frames: frames.length });
     resets++;
     // A frame under way is lost; the display sees its transfer cut off (no STOP).

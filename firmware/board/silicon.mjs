@@ -43,6 +43,8 @@ const FLASH_REGION = 0x1; // 0x10000000..0x1fffffff; the XIP aliases are 0x10..0
 const PSM_FRCE_OFF = 0x40010004;
 const PROC1 = 1 << 16;
 const I2C_FS_SPKLEN = [0x400440a0, 0x400480a0];
+const RESETS_RESET = 0x4000c000;
+const RESET_I2C = [1 << 3, 1 << 4]; // RESETS' bits for I2C0 and I2C1
 const OP_WFE = 0xbf20;
 
 // SIO registers this file answers per core (the rest go to rp2040js's SIO, shared).
@@ -455,6 +457,7 @@ export class SiliconBoard {
     this.busCycles = 0; // cycles the display buses spent: I2C START, bytes and STOP; SPI frames
     this.stop = null; // why the run must end
     for (const i2c of mcu.i2c) levelTxEmpty(i2c);
+    this.i2cBuses = [null, null]; // each I2C bus's wires and faults (attachI2c)
   }
 
   loadBootrom(words) {
@@ -503,6 +506,29 @@ export class SiliconBoard {
     }
     const i = I2C_FS_SPKLEN.indexOf(base);
     if (i >= 0 && kind === 0) this.spklen[i] = value & 0xff;
+    if (base === RESETS_RESET) {
+      const before = this.mcu.peripherals[0x4000c].reset;
+      const after = [value, before ^ value, before | value, before & ~value][kind];
+      for (const [n, bit] of RESET_I2C.entries()) if (after & bit && !(before & bit)) this.resetI2c(n);
+    }
+  }
+
+  /**
+   * RESETS puts I2C controller `n` in reset: every register back to its reset value, the
+   * transfer under way dropped with every bus event still due for it (a START waiting for a
+   * busy bus included). rp2040js's RESETS keeps peripherals as they are; silicon does not.
+   */
+  resetI2c(n) {
+    const i2c = this.mcu.i2c[n];
+    const fresh = new i2c.constructor(i2c.rp2040, i2c.name, i2c.irq);
+    for (const [k, v] of Object.entries(fresh)) if (typeof v !== 'function') i2c[k] = v;
+    i2c.checkInterrupts();
+    this.spklen[n] = 7;
+    const bus = this.i2cBuses[n];
+    if (bus) {
+      bus.generation++;
+      bus.waiting = false;
+    }
   }
 
   /** SEV on core `from`: both event registers are set; a core asleep in WFE wakes. */
@@ -605,20 +631,43 @@ export class SiliconBoard {
   }
 
   /**
-   * Puts `device` (start, connect, write, stop; see ssd1306.mjs) on I2C controller `n`, with
-   * the bus's timing unless `timed` is false. `listen` hears each event as the bus finishes it.
+   * Puts `device` (start, connect, write, stop, interrupted; see ssd1306.mjs) on I2C controller
+   * `n`, with the bus's timing unless `timed` is false. `listen` hears each event as the bus
+   * finishes it (connect, byte, nack, released). With `pins` ({sda, scl}: GPIO numbers) the
+   * two wires are modelled too, pulled up, for firmware that takes the pins as GPIOs: each reads
+   * its line's level, and a START or STOP made on them reaches the device. Faults:
+   * `holdSda(n, pulses)` and `nackNext(n)`.
    */
-  attachI2c(n, device, { timed = true, listen = {} } = {}) {
+  attachI2c(n, device, { timed = true, listen = {}, pins = null } = {}) {
     const i2c = this.mcu.i2c[n];
-    const later = timed ? (periods, fn) => this.afterScl(n, periods, fn) : (_, fn) => fn();
-    i2c.onStart = () => {
+    // stuck: the falling SCL edges the device needs before it lets SDA go (0: it does not hold
+    // it); waiting: a START the controller is holding back for a busy bus; generation: bumped
+    // when the controller is reset, so events due for its old transfer are dropped.
+    const bus = { device, stuck: 0, nack: false, waiting: false, generation: 0, update: () => {} };
+    this.i2cBuses[n] = bus;
+    const later = (periods, fn) => {
+      const g = bus.generation;
+      const run = () => {
+        if (g === bus.generation) fn();
+      };
+      if (timed) this.afterScl(n, periods, run);
+      else run();
+    };
+    const start = () =>
       later(1, () => {
         device?.start();
         i2c.completeStart();
       });
+    // SDA held low: to the controller the bus is busy (another master's START), so it sends no
+    // START and no clock until it sees a STOP; nothing it sends while SDA is held gets through
+    // (it loses arbitration at its first 1 bit).
+    i2c.onStart = () => {
+      if (bus.stuck > 0) bus.waiting = true;
+      else start();
     };
     i2c.onConnect = (address, mode) => {
       later(9, () => {
+        if (bus.stuck > 0) return i2c.arbitrationLost();
         const ack = device ? device.connect(address, mode === 1) : false;
         listen.connect?.(ack);
         i2c.completeConnect(ack);
@@ -626,6 +675,14 @@ export class SiliconBoard {
     };
     i2c.onWriteByte = (value) => {
       later(9, () => {
+        if (bus.stuck > 0) return i2c.arbitrationLost();
+        if (bus.nack) {
+          // The device does not take this byte: what it held of a command is dropped.
+          bus.nack = false;
+          device?.interrupted();
+          listen.nack?.();
+          return i2c.completeWrite(false);
+        }
         listen.byte?.(value);
         i2c.completeWrite(device ? device.write(value) : false);
       });
@@ -637,6 +694,57 @@ export class SiliconBoard {
         i2c.completeStop();
       });
     };
+    if (pins) this.wireI2c(bus, device, pins, { start, listen });
+  }
+
+  /**
+   * The SDA and SCL wires of `bus` on GPIOs `sda` and `scl`: a line is low when the chip drives
+   * its pin low (SIO, output enabled) or, for SDA, while the device holds it; each falling SCL
+   * edge shifts a holding device on by a bit. SDA falling while SCL is high is a START, rising a
+   * STOP; a STOP frees the bus for a START the controller held back.
+   */
+  wireI2c(bus, device, { sda, scl }, { start, listen }) {
+    const [sdaPin, sclPin] = [this.mcu.gpio[sda], this.mcu.gpio[scl]];
+    let line = { sda: true, scl: true, held: false };
+    bus.update = () => {
+      const sclHigh = sclPin.value !== GPIOPinState.Low;
+      if (!sclHigh && line.scl && bus.stuck > 0 && --bus.stuck === 0) listen.released?.();
+      const held = bus.stuck > 0;
+      const sdaHigh = sdaPin.value !== GPIOPinState.Low && !held;
+      // A START or STOP is the chip's doing: the device taking SDA is not one to itself.
+      if (sclHigh && line.scl && sdaHigh !== line.sda && held === line.held) {
+        if (!sdaHigh) device?.start();
+        else {
+          device?.stop();
+          if (bus.waiting) {
+            bus.waiting = false;
+            start();
+          }
+        }
+      }
+      line = { sda: sdaHigh, scl: sclHigh, held };
+      sdaPin.setInputValue(sdaHigh);
+      sclPin.setInputValue(sclHigh);
+    };
+    sdaPin.addListener(bus.update);
+    sclPin.addListener(bus.update);
+    bus.update();
+  }
+
+  /**
+   * The device on I2C bus `n` holds SDA low (its transfer cut off in the middle of a byte)
+   * until it has seen `pulses` falling SCL edges (1 to 9: the rest of its byte).
+   */
+  holdSda(n, pulses) {
+    const bus = this.i2cBuses[n];
+    bus.stuck = pulses;
+    bus.device?.interrupted();
+    bus.update();
+  }
+
+  /** The device on I2C bus `n` does not acknowledge the next byte written to it. */
+  nackNext(n) {
+    this.i2cBuses[n].nack = true;
   }
 
   /** Clock cycles (clk_sys) one frame of SPI controller `n` takes on its bus, from its registers. */

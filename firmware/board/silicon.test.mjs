@@ -149,3 +149,87 @@ test('a panel that loses power answers nothing, and comes back dark with its set
   assert.equal(d.gddram.every((b) => b === 0), true, 'its RAM lost');
   assert.equal(d.connect(0x3c, false), true, 'power back: it answers');
 });
+
+test('a panel holding SDA low keeps the controller from its START until the pins clock it free and make a STOP', () => {
+  const board = new SiliconBoard({ dualCore: false });
+  const mcu = board.mcu;
+  const bus = board.buses[0]; // writes as core 0 makes them (RESETS reaches the board first)
+  const seen = [];
+  const device = {
+    start: () => seen.push('start'),
+    connect: (a) => (seen.push(`connect ${a.toString(16)}`), true),
+    write: (b) => (seen.push(`write ${b.toString(16)}`), true),
+    stop: () => seen.push('stop'),
+    interrupted: () => seen.push('interrupted'),
+  };
+  const events = [];
+  board.attachI2c(0, device, { timed: false, pins: { sda: 4, scl: 5 }, listen: { released: () => events.push('released') } });
+  const I2C = 0x40044000;
+  const ACTIVITY = 1;
+  const line = (pin) => (bus.readUint32(0xd0000004) >>> pin) & 1; // SIO GPIO_IN
+  for (const pin of [4, 5]) bus.writeUint32(0x4001c004 + 4 * pin, 0x4a); // pads: input enabled, pull-up
+  assert.equal(line(4), 1, 'an idle bus reads high');
+  board.holdSda(0, 2);
+  assert.deepEqual(seen, ['interrupted']);
+  assert.equal(line(4), 0, 'SDA reads low while the panel holds it');
+  bus.writeUint32(I2C + 0x04, 0x3c); // IC_TAR
+  bus.writeUint32(I2C + 0x6c, 1); // IC_ENABLE
+  bus.writeUint32(I2C + 0x10, 0x200 | 0x80); // one byte, then STOP
+  assert.equal(bus.readUint32(I2C + 0x70) & ACTIVITY, ACTIVITY, 'the controller waits for the bus');
+  assert.deepEqual(seen, ['interrupted'], 'no START while SDA is held');
+  // The pins as GPIOs (FUNCSEL 5), outputs at 0: a pin is driven low by enabling its output.
+  for (const pin of [4, 5]) bus.writeUint32(0x40014004 + 8 * pin, 5);
+  const drive = (pin, low) => bus.writeUint32(low ? 0xd0000024 : 0xd0000028, 1 << pin); // GPIO_OE_SET/CLR
+  drive(5, true);
+  drive(5, false);
+  assert.equal(line(4), 0, 'one pulse of the two it needs');
+  drive(5, true);
+  assert.deepEqual(events, ['released'], 'the second falling edge ends its byte');
+  drive(5, false);
+  assert.equal(line(4), 1);
+  // STOP: SDA low while SCL is low, SCL high, then SDA high.
+  drive(5, true);
+  drive(4, true);
+  drive(5, false);
+  drive(4, false);
+  assert.deepEqual(seen, ['interrupted', 'stop', 'start', 'connect 3c', 'write 80', 'stop'], 'the STOP frees the bus: the held START goes out');
+});
+
+test('RESETS drops a START the I2C controller holds back for a busy bus', () => {
+  const board = new SiliconBoard({ dualCore: false });
+  const bus = board.buses[0];
+  const seen = [];
+  const device = { start: () => seen.push('start'), connect: () => true, write: () => true, stop: () => seen.push('stop'), interrupted() {} };
+  board.attachI2c(0, device, { timed: false, pins: { sda: 4, scl: 5 } });
+  const I2C = 0x40044000;
+  board.holdSda(0, 1);
+  bus.writeUint32(I2C + 0x6c, 1);
+  bus.writeUint32(I2C + 0x10, 0x200);
+  assert.equal(bus.readUint32(I2C + 0x70) & 1, 1);
+  bus.writeUint32(0x4000c000 + 0x2000, 1 << 3); // RESETS set alias: I2C0 into reset
+  assert.equal(bus.readUint32(I2C + 0x70) & 1, 0, 'idle after its reset');
+  assert.equal(bus.readUint32(I2C + 0x6c), 0, 'IC_ENABLE back to 0');
+  assert.equal(board.mcu.i2c[0].txFIFO.itemCount, 0, 'its FIFO emptied');
+  assert.deepEqual(seen, []);
+});
+
+test('a byte the panel does not acknowledge aborts the transfer, and the panel drops its half command', () => {
+  const board = new SiliconBoard({ dualCore: false });
+  const bus = board.buses[0];
+  const seen = [];
+  const device = {
+    start: () => seen.push('start'),
+    connect: () => true,
+    write: (b) => (seen.push(b), true),
+    stop: () => seen.push('stop'),
+    interrupted: () => seen.push('interrupted'),
+  };
+  board.attachI2c(0, device, { timed: false });
+  const I2C = 0x40044000;
+  bus.writeUint32(I2C + 0x6c, 1);
+  bus.writeUint32(I2C + 0x10, 0x00);
+  board.nackNext(0);
+  bus.writeUint32(I2C + 0x10, 0x81);
+  assert.deepEqual(seen, ['start', 0x00, 'interrupted', 'stop']);
+  assert.equal(bus.readUint32(I2C + 0x80) & (1 << 3), 1 << 3, 'IC_TX_ABRT_SOURCE: ABRT_TXDATA_NOACK');
+});

@@ -170,6 +170,15 @@ export class Ssd1306 {
     } else this.command(byte);
   }
 
+  /**
+   * A transfer cut off by a fault on the bus (a byte it did not acknowledge, SDA held low):
+   * the command it was collecting arguments for is dropped, with no error.
+   */
+  interrupted() {
+    this.cmd = null;
+    this.args = [];
+  }
+
   /** An I2C STOP. */
   stop() {
     if (this.selected && this.cmd !== null) {

@@ -218,6 +218,8 @@ enum Event {
     Frame(PanelFrame),
     /// The chip reset (run.mjs's `reset` event: why, and when in emulated milliseconds).
     Reset(String, f64),
+    /// A fault on the display's bus (run.mjs's `bus` event: what, and when).
+    Bus(String, f64),
     End(RunEnd),
 }
 
@@ -231,6 +233,7 @@ impl Event {
             Some("reset") => {
                 Event::Reset(v["reason"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0))
             }
+            Some("bus") => Event::Bus(v["what"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0)),
             _ => bail!("emulator printed an unknown event: {line}"),
         };
         Ok(event)
@@ -265,6 +268,8 @@ struct BoardRun {
     records: Vec<Record>,
     /// The chip's resets: why, and when (emulated milliseconds from the first boot).
     resets: Vec<(String, f64)>,
+    /// The faults on the display's bus as they happened: what, and when.
+    bus: Vec<(String, f64)>,
 }
 
 /// One decoded defmt log line.
@@ -332,6 +337,10 @@ fn run_emulator(
             Event::Reset(why, ms) => {
                 eprintln!("  reset ({why}) at {ms:.1} ms");
                 run.resets.push((why, ms));
+            }
+            Event::Bus(what, ms) => {
+                eprintln!("  bus: {what} at {ms:.1} ms");
+                run.bus.push((what, ms));
             }
             Event::End(e) => {
                 run.ok = e.ok;

@@ -4,7 +4,9 @@
 //! the RUN pin) and core 1 stopping for good (`--hang-core1-at`, which the watchdog must turn
 //! into a reset). Each run checks what the board did: every frame it reported as shown is on
 //! the panel, bit-identical to host-sim's, and a good frame follows within a second of the
-//! fault's end (the power's return, the reset).
+//! fault's end (the power's return, the reset). On the bus: the panel holding SDA low until it
+//! is clocked (`--sda-stuck`, which the firmware must clear through the pins) and one byte not
+//! acknowledged (`--nack-at`).
 
 use super::{host_frame, run_emulator, PanelFrame, SceneRow, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
@@ -31,6 +33,10 @@ enum Fault {
     HangCore1(f64),
     /// The firmware panics (asked through its `PANIC_REQUEST` word at this address).
     Panic(f64, u64),
+    /// The panel holds SDA low until it has seen the second's falling SCL edges.
+    SdaStuck(f64, u8),
+    /// The panel does not acknowledge the first byte after this moment.
+    Nack(f64),
 }
 
 impl Fault {
@@ -43,12 +49,19 @@ impl Fault {
             Fault::Panic(at, request) => {
                 vec!["--panic-at".into(), format!("{at:.3}"), "--panic-request".into(), format!("{request:#x}")]
             }
+            Fault::SdaStuck(at, pulses) => vec!["--sda-stuck".into(), format!("{at:.3}:{pulses}")],
+            Fault::Nack(at) => vec!["--nack-at".into(), format!("{at:.3}")],
         }
     }
     /// When it starts.
     fn start(self) -> f64 {
         match self {
-            Fault::PanelOff(start, _) | Fault::Reset(start) | Fault::HangCore1(start) | Fault::Panic(start, _) => start,
+            Fault::PanelOff(start, _)
+            | Fault::Reset(start)
+            | Fault::HangCore1(start)
+            | Fault::Panic(start, _)
+            | Fault::SdaStuck(start, _)
+            | Fault::Nack(start) => start,
         }
     }
 }
@@ -70,8 +83,9 @@ fn mid(f: &PanelFrame) -> f64 {
 /// The scenarios: a power cut in the middle of a frame (the bus sees it), one inside the pause
 /// after a frame (no transfer sees it: the board's probes do), a long one that spans the start
 /// of the next frame (its set-up waits for the panel); a reset in the middle of a frame; core 1
-/// stopping in the middle of a frame; a panic between frames.
-const SCENARIOS: [Scenario; 6] = [
+/// stopping in the middle of a frame; a panic between frames; SDA held low in the middle of a
+/// frame and in the pause; one byte of a frame not acknowledged.
+const SCENARIOS: [Scenario; 9] = [
     Scenario {
         name: "power cut mid-frame",
         what: "the display's power, the second frame half sent, back after 300 ms",
@@ -101,6 +115,21 @@ const SCENARIOS: [Scenario; 6] = [
         name: "panic",
         what: "the firmware panics, 0.5 s into the pause after the first frame",
         fault: |f0, _, request| Fault::Panic(f0.end_ms + 500.0, request),
+    },
+    Scenario {
+        name: "SDA held low mid-frame",
+        what: "the panel holds SDA low, the second frame half sent, until clocked 9 times",
+        fault: |_, f1, _| Fault::SdaStuck(mid(f1), 9),
+    },
+    Scenario {
+        name: "SDA held low in the pause",
+        what: "the panel holds SDA low, 0.3 s into the pause after the first frame, until clocked once",
+        fault: |f0, _, _| Fault::SdaStuck(f0.end_ms + 300.0, 1),
+    },
+    Scenario {
+        name: "one byte not acknowledged",
+        what: "the panel does not acknowledge one byte, the second frame half sent",
+        fault: |_, f1, _| Fault::Nack(mid(f1)),
     },
 ];
 
@@ -221,6 +250,23 @@ impl Session<'_> {
                 });
                 reset
             }
+            // The fault ends when the firmware's bus clear has clocked the panel free.
+            Fault::SdaStuck(at, _) => {
+                let released = run.bus.iter().find(|(what, ms)| what == "sda released" && *ms >= at).map(|(_, ms)| *ms);
+                self.checks.check(released.is_some_and(|ms| ms - at <= RECOVERY_MS), || {
+                    format!(
+                        "{name}: SDA held low at {at:.1} ms, released {released:?} (at most {RECOVERY_MS} ms later)"
+                    )
+                });
+                let said = run.log.iter().any(|l| l.text.contains("the bus cleared with"));
+                self.checks.check(said, || format!("{name}: the firmware did not log its bus clear"));
+                released
+            }
+            Fault::Nack(at) => {
+                let nack = run.bus.iter().find(|(what, ms)| what == "nack" && *ms >= at).map(|(_, ms)| *ms);
+                self.checks.check(nack.is_some(), || format!("{name}: no byte went unacknowledged after {at:.1} ms"));
+                nack
+            }
         }
     }
 
@@ -272,10 +318,10 @@ impl Session<'_> {
 /// The report's section on the faults.
 pub(super) fn fault_report(rows: &[FaultRow]) -> Result<String> {
     let mut md = String::new();
-    writeln!(md, "\n## Faults on the desk: power cuts, resets, a core that stops\n")?;
+    writeln!(md, "\n## Faults on the desk: power cuts, resets, a core that stops, a stuck bus\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask board`: each fault is one run of the default image on the emulated board ({FRAMES} frames), placed by the clean run's first two frames. *Power cut*: the emulated panel stops answering (every I2C address NACKs) and comes back as a freshly powered SSD1306, its settings and RAM lost and its display off (`run.mjs --panel-off START:LEN`). *Reset*: the chip resets as the RUN pin resets it (`--reset-at`); SRAM is kept, as on silicon. *Core 1 stops*: it makes no more progress (`--hang-core1-at`). *Panic*: the firmware panics between frames (`--panic-at`, through its `PANIC_REQUEST` word, the one way the harness can reach the panic handler).\n\nWhat the firmware does: it sets the panel up before every frame (a write-only bus cannot tell that it lost power); it draws again a frame the display did not take once the panel answers (set up again every 100 ms); while it waits between frames it asks the panel every 20 ms whether it answers, and draws the frame again when it stopped and answers again. The watchdog ({WATCHDOG_MS:.0} ms) is fed by core 0 after each tile it traces, between frames and while it waits for the panel, never while it waits for core 1: a core that stops resets the board, and the next boot logs why. Without a probe (the UF2 images; `cargo pico` keeps panic-probe), a panic writes its reason into RAM that a reset keeps, resets the board through the watchdog, and the next boot logs it and shows `Panicked: REASON` on the panel for 0.8 s before the scenes. Checked in each run: every frame the board reported as shown is on the panel, bit-identical to host-sim's; a good frame ends within {RECOVERY_MS:.0} ms of the fault's end (the power's return, the reset); the run ends with no hard fault and no lock-up.\n"
+        "Written by `cargo xtask board`: each fault is one run of the default image on the emulated board ({FRAMES} frames), placed by the clean run's first two frames. *Power cut*: the emulated panel stops answering (every I2C address NACKs) and comes back as a freshly powered SSD1306, its settings and RAM lost and its display off (`run.mjs --panel-off START:LEN`). *Reset*: the chip resets as the RUN pin resets it (`--reset-at`); SRAM is kept, as on silicon. *Core 1 stops*: it makes no more progress (`--hang-core1-at`). *Panic*: the firmware panics between frames (`--panic-at`, through its `PANIC_REQUEST` word, the one way the harness can reach the panic handler). *SDA held low*: the panel holds SDA low, as one whose transfer was cut off in the middle of a byte does, until it has seen the given number of falling SCL edges (`--sda-stuck START:PULSES`); the controller then sees a busy bus and sends no START (the RP2040's I2C block has no bus clear of its own). *Not acknowledged*: the panel does not acknowledge one byte (`--nack-at`).\n\nWhat the firmware does: it sets the panel up before every frame (a write-only bus cannot tell that it lost power); it draws again a frame the display did not take once the panel answers (set up again every 100 ms); while it waits between frames it asks the panel every 20 ms whether it answers, and draws the frame again when it stopped and answers again. A transfer that fails or moves no byte for 10 ms resets the I2C controller before the next one and, when SDA reads low, clears the bus: SCL pulsed through the pins until the panel lets SDA go (at most 9 times), then a STOP. The watchdog ({WATCHDOG_MS:.0} ms) is fed by core 0 after each tile it traces, between frames and while it waits for the panel, never while it waits for core 1: a core that stops resets the board, and the next boot logs why. Without a probe (the UF2 images; `cargo pico` keeps panic-probe), a panic writes its reason into RAM that a reset keeps, resets the board through the watchdog, and the next boot logs it and shows `Panicked: REASON` on the panel for 0.8 s before the scenes. Checked in each run: every frame the board reported as shown is on the panel, bit-identical to host-sim's; a good frame ends within {RECOVERY_MS:.0} ms of the fault's end (the power's return, the reset); the run ends with no hard fault and no lock-up.\n"
     )?;
     writeln!(md, "| scenario | fault | starts (ms from boot) | ends (ms) | resets | frames not taken | fault's end to the next good frame | passed |")?;
     writeln!(md, "|---|---|---:|---:|---|---:|---:|---|")?;
@@ -293,6 +339,6 @@ pub(super) fn fault_report(rows: &[FaultRow]) -> Result<String> {
             if r.ok { "yes" } else { "**no**" }
         )?;
     }
-    writeln!(md, "\nNot survived yet: a power cut shorter than the gaps between one frame's transfers (the bus idles while the cores trace) that ends before the frame's last byte. No transfer fails, the board reports the frame shown, and the panel stays dark until the next frame sets it up: an SSD1306 on I2C cannot be read back. The SPI image sees no cut at all (SPI has no acknowledge); its frames still set the panel up, so the next frame after the power's return is good. Not yet emulated: SDA held low by the panel (and the bus clear it needs).")?;
+    writeln!(md, "\nNot survived yet: a power cut shorter than the gaps between one frame's transfers (the bus idles while the cores trace) that ends before the frame's last byte. No transfer fails, the board reports the frame shown, and the panel stays dark until the next frame sets it up: an SSD1306 on I2C cannot be read back. The SPI image sees no cut at all (SPI has no acknowledge); its frames still set the panel up, so the next frame after the power's return is good. A panel that holds SDA low through nine clock pulses needs its power cycled: the firmware logs it and keeps trying.")?;
     Ok(md)
 }

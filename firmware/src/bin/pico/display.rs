@@ -5,6 +5,8 @@
 //! frame is on the panel.
 
 #[cfg(not(feature = "spi"))]
+mod bus_clear;
+#[cfg(not(feature = "spi"))]
 mod i2c;
 #[cfg(not(feature = "spi"))]
 pub use i2c::{flush, reset, Pump, QueuedI2c};

@@ -54,6 +54,17 @@ pub type Alarm0 = hal::timer::Alarm0<hal::timer::CopyableTimer0>;
 #[cfg(feature = "pico2")]
 const ALARM_IRQ: pac::Interrupt = pac::Interrupt::TIMER0_IRQ_0;
 
+/// The timer's microseconds (its raw low word: it wraps every 71 minutes, so take differences
+/// with `wrapping_sub`), for waits that must not outlast a deadline (the I2C queue's).
+#[cfg(not(feature = "spi"))]
+pub fn micros() -> u32 {
+    // SAFETY: a read of TIMERAWL, which has no side effects (unlike TIMELR, which latches TIMEHR).
+    #[allow(unsafe_code)]
+    unsafe {
+        (*TimerBlock::ptr()).timerawl().read().bits()
+    }
+}
+
 /// Sleeps (`wfi`) until `alarm` has run `ms` milliseconds, instead of spinning: the core draws
 /// less power, and an emulator skips the idle time. The check and the `wfi` run with interrupts
 /// masked, so an alarm that fires between them still ends the `wfi` (a pending interrupt wakes

@@ -1,8 +1,12 @@
 //! The display on I2C0: a queue in RAM in front of the controller's TX FIFO, refilled by the
 //! controller's TX_EMPTY interrupt on core 0 (and after each tile core 0 traces), so the bus
-//! sends a band while the cores trace the next, and never waits for a tile to end.
+//! sends a band while the cores trace the next, and never waits for a tile to end. A transfer
+//! that fails (no acknowledge, arbitration lost, a bus that stops moving) leaves the controller
+//! reset and the bus cleared ([`super::bus_clear`]) before the next one.
 
 use crate::hal;
+use crate::wiring::Wiring;
+use core::sync::atomic::{AtomicBool, Ordering};
 use hal::pac;
 use hal::pac::interrupt;
 
@@ -21,6 +25,54 @@ pub struct QueuedI2c<P> {
     /// The one target address (set once: changing it needs the controller disabled, which would
     /// cut off a transfer under way).
     address: u8,
+    /// The controller's settings as set up, written again after it is reset ([`Self::recover`]).
+    settings: Settings,
+}
+
+/// What went wrong on the display's bus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BusError {
+    /// The controller aborted the transfer: IC_TX_ABRT_SOURCE's bits (no acknowledge of the
+    /// address or of a byte, arbitration lost).
+    Abort(u32),
+    /// The bus moved no byte for [`STALL_US`]: a START the controller cannot send (a device
+    /// holds SDA low, so the bus looks busy) or a transfer that never ends.
+    Stalled,
+    /// A transaction this queue does not take: a read, an empty write, another address.
+    Unsupported,
+}
+
+impl embedded_hal::i2c::Error for BusError {
+    fn kind(&self) -> embedded_hal::i2c::ErrorKind {
+        use embedded_hal::i2c::{ErrorKind, NoAcknowledgeSource};
+        match *self {
+            BusError::Abort(r) if r & ABRT_ADDR_NOACK != 0 => ErrorKind::NoAcknowledge(NoAcknowledgeSource::Address),
+            BusError::Abort(r) if r & ABRT_TXDATA_NOACK != 0 => ErrorKind::NoAcknowledge(NoAcknowledgeSource::Data),
+            BusError::Abort(r) if r & ABRT_ARB_LOST != 0 => ErrorKind::ArbitrationLoss,
+            _ => ErrorKind::Other,
+        }
+    }
+}
+
+/// IC_TX_ABRT_SOURCE: an address not acknowledged (7-bit, either 10-bit byte).
+const ABRT_ADDR_NOACK: u32 = 0b111;
+/// IC_TX_ABRT_SOURCE: a data byte not acknowledged.
+const ABRT_TXDATA_NOACK: u32 = 1 << 3;
+/// IC_TX_ABRT_SOURCE: arbitration lost (SDA low where the controller let it go high).
+const ABRT_ARB_LOST: u32 = 1 << 12;
+
+/// How long the bus may move no byte while bytes wait before the transfer counts as failed: a
+/// byte takes 22.5 µs at 400 kHz, so 10 ms is hundreds of bytes' time.
+const STALL_US: u32 = 10_000;
+
+/// Set when a transfer failed: the next transaction resets the controller and clears the bus
+/// first ([`QueuedI2c::recover`]).
+static FAILED: AtomicBool = AtomicBool::new(false);
+
+/// A failure, noted for the next transaction's recovery.
+fn failed(e: BusError) -> BusError {
+    FAILED.store(true, Ordering::Relaxed);
+    e
 }
 
 /// Words the queue holds: IC_DATA_CMD values (the byte, and the STOP bit on a transaction's
@@ -105,22 +157,54 @@ pub fn pump() {
 }
 
 /// The abort reported since the last call, if any.
-fn take_abort() -> Result<(), hal::i2c::Error> {
+fn take_abort() -> Result<(), BusError> {
     critical_section::with(|cs| {
         let mut q = QUEUE.borrow(cs).borrow_mut();
         pump_queue(&mut q);
-        q.abort.take().map_or(Ok(()), |reason| Err(hal::i2c::Error::Abort(reason)))
+        q.abort.take().map_or(Ok(()), |reason| Err(failed(BusError::Abort(reason))))
     })
 }
 
+/// Watches a wait on the bus: how much waits (queued words, FIFO entries, a transfer under way)
+/// and since when that has not changed.
+struct Progress {
+    waiting: u32,
+    since: u32,
+}
+
+impl Progress {
+    /// What waits now, and the timer's microseconds.
+    fn now() -> (u32, u32) {
+        let queued = critical_section::with(|cs| QUEUE.borrow(cs).borrow().len) as u32;
+        let r = regs();
+        let active = u32::from(r.ic_status().read().activity().bit_is_set());
+        (queued + r.ic_txflr().read().bits() + active, crate::sleep::micros())
+    }
+
+    fn start() -> Self {
+        let (waiting, since) = Self::now();
+        Progress { waiting, since }
+    }
+
+    /// `Stalled` when nothing has moved for [`STALL_US`]; else whether anything still waits.
+    fn check(&mut self) -> Result<bool, BusError> {
+        let (waiting, now) = Self::now();
+        if waiting != self.waiting {
+            *self = Progress { waiting, since: now };
+        } else if waiting > 0 && now.wrapping_sub(self.since) > STALL_US {
+            return Err(failed(BusError::Stalled));
+        }
+        Ok(waiting > 0)
+    }
+}
+
 /// Waits until every queued byte has left the controller and the bus is idle: the frame is on
-/// the panel. Reports an abort of the last transfers.
-pub fn flush() -> Result<(), hal::i2c::Error> {
+/// the panel. Reports an abort of the last transfers, or a bus that stopped moving.
+pub fn flush() -> Result<(), BusError> {
+    let mut progress = Progress::start();
     loop {
         take_abort()?;
-        let empty = critical_section::with(|cs| QUEUE.borrow(cs).borrow().len == 0);
-        let status = regs().ic_status().read();
-        if empty && status.tfe().bit_is_set() && status.activity().bit_is_clear() {
+        if !progress.check()? {
             return take_abort();
         }
     }
@@ -135,6 +219,45 @@ impl lattice_rt::render::Hooks for Pump {
         pump();
         crate::guard::feed();
         true
+    }
+}
+
+/// The controller's registers the HAL and [`QueuedI2c::new`] set: IC_CON, the SCL counts,
+/// the spike filter, the SDA hold time, IC_TAR and IC_TX_TL.
+#[derive(Clone, Copy)]
+struct Settings([u32; 7]);
+
+impl Settings {
+    /// The registers as they are.
+    fn read() -> Self {
+        let r = regs();
+        Settings([
+            r.ic_con().read().bits(),
+            r.ic_fs_scl_hcnt().read().bits(),
+            r.ic_fs_scl_lcnt().read().bits(),
+            r.ic_fs_spklen().read().bits(),
+            r.ic_sda_hold().read().bits(),
+            r.ic_tar().read().bits(),
+            r.ic_tx_tl().read().bits(),
+        ])
+    }
+
+    /// The registers written back (the controller disabled, as they must be written).
+    fn write(self) {
+        let r = regs();
+        let [con, hcnt, lcnt, spklen, hold, tar, tl] = self.0;
+        // SAFETY: each value was read from the same register after the HAL set it.
+        #[allow(unsafe_code)]
+        unsafe {
+            r.ic_con().write(|w| w.bits(con));
+            r.ic_fs_scl_hcnt().write(|w| w.bits(hcnt));
+            r.ic_fs_scl_lcnt().write(|w| w.bits(lcnt));
+            r.ic_fs_spklen().write(|w| w.bits(spklen));
+            r.ic_sda_hold().write(|w| w.bits(hold));
+            r.ic_tar().write(|w| w.bits(tar));
+            r.ic_tx_tl().write(|w| w.bits(tl));
+            r.ic_intr_mask().write(|w| w.bits(0));
+        }
     }
 }
 
@@ -153,18 +276,46 @@ impl<P> QueuedI2c<P> {
             r.ic_tx_tl().write(|w| unsafe { w.tx_tl().bits(TX_THRESHOLD) });
             r.ic_intr_mask().write(|w| unsafe { w.bits(0) });
         }
+        let settings = Settings::read();
         r.ic_enable().write(|w| w.enable().set_bit());
         // SAFETY: the handler only takes the queue's critical section, as every other user does.
         #[allow(unsafe_code)]
         unsafe {
             cortex_m::peripheral::NVIC::unmask(pac::Interrupt::I2C0_IRQ)
         };
-        QueuedI2c { _bus: bus, address }
+        QueuedI2c { _bus: bus, address, settings }
+    }
+
+    /// After a failed transfer: the controller reset (whatever it was waiting for is dropped,
+    /// a START it could not send included) and set up again, the queue emptied, and the bus
+    /// cleared if a device holds SDA low (a transfer cut off in the middle of a byte). A device
+    /// that keeps SDA low through the clear is logged; the next transfer then fails again.
+    fn recover(&mut self) {
+        critical_section::with(|cs| {
+            let mut q = QUEUE.borrow(cs).borrow_mut();
+            // SAFETY: RESETS' I2C0 bit, set and cleared by this driver alone once the HAL set it up.
+            #[allow(unsafe_code)]
+            let resets = unsafe { &*pac::RESETS::ptr() };
+            resets.reset().modify(|_, w| w.i2c0().set_bit());
+            if super::bus_clear::sda_held(Wiring::SDA) {
+                match super::bus_clear::clear(Wiring::SDA, Wiring::SCL) {
+                    Some(pulses) => {
+                        defmt::warn!("the display held SDA low: the bus cleared with {} clock pulses", pulses)
+                    }
+                    None => defmt::error!("the display holds SDA low through 9 clock pulses: its power needs cycling"),
+                }
+            }
+            resets.reset().modify(|_, w| w.i2c0().clear_bit());
+            while resets.reset_done().read().i2c0().bit_is_clear() {}
+            self.settings.write();
+            regs().ic_enable().write(|w| w.enable().set_bit());
+            (q.head, q.len, q.abort) = (0, 0, None);
+        });
     }
 }
 
 impl<P> embedded_hal::i2c::ErrorType for QueuedI2c<P> {
-    type Error = hal::i2c::Error;
+    type Error = BusError;
 }
 
 impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
@@ -175,18 +326,24 @@ impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
     ) -> Result<(), Self::Error> {
         use embedded_hal::i2c::Operation;
         if address != self.address {
-            return Err(hal::i2c::Error::AddressOutOfRange(u16::from(address)));
+            return Err(BusError::Unsupported);
         }
         take_abort()?;
+        // Core 0 alone sends (and fails): a load and a store need no atomic swap (which the
+        // Cortex-M0+ lacks).
+        if FAILED.load(Ordering::Relaxed) {
+            FAILED.store(false, Ordering::Relaxed);
+            self.recover();
+        }
         let mut left: usize = 0;
         for op in operations.iter() {
             match op {
                 Operation::Write(bytes) => left += bytes.len(),
-                Operation::Read(_) => return Err(hal::i2c::Error::InvalidReadBufferLength),
+                Operation::Read(_) => return Err(BusError::Unsupported),
             }
         }
         if left == 0 {
-            return Err(hal::i2c::Error::InvalidWriteBufferLength);
+            return Err(BusError::Unsupported);
         }
         /// IC_DATA_CMD's STOP bit.
         const STOP: u16 = 1 << 9;
@@ -196,6 +353,7 @@ impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
         });
         // Queued in runs under one critical section each; while the queue is full, its words
         // move into the FIFO as the bus takes them.
+        let mut progress = Progress::start();
         while left > 0 {
             critical_section::with(|cs| {
                 let mut q = QUEUE.borrow(cs).borrow_mut();
@@ -209,6 +367,7 @@ impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
                 }
             });
             take_abort()?;
+            progress.check()?;
         }
         Ok(())
     }
