@@ -20,6 +20,9 @@
 // bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2; core 1
 // starts in the bootrom and waits there for the launch sequence.
 //
+// --panel NAME puts another controller on the buses in place of the SSD1306: sh1106 (the 1.3"
+// modules: 132 columns of RAM, page addressing only) or ssd1309 (the 2.42" modules: no charge
+// pump); the image must be built for it (its `sh1106` or `ssd1309` feature).
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
 // --panel-off START_MS:LEN_MS (repeatable) cuts the display's power at START_MS of emulated
@@ -51,10 +54,15 @@
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
 //                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
-//                     [--sda-stuck START_MS:PULSES] [--nack-at MS]
+//                     [--sda-stuck START_MS:PULSES] [--nack-at MS] [--panel NAME]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306 } from './ssd1306.mjs';
+import { Sh1106 } from './sh1106.mjs';
+import { Ssd1309 } from './ssd1309.mjs';
+
+/** The panel controllers --panel chooses from (the image must drive the same one). */
+const PANELS = { ssd1306: Ssd1306, sh1106: Sh1106, ssd1309: Ssd1309 };
 
 const LED_PIN = 25;
 /** The SPI display's control pins (firmware/src/bin/pico/wiring.rs, `spi`). */
@@ -66,7 +74,7 @@ const I2C_PINS = { sda: 4, scl: 5 };
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [], sdaStuck: [], nackAt: [] };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [], sdaStuck: [], nackAt: [], panel: 'ssd1306' };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -100,6 +108,10 @@ function parseArgs(argv) {
       if (!m) throw new Error(`--sda-stuck ${v}: START_MS:PULSES expected (PULSES 1 to 9)`);
       o.sdaStuck.push({ startMs: Number(m[1]), pulses: Number(m[2]) });
     } else if (a === '--nack-at') o.nackAt.push(Number(next()));
+    else if (a === '--panel') {
+      o.panel = next();
+      if (!PANELS[o.panel]) throw new Error(`--panel ${o.panel}: one of ${Object.keys(PANELS).join(', ')} expected`);
+    }
     else if (a === '--reset-at') o.resetAt.push(Number(next()));
     else if (a === '--hang-core1-at') o.hangAt.push(Number(next()));
     else if (a === '--panic-at') o.panicAt.push(Number(next()));
@@ -208,7 +220,7 @@ function main() {
 
   // The display model on I2C0 and SPI0 (or nothing: every I2C address NACKs), bytes delivered
   // when the bus would deliver them.
-  const display = opt.display ? new Ssd1306(0x3c) : null;
+  const display = opt.display ? new PANELS[opt.panel](0x3c) : null;
   let busBytes = 0; // bytes the display heard (on I2C, those after an address byte)
   let i2cTransfers = 0; // address bytes sent (each START or repeated START)
   let naks = 0;

@@ -233,3 +233,46 @@ test('a byte the panel does not acknowledge aborts the transfer, and the panel d
   assert.deepEqual(seen, ['start', 0x00, 'interrupted', 'stop']);
   assert.equal(bus.readUint32(I2C + 0x80) & (1 << 3), 1 << 3, 'IC_TX_ABRT_SOURCE: ABRT_TXDATA_NOACK');
 });
+
+/** Sends `bytes` to an I2C panel model as one transfer (a control byte first). */
+function i2cSend(d, bytes) {
+  d.start();
+  assert.equal(d.connect(0x3c, false), true);
+  for (const b of bytes) d.write(b);
+  d.stop();
+}
+
+test('SH1106: page addressing only, 132 columns that stop at 131, the glass from column 2', async () => {
+  const { Sh1106 } = await import('./sh1106.mjs');
+  const d = new Sh1106(0x3c);
+  assert.equal(d.gddram.length, 132 * 8);
+  i2cSend(d, [0x00, 0xa1, 0xc8, 0xaf]);
+  assert.equal(d.notShowable(), null, 'DC-DC is on after reset');
+  // Page 0 from column 2 (0x02, 0x10): the first byte is the glass's left column.
+  i2cSend(d, [0x00, 0xb0, 0x02, 0x10]);
+  i2cSend(d, [0x40, 0x01]);
+  assert.equal(d.shown()[0], 0x80, 'top left pixel');
+  // From column 130: the counter stops at 131, so the third byte overwrites the second.
+  i2cSend(d, [0x00, 0xb1, 0x02, 0x18]);
+  i2cSend(d, [0x40, 0xaa, 0xbb, 0xcc]);
+  assert.deepEqual([...d.gddram.slice(132 + 130, 132 + 132)], [0xaa, 0xcc]);
+  assert.equal(d.error, null);
+  const e = new Sh1106(0x3c);
+  i2cSend(e, [0x00, 0x20, 0x00]);
+  assert.match(e.error, /unknown command byte 0x20/, 'no horizontal addressing');
+  const f = new Sh1106(0x3c);
+  i2cSend(f, [0x00, 0x8d, 0x14]);
+  assert.match(f.error, /unknown command byte 0x8d/, 'no charge pump command');
+});
+
+test('SSD1309: no charge pump command, and a command lock', async () => {
+  const { Ssd1309 } = await import('./ssd1309.mjs');
+  const d = new Ssd1309(0x3c);
+  i2cSend(d, [0x00, 0xfd, 0x16, 0xaf]);
+  assert.match(d.notShowable(), /never switched on/, 'locked: 0xAF ignored');
+  i2cSend(d, [0x00, 0xfd, 0x12, 0xaf]);
+  assert.equal(d.notShowable(), null);
+  const e = new Ssd1309(0x3c);
+  i2cSend(e, [0x00, 0x8d, 0x14]);
+  assert.match(e.error, /unknown command byte 0x8d/);
+});

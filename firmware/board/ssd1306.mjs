@@ -53,12 +53,12 @@ function argumentCount(cmd) {
   }
 }
 
-const hex = (b) => '0x' + b.toString(16).padStart(2, '0');
+export const hex = (b) => '0x' + b.toString(16).padStart(2, '0');
 
 export class Ssd1306 {
   constructor(address = 0x3c) {
     this.address = address;
-    this.gddram = new Uint8Array(WIDTH * PAGES); // [page * 128 + column], bit k = COM row 8*page + k
+    this.gddram = new Uint8Array(this.ramColumns * PAGES); // [page * columns + column], bit k = COM row 8*page + k
     this.commands = 0; // command bytes received (arguments included)
     this.dataBytes = 0; // GDDRAM bytes received
     this.bytes = 0; // every byte addressed to the display, control bytes included
@@ -67,6 +67,16 @@ export class Ssd1306 {
     this.error = null; // the first protocol error
     this.absent = false; // without power: the panel answers nothing (powerOff, powerOn)
     this.reset();
+  }
+
+  /** Columns of display RAM. */
+  get ramColumns() {
+    return WIDTH;
+  }
+
+  /** Argument bytes command `cmd` takes; -1 for a byte that is no command of this controller. */
+  argumentCount(cmd) {
+    return argumentCount(cmd);
   }
 
   /** Power lost (a loose wire): the panel answers nothing until `powerOn`. */
@@ -165,7 +175,7 @@ export class Ssd1306 {
     if (this.absent) return;
     this.bytes++;
     if (isData) {
-      if (this.cmd !== null) this.fail(`data byte while command ${hex(this.cmd)} waits for ${argumentCount(this.cmd) - this.args.length} more argument bytes`);
+      if (this.cmd !== null) this.fail(`data byte while command ${hex(this.cmd)} waits for ${this.argumentCount(this.cmd) - this.args.length} more argument bytes`);
       this.data(byte);
     } else this.command(byte);
   }
@@ -182,7 +192,7 @@ export class Ssd1306 {
   /** An I2C STOP. */
   stop() {
     if (this.selected && this.cmd !== null) {
-      this.fail(`command ${hex(this.cmd)} cut off by STOP after ${this.args.length} of ${argumentCount(this.cmd)} argument bytes`);
+      this.fail(`command ${hex(this.cmd)} cut off by STOP after ${this.args.length} of ${this.argumentCount(this.cmd)} argument bytes`);
     }
     this.endTransfer();
   }
@@ -192,7 +202,7 @@ export class Ssd1306 {
     if (this.cmd !== null) {
       this.args.push(byte);
     } else {
-      const n = argumentCount(byte);
+      const n = this.argumentCount(byte);
       if (n < 0) {
         this.fail(`unknown command byte ${hex(byte)}`);
         return;
@@ -200,7 +210,7 @@ export class Ssd1306 {
       this.cmd = byte;
       this.args = [];
     }
-    if (this.args.length === argumentCount(this.cmd)) {
+    if (this.args.length === this.argumentCount(this.cmd)) {
       this.execute(this.cmd, this.args);
       this.cmd = null;
     }
@@ -285,6 +295,11 @@ export class Ssd1306 {
     return null;
   }
 
+  /** The RAM column that panel column `x` shows (segment remap 0xA1: column x). */
+  glassColumn(x) {
+    return this.segmentRemap ? x : WIDTH - 1 - x;
+  }
+
   /**
    * What the panel shows: row y of the panel is COM line y; with reversed COM scan (0xC8) the
    * top row is driven from the last multiplexed line. Upright for a module whose init uses the
@@ -296,8 +311,7 @@ export class Ssd1306 {
       const com = this.comReverse ? y : HEIGHT - 1 - y;
       const row = (com + this.startLine + this.offset) % HEIGHT;
       for (let x = 0; x < WIDTH; x++) {
-        const col = this.segmentRemap ? x : WIDTH - 1 - x;
-        let on = (this.gddram[(row >> 3) * WIDTH + col] >> (row & 7)) & 1;
+        let on = (this.gddram[(row >> 3) * this.ramColumns + this.glassColumn(x)] >> (row & 7)) & 1;
         if (this.entireOn) on = 1;
         if (this.inverse) on ^= 1;
         if (on) out[y * (WIDTH / 8) + (x >> 3)] |= 0x80 >> (x & 7);

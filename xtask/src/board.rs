@@ -12,6 +12,7 @@
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
 
 mod faults;
+mod panels;
 mod slot;
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
@@ -514,6 +515,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let plain_run = s.variant("no-outline", false, 1, &[])?;
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
     let slot_rows = s.slot_runs()?;
+    let panel_rows = s.panel_runs()?;
 
     let spi_byte = levers
         .iter()
@@ -546,6 +548,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
     md.push_str(&slot::slot_report(&slot_rows)?);
     md.push_str(&faults::fault_report(&fault_rows)?);
+    md.push_str(&panels::panel_report(&panel_rows, s.scenes.first().map_or("", String::as_str), run.clk_sys_hz)?);
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     let Checks { passed, failures } = s.checks;

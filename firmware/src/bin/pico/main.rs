@@ -37,7 +37,6 @@ use panic_probe as _;
 use rp2040_hal as hal;
 #[cfg(feature = "pico2")]
 use rp235x_hal as hal;
-use ssd1306::prelude::*;
 use wiring::Wiring;
 
 #[cfg(all(feature = "pico", feature = "pico2"))]
@@ -116,12 +115,12 @@ fn main() -> ! {
     let timer_block = pac.TIMER0;
     let (timer, mut alarm) = sleep::start(timer_block, &mut pac.RESETS, &clocks);
 
-    let mut display = ssd1306::Ssd1306::new(interface, DisplaySize128x64, DisplayRotation::Rotate0);
-    display::reset(&mut display, &mut reset, &mut { timer });
-    let mut target = display::PageTiles { display };
+    display::reset(&mut reset, &mut { timer });
+    let mut target = display::PageTiles { interface };
     while target.set_up().is_err() {
         defmt::error!(
-            "no SSD1306 answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
+            "no {} answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
+            display::controller::PANEL.name,
             Wiring::SDA,
             Wiring::SCL,
             Wiring::ADDRESS

@@ -374,9 +374,4 @@ impl<P> embedded_hal::i2c::I2c for QueuedI2c<P> {
 }
 
 /// An I2C module resets itself at power-on: nothing to pulse.
-pub fn reset<DI, D>(
-    _display: &mut ssd1306::Ssd1306<DI, ssd1306::prelude::DisplaySize128x64, ssd1306::mode::BasicMode>,
-    _line: &mut crate::wiring::Reset,
-    _delay: &mut D,
-) {
-}
+pub fn reset<D>(_line: &mut crate::wiring::Reset, _delay: &mut D) {}

@@ -21,13 +21,14 @@ pub fn flush() -> Result<(), core::convert::Infallible> {
     Ok(())
 }
 
-/// Pulses the module's RES line (high, low for 10 ms, high) before the display is set up, as
-/// the SSD1306 needs after power-on.
-pub fn reset<DI, D: embedded_hal::delay::DelayNs>(
-    display: &mut ssd1306::Ssd1306<DI, ssd1306::prelude::DisplaySize128x64, ssd1306::mode::BasicMode>,
-    line: &mut crate::wiring::Reset,
-    delay: &mut D,
-) {
+/// Pulses the module's RES line (high for 1 ms, low for 10 ms, high) before the display is set
+/// up, as the controllers need after power-on.
+pub fn reset<D: embedded_hal::delay::DelayNs>(line: &mut crate::wiring::Reset, delay: &mut D) {
+    use embedded_hal::digital::OutputPin;
     // The pin's error type is Infallible.
-    let _ = display.reset(line, delay);
+    let _ = line.set_high();
+    delay.delay_ms(1);
+    let _ = line.set_low();
+    delay.delay_ms(10);
+    let _ = line.set_high();
 }
