@@ -212,8 +212,11 @@ fn plan<R: Real + Literal>(
 ) -> (Sizes, u8, bool) {
     let mut storage = vec![Object::<R>::default(); lattice_rt::object_count(text).max(1)];
     let mut parts = lattice_rt::Parts::default();
-    let scene =
-        lattice_rt::parse::<R>(text, &mut storage, &mut parts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    // The frame this build renders, from its features (as `app::RENDERED` has it): the view is
+    // fitted to its shape (square pixels on any glass).
+    let frame = frame::rendered(frame::Build::of(has));
+    let scene = lattice_rt::scene::parse_with::<R>(text, &mut storage, &mut parts, |c| c.frame = frame.size())
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     // build.rs's own lattice-rt has every shape: the firmware's may not.
     for (i, o) in scene.objects().iter().enumerate() {
         let Some(feature) = o.shape().feature() else { continue };
@@ -223,8 +226,7 @@ fn plan<R: Real + Literal>(
     }
     let effects = lattice_rt::Effects::of(&scene).bits();
     let cfg = LatticeConfig::default();
-    // The frame this build renders, from its features (as `app::RENDERED` has it).
-    let sizes = Sizes::of(&scene, Some(&cfg), &frame::rendered(frame::Build::of(has)));
+    let sizes = Sizes::of(&scene, Some(&cfg), &frame);
     if let Some((name, with_lattice, out)) = bake {
         let s = Lattice::plan(&scene, &cfg);
         let (mut lattices, mut coords, mut words) =

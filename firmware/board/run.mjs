@@ -20,9 +20,10 @@
 // bootrom's stack pointer, as on silicon after the bootrom has found a valid boot2; core 1
 // starts in the bootrom and waits there for the launch sequence.
 //
-// --panel NAME puts another controller on the buses in place of the SSD1306: sh1106 (the 1.3"
-// modules: 132 columns of RAM, page addressing only) or ssd1309 (the 2.42" modules: no charge
-// pump); the image must be built for it (its `sh1106` or `ssd1309` feature).
+// --panel NAME puts another panel on the buses in place of the SSD1306 128x64: sh1106 (the 1.3"
+// modules: 132 columns of RAM, page addressing only), ssd1309 (the 2.42" modules: no charge
+// pump), ssd1306-128x32 or ssd1306-72x40 (smaller glass: the frame's pixels are its size); the
+// image must be built for it (its `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature).
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
 // --panel-off START_MS:LEN_MS (repeatable) cuts the display's power at START_MS of emulated
@@ -57,12 +58,18 @@
 //                     [--sda-stuck START_MS:PULSES] [--nack-at MS] [--panel NAME]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
-import { Ssd1306 } from './ssd1306.mjs';
+import { Ssd1306, GLASSES } from './ssd1306.mjs';
 import { Sh1106 } from './sh1106.mjs';
 import { Ssd1309 } from './ssd1309.mjs';
 
 /** The panel controllers --panel chooses from (the image must drive the same one). */
-const PANELS = { ssd1306: Ssd1306, sh1106: Sh1106, ssd1309: Ssd1309 };
+const PANELS = {
+  ssd1306: (address) => new Ssd1306(address),
+  'ssd1306-128x32': (address) => new Ssd1306(address, GLASSES['128x32']),
+  'ssd1306-72x40': (address) => new Ssd1306(address, GLASSES['72x40']),
+  sh1106: (address) => new Sh1106(address),
+  ssd1309: (address) => new Ssd1309(address),
+};
 
 const LED_PIN = 25;
 /** The SPI display's control pins (firmware/src/bin/pico/wiring.rs, `spi`). */
@@ -220,7 +227,7 @@ function main() {
 
   // The display model on I2C0 and SPI0 (or nothing: every I2C address NACKs), bytes delivered
   // when the bus would deliver them.
-  const display = opt.display ? new PANELS[opt.panel](0x3c) : null;
+  const display = opt.display ? PANELS[opt.panel](0x3c) : null;
   let busBytes = 0; // bytes the display heard (on I2C, those after an address byte)
   let i2cTransfers = 0; // address bytes sent (each START or repeated START)
   let naks = 0;

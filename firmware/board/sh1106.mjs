@@ -9,7 +9,7 @@
 // modes 0x20-0x22 and charge pump 0x8D among them), an argument out of its range, a command cut
 // off by a STOP fail the run.
 
-import { Ssd1306, WIDTH, HEIGHT, hex } from './ssd1306.mjs';
+import { Ssd1306, HEIGHT, hex } from './ssd1306.mjs';
 
 const COLUMNS = 132;
 /** The first RAM column the glass shows, with segment remap (0xA1): SEG129 is its left edge. */

@@ -2,16 +2,27 @@
 // it: on I2C the control byte after the address (Co and D/C# bits), on SPI the D/C# pin and
 // RES#; the fundamental, addressing, hardware configuration, timing and scrolling commands with
 // their arguments, and the 1 KiB GDDRAM written through the page/horizontal/vertical addressing
-// modes. `shown()` is what the panel displays, as a packed 1-bit raster (rows MSB first, lit
-// pixel = 1: the raster of host-sim's BitFrame), after segment remap, COM scan direction, start
-// line, offset and inversion.
+// modes. `shown()` is what the module's glass displays (128x64, or the 128x32 and 72x40 glass of
+// `GLASSES`), as a packed 1-bit raster (rows MSB first, lit pixel = 1: the raster of host-sim's
+// BitFrame), after segment remap, COM scan direction, start line, offset and inversion.
 //
 // Anything the model does not understand is an error, never silently ignored: an unknown
 // command byte, a command cut off by a STOP, a data byte before any display set-up, a read.
 
-export const WIDTH = 128;
-export const HEIGHT = 64;
+export const WIDTH = 128; // columns of RAM
+export const HEIGHT = 64; // rows of RAM
 const PAGES = HEIGHT / 8;
+
+/**
+ * The glass a module puts on the controller: its size, the first RAM column it shows (with
+ * segment remap 0xA1), the COM pins configuration its wiring needs (0xDA), and whether its
+ * controller has the internal current reference command (0xAD, on the 72x40 modules).
+ */
+export const GLASSES = {
+  '128x64': { width: 128, height: 64, column: 0, comPins: 0x12, iref: false },
+  '128x32': { width: 128, height: 32, column: 0, comPins: 0x02, iref: false },
+  '72x40': { width: 72, height: 40, column: 28, comPins: 0x12, iref: true },
+};
 
 /** Arguments each command takes (commands not listed take none; unlisted bytes are unknown). */
 function argumentCount(cmd) {
@@ -56,8 +67,9 @@ function argumentCount(cmd) {
 export const hex = (b) => '0x' + b.toString(16).padStart(2, '0');
 
 export class Ssd1306 {
-  constructor(address = 0x3c) {
+  constructor(address = 0x3c, glass = GLASSES['128x64']) {
     this.address = address;
+    this.glass = glass;
     this.gddram = new Uint8Array(this.ramColumns * PAGES); // [page * columns + column], bit k = COM row 8*page + k
     this.commands = 0; // command bytes received (arguments included)
     this.dataBytes = 0; // GDDRAM bytes received
@@ -76,6 +88,7 @@ export class Ssd1306 {
 
   /** Argument bytes command `cmd` takes; -1 for a byte that is no command of this controller. */
   argumentCount(cmd) {
+    if (cmd === 0xad) return this.glass.iref ? 1 : -1;
     return argumentCount(cmd);
   }
 
@@ -255,6 +268,9 @@ export class Ssd1306 {
           if (this.chargePump) this.everOn = true;
           break;
         case 0xc0: case 0xc8: this.comReverse = c === 0xc8; break;
+        case 0xad:
+          if ((a[0] & ~0x30) !== 0) this.fail(`IREF setting ${hex(a[0])} (0x00 external, 0x30 internal)`);
+          break;
         case 0xd3: this.offset = a[0] & 0x3f; break;
         case 0xda: this.comPins = a[0]; break;
         case 0x2e: this.scrolling = false; break;
@@ -290,31 +306,35 @@ export class Ssd1306 {
     if (!this.everOn) return 'the display was never switched on with its charge pump (0x8D 0x14, 0xAF)';
     if (!this.displayOn) return 'the display is switched off (0xAE)';
     if (this.scrolling) return 'scrolling is active (0x2F)';
-    if (this.multiplex !== HEIGHT - 1) return `multiplex ratio ${this.multiplex + 1}, not ${HEIGHT}`;
-    if (this.comPins !== 0x12) return `COM pins configuration ${hex(this.comPins)}: a 128x64 panel needs 0x12`;
+    const { width, height, comPins } = this.glass;
+    if (this.multiplex !== height - 1) return `multiplex ratio ${this.multiplex + 1}, not ${height}`;
+    if (this.comPins !== comPins) return `COM pins configuration ${hex(this.comPins)}: a ${width}x${height} panel needs ${hex(comPins)}`;
     return null;
   }
 
-  /** The RAM column that panel column `x` shows (segment remap 0xA1: column x). */
+  /** The RAM column that panel column `x` shows (segment remap 0xA1: the glass's first + x). */
   glassColumn(x) {
-    return this.segmentRemap ? x : WIDTH - 1 - x;
+    const first = this.glass.column;
+    return this.segmentRemap ? first + x : WIDTH - 1 - first - x;
   }
 
   /**
-   * What the panel shows: row y of the panel is COM line y; with reversed COM scan (0xC8) the
-   * top row is driven from the last multiplexed line. Upright for a module whose init uses the
+   * What the glass shows, its rows packed MSB first: row y of the panel is COM line y; with
+   * reversed COM scan (0xC8) the top row is driven from the last multiplexed line. Upright for a module whose init uses the
    * common segment remap 0xA1 and scan direction 0xC8 (the Adafruit and `ssd1306` crate set-up).
    */
   shown() {
-    const out = new Uint8Array((WIDTH / 8) * HEIGHT);
-    for (let y = 0; y < HEIGHT; y++) {
-      const com = this.comReverse ? y : HEIGHT - 1 - y;
+    const { width, height } = this.glass;
+    const stride = Math.ceil(width / 8);
+    const out = new Uint8Array(stride * height);
+    for (let y = 0; y < height; y++) {
+      const com = this.comReverse ? y : height - 1 - y;
       const row = (com + this.startLine + this.offset) % HEIGHT;
-      for (let x = 0; x < WIDTH; x++) {
+      for (let x = 0; x < width; x++) {
         let on = (this.gddram[(row >> 3) * this.ramColumns + this.glassColumn(x)] >> (row & 7)) & 1;
         if (this.entireOn) on = 1;
         if (this.inverse) on ^= 1;
-        if (on) out[y * (WIDTH / 8) + (x >> 3)] |= 0x80 >> (x & 7);
+        if (on) out[y * stride + (x >> 3)] |= 0x80 >> (x & 7);
       }
     }
     return out;

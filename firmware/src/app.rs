@@ -18,7 +18,7 @@ use lattice_rt::{
     Share, Stats, Traced, Tracer,
 };
 
-pub use board_records::frame::{rendered, Build, Tuning, FRAME, HEIGHT, LADDER, ORBIT_FRAMES, SHARES, TUNING, WIDTH};
+pub use board_records::frame::{rendered, Build, Glass, Tuning, FRAME, LADDER, ORBIT_FRAMES, SHARES, TUNING};
 
 /// What this build asks of its frame (its features; `board_records::frame::Build::of` reads
 /// the same names for build.rs and the checks).
@@ -34,12 +34,24 @@ pub const BUILD: Build = Build {
         None
     },
     exact_sampling: cfg!(feature = "exact-sampling"),
+    glass: if cfg!(feature = "oled-128x32") {
+        Glass::Oled128x32
+    } else if cfg!(feature = "oled-72x40") {
+        Glass::Oled72x40
+    } else {
+        Glass::Oled128x64
+    },
 };
 
 /// The frame the firmware renders ([`rendered`]): on the Raspberry Pi boards' panel a still in
 /// Floyd-Steinberg with silhouette lines, orbit and progressive frames in blue noise with lines;
 /// elsewhere [`FRAME`].
 pub const RENDERED: lattice_rt::Frame = rendered(BUILD);
+
+/// The frame's width in pixels: the panel's glass ([`Glass`]), or 128 without a panel.
+pub const WIDTH: u16 = RENDERED.width;
+/// The frame's height in pixels.
+pub const HEIGHT: u16 = RENDERED.height;
 
 /// The scalar the firmware traces in, chosen by a `scalar-*` feature (default f32 with libm).
 #[cfg(feature = "scalar-fixed")]
@@ -337,7 +349,10 @@ pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Se
     shot: &Shot,
     board: Board<'_, impl Cores>,
 ) -> Result<Report, AppError<'t, D::Error>> {
-    let at = |c: &mut lattice_rt::scene::CameraDesc| *c = c.orbit(shot.turn);
+    // The view fitted to the frame's shape (square pixels on any glass), then turned.
+    let at = |c: &mut lattice_rt::scene::CameraDesc| {
+        *c = lattice_rt::scene::CameraDesc { frame: RENDERED.size(), ..c.orbit(shot.turn) }
+    };
     let Loaded { scene, lattice, scratch } = st.view().load_with(text, &lattice_rt::LatticeConfig::default(), at)?;
     render_loaded(&scene, (&lattice, lattice.bytes()), scratch, target, hooks, shot, board)
 }

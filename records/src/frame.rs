@@ -4,9 +4,10 @@
 use lattice_rt::render::Sampling;
 use lattice_rt::{Dither, EyeRays, Frame, Tone};
 
-/// Display width (SSD1306 128x64).
+/// The frame's width on the boards without a panel, and on the default panel (SSD1306 128x64;
+/// a build's own is [`rendered`]'s).
 pub const WIDTH: u16 = 128;
-/// Display height.
+/// Its height.
 pub const HEIGHT: u16 = 64;
 
 /// How the boards without a panel spend eye rays: adaptive sub-sampling (every second pixel
@@ -67,6 +68,40 @@ pub const STILL_DITHER: Dither = Dither::FloydSteinberg;
 /// which flickers least from frame to frame in `cargo xtask motion` (docs/motion.md).
 pub const MOTION_DITHER: Dither = Dither::BlueNoise;
 
+/// The glass a panel board draws on: its size in pixels (the controller's RAM may be larger).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Glass {
+    /// 128x64, the common 0.96" (SSD1306), 1.3" (SH1106) and 2.42" (SSD1309) modules.
+    #[default]
+    Oled128x64,
+    /// 128x32, the 0.91" SSD1306 modules (the firmware's `oled-128x32` feature).
+    Oled128x32,
+    /// 72x40, the 0.42" SSD1306 modules and the Thumby's panel (`oled-72x40`).
+    Oled72x40,
+}
+
+impl Glass {
+    /// Width and height in pixels.
+    pub const fn size(self) -> (u16, u16) {
+        match self {
+            Glass::Oled128x64 => (128, 64),
+            Glass::Oled128x32 => (128, 32),
+            Glass::Oled72x40 => (72, 40),
+        }
+    }
+
+    /// The glass a build's features (answered by name) choose.
+    pub fn of(has: impl Fn(&str) -> bool) -> Glass {
+        if has("oled-128x32") {
+            Glass::Oled128x32
+        } else if has("oled-72x40") {
+            Glass::Oled72x40
+        } else {
+            Glass::Oled128x64
+        }
+    }
+}
+
 /// What a firmware build asks of its frame: its features.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Build {
@@ -82,6 +117,8 @@ pub struct Build {
     pub lines: Option<bool>,
     /// One eye ray per pixel (`exact-sampling`).
     pub exact_sampling: bool,
+    /// The panel's glass, whose size the frame takes (boards without a panel: [`FRAME`]'s).
+    pub glass: Glass,
 }
 
 impl Build {
@@ -101,13 +138,15 @@ impl Build {
             progressive: has("progressive"),
             lines,
             exact_sampling: has("exact-sampling"),
+            glass: Glass::of(&has),
         }
     }
 }
 
 /// The frame a build renders. On a panel: stills in [`STILL_DITHER`], frames in motion in
 /// [`MOTION_DITHER`], both with silhouette lines, without which the chair's legs and seat vanish
-/// into a floor of the same gray, and [`PANEL_TILE`]. Without a panel: [`FRAME`].
+/// into a floor of the same gray, and [`PANEL_TILE`], at the glass's size. Without a panel:
+/// [`FRAME`].
 pub const fn rendered(b: Build) -> Frame {
     let dither = if b.panel && !b.orbit && !b.progressive { STILL_DITHER } else { MOTION_DITHER };
     let outline = match b.lines {
@@ -119,12 +158,19 @@ pub const fn rendered(b: Build) -> Frame {
         (false, true) => PANEL_SAMPLING,
         (false, false) => SAMPLING,
     };
-    let tile = if b.panel { PANEL_TILE } else { FRAME.tile };
-    Frame { dither, outline, sampling, tile, ..FRAME }
+    let (tile, (width, height)) = if b.panel { (PANEL_TILE, b.glass.size()) } else { (FRAME.tile, (WIDTH, HEIGHT)) };
+    Frame { dither, outline, sampling, tile, width, height, ..FRAME }
 }
 
 /// The Raspberry Pi Pico's default image: a still frame on a panel.
-pub const PICO: Build = Build { panel: true, orbit: false, progressive: false, lines: None, exact_sampling: false };
+pub const PICO: Build = Build {
+    panel: true,
+    orbit: false,
+    progressive: false,
+    lines: None,
+    exact_sampling: false,
+    glass: Glass::Oled128x64,
+};
 
 /// Frames per turn of the camera in orbit mode (the firmware's `orbit` feature, `host-sim orbit`).
 pub const ORBIT_FRAMES: u32 = 36;

@@ -415,16 +415,21 @@ fn section_size(elf: &Path, name: &str) -> Result<u64> {
     crate::elf::Elf::read(elf)?.section_size(name)
 }
 
-/// Writes a panel frame (rows MSB first, lit = 1) as a PNG the way the OLED shows it.
+/// Writes a 128x64 panel frame (rows MSB first, lit = 1) as a PNG the way the OLED shows it.
 fn save_frame(bits: &[u8], path: &Path) -> Result<()> {
-    with_panel(bits, |frame| host_sim::output::write_png(frame, path, host_sim::output::Theme::OledWhite, 4))
+    save_frame_sized(bits, PANEL, path)
 }
 
-/// Calls `f` with a panel frame's bits (rows MSB first, lit = 1) as a [`BitFrame`].
-fn with_panel<T>(bits: &[u8], f: impl FnOnce(&BitFrame<'_>) -> Result<T>) -> Result<T> {
+/// Writes a panel frame of `size` (width, height) as a PNG the way the OLED shows it.
+fn save_frame_sized(bits: &[u8], size: (u32, u32), path: &Path) -> Result<()> {
+    with_panel(bits, size, |frame| host_sim::output::write_png(frame, path, host_sim::output::Theme::OledWhite, 4))
+}
+
+/// Calls `f` with a panel frame's bits (rows MSB first, lit = 1) of `size` as a [`BitFrame`].
+fn with_panel<T>(bits: &[u8], (w, h): (u32, u32), f: impl FnOnce(&BitFrame<'_>) -> Result<T>) -> Result<T> {
     let mut raster = bits.to_vec();
-    raster.resize(BitFrame::bytes(PANEL.0, PANEL.1), 0);
-    f(&BitFrame::wrap(PANEL.0, PANEL.1, &mut raster).context("frame size")?)
+    raster.resize(BitFrame::bytes(w, h), 0);
+    f(&BitFrame::wrap(w, h, &mut raster).context("frame size")?)
 }
 
 /// A picture of where two frames differ: lit where they do.
@@ -503,6 +508,10 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         }
     }
     let fault_rows = s.fault_runs(&rows)?;
+    let panel_rows = s.panel_runs()?;
+    if let Some(images) = out.parent().map(|p| p.join("images")) {
+        panels::save_pictures(&panel_rows, &images)?;
+    }
     let bare = s.no_display_run()?;
     let (models, (alone, levers)) = (s.model_runs()?, s.lever_runs()?);
     let (orun, orbit_same) = s.orbit_run()?;
@@ -515,7 +524,6 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let plain_run = s.variant("no-outline", false, 1, &[])?;
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
     let slot_rows = s.slot_runs()?;
-    let panel_rows = s.panel_runs()?;
 
     let spi_byte = levers
         .iter()
@@ -653,7 +661,7 @@ impl<'a> Session<'a> {
         let dir = self.frames_dir;
         save_frame(pixels, &dir.join(format!("{name}.png")))?;
         // The panel's bits as a PBM, for `cargo xtask display`.
-        with_panel(pixels, |frame| host_sim::output::write_pbm(frame, &dir.join(format!("{name}.pbm"))))?;
+        with_panel(pixels, PANEL, |frame| host_sim::output::write_pbm(frame, &dir.join(format!("{name}.pbm"))))?;
         let differ: u32 = want.iter().zip(pixels).map(|(a, b)| (a ^ b).count_ones()).sum();
         let (host, diff) = (dir.join(format!("{name}-host.png")), dir.join(format!("{name}-diff.png")));
         if want != pixels {

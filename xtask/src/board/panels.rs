@@ -1,19 +1,26 @@
-//! The panels beside the SSD1306: each image built for its controller (the firmware's `sh1106`
-//! or `ssd1309` feature) runs with the emulated controller in place of the SSD1306 (run.mjs
-//! `--panel`), on I2C at 1 MHz and on SPI, and every scene's frame must be bit-identical to
-//! host-sim's. The models follow their datasheets (firmware/board/sh1106.mjs, ssd1309.mjs):
-//! a command the controller does not have fails the run.
+//! The panels beside the SSD1306 128x64: each image built for its panel (the firmware's
+//! `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature) runs with that panel emulated in
+//! place of the SSD1306 (run.mjs `--panel`), on I2C at 1 MHz and on SPI, and every scene's
+//! frame must be bit-identical to host-sim's at the glass's size. The models follow their
+//! datasheets (firmware/board/sh1106.mjs, ssd1309.mjs, ssd1306.mjs's glasses): a command the
+//! controller does not have fails the run.
 
-use super::{host_frame, m, save_frame, Session, PICO, PICO_SCALAR};
+use super::{host_frame, m, save_frame_sized, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
+use board_records::frame::{Build, Glass};
 use std::fmt::Write as _;
 
-/// The images checked: their features, the emulated controller, what the module is.
-const PANELS: [(&str, &str, &str); 4] = [
-    ("sh1106,i2c-1mhz", "sh1106", "SH1106 (1.3\" 128x64), I2C at 1 MHz"),
-    ("sh1106,spi", "sh1106", "SH1106 (1.3\" 128x64), SPI at 10 MHz"),
-    ("ssd1309,i2c-1mhz", "ssd1309", "SSD1309 (2.42\" 128x64), I2C at 1 MHz"),
-    ("ssd1309,spi", "ssd1309", "SSD1309 (2.42\" 128x64), SPI at 10 MHz"),
+/// An image checked: its features, the emulated panel, what the module is, its glass.
+type Panel = (&'static str, &'static str, &'static str, Glass);
+
+/// The images checked.
+const PANELS: [Panel; 6] = [
+    ("sh1106,i2c-1mhz", "sh1106", "SH1106 (1.3\" 128x64), I2C at 1 MHz", Glass::Oled128x64),
+    ("sh1106,spi", "sh1106", "SH1106 (1.3\" 128x64), SPI at 10 MHz", Glass::Oled128x64),
+    ("ssd1309,i2c-1mhz", "ssd1309", "SSD1309 (2.42\" 128x64), I2C at 1 MHz", Glass::Oled128x64),
+    ("ssd1309,spi", "ssd1309", "SSD1309 (2.42\" 128x64), SPI at 10 MHz", Glass::Oled128x64),
+    ("oled-128x32", "ssd1306-128x32", "SSD1306 (0.91\" 128x32), I2C at 400 kHz", Glass::Oled128x32),
+    ("oled-72x40,spi", "ssd1306-72x40", "SSD1306 (0.42\" 72x40, the Thumby's), SPI at 10 MHz", Glass::Oled72x40),
 ];
 
 /// What one panel's run did, for the report.
@@ -25,19 +32,41 @@ pub(super) struct PanelRow {
     scenes: usize,
     /// The first scene's frame: cycles, and bytes on the bus.
     first: Option<(u64, u64)>,
+    /// The glass's width and height.
+    size: (u16, u16),
+    /// The first scene's frame as the panel showed it.
+    picture: Vec<u8>,
+}
+
+impl PanelRow {
+    /// The file its picture is saved as, in docs/images.
+    fn picture_name(&self) -> String {
+        format!("board-panel-{}.png", self.features.replace(',', "-"))
+    }
+}
+
+/// Saves each panel's first frame into `images` (docs/images), as the report shows them.
+pub(super) fn save_pictures(rows: &[PanelRow], images: &std::path::Path) -> Result<()> {
+    for r in rows {
+        let (w, h) = r.size;
+        save_frame_sized(&r.picture, (u32::from(w), u32::from(h)), &images.join(r.picture_name()))?;
+    }
+    Ok(())
 }
 
 impl Session<'_> {
     /// Every panel's image on every embedded scene.
     pub(super) fn panel_runs(&mut self) -> Result<Vec<PanelRow>> {
         let mut rows = Vec::new();
-        for (features, panel, what) in PANELS {
+        for (features, panel, what, glass) in PANELS {
+            let build = Build { glass, ..PICO };
+            let (w, h) = glass.size();
             let (run, dir) = self.variant(features, true, self.scenes.len(), &["--panel", panel])?;
             self.checks.check(run.ok, || format!("{what}: the run did not finish: {}", run.reason));
             let mut same = 0;
             for (name, frame) in self.scenes.clone().iter().zip(&run.frames) {
-                let want = host_frame(&self.scenes_dir, name, PICO_SCALAR, PICO)?;
-                save_frame(&frame.pixels, &dir.join(format!("{name}.png")))?;
+                let want = host_frame(&self.scenes_dir, name, PICO_SCALAR, build)?;
+                save_frame_sized(&frame.pixels, (u32::from(w), u32::from(h)), &dir.join(format!("{name}.png")))?;
                 let ok = frame.error.is_none() && frame.pixels == want;
                 same += usize::from(ok);
                 self.checks.check(ok, || {
@@ -49,7 +78,8 @@ impl Session<'_> {
                 format!("{what}: {} frames shown of {}", run.frames.len(), self.scenes.len())
             });
             let first = run.frames.first().map(|f| (f.cycles, f.bus_bytes));
-            rows.push(PanelRow { what, features, same, scenes: self.scenes.len(), first });
+            let picture = run.frames.first().map(|f| f.pixels.clone()).unwrap_or_default();
+            rows.push(PanelRow { what, features, same, scenes: self.scenes.len(), first, size: (w, h), picture });
         }
         Ok(rows)
     }
@@ -58,18 +88,27 @@ impl Session<'_> {
 /// The report's section on the panels.
 pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Result<String> {
     let mut md = String::new();
-    writeln!(md, "\n## Other panels: SH1106 and SSD1309\n")?;
+    writeln!(md, "\n## Other panels: SH1106, SSD1309, 128x32 and 72x40\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask board`: each image is built for its panel's controller (`cargo pico-build --features ...`) and runs on the emulated board with that controller on the bus in place of the SSD1306 (`run.mjs --panel`), every scene's frame checked against host-sim's. The SH1106 model (firmware/board/sh1106.mjs) has the SH1106's 132 columns of RAM, page addressing only and the glass on columns 2 to 129; the SSD1309 model (ssd1309.mjs) has no charge pump command and a command lock; a command either controller does not have fails the run. The firmware sends each controller its own set-up and addresses the SH1106 page by page (`firmware/src/bin/pico/display/controller.rs`).\n"
+        "Written by `cargo xtask board`: each image is built for its panel's controller (`cargo pico-build --features ...`) and runs on the emulated board with that controller on the bus in place of the SSD1306 (`run.mjs --panel`), every scene's frame checked against host-sim's. The SH1106 model (firmware/board/sh1106.mjs) has the SH1106's 132 columns of RAM, page addressing only and the glass on columns 2 to 129; the SSD1309 model (ssd1309.mjs) has no charge pump command and a command lock; the smaller SSD1306 modules show part of the controller's RAM (128x32: 32 multiplexed rows, COM pins in sequence; 72x40: columns 28 to 99 and 40 rows) and the frame is traced at the glass's size. A command a controller does not have fails the run. The firmware sends each controller its own set-up and addresses the SH1106 page by page (`firmware/src/bin/pico/display/controller.rs`).\n"
     )?;
-    writeln!(md, "| panel and bus | features | frames bit-identical to host-sim | {first}: cycles | fps at 125 MHz | bytes on the bus |")?;
-    writeln!(md, "|---|---|---:|---:|---:|---:|")?;
+    writeln!(md, "| panel and bus | features | pixels | frames bit-identical to host-sim | {first}: cycles | fps at 125 MHz | bytes on the bus |")?;
+    writeln!(md, "|---|---|---|---:|---:|---:|---:|")?;
     for r in rows {
         let (cycles, fps, bytes) = r.first.map_or(("-".into(), "-".into(), "-".into()), |(c, b)| {
             (m(c), format!("{:.2}", clk_hz / c as f64), b.to_string())
         });
-        writeln!(md, "| {} | `{}` | {} of {} | {cycles} | {fps} | {bytes} |", r.what, r.features, r.same, r.scenes)?;
+        let (w, h) = r.size;
+        writeln!(
+            md,
+            "| {} | `{}` | {w}x{h} | {} of {} | {cycles} | {fps} | {bytes} |",
+            r.what, r.features, r.same, r.scenes
+        )?;
+    }
+    writeln!(md, "\nThe {first} as each panel showed it (its pixels as they are, 4x):\n")?;
+    for r in rows {
+        writeln!(md, "![{}](images/{})", r.what.replace('"', "''"), r.picture_name())?;
     }
     Ok(md)
 }

@@ -40,7 +40,7 @@ pub trait SetUp {
 
 impl<DI: WriteOnlyDataCommand> SetUp for PageTiles<DI> {
     fn set_up(&mut self) -> Result<(), DisplayError> {
-        for command in PANEL.set_up {
+        for command in PANEL.set_up.iter().copied().flatten() {
             self.interface.send_commands(DataFormat::U8(command))?;
         }
         flush().map_err(|_| DisplayError::BusWriteError)

@@ -1,6 +1,7 @@
 //! The OLED controllers with page-organised RAM the firmware drives, one chosen by a feature:
-//! the SSD1306 (default), the SH1106 (`sh1106`: the common 1.3" 128x64 modules) and the
-//! SSD1309 (`ssd1309`: the 2.42" modules). Each is its set-up, sent command by command, and how
+//! the SSD1306 (default; on 128x32 glass with `oled-128x32`, on 72x40 glass with
+//! `oled-72x40`), the SH1106 (`sh1106`: the common 1.3" 128x64 modules) and the SSD1309
+//! (`ssd1309`: the 2.42" modules). Each is its set-up, sent command by command, and how
 //! an area of pages is addressed. They share the bus (`display-interface`: the control byte on
 //! I2C, D/C# on SPI) and the page layout (a byte is 8 rows of one column, LSB on top), so one
 //! draw target serves all three. (The `ssd1306` crate drives only the SSD1306: it sends a
@@ -27,8 +28,8 @@ pub struct Controller {
     /// Its name in the log.
     pub name: &'static str,
     /// The commands that set it up from any state (a panel that lost power included), each with
-    /// its arguments and sent as its own transfer, display on last.
-    pub set_up: &'static [&'static [u8]],
+    /// its arguments and sent as its own transfer, display on last; in runs the tables share.
+    pub set_up: &'static [&'static [&'static [u8]]],
     /// How a draw area is addressed.
     pub addressing: Addressing,
     /// The RAM column of the panel's first column (the SH1106's 132 columns drive a 128-column
@@ -36,31 +37,40 @@ pub struct Controller {
     pub column_offset: u8,
 }
 
+/// Display off and the oscillator at its reset frequency: every set-up's first commands.
+const HEAD: &[&[u8]] = &[&[0xae], &[0xd5, 0x80]];
+/// No offset, start line 0, the SSD1306's charge pump on and horizontal addressing.
+const SSD1306_PUMP: &[&[u8]] = &[&[0xd3, 0], &[0x40], &[0x8d, 0x14], &[0x20, 0x00]];
+/// Segment remap and reversed COM scan (upright), the SSD1306's pre-charge, contrast and VCOMH
+/// (the `ssd1306` crate's), the RAM shown as it is, no scrolling, display on.
+const SSD1306_TAIL: &[&[u8]] =
+    &[&[0xa1], &[0xc8], &[0xd9, 0x21], &[0x81, 0x5f], &[0xdb, 0x40], &[0xa4], &[0xa6], &[0x2e], &[0xaf]];
+
 /// The SSD1306, 128x64 (the `ssd1306` crate's set-up: horizontal addressing, charge pump on,
 /// segment remap and reversed COM scan, contrast 0x5F).
 pub const SSD1306: Controller = Controller {
     name: "SSD1306",
-    set_up: &[
-        &[0xae],
-        &[0xd5, 0x80],
-        &[0xa8, 63],
-        &[0xd3, 0],
-        &[0x40],
-        &[0x8d, 0x14],
-        &[0x20, 0x00],
-        &[0xda, 0x12],
-        &[0xa1],
-        &[0xc8],
-        &[0xd9, 0x21],
-        &[0x81, 0x5f],
-        &[0xdb, 0x40],
-        &[0xa4],
-        &[0xa6],
-        &[0x2e],
-        &[0xaf],
-    ],
+    set_up: &[HEAD, &[&[0xa8, 63]], SSD1306_PUMP, &[&[0xda, 0x12]], SSD1306_TAIL],
     addressing: Addressing::Window,
     column_offset: 0,
+};
+
+/// The SSD1306 on a 0.91" 128x32 module: 32 multiplexed rows, COM pins in sequence (0xDA 0x02).
+pub const SSD1306_128X32: Controller = Controller {
+    name: "SSD1306 (128x32)",
+    set_up: &[HEAD, &[&[0xa8, 31]], SSD1306_PUMP, &[&[0xda, 0x02]], SSD1306_TAIL],
+    addressing: Addressing::Window,
+    column_offset: 0,
+};
+
+/// The SSD1306 on a 0.42" 72x40 module (the Thumby's panel): 40 multiplexed rows, the glass on
+/// RAM columns 28 to 99, the internal current reference on (0xAD 0x30), as the `ssd1306`
+/// crate sets it up.
+pub const SSD1306_72X40: Controller = Controller {
+    name: "SSD1306 (72x40)",
+    set_up: &[HEAD, &[&[0xa8, 39]], SSD1306_PUMP, &[&[0xda, 0x12], &[0xad, 0x30]], SSD1306_TAIL],
+    addressing: Addressing::Window,
+    column_offset: 28,
 };
 
 /// The SH1106 on a 128x64 module (datasheet V2.3): page addressing, DC-DC on (0xAD 0x8B), pump
@@ -68,22 +78,9 @@ pub const SSD1306: Controller = Controller {
 pub const SH1106: Controller = Controller {
     name: "SH1106",
     set_up: &[
-        &[0xae],
-        &[0xd5, 0x80],
-        &[0xa8, 63],
-        &[0xd3, 0],
-        &[0x40],
-        &[0xad, 0x8b],
-        &[0x32],
-        &[0xda, 0x12],
-        &[0xa1],
-        &[0xc8],
-        &[0xd9, 0x22],
-        &[0x81, 0x80],
-        &[0xdb, 0x35],
-        &[0xa4],
-        &[0xa6],
-        &[0xaf],
+        HEAD,
+        &[&[0xa8, 63], &[0xd3, 0], &[0x40], &[0xad, 0x8b], &[0x32], &[0xda, 0x12], &[0xa1], &[0xc8]],
+        &[&[0xd9, 0x22], &[0x81, 0x80], &[0xdb, 0x35], &[0xa4], &[0xa6], &[0xaf]],
     ],
     addressing: Addressing::Pages,
     column_offset: 2,
@@ -94,30 +91,23 @@ pub const SH1106: Controller = Controller {
 pub const SSD1309: Controller = Controller {
     name: "SSD1309",
     set_up: &[
-        &[0xae],
-        &[0xd5, 0x70],
-        &[0xa8, 63],
-        &[0xd3, 0],
-        &[0x40],
-        &[0x20, 0x00],
-        &[0xda, 0x12],
-        &[0xa1],
-        &[0xc8],
-        &[0xd9, 0x22],
-        &[0x81, 0x7f],
-        &[0xdb, 0x34],
-        &[0xa4],
-        &[0xa6],
-        &[0x2e],
-        &[0xaf],
+        HEAD,
+        &[&[0xa8, 63], &[0xd3, 0], &[0x40], &[0x20, 0x00], &[0xda, 0x12], &[0xa1], &[0xc8]],
+        &[&[0xd9, 0x22], &[0x81, 0x7f], &[0xdb, 0x34], &[0xa4], &[0xa6], &[0x2e], &[0xaf]],
     ],
     addressing: Addressing::Window,
     column_offset: 0,
 };
 
 /// The controller this image drives.
-#[cfg(not(any(feature = "sh1106", feature = "ssd1309")))]
+#[cfg(not(any(feature = "sh1106", feature = "ssd1309", feature = "oled-128x32", feature = "oled-72x40")))]
 pub const PANEL: Controller = SSD1306;
+/// The controller this image drives.
+#[cfg(feature = "oled-128x32")]
+pub const PANEL: Controller = SSD1306_128X32;
+/// The controller this image drives.
+#[cfg(feature = "oled-72x40")]
+pub const PANEL: Controller = SSD1306_72X40;
 /// The controller this image drives.
 #[cfg(feature = "sh1106")]
 pub const PANEL: Controller = SH1106;
@@ -125,8 +115,12 @@ pub const PANEL: Controller = SH1106;
 #[cfg(feature = "ssd1309")]
 pub const PANEL: Controller = SSD1309;
 
-#[cfg(all(feature = "sh1106", feature = "ssd1309"))]
-compile_error!("choose one panel: `sh1106` or `ssd1309` (or neither, for the SSD1306)");
+#[cfg(any(
+    all(feature = "sh1106", feature = "ssd1309"),
+    all(feature = "oled-128x32", feature = "oled-72x40"),
+    all(any(feature = "sh1106", feature = "ssd1309"), any(feature = "oled-128x32", feature = "oled-72x40"))
+))]
+compile_error!("choose one panel: `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` (or none: the SSD1306 128x64)");
 
 /// A command that changes nothing shown (normal, not inverted, display): the probe of a panel
 /// between frames.
