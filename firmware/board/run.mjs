@@ -23,7 +23,8 @@
 // --panel NAME puts another panel on the buses in place of the SSD1306 128x64: sh1106 (the 1.3"
 // modules: 132 columns of RAM, page addressing only), ssd1309 (the 2.42" modules: no charge
 // pump), ssd1306-128x32 or ssd1306-72x40 (smaller glass: the frame's pixels are its size); the
-// image must be built for it (its `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature).
+// image must be built for it (its `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature);
+// sharp-400x240 or sharp-128x128 puts a Sharp memory LCD on SPI0 alone (its own wiring).
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
 // --panel-off START_MS:LEN_MS (repeatable) cuts the display's power at START_MS of emulated
@@ -61,14 +62,24 @@ import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306, GLASSES } from './ssd1306.mjs';
 import { Sh1106 } from './sh1106.mjs';
 import { Ssd1309 } from './ssd1309.mjs';
+import { SharpMemoryLcd } from './sharp.mjs';
 
-/** The panel controllers --panel chooses from (the image must drive the same one). */
+/** A Sharp memory LCD's wiring (the `sharp` builds'): SCS (active high) on GP17, DISP on GP20. */
+const SHARP_SPI = { cs: 17, disp: 20, csActiveHigh: true };
+
+/**
+ * The panels --panel chooses from (the image must drive the same one): each made with the
+ * time (`now`: emulated nanoseconds), on both buses with the SSD1306 modules' wiring, or on SPI
+ * alone with its own.
+ */
 const PANELS = {
-  ssd1306: (address) => new Ssd1306(address),
-  'ssd1306-128x32': (address) => new Ssd1306(address, GLASSES['128x32']),
-  'ssd1306-72x40': (address) => new Ssd1306(address, GLASSES['72x40']),
-  sh1106: (address) => new Sh1106(address),
-  ssd1309: (address) => new Ssd1309(address),
+  ssd1306: { make: () => new Ssd1306(0x3c) },
+  'ssd1306-128x32': { make: () => new Ssd1306(0x3c, GLASSES['128x32']) },
+  'ssd1306-72x40': { make: () => new Ssd1306(0x3c, GLASSES['72x40']) },
+  sh1106: { make: () => new Sh1106(0x3c) },
+  ssd1309: { make: () => new Ssd1309(0x3c) },
+  'sharp-400x240': { make: (now) => new SharpMemoryLcd(400, 240, now), spi: SHARP_SPI },
+  'sharp-128x128': { make: (now) => new SharpMemoryLcd(128, 128, now), spi: SHARP_SPI },
 };
 
 const LED_PIN = 25;
@@ -227,7 +238,8 @@ function main() {
 
   // The display model on I2C0 and SPI0 (or nothing: every I2C address NACKs), bytes delivered
   // when the bus would deliver them.
-  const display = opt.display ? PANELS[opt.panel](0x3c) : null;
+  const panel = PANELS[opt.panel];
+  const display = opt.display ? panel.make(() => mcu.clock.nanos + epoch.nanos) : null;
   let busBytes = 0; // bytes the display heard (on I2C, those after an address byte)
   let i2cTransfers = 0; // address bytes sent (each START or repeated START)
   let naks = 0;
@@ -340,7 +352,7 @@ function main() {
     board.loadBootrom(bootWords);
     flashBytes = loadUf2(mcu, uf2);
     mcu.logger = logger;
-    board.attachI2c(0, display, {
+    board.attachI2c(0, panel.spi ? null : display, {
       timed: opt.timedBus,
       listen: {
         connect: (ack) => {
@@ -353,7 +365,7 @@ function main() {
       },
       pins: I2C_PINS,
     });
-    board.attachSpi(0, display, { ...SPI_DISPLAY, timed: opt.timedBus, listen: { byte } });
+    board.attachSpi(0, display, { ...(panel.spi ?? SPI_DISPLAY), timed: opt.timedBus, listen: { byte } });
     board.gpio(LED_PIN).addListener(onLed);
     const watchdog = mcu.peripherals[0x40058];
     // The watchdog resets the chip: its timer stops here (rp2040js would re-arm it at 0 and
@@ -438,7 +450,10 @@ function main() {
       records?.poll();
       board.stop ??= board.fault();
       if (board.time + epoch.cycles > opt.maxCycles) board.stop ??= `no result within ${opt.maxCycles} cycles`;
-      else if (display?.error) board.stop ??= `display: ${display.error}`;
+      else {
+        display?.tick?.();
+        if (display?.error) board.stop ??= `display: ${display.error}`;
+      }
       if (mcu.clock.nanos + epoch.nanos >= untilNanos && board.stop === null) {
         board.stop = `${opt.untilMs} ms of emulated time`;
         ok = true;

@@ -760,18 +760,21 @@ export class SiliconBoard {
    * Puts `device` (spiByte, reset; see ssd1306.mjs) on SPI controller `n` as a 4-wire module
    * wires it: chip select on GPIO `cs` (active low: bytes sent while it is high are not heard),
    * data/command on GPIO `dc` (sampled as each byte completes, as the SSD1306 latches it on the
-   * last SCLK edge) and reset on GPIO `res` (low resets the controller). Each byte takes the
-   * time the controller's clock divisors give, unless `timed` is false; `listen.byte` hears each
-   * byte as the bus finishes it.
+   * last SCLK edge) and reset on GPIO `res` (low resets the controller). A Sharp memory LCD
+   * (sharp.mjs) is wired with `csActiveHigh`, no `dc` nor `res`, and its DISP on GPIO `disp`:
+   * it hears its chip select's changes (`select`) and DISP's (`display`). Each byte takes the
+   * time the controller's clock divisors give, unless `timed` is false; `listen.byte` hears
+   * each byte as the bus finishes it.
    */
-  attachSpi(n, device, { cs, dc, res, timed = true, listen = {} }) {
+  attachSpi(n, device, { cs, dc = null, res = null, disp = null, csActiveHigh = false, timed = true, listen = {} }) {
     const spi = this.mcu.spi[n];
     const high = (pin) => this.mcu.gpio[pin].value === GPIOPinState.High;
+    const selected = () => high(cs) === csActiveHigh;
     spi.onTransmit = (value) => {
       const deliver = () => {
-        if (device && !high(cs)) {
+        if (device && selected()) {
           listen.byte?.(value);
-          device.spiByte(value & 0xff, high(dc));
+          device.spiByte(value & 0xff, dc !== null && high(dc));
         }
         spi.completeTransmit(0);
       };
@@ -780,11 +783,14 @@ export class SiliconBoard {
       this.busCycles += cycles;
       this.mcu.clock.createAlarm(deliver).schedule((cycles * 1e9) / this.mcu.clkSys);
     };
-    if (device) {
+    if (!device) return;
+    if (res !== null) {
       this.mcu.gpio[res].addListener((state) => {
         if (state === GPIOPinState.Low) device.reset();
       });
     }
+    if (device.select) this.mcu.gpio[cs].addListener(() => device.select(selected()));
+    if (disp !== null && device.display) this.mcu.gpio[disp].addListener(() => device.display(high(disp)));
   }
 
   gpio(pin) {

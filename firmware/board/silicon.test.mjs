@@ -276,3 +276,41 @@ test('SSD1309: no charge pump command, and a command lock', async () => {
   i2cSend(e, [0x00, 0x8d, 0x14]);
   assert.match(e.error, /unknown command byte 0x8d/);
 });
+
+test('Sharp memory LCD: SCS active high, LSB-first mode and addresses, whole lines, VCOM inverted each second', async () => {
+  const { SharpMemoryLcd } = await import('./sharp.mjs');
+  let now = 0;
+  const d = new SharpMemoryLcd(16, 4, () => now);
+  const rev = (b) => parseInt(b.toString(2).padStart(8, '0').split('').reverse().join(''), 2);
+  const send = (bytes) => {
+    d.select(true);
+    for (const b of bytes) d.spiByte(b);
+    d.select(false);
+  };
+  d.display(true);
+  assert.match(d.notShowable(), /noise/, 'noise until cleared');
+  send([rev(0b100), 0]); // M2: clear all
+  assert.equal(d.notShowable(), null);
+  // M0 write with VCOM (M1) high: line 2, then line 4, each 2 bytes and a dummy; a final dummy.
+  now = 0.4e9;
+  send([rev(0b011), rev(2), 0xf0, 0x01, 0, rev(4), 0xaa, 0x55, 0, 0]);
+  assert.equal(d.error, null);
+  assert.deepEqual([...d.shown()], [0xff, 0xff, 0xf0, 0x01, 0xff, 0xff, 0xaa, 0x55]);
+  d.spiByte(0x12);
+  assert.equal(d.memory[0], 0xff, 'bytes with SCS low are not heard');
+  now = 1.3e9;
+  send([rev(0b000), 0]); // display mode, VCOM low: inverted 0.9 s after it went high
+  assert.equal(d.error, null);
+  now = 2.5e9;
+  assert.match(d.notShowable(), /VCOM not inverted for 1200 ms/);
+  const e = new SharpMemoryLcd(16, 4, () => 0);
+  e.select(true);
+  e.spiByte(rev(0b001));
+  e.spiByte(rev(5));
+  assert.match(e.error, /line address 5/);
+  const f = new SharpMemoryLcd(16, 4, () => 0);
+  f.select(true);
+  for (const b of [rev(0b001), rev(1), 0, 0, 0]) f.spiByte(b);
+  f.select(false);
+  assert.match(f.error, /no dummy byte after the last line/);
+});

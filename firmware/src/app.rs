@@ -38,6 +38,10 @@ pub const BUILD: Build = Build {
         Glass::Oled128x32
     } else if cfg!(feature = "oled-72x40") {
         Glass::Oled72x40
+    } else if cfg!(feature = "sharp-400x240") {
+        Glass::Sharp400x240
+    } else if cfg!(feature = "sharp-128x128") {
+        Glass::Sharp128x128
     } else {
         Glass::Oled128x64
     },
@@ -295,6 +299,11 @@ const fn dithered(n: usize) -> usize {
 const TILES_X: usize = (WIDTH as usize).div_ceil(RENDERED.tile as usize);
 /// Tiles of the frame.
 const TILES: usize = TILES_X * (HEIGHT as usize).div_ceil(RENDERED.tile as usize);
+/// Tiles whose storage trace, then dither keeps at once (`schedule`'s ring of bands): every
+/// tile of a frame as small as the 128x64 panel's (32) and of a progressive one (its tiles keep
+/// rays between passes); of a larger frame three bands, so core 1 traces up to two bands ahead
+/// of core 0's dithering (a 400x240 frame keeps 75 tiles of its 375).
+const RING: usize = if cfg!(feature = "progressive") || TILES <= 32 { TILES } else { TILES_X * 3 };
 
 /// The memory of the second tile share: on a board with two cores its own query scratch; and
 /// the rays both shares keep between progressive passes ([`TRACED`] each) on one core. Where
@@ -305,7 +314,7 @@ pub struct ShareMemory {
     mailbox: [u32; second(MAX_OBJECTS + MAX_LATTICES)],
     rows: [i16; second(MAX_ROWS)],
     traced: [[Traced; TRACED]; 2],
-    kept: [KeptTile; dithered(TILES)],
+    kept: [KeptTile; dithered(RING)],
     rays: [[Traced; TILE_RAYS]; TILES],
     above: [(u16, u16); dithered(WIDTH as usize)],
     band: [BinaryColor; dithered(WIDTH as usize * RENDERED.tile as usize)],
@@ -320,7 +329,7 @@ impl ShareMemory {
             mailbox: [0; second(MAX_OBJECTS + MAX_LATTICES)],
             rows: [0; second(MAX_ROWS)],
             traced: [[NONE; TRACED]; 2],
-            kept: [KeptTile::EMPTY; dithered(TILES)],
+            kept: [KeptTile::EMPTY; dithered(RING)],
             rays: [[NONE; TILE_RAYS]; TILES],
             above: [(0, 0); dithered(WIDTH as usize)],
             band: [BinaryColor::Off; dithered(WIDTH as usize * RENDERED.tile as usize)],
@@ -561,7 +570,9 @@ fn trace_then_dither<
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
     let DitherMemory { mailbox, rows, kept, rays, above, band, carries } = memory;
-    let schedule = FrameSchedule::new(frame, PASSES.len(), kept, rays);
+    let Some(schedule) = FrameSchedule::new(frame, PASSES.len(), kept, rays) else {
+        return Err(AppError::Render(RenderError::ScratchTooSmall { needed: TILES }));
+    };
     let mut there = (Stats::default(), None, 0);
     let mut here: (Stats, Result<(), AppError<'t, D::Error>>, u64) = (Stats::default(), Ok(()), 0);
     cores.join(
@@ -606,7 +617,7 @@ fn trace_then_dither<
 }
 
 /// The scheduler of [`trace_then_dither`] for this build's frame.
-type FrameSchedule<'l> = Schedule<'l, TILES, TILES_X, TILE_RAYS>;
+type FrameSchedule<'l> = Schedule<'l, RING, TILES_X, TILE_RAYS>;
 
 /// The one way a core traces a tile in trace, then dither: [`trace_tile`] of pass `PASSES[p]`,
 /// with `hooks` (core 0's report progress; core 1 has none).

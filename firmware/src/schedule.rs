@@ -1,9 +1,13 @@
 //! The tile scheduler of trace, then dither on two cores: which tile each core traces next,
 //! and which bands core 0 may dither.
 //!
-//! Each of a frame's tiles has one slot of storage (what it keeps for its dithering, and in a
-//! progressive build its rays between passes). A slot is *free* (to be traced), then *done* (to
-//! be dithered), then free again for the next progressive pass. The cores take tiles one at a
+//! Each tile being traced or waiting for its dithering has one slot of storage (what it keeps
+//! for its dithering, and in a progressive build its rays between passes). The slots are a ring
+//! of whole bands: tile `k` has slot `k % slots`, so a frame taller than the ring reuses a
+//! band's slots once core 0 has dithered it (a 400x240 frame's 375 tiles in three bands' worth);
+//! a progressive frame, whose tiles keep rays between passes, needs a slot per tile. A slot is
+//! *free* (to be traced), then *done* (to be dithered), then free again for the next tile that
+//! maps to it, or the next progressive pass. The cores take tiles one at a
 //! time in raster order, pass after pass ([`Schedule::take`]); core 0 takes a band's done slots
 //! when all of them are done ([`Schedule::ready`]) and frees them once it has dithered them
 //! ([`Schedule::free`]). Every step is one short critical section.
@@ -66,34 +70,52 @@ pub enum Take<T> {
     Finished,
 }
 
-/// The slots: free to trace, done to dither, and the next tile to trace.
+/// The slots (`TILES` of them at most): free to trace, done to dither, and the next tile to
+/// trace.
 struct Board<'l, const TILES: usize, const RAYS: usize> {
     free: [Option<Slot<'l, RAYS>>; TILES],
     done: [Option<Slot<'l, RAYS>>; TILES],
     next: usize,
 }
 
-/// The schedule of one frame's `passes` passes over `TILES` tiles, `TILES_X` across.
+/// The schedule of one frame's `passes` passes over its tiles, at most `TILES_X` across, in a
+/// ring of at most `TILES` slots.
 pub struct Schedule<'l, const TILES: usize, const TILES_X: usize, const RAYS: usize> {
     board: Mutex<RefCell<Board<'l, TILES, RAYS>>>,
     frame: Frame,
+    /// The frame's tiles.
     tiles: usize,
     tiles_x: usize,
+    /// The slots in the ring: whole bands.
+    slots: usize,
     passes: usize,
 }
 
 impl<'l, const TILES: usize, const TILES_X: usize, const RAYS: usize> Schedule<'l, TILES, TILES_X, RAYS> {
-    /// The schedule of `frame` in `passes` passes, its tiles' slots in `kept` and `rays` (the
-    /// frame's tiles past either's length, or past `TILES`, are not traced).
-    pub fn new(frame: &Frame, passes: usize, kept: &'l mut [KeptTile], rays: &'l mut [[Traced; RAYS]]) -> Self {
+    /// The schedule of `frame` in `passes` passes, its tiles' slots in `kept` and `rays` (whole
+    /// bands of them: as many as fit in `TILES` and both lengths). `None` when not one band fits,
+    /// or when a progressive frame (more than one pass) has fewer slots than tiles.
+    pub fn new(frame: &Frame, passes: usize, kept: &'l mut [KeptTile], rays: &'l mut [[Traced; RAYS]]) -> Option<Self> {
         let (tiles_x, down) = frame.grid().tiles();
-        let tiles_x = tiles_x.min(TILES_X);
-        let tiles = (tiles_x * down).min(TILES).min(kept.len());
+        if tiles_x > TILES_X {
+            return None;
+        }
+        let tiles = tiles_x * down;
+        let room = TILES.min(kept.len()).min(rays.len());
+        let slots = (room / tiles_x * tiles_x).min(tiles);
+        if slots == 0 || (passes > 1 && slots < tiles) {
+            return None;
+        }
         let mut board = Board { free: [const { None }; TILES], done: [const { None }; TILES], next: 0 };
-        for (slot, (kept, rays)) in board.free.iter_mut().zip(kept.iter_mut().zip(rays.iter_mut())).take(tiles) {
+        for (slot, (kept, rays)) in board.free.iter_mut().zip(kept.iter_mut().zip(rays.iter_mut())).take(slots) {
             *slot = Some(Slot::new(kept, rays));
         }
-        Schedule { board: Mutex::new(RefCell::new(board)), frame: *frame, tiles, tiles_x, passes }
+        Some(Schedule { board: Mutex::new(RefCell::new(board)), frame: *frame, tiles, tiles_x, slots, passes })
+    }
+
+    /// The first slot of band `band`'s tiles (a band's slots follow each other).
+    fn band_slot(&self, band: usize) -> usize {
+        band * self.tiles_x % self.slots
     }
 
     /// Tiles across the frame.
@@ -115,7 +137,7 @@ impl<'l, const TILES: usize, const TILES_X: usize, const RAYS: usize> Schedule<'
             if i >= self.passes * self.tiles {
                 return Take::Finished;
             }
-            match b.free[i % self.tiles].take() {
+            match b.free[i % self.tiles % self.slots].take() {
                 Some(slot) => {
                     b.next += 1;
                     Take::Tile((i / self.tiles, i % self.tiles, slot))
@@ -132,7 +154,7 @@ impl<'l, const TILES: usize, const TILES_X: usize, const RAYS: usize> Schedule<'
         let band = Frame { rows: (ty as u16, ty as u16 + 1), ..self.frame };
         let (kept, rays) = slot.parts();
         let traced = trace(scratch, p, band, Share::single(tx, ty, self.tiles_x), core::slice::from_mut(kept), rays);
-        critical_section::with(|cs| self.board.borrow(cs).borrow_mut().done[k] = Some(slot));
+        critical_section::with(|cs| self.board.borrow(cs).borrow_mut().done[k % self.slots] = Some(slot));
         Take::Tile(traced)
     }
 
@@ -142,7 +164,8 @@ impl<'l, const TILES: usize, const TILES_X: usize, const RAYS: usize> Schedule<'
     pub fn ready(&self, band: usize, from: usize, parts: bool) -> Option<[Option<Slot<'l, RAYS>>; TILES_X]> {
         critical_section::with(|cs| {
             let mut b = self.board.borrow(cs).borrow_mut();
-            let row = &mut b.done[band * self.tiles_x + from..(band + 1) * self.tiles_x];
+            let first = self.band_slot(band);
+            let row = &mut b.done[first + from..first + self.tiles_x];
             let traced = row.iter().take_while(|r| r.is_some()).count();
             if traced == 0 || (traced < row.len() && !parts) {
                 return None;
@@ -157,9 +180,10 @@ impl<'l, const TILES: usize, const TILES_X: usize, const RAYS: usize> Schedule<'
     pub fn free(&self, band: usize, from: usize, part: &mut [Option<Slot<'l, RAYS>>; TILES_X]) {
         critical_section::with(|cs| {
             let mut b = self.board.borrow(cs).borrow_mut();
+            let first = self.band_slot(band);
             for (tx, slot) in part.iter_mut().enumerate() {
                 if let Some(slot) = slot.take() {
-                    b.free[band * self.tiles_x + from + tx] = Some(slot);
+                    b.free[first + from + tx] = Some(slot);
                 }
             }
         });

@@ -212,6 +212,19 @@ pub struct RenderArgs {
     /// cutoff 7 (the frame options above cannot be given with it).
     #[arg(long, value_enum, conflicts_with_all = ["size", "dither", "sampling", "scalar", "tile", "no_outline", "gamma", "cutoff"])]
     pub board: Option<crate::uf2::Board>,
+    /// With --board: the panel the image drives, whose glass sets the frame's size (ssd1306,
+    /// sh1106, ssd1309: 128x64; ssd1306-128x32; ssd1306-72x40; sharp-400x240; sharp-128x128).
+    #[arg(long, value_parser = parse_panel, requires = "board")]
+    pub panel: Option<board_records::frame::Panel>,
+}
+
+/// A panel's name as `--panel` takes it.
+pub fn parse_panel(name: &str) -> Result<board_records::frame::Panel, String> {
+    use board_records::frame::Panel;
+    Panel::of(name).ok_or_else(|| {
+        let names: Vec<&str> = Panel::ALL.iter().map(|p| p.name()).collect();
+        format!("one of {}", names.join(", "))
+    })
 }
 
 impl RenderArgs {
@@ -224,10 +237,11 @@ impl RenderArgs {
         }
     }
 
-    /// The frame the options describe (the board's own with `--board`).
+    /// The frame the options describe (the board's own with `--board`, at its panel's size).
     pub fn frame(&self) -> lattice_rt::Frame {
         if self.board.is_some() {
-            return board_records::frame::rendered(board_records::frame::PICO);
+            let glass = self.panel.unwrap_or_default().glass();
+            return board_records::frame::rendered(board_records::frame::Build { glass, ..board_records::frame::PICO });
         }
         lattice_rt::Frame {
             tile: self.tile,

@@ -97,6 +97,11 @@ enum Command {
         /// module, `i2c-1mhz`, `orbit`, `progressive`, `no-outline`, ...
         #[arg(long, value_name = "LIST")]
         features: Option<String>,
+        /// The panel the image drives (its firmware feature added to --features): ssd1306 (the
+        /// default), sh1106 (1.3" modules), ssd1309 (2.42"), ssd1306-128x32, ssd1306-72x40,
+        /// sharp-400x240 (Sharp memory LCD LS027B7DH01), sharp-128x128 (LS013B7DH03).
+        #[arg(long, value_parser = host_sim::cli::parse_panel, conflicts_with = "scene")]
+        panel: Option<board_records::frame::Panel>,
         /// UF2 file to write [default: out/lattice-rt-<board>.uf2; with --features,
         /// out/lattice-rt-<board>-<features>.uf2; with --scene, out/lattice-rt-pico-<scene>.uf2].
         #[arg(short, long)]
@@ -166,9 +171,12 @@ fn real_main() -> Result<()> {
             Ok(())
         }
         Some(Command::Orbit { scene, output, frames }) => orbit::orbit_cmd(&scene, &output, frames),
-        Some(Command::Uf2 { board, features, output, scene, image }) => match scene {
+        Some(Command::Uf2 { board, features, panel, output, scene, image }) => match scene {
             Some(scene) => uf2::scene_cmd(board, &scene, &image, output.as_deref()),
-            None => uf2::uf2_cmd(&std::env::current_dir()?, board, features.as_deref(), output.as_deref()),
+            None => {
+                let features = uf2::with_panel(features.as_deref(), panel);
+                uf2::uf2_cmd(&std::env::current_dir()?, board, features.as_deref(), output.as_deref())
+            }
         },
         Some(Command::Stats(a)) => match a.scalar {
             Scalar::F64 => run::stats_cmd::<f64>(&a),

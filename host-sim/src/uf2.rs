@@ -149,6 +149,15 @@ pub fn write_uf2(elf: &Path, out: &Path) -> Result<()> {
     Board::Pico.write_uf2(elf, out)
 }
 
+/// The firmware's `features` with `panel`'s own added (the default panel has none).
+pub fn with_panel(features: Option<&str>, panel: Option<board_records::frame::Panel>) -> Option<String> {
+    let own = panel.and_then(board_records::frame::Panel::feature);
+    match (features, own) {
+        (Some(f), Some(p)) => Some(format!("{p},{f}")),
+        (f, p) => f.or(p).map(str::to_string),
+    }
+}
+
 /// The command `host-sim uf2`: the image with the firmware's `features` (comma-separated, such
 /// as `spi`), if any; `out` defaults to `out/lattice-rt-<board>[-<features>].uf2`.
 pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, out: Option<&Path>) -> Result<()> {

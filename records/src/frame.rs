@@ -78,6 +78,10 @@ pub enum Glass {
     Oled128x32,
     /// 72x40, the 0.42" SSD1306 modules and the Thumby's panel (`oled-72x40`).
     Oled72x40,
+    /// 400x240, the Sharp memory LCD LS027B7DH01 (2.7", the Playdate's kind; `sharp-400x240`).
+    Sharp400x240,
+    /// 128x128, the Sharp memory LCD LS013B7DH03 (1.28"; `sharp-128x128`).
+    Sharp128x128,
 }
 
 impl Glass {
@@ -87,6 +91,8 @@ impl Glass {
             Glass::Oled128x64 => (128, 64),
             Glass::Oled128x32 => (128, 32),
             Glass::Oled72x40 => (72, 40),
+            Glass::Sharp400x240 => (400, 240),
+            Glass::Sharp128x128 => (128, 128),
         }
     }
 
@@ -96,9 +102,89 @@ impl Glass {
             Glass::Oled128x32
         } else if has("oled-72x40") {
             Glass::Oled72x40
+        } else if has("sharp-400x240") {
+            Glass::Sharp400x240
+        } else if has("sharp-128x128") {
+            Glass::Sharp128x128
         } else {
             Glass::Oled128x64
         }
+    }
+}
+
+/// The panels the Raspberry Pi boards' image drives, each chosen by a firmware feature (none:
+/// the SSD1306 128x64).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Panel {
+    /// SSD1306 128x64 (the default).
+    #[default]
+    Ssd1306,
+    /// SH1106 128x64, the 1.3" modules.
+    Sh1106,
+    /// SSD1309 128x64, the 2.42" modules.
+    Ssd1309,
+    /// SSD1306 on 128x32 glass.
+    Ssd1306x32,
+    /// SSD1306 on 72x40 glass.
+    Ssd1306x40,
+    /// Sharp memory LCD LS027B7DH01, 400x240.
+    Sharp400x240,
+    /// Sharp memory LCD LS013B7DH03, 128x128.
+    Sharp128x128,
+}
+
+impl Panel {
+    /// Every panel.
+    pub const ALL: [Panel; 7] = [
+        Panel::Ssd1306,
+        Panel::Sh1106,
+        Panel::Ssd1309,
+        Panel::Ssd1306x32,
+        Panel::Ssd1306x40,
+        Panel::Sharp400x240,
+        Panel::Sharp128x128,
+    ];
+
+    /// Its name: `host-sim --panel`'s and the emulated board's (`run.mjs --panel`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Panel::Ssd1306 => "ssd1306",
+            Panel::Sh1106 => "sh1106",
+            Panel::Ssd1309 => "ssd1309",
+            Panel::Ssd1306x32 => "ssd1306-128x32",
+            Panel::Ssd1306x40 => "ssd1306-72x40",
+            Panel::Sharp400x240 => "sharp-400x240",
+            Panel::Sharp128x128 => "sharp-128x128",
+        }
+    }
+
+    /// The firmware feature that drives it (none for the default).
+    pub const fn feature(self) -> Option<&'static str> {
+        match self {
+            Panel::Ssd1306 => None,
+            Panel::Sh1106 => Some("sh1106"),
+            Panel::Ssd1309 => Some("ssd1309"),
+            Panel::Ssd1306x32 => Some("oled-128x32"),
+            Panel::Ssd1306x40 => Some("oled-72x40"),
+            Panel::Sharp400x240 => Some("sharp-400x240"),
+            Panel::Sharp128x128 => Some("sharp-128x128"),
+        }
+    }
+
+    /// Its glass.
+    pub const fn glass(self) -> Glass {
+        match self {
+            Panel::Ssd1306 | Panel::Sh1106 | Panel::Ssd1309 => Glass::Oled128x64,
+            Panel::Ssd1306x32 => Glass::Oled128x32,
+            Panel::Ssd1306x40 => Glass::Oled72x40,
+            Panel::Sharp400x240 => Glass::Sharp400x240,
+            Panel::Sharp128x128 => Glass::Sharp128x128,
+        }
+    }
+
+    /// The panel named `name`.
+    pub fn of(name: &str) -> Option<Panel> {
+        Panel::ALL.into_iter().find(|p| p.name() == name)
     }
 }
 

@@ -14,13 +14,25 @@ use std::fmt::Write as _;
 type Panel = (&'static str, &'static str, &'static str, Glass);
 
 /// The images checked.
-const PANELS: [Panel; 6] = [
+const PANELS: [Panel; 8] = [
     ("sh1106,i2c-1mhz", "sh1106", "SH1106 (1.3\" 128x64), I2C at 1 MHz", Glass::Oled128x64),
     ("sh1106,spi", "sh1106", "SH1106 (1.3\" 128x64), SPI at 10 MHz", Glass::Oled128x64),
     ("ssd1309,i2c-1mhz", "ssd1309", "SSD1309 (2.42\" 128x64), I2C at 1 MHz", Glass::Oled128x64),
     ("ssd1309,spi", "ssd1309", "SSD1309 (2.42\" 128x64), SPI at 10 MHz", Glass::Oled128x64),
     ("oled-128x32", "ssd1306-128x32", "SSD1306 (0.91\" 128x32), I2C at 400 kHz", Glass::Oled128x32),
     ("oled-72x40,spi", "ssd1306-72x40", "SSD1306 (0.42\" 72x40, the Thumby's), SPI at 10 MHz", Glass::Oled72x40),
+    (
+        "sharp-400x240",
+        "sharp-400x240",
+        "Sharp memory LCD LS027B7DH01 (2.7\" 400x240), SPI at 2 MHz",
+        Glass::Sharp400x240,
+    ),
+    (
+        "sharp-128x128",
+        "sharp-128x128",
+        "Sharp memory LCD LS013B7DH03 (1.28\" 128x128), SPI at 1 MHz",
+        Glass::Sharp128x128,
+    ),
 ];
 
 /// What one panel's run did, for the report.

@@ -1,30 +1,47 @@
-//! The panel as the render loop's draw target: whole bands of tiles sent as page bytes (no
-//! framebuffer) to the controller the image drives ([`controller`]: SSD1306, SH1106, SSD1309),
-//! over I2C ([`i2c`]: a queue the bus drains while the cores trace, and a display
-//! that does not answer reported) or, with the `spi` feature, 4-wire SPI ([`spi`]). Each gives
-//! the render loop the same two things: [`Pump`], its hooks, and [`flush`], the wait until the
-//! frame is on the panel.
+//! The panel as the render loop's draw target, with no framebuffer: whole bands of tiles sent
+//! as page bytes to an OLED controller ([`pages`], the controller the image drives from
+//! [`controller`]: SSD1306, SH1106, SSD1309) over I2C ([`i2c`]: a queue the bus drains while the
+//! cores trace, and a display that does not answer reported) or 4-wire SPI ([`spi`], the `spi`
+//! feature), or as line writes to a Sharp memory LCD on SPI ([`sharp`], the `sharp-*`
+//! features). Each bus gives the render loop the same two things: [`Pump`], its hooks, and
+//! [`flush`], the wait until the frame is on the panel.
 
 #[cfg(not(feature = "spi"))]
 mod bus_clear;
+#[cfg(not(feature = "sharp"))]
 pub mod controller;
 #[cfg(not(feature = "spi"))]
 mod i2c;
 #[cfg(not(feature = "spi"))]
 pub use i2c::{flush, reset, Pump, QueuedI2c};
+#[cfg(not(feature = "sharp"))]
+mod pages;
+#[cfg(not(feature = "sharp"))]
+pub use pages::PageTiles;
+#[cfg(feature = "sharp")]
+pub mod sharp;
 #[cfg(feature = "spi")]
 mod spi;
 #[cfg(feature = "spi")]
 pub use spi::{flush, reset, Pump};
 
-use controller::{Addressing, PANEL};
-use display_interface::{DataFormat, DisplayError, WriteOnlyDataCommand};
+use display_interface::DisplayError;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-use firmware::app::{HEIGHT, RENDERED, WIDTH};
+use firmware::app::{HEIGHT, WIDTH};
+
+/// The most rows drawn at once: a band of tiles.
+const BAND_ROWS: usize = firmware::app::RENDERED.tile as usize;
+
+/// The panel's name in the log.
+#[cfg(not(feature = "sharp"))]
+pub const NAME: &str = controller::PANEL.name;
+/// The panel's name in the log.
+#[cfg(feature = "sharp")]
+pub const NAME: &str = "Sharp memory LCD";
 
 /// A panel the modes set up before every frame: a panel that lost power (a loose wire) comes
 /// back dark, with its settings lost, and a write-only bus cannot tell, so no frame may count
@@ -38,37 +55,40 @@ pub trait SetUp {
     fn answers(&mut self) -> bool;
 }
 
-impl<DI: WriteOnlyDataCommand> SetUp for PageTiles<DI> {
+/// A panel that takes an area of one band of tiles at a time: at most [`BAND_ROWS`] rows from a
+/// row that is a multiple of 8, within the frame, its pixels row by row.
+pub trait Band {
+    /// Sends `colors` (row by row) for the area of size `size` (width, height) at `at` (x, y).
+    fn band(
+        &mut self,
+        at: (usize, usize),
+        size: (usize, usize),
+        colors: &mut dyn Iterator<Item = BinaryColor>,
+    ) -> Result<(), DisplayError>;
+}
+
+/// A [`Band`] panel as the render loop's draw target: the areas it takes are passed on; nothing
+/// else is supported (there is no framebuffer to merge single pixels into), and anything else is
+/// refused with an error.
+pub struct Bands<T>(pub T);
+
+impl<T: SetUp> SetUp for Bands<T> {
     fn set_up(&mut self) -> Result<(), DisplayError> {
-        for command in PANEL.set_up.iter().copied().flatten() {
-            self.interface.send_commands(DataFormat::U8(command))?;
-        }
-        flush().map_err(|_| DisplayError::BusWriteError)
+        self.0.set_up()
     }
 
     fn answers(&mut self) -> bool {
-        self.interface.send_commands(DataFormat::U8(controller::PROBE)).is_ok() && flush().is_ok()
+        self.0.answers()
     }
 }
 
-/// The most rows drawn at once: a band of tiles.
-const BAND_ROWS: usize = RENDERED.tile as usize;
-
-/// Draws areas that start on a page and are at most a band high ([`BAND_ROWS`]) by sending
-/// page bytes to the controller ([`PANEL`]); nothing else is supported (there is no framebuffer
-/// to merge single pixels into), and anything else is refused with an error.
-pub struct PageTiles<DI> {
-    /// The display's bus (commands and page data).
-    pub interface: DI,
-}
-
-impl<DI: WriteOnlyDataCommand> OriginDimensions for PageTiles<DI> {
+impl<T> OriginDimensions for Bands<T> {
     fn size(&self) -> Size {
         Size::new(WIDTH as u32, HEIGHT as u32)
     }
 }
 
-impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
+impl<T: Band> DrawTarget for Bands<T> {
     type Color = BinaryColor;
     type Error = DisplayError;
 
@@ -86,38 +106,10 @@ impl<DI: WriteOnlyDataCommand> DrawTarget for PageTiles<DI> {
         if w == 0 || h == 0 {
             return Ok(());
         }
-        if y0 < 0 || x0 < 0 || y0 % 8 != 0 || h > BAND_ROWS || x0 as usize + w > WIDTH as usize {
+        let inside = x0 >= 0 && y0 >= 0 && x0 as usize + w <= WIDTH as usize && y0 as usize + h <= HEIGHT as usize;
+        if !inside || y0 % 8 != 0 || h > BAND_ROWS {
             return Err(DisplayError::OutOfBoundsError);
         }
-        // One byte per column of each page, the pages one after the other (the SSD1306's
-        // horizontal addressing fills a draw area that way); bit k = row k of its page (LSB on
-        // top).
-        let mut pages = [0u8; WIDTH as usize * BAND_ROWS.div_ceil(8)];
-        let mut colors = colors.into_iter();
-        for y in 0..h {
-            let (page, bit) = (&mut pages[y / 8 * w..(y / 8 + 1) * w], 1u8 << (y % 8));
-            for col in page.iter_mut() {
-                if colors.next().is_some_and(|c| c.is_on()) {
-                    *col |= bit;
-                }
-            }
-        }
-        let (pages, w) = (&pages[..h.div_ceil(8) * w], w as u8);
-        let (x0, p0) = (x0 as u8, (y0 / 8) as u8);
-        match PANEL.addressing {
-            Addressing::Window => {
-                let (columns, rows) = controller::window(x0, w, p0, p0 + h.div_ceil(8) as u8 - 1);
-                self.interface.send_commands(DataFormat::U8(&columns))?;
-                self.interface.send_commands(DataFormat::U8(&rows))?;
-                self.interface.send_data(DataFormat::U8(pages))
-            }
-            Addressing::Pages => {
-                for (k, page) in pages.chunks(usize::from(w)).enumerate() {
-                    self.interface.send_commands(DataFormat::U8(&controller::page_start(x0, p0 + k as u8)))?;
-                    self.interface.send_data(DataFormat::U8(page))?;
-                }
-                Ok(())
-            }
-        }
+        self.0.band((x0 as usize, y0 as usize), (w, h), &mut colors.into_iter())
     }
 }

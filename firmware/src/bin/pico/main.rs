@@ -116,26 +116,21 @@ fn main() -> ! {
     let (timer, mut alarm) = sleep::start(timer_block, &mut pac.RESETS, &clocks);
 
     display::reset(&mut reset, &mut { timer });
-    let mut target = display::PageTiles { interface };
+    #[cfg(not(feature = "sharp"))]
+    let mut target = display::Bands(display::PageTiles { interface });
+    #[cfg(feature = "sharp")]
+    let mut target = display::Bands(display::sharp::LineTiles::new(interface));
     while target.set_up().is_err() {
         defmt::error!(
             "no {} answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",
-            display::controller::PANEL.name,
+            display::NAME,
             Wiring::SDA,
             Wiring::SCL,
             Wiring::ADDRESS
         );
         sleep::blink(&mut led, &mut alarm, 5);
     }
-    #[cfg(feature = "spi")]
-    defmt::info!(
-        "the display on SPI0: SCK GP{}, MOSI GP{}, CS GP{}, DC GP{}, RES GP{}",
-        Wiring::SCK,
-        Wiring::MOSI,
-        Wiring::CS,
-        Wiring::DC,
-        Wiring::RES
-    );
+    wiring::log();
     let cores = cores::TwoCores::start(&mut pac.PSM, &mut pac.PPB, sio.fifo);
     guard::start(watchdog);
     modes::report(board_records::Record::Started {

@@ -55,8 +55,9 @@ pub type Alarm0 = hal::timer::Alarm0<hal::timer::CopyableTimer0>;
 const ALARM_IRQ: pac::Interrupt = pac::Interrupt::TIMER0_IRQ_0;
 
 /// The timer's microseconds (its raw low word: it wraps every 71 minutes, so take differences
-/// with `wrapping_sub`), for waits that must not outlast a deadline (the I2C queue's).
-#[cfg(not(feature = "spi"))]
+/// with `wrapping_sub`), for waits that must not outlast a deadline (the I2C queue's) and the
+/// Sharp LCD's VCOM.
+#[cfg(any(not(feature = "spi"), feature = "sharp"))]
 pub fn micros() -> u32 {
     // SAFETY: a read of TIMERAWL, which has no side effects (unlike TIMELR, which latches TIMEHR).
     #[allow(unsafe_code)]

@@ -11,7 +11,7 @@ use hal::pac;
 /// The display's bus, pins, address and clock.
 pub struct Wiring;
 
-#[cfg_attr(not(feature = "spi"), allow(dead_code))] // the SPI pins, named in the `spi` build's log
+#[allow(dead_code)] // every bus's pins; each build names those of its own in its log
 impl Wiring {
     /// The GPIO the display's SDA is on (I2C).
     pub const SDA: u8 = 4;
@@ -32,9 +32,20 @@ impl Wiring {
     pub const DC: u8 = 20;
     /// The GPIO the display's RES (reset, active low) is on (`spi`).
     pub const RES: u8 = 21;
-    /// The SPI clock asked for: 10 MHz, the SSD1306's fastest serial clock (100 ns a cycle);
-    /// rp2040-hal sets the nearest clock at or under it that clk_peri divides to.
-    pub const SPI_HZ: u32 = 10_000_000;
+    /// The GPIO a Sharp memory LCD's DISP (display on) is on (`sharp`; its SCS, active high, is
+    /// on [`Wiring::CS`], its SCLK and SI on SPI0's).
+    pub const DISP: u8 = 20;
+    /// The SPI clock asked for: 10 MHz, the SSD1306's fastest serial clock (100 ns a cycle); for
+    /// a Sharp memory LCD 2 MHz on the LS027B7DH01 (what Adafruit's and micropython-nano-gui's
+    /// drivers run it at) and 1 MHz on the smaller LS013B7DH03. rp2040-hal sets the nearest clock
+    /// at or under it that clk_peri divides to.
+    pub const SPI_HZ: u32 = if cfg!(feature = "sharp-400x240") {
+        2_000_000
+    } else if cfg!(feature = "sharp") {
+        1_000_000
+    } else {
+        10_000_000
+    };
     /// The display bus's clock in kHz, as the log and the `Started` record give it.
     pub const BUS_KHZ: u32 = if cfg!(feature = "spi") { Wiring::SPI_HZ / 1000 } else { Wiring::I2C_HZ / 1000 };
     /// The display bus's name in the log.
@@ -54,23 +65,32 @@ pub type Interface = ssd1306::prelude::I2CInterface<
     )>,
 >;
 
+/// SPI0 on [`Wiring::MOSI`] and [`Wiring::SCK`] at [`Wiring::SPI_HZ`].
+#[cfg(feature = "spi")]
+pub type Spi0 = hal::spi::Spi<
+    hal::spi::Enabled,
+    pac::SPI0,
+    (Pin<bank0::Gpio19, hal::gpio::FunctionSpi, PullDown>, Pin<bank0::Gpio18, hal::gpio::FunctionSpi, PullDown>),
+    8,
+>;
+
+/// A Sharp memory LCD's bus: SPI0, its chip select (active high) on [`Wiring::CS`] and its
+/// DISP on [`Wiring::DISP`].
+#[cfg(feature = "sharp")]
+pub struct Interface {
+    /// SPI0.
+    pub spi: Spi0,
+    /// SCS: high while a command is sent.
+    pub cs: Output<bank0::Gpio17>,
+    /// DISP: high shows the memory's picture.
+    pub disp: Output<bank0::Gpio20>,
+}
+
 /// SPI0 on [`Wiring::MOSI`] and [`Wiring::SCK`] at [`Wiring::SPI_HZ`], chip select on
 /// [`Wiring::CS`], data/command on [`Wiring::DC`].
-#[cfg(feature = "spi")]
+#[cfg(all(feature = "spi", not(feature = "sharp")))]
 pub type Interface = ssd1306::prelude::SPIInterface<
-    embedded_hal_bus::spi::ExclusiveDevice<
-        hal::spi::Spi<
-            hal::spi::Enabled,
-            pac::SPI0,
-            (
-                Pin<bank0::Gpio19, hal::gpio::FunctionSpi, PullDown>,
-                Pin<bank0::Gpio18, hal::gpio::FunctionSpi, PullDown>,
-            ),
-            8,
-        >,
-        Output<bank0::Gpio17>,
-        embedded_hal_bus::spi::NoDelay,
-    >,
+    embedded_hal_bus::spi::ExclusiveDevice<Spi0, Output<bank0::Gpio17>, embedded_hal_bus::spi::NoDelay>,
     Output<bank0::Gpio20>,
 >;
 
@@ -78,10 +98,11 @@ pub type Interface = ssd1306::prelude::SPIInterface<
 pub type Led = Output<bank0::Gpio25>;
 
 /// The display's reset line (`spi`: [`Wiring::RES`]; an I2C module resets itself at power-on).
-#[cfg(feature = "spi")]
+#[cfg(all(feature = "spi", not(feature = "sharp")))]
 pub type Reset = Output<bank0::Gpio21>;
-/// The display's reset line (none on an I2C module: it resets itself at power-on).
-#[cfg(not(feature = "spi"))]
+/// The display's reset line (none on an I2C module, which resets itself at power-on, nor on a
+/// Sharp memory LCD).
+#[cfg(any(not(feature = "spi"), feature = "sharp"))]
 pub type Reset = ();
 
 /// What [`connect`] sets up.
@@ -113,25 +134,56 @@ pub fn connect(
         (ssd1306::I2CDisplayInterface::new_custom_address(queued, Wiring::ADDRESS), ())
     };
     #[cfg(feature = "spi")]
-    let (display, reset) = {
+    let spi = {
         use hal::Clock;
         let pins_spi = (
             pins.gpio19.into_function::<hal::gpio::FunctionSpi>(),
             pins.gpio18.into_function::<hal::gpio::FunctionSpi>(),
         );
-        let bus = hal::spi::Spi::<_, _, _, 8>::new(spi0, pins_spi).init(
+        hal::spi::Spi::<_, _, _, 8>::new(spi0, pins_spi).init(
             resets,
             clocks.peripheral_clock.freq(),
             Wiring::SPI_HZ.Hz(),
             embedded_hal::spi::MODE_0,
-        );
+        )
+    };
+    #[cfg(all(feature = "spi", not(feature = "sharp")))]
+    let (display, reset) = {
         let cs = pins.gpio17.into_push_pull_output_in_state(hal::gpio::PinState::High);
-        let Ok(device) = embedded_hal_bus::spi::ExclusiveDevice::new_no_delay(bus, cs);
+        let Ok(device) = embedded_hal_bus::spi::ExclusiveDevice::new_no_delay(spi, cs);
         let dc = pins.gpio20.into_push_pull_output();
         (
             ssd1306::prelude::SPIInterface::new(device, dc),
             pins.gpio21.into_push_pull_output_in_state(hal::gpio::PinState::High),
         )
     };
+    #[cfg(feature = "sharp")]
+    let (display, reset) = {
+        let cs = pins.gpio17.into_push_pull_output_in_state(hal::gpio::PinState::Low);
+        let disp = pins.gpio20.into_push_pull_output_in_state(hal::gpio::PinState::Low);
+        (Interface { spi, cs, disp }, ())
+    };
     Connected { display, led: pins.gpio25.into_push_pull_output(), reset }
+}
+
+/// Logs how the display is wired, on the SPI builds (the I2C build says it only when no display
+/// answers).
+pub fn log() {
+    #[cfg(feature = "sharp")]
+    defmt::info!(
+        "the Sharp memory LCD on SPI0: SCLK GP{}, SI GP{}, SCS GP{} (active high), DISP GP{}",
+        Wiring::SCK,
+        Wiring::MOSI,
+        Wiring::CS,
+        Wiring::DISP
+    );
+    #[cfg(all(feature = "spi", not(feature = "sharp")))]
+    defmt::info!(
+        "the display on SPI0: SCK GP{}, MOSI GP{}, CS GP{}, DC GP{}, RES GP{}",
+        Wiring::SCK,
+        Wiring::MOSI,
+        Wiring::CS,
+        Wiring::DC,
+        Wiring::RES
+    );
 }

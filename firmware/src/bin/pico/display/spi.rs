@@ -21,8 +21,13 @@ pub fn flush() -> Result<(), core::convert::Infallible> {
     Ok(())
 }
 
+/// A Sharp memory LCD has no reset line.
+#[cfg(feature = "sharp")]
+pub fn reset<D>(_line: &mut crate::wiring::Reset, _delay: &mut D) {}
+
 /// Pulses the module's RES line (high for 1 ms, low for 10 ms, high) before the display is set
 /// up, as the controllers need after power-on.
+#[cfg(not(feature = "sharp"))]
 pub fn reset<D: embedded_hal::delay::DelayNs>(line: &mut crate::wiring::Reset, delay: &mut D) {
     use embedded_hal::digital::OutputPin;
     // The pin's error type is Infallible.
