@@ -53,6 +53,11 @@ pub trait SetUp {
     /// Whether the panel answers a command that changes nothing it shows (normal, not inverted,
     /// display): a probe while the board waits between frames.
     fn answers(&mut self) -> bool;
+    /// Waits until everything drawn is on the panel: the bus's own wait ([`flush`]) unless the
+    /// panel has its own.
+    fn flush(&mut self) -> Result<(), DisplayError> {
+        flush().map_err(|_| DisplayError::BusWriteError)
+    }
 }
 
 /// A panel that takes an area of one band of tiles at a time: at most [`BAND_ROWS`] rows from a
@@ -63,7 +68,7 @@ pub trait Band {
         &mut self,
         at: (usize, usize),
         size: (usize, usize),
-        colors: &mut dyn Iterator<Item = BinaryColor>,
+        colors: impl Iterator<Item = BinaryColor>,
     ) -> Result<(), DisplayError>;
 }
 
@@ -79,6 +84,10 @@ impl<T: SetUp> SetUp for Bands<T> {
 
     fn answers(&mut self) -> bool {
         self.0.answers()
+    }
+
+    fn flush(&mut self) -> Result<(), DisplayError> {
+        self.0.flush()
     }
 }
 
@@ -110,6 +119,6 @@ impl<T: Band> DrawTarget for Bands<T> {
         if !inside || y0 % 8 != 0 || h > BAND_ROWS {
             return Err(DisplayError::OutOfBoundsError);
         }
-        self.0.band((x0 as usize, y0 as usize), (w, h), &mut colors.into_iter())
+        self.0.band((x0 as usize, y0 as usize), (w, h), colors.into_iter())
     }
 }

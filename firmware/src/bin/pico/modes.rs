@@ -97,7 +97,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
         let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut |_| {} };
         let result = render_embedded_at(scene, self.st, &mut self.target, &mut crate::display::Pump, shot, board);
         // The frame is on the panel once the bus has sent its last queued byte.
-        let sent = crate::display::flush();
+        let sent = self.target.flush();
         let _ = self.led.set_low();
         let result = result.and_then(|r| {
             sent.map(|()| r).map_err(|_| AppError::Render(RenderError::Draw(DisplayError::BusWriteError)))
@@ -157,7 +157,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
                 .map(|(x, y)| BinaryColor::from(frame.get(x, y)));
             self.target.fill_contiguous(&Rectangle::new(Point::new(0, y0 as i32), Size::new(w, rows)), colors)?;
         }
-        let sent = crate::display::flush();
+        let sent = self.target.flush();
         let _ = self.led.set_low();
         sent.map_err(|_| DisplayError::BusWriteError)
     }

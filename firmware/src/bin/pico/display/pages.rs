@@ -33,7 +33,7 @@ impl<DI: WriteOnlyDataCommand> Band for PageTiles<DI> {
         &mut self,
         (x0, y0): (usize, usize),
         (w, h): (usize, usize),
-        colors: &mut dyn Iterator<Item = BinaryColor>,
+        mut colors: impl Iterator<Item = BinaryColor>,
     ) -> Result<(), DisplayError> {
         // One byte per column of each page, the pages one after the other (the SSD1306's
         // horizontal addressing fills a draw area that way); bit k = row k of its page (LSB on
