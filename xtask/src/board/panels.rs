@@ -100,10 +100,10 @@ impl Session<'_> {
 /// The report's section on the panels.
 pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Result<String> {
     let mut md = String::new();
-    writeln!(md, "\n## Other panels: SH1106, SSD1309, 128x32 and 72x40\n")?;
+    writeln!(md, "\n## Other panels: SH1106, SSD1309, 128x32, 72x40 and Sharp memory LCDs\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask board`: each image is built for its panel's controller (`cargo pico-build --features ...`) and runs on the emulated board with that controller on the bus in place of the SSD1306 (`run.mjs --panel`), every scene's frame checked against host-sim's. The SH1106 model (firmware/board/sh1106.mjs) has the SH1106's 132 columns of RAM, page addressing only and the glass on columns 2 to 129; the SSD1309 model (ssd1309.mjs) has no charge pump command and a command lock; the smaller SSD1306 modules show part of the controller's RAM (128x32: 32 multiplexed rows, COM pins in sequence; 72x40: columns 28 to 99 and 40 rows) and the frame is traced at the glass's size. A command a controller does not have fails the run. The firmware sends each controller its own set-up and addresses the SH1106 page by page (`firmware/src/bin/pico/display/controller.rs`).\n"
+        "Written by `cargo xtask board`: each image is built for its panel's controller (`cargo pico-build --features ...`) and runs on the emulated board with that controller on the bus in place of the SSD1306 (`run.mjs --panel`), every scene's frame checked against host-sim's. The SH1106 model (firmware/board/sh1106.mjs) has the SH1106's 132 columns of RAM, page addressing only and the glass on columns 2 to 129; the SSD1309 model (ssd1309.mjs) has no charge pump command and a command lock; the smaller SSD1306 modules show part of the controller's RAM (128x32: 32 multiplexed rows, COM pins in sequence; 72x40: columns 28 to 99 and 40 rows) and the frame is traced at the glass's size. The Sharp memory LCD model (sharp.mjs) takes line writes with its chip select active high, the mode and addresses LSB first, a dummy byte after each line and one after the last, holds noise after power-on until cleared or written, and fails the run when VCOM is left uninverted for more than a second. A command a controller does not have fails the run. The firmware sends each controller its own set-up and addresses the SH1106 page by page (`firmware/src/bin/pico/display/controller.rs`); it gathers a band of tiles for the Sharp LCD and sends its lines by DMA while the cores trace on (`display/sharp.rs`), and on frames of more than 32 tiles keeps three bands of tiles between trace and dither, not the whole frame (a 400x240 frame: 75 of 375 tiles). Target for the Sharp LCD at 400x240: the {first} in at most 62.5 M cycles (2 frames per second).\n"
     )?;
     writeln!(md, "| panel and bus | features | pixels | frames bit-identical to host-sim | {first}: cycles | fps at 125 MHz | bytes on the bus |")?;
     writeln!(md, "|---|---|---|---:|---:|---:|---:|")?;
@@ -118,7 +118,7 @@ pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Resul
             r.what, r.features, r.same, r.scenes
         )?;
     }
-    writeln!(md, "\nThe {first} as each panel showed it (its pixels as they are, 4x):\n")?;
+    writeln!(md, "\nThe {first} as each panel showed it (its pixels as they are, 4x; the Sharp LCD's white pixels drawn lit):\n")?;
     for r in rows {
         writeln!(md, "![{}](images/{})", r.what.replace('"', "''"), r.picture_name())?;
     }
