@@ -5,7 +5,7 @@
 //! datasheets (firmware/board/sh1106.mjs, ssd1309.mjs, ssd1306.mjs's glasses): a command the
 //! controller does not have fails the run.
 
-use super::{host_frame, m, save_frame_sized, Session, PICO, PICO_SCALAR};
+use super::{host_frame, m3, save_frame_sized, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
 use board_records::frame::{Build, Glass};
 use std::fmt::Write as _;
@@ -109,7 +109,7 @@ pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Resul
     writeln!(md, "|---|---|---|---:|---:|---:|---:|")?;
     for r in rows {
         let (cycles, fps, bytes) = r.first.map_or(("-".into(), "-".into(), "-".into()), |(c, b)| {
-            (m(c), format!("{:.2}", clk_hz / c as f64), b.to_string())
+            (m3(c), format!("{:.2}", clk_hz / c as f64), b.to_string())
         });
         let (w, h) = r.size;
         writeln!(
@@ -118,7 +118,10 @@ pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Resul
             r.what, r.features, r.same, r.scenes
         )?;
     }
-    writeln!(md, "\nThe {first} as each panel showed it (its pixels as they are, 4x; the Sharp LCD's white pixels drawn lit):\n")?;
+    writeln!(
+        md,
+        "\nThe {first} as each panel showed it (its pixels as they are, 4x; the Sharp LCD's white pixels drawn lit):\n"
+    )?;
     for r in rows {
         writeln!(md, "![{}](images/{})", r.what.replace('"', "''"), r.picture_name())?;
     }

@@ -33,6 +33,8 @@ const CLEAR: u8 = 0x20;
 /// Clock cycles of the chip select's set-up before the first clock (3 µs) and hold after the
 /// last (1 µs), at 125 MHz.
 const SCS_SETUP: u32 = 375;
+/// The chip select's set-up in microseconds.
+const SCS_SETUP_US: u32 = 3;
 /// See [`SCS_SETUP`].
 const SCS_HOLD: u32 = 125;
 
@@ -111,6 +113,9 @@ impl LineTiles {
 
     /// Starts the line writes of the gathered band's first `rows` rows, from row `y0`, by DMA.
     fn send_lines(&mut self, y0: usize, rows: usize) {
+        // The chip select's set-up time passes while the lines' addresses are written.
+        let _ = self.bus.cs.set_high();
+        let raised = crate::sleep::micros();
         let mode = self.mode(WRITE);
         self.command[0] = mode;
         for r in 0..rows {
@@ -120,8 +125,8 @@ impl LineTiles {
         // The rows' lines and the final dummy byte (where a next row's address would be).
         let len = pixels(rows);
         self.command[len - 1] = 0;
-        let _ = self.bus.cs.set_high();
-        cortex_m::asm::delay(SCS_SETUP);
+        // 3 µs at least: the timer counts whole microseconds, so 4 of its ticks.
+        while crate::sleep::micros().wrapping_sub(raised) < SCS_SETUP_US + 1 {}
         core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
         // SAFETY: channel 0 reads `len` bytes of the static command buffer, which nothing
         // writes until `finish` has seen the channel stop, into SPI0's data register, paced by
