@@ -30,13 +30,14 @@ const WRITE: u8 = 0x80;
 const VCOM: u8 = 0x40;
 /// M2: clear the whole memory (white).
 const CLEAR: u8 = 0x20;
-/// Clock cycles of the chip select's set-up before the first clock (3 µs) and hold after the
-/// last (1 µs), at 125 MHz.
-const SCS_SETUP: u32 = 375;
-/// The chip select's set-up in microseconds.
+/// The system clock in MHz (rp2040-hal's and rp235x-hal's default clocks).
+const CLK_MHZ: u32 = if cfg!(feature = "pico2") { 150 } else { 125 };
+/// The chip select's set-up before the first clock, in microseconds.
 const SCS_SETUP_US: u32 = 3;
+/// Clock cycles of the chip select's set-up (3 µs) and of its hold after the last clock (1 µs).
+const SCS_SETUP: u32 = SCS_SETUP_US * CLK_MHZ;
 /// See [`SCS_SETUP`].
-const SCS_HOLD: u32 = 125;
+const SCS_HOLD: u32 = CLK_MHZ;
 
 const _: () =
     assert!(WIDTH.is_multiple_of(8) && HEIGHT <= 255, "a Sharp LCD line is whole bytes, its address one byte");
