@@ -42,6 +42,9 @@
 // it through the pins (I2C0's SDA on GP4, SCL on GP5). --nack-at MS (repeatable): the display
 // does not acknowledge the first byte written to it after MS. Each gives an {"event":"bus"}
 // line when it happens (what: "sda held", "sda released", "nack").
+// --press MS[:LEN_MS] (repeatable) presses the board's button (GP14 to ground, the firmware's
+// `Wiring::NEXT`; pulled up, so high while nobody presses) at MS for LEN_MS (100 by default),
+// with an {"event":"button"} line.
 // --panic-at MS with --panic-request ADDR writes 1 to the word at ADDR (the firmware's
 // PANIC_REQUEST) at MS: the firmware panics at its next check between frames.
 // --pass-bytes N shows a picture every N GDDRAM bytes the display receives while the LED is lit
@@ -57,6 +60,7 @@
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
 //                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
 //                     [--sda-stuck START_MS:PULSES] [--nack-at MS] [--panel NAME]
+//                     [--press MS[:LEN_MS]]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306, GLASSES } from './ssd1306.mjs';
@@ -87,12 +91,14 @@ const LED_PIN = 25;
 const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
 /** The I2C display's pins (wiring.rs): I2C0's SDA and SCL. */
 const I2C_PINS = { sda: 4, scl: 5 };
+/** The board's button (wiring.rs `Wiring::NEXT`): to ground when pressed, pulled up. */
+const BUTTON_PIN = 14;
 // Every how many instructions --profile samples the program counter (a prime, so no loop of
 // the renderer beats in step with it).
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [], sdaStuck: [], nackAt: [], panel: 'ssd1306' };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [], sdaStuck: [], nackAt: [], presses: [], panel: 'ssd1306' };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -126,7 +132,12 @@ function parseArgs(argv) {
       if (!m) throw new Error(`--sda-stuck ${v}: START_MS:PULSES expected (PULSES 1 to 9)`);
       o.sdaStuck.push({ startMs: Number(m[1]), pulses: Number(m[2]) });
     } else if (a === '--nack-at') o.nackAt.push(Number(next()));
-    else if (a === '--panel') {
+    else if (a === '--press') {
+      const v = next();
+      const m = /^(\d+(?:\.\d+)?)(?::(\d+(?:\.\d+)?))?$/.exec(v);
+      if (!m) throw new Error(`--press ${v}: MS or MS:LEN_MS expected`);
+      o.presses.push({ startMs: Number(m[1]), lenMs: m[2] === undefined ? 100 : Number(m[2]) });
+    } else if (a === '--panel') {
       o.panel = next();
       if (!PANELS[o.panel]) throw new Error(`--panel ${o.panel}: one of ${Object.keys(PANELS).join(', ')} expected`);
     }
@@ -344,6 +355,10 @@ function main() {
     moments.push({ nanos: startMs * 1e6, fn: () => (board.holdSda(0, pulses), busEvent('sda held')) });
   }
   for (const ms of display ? opt.nackAt : []) moments.push({ nanos: ms * 1e6, fn: () => board.nackNext(0) });
+  for (const { startMs, lenMs } of opt.presses) {
+    moments.push({ nanos: startMs * 1e6, fn: () => (mcu.gpio[BUTTON_PIN].setInputValue(false), emit({ event: 'button', ms: startMs })) });
+    moments.push({ nanos: (startMs + lenMs) * 1e6, fn: () => mcu.gpio[BUTTON_PIN].setInputValue(true) });
+  }
 
   /** A board from power-on (or, with `kept`, after a reset: SRAM and the watchdog's scratch and reason). */
   const boot = (kept) => {
@@ -367,6 +382,8 @@ function main() {
     });
     board.attachSpi(0, display, { ...(panel.spi ?? SPI_DISPLAY), timed: opt.timedBus, listen: { byte } });
     board.gpio(LED_PIN).addListener(onLed);
+    // Nobody presses the button at power-on: its pull-up holds it high.
+    mcu.gpio[BUTTON_PIN].setInputValue(true);
     const watchdog = mcu.peripherals[0x40058];
     // The watchdog resets the chip: its timer stops here (rp2040js would re-arm it at 0 and
     // fire again at once), and the board boots again after this step.

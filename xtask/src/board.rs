@@ -11,6 +11,7 @@
 //! `host-sim uf2` is the first half alone: the UF2 file to drag onto a Pico (or, with
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
 
+mod button;
 mod faults;
 mod panels;
 mod slot;
@@ -221,6 +222,8 @@ enum Event {
     Reset(String, f64),
     /// A fault on the display's bus (run.mjs's `bus` event: what, and when).
     Bus(String, f64),
+    /// The button pressed (run.mjs's `button` event: when).
+    Button(f64),
     End(RunEnd),
 }
 
@@ -235,6 +238,7 @@ impl Event {
                 Event::Reset(v["reason"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0))
             }
             Some("bus") => Event::Bus(v["what"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0)),
+            Some("button") => Event::Button(v["ms"].as_f64().unwrap_or(0.0)),
             _ => bail!("emulator printed an unknown event: {line}"),
         };
         Ok(event)
@@ -271,6 +275,8 @@ struct BoardRun {
     resets: Vec<(String, f64)>,
     /// The faults on the display's bus as they happened: what, and when.
     bus: Vec<(String, f64)>,
+    /// When the button was pressed.
+    presses: Vec<f64>,
 }
 
 /// One decoded defmt log line.
@@ -342,6 +348,10 @@ fn run_emulator(
             Event::Bus(what, ms) => {
                 eprintln!("  bus: {what} at {ms:.1} ms");
                 run.bus.push((what, ms));
+            }
+            Event::Button(ms) => {
+                eprintln!("  button pressed at {ms:.1} ms");
+                run.presses.push(ms);
             }
             Event::End(e) => {
                 run.ok = e.ok;
@@ -508,6 +518,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
         }
     }
     let fault_rows = s.fault_runs(&rows)?;
+    let button_row = s.button_run(&rows)?;
     let panel_rows = s.panel_runs()?;
     if let Some(images) = out.parent().map(|p| p.join("images")) {
         panels::save_pictures(&panel_rows, &images)?;
@@ -556,6 +567,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
     md.push_str(&slot::slot_report(&slot_rows)?);
     md.push_str(&faults::fault_report(&fault_rows)?);
+    md.push_str(&button::button_report(button_row.as_ref())?);
     md.push_str(&panels::panel_report(&panel_rows, s.scenes.first().map_or("", String::as_str), run.clk_sys_hz)?);
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());

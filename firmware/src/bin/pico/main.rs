@@ -12,12 +12,14 @@
 //! the display bus's timing) and relies on that LED protocol.
 //!
 //! The rooms: [`wiring`] (the pins, address and bus clock: the one place to change them),
-//! [`display`] (the SSD1306 as a draw target), [`cores`] (core 1), [`sleep`] (the timer alarm),
-//! [`modes`] (what is shown: scenes, orbit or ladder), [`guard`] (the watchdog), [`ram_code`] (the hot code copied to SRAM). The two boards differ only in what their
+//! [`display`] (the panel as a draw target), [`cores`] (core 1), [`sleep`] (the timer alarm),
+//! [`modes`] (what is shown: scenes, orbit or ladder), [`button`] (the next scene), [`guard`]
+//! (the watchdog), [`ram_code`] (the hot code copied to SRAM). The two boards differ only in what their
 //! HALs name differently (boot block, timer, its interrupt); each difference is one `cfg`.
 #![no_std]
 #![no_main]
 
+mod button;
 mod cores;
 mod display;
 mod guard;

@@ -178,13 +178,17 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
 
     /// Sleeps between scenes, asking the panel every [`PROBE_MS`] whether it answers. True, at
     /// once, when it stopped answering and answers again: it lost power and shows nothing, so
-    /// the frame is to be drawn again.
+    /// the frame is to be drawn again. A press of the button ([`crate::button`]) ends it early.
     pub fn pause(&mut self) -> bool {
         let mut lost = false;
         for _ in 0..PAUSE_MS / PROBE_MS {
             sleep_ms(&mut self.alarm, PROBE_MS);
             crate::guard::feed();
             crate::guard::check_requests();
+            if crate::button::pressed() {
+                defmt::info!("the button: the next scene");
+                return false;
+            }
             match (self.target.answers(), lost) {
                 (false, _) => lost = true,
                 (true, true) => {

@@ -32,6 +32,9 @@ impl Wiring {
     pub const DC: u8 = 20;
     /// The GPIO the display's RES (reset, active low) is on (`spi`).
     pub const RES: u8 = 21;
+    /// The GPIO a push button to ground shows the next scene on (pulled up inside; pressed
+    /// during the pause between scenes, it ends the pause).
+    pub const NEXT: u8 = 14;
     /// The GPIO a Sharp memory LCD's DISP (display on) is on (`sharp`; its SCS, active high, is
     /// on [`Wiring::CS`], its SCLK and SI on SPI0's).
     pub const DISP: u8 = 20;
@@ -116,7 +119,7 @@ pub struct Connected {
 }
 
 /// Sets the pins up as [`Wiring`] says: the display's bus (I2C0 on the default build, SPI0 with
-/// `spi`; the other controller is left in reset), and the on-board LED.
+/// `spi`; the other controller is left in reset), the on-board LED and the button's input.
 #[allow(unused_variables)]
 pub fn connect(
     pins: hal::gpio::Pins,
@@ -163,6 +166,9 @@ pub fn connect(
         let disp = pins.gpio20.into_push_pull_output_in_state(hal::gpio::PinState::Low);
         (Interface { spi, cs, disp }, ())
     };
+    // The button's pin: an input with its pull-up (read by `button::pressed`); the pin's
+    // setting stays when its value is dropped.
+    let _ = pins.gpio14.into_pull_up_input();
     Connected { display, led: pins.gpio25.into_push_pull_output(), reset }
 }
 
