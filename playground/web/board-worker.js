@@ -14,6 +14,8 @@ import { Ssd1306 } from '../../firmware/board/ssd1306.mjs';
 const LED_PIN = 25;
 // Steps between two looks at the panel: about 1.6 ms of emulated time, a few ms of the page's.
 const CHUNK = 200_000;
+// The board's button (firmware/src/bin/pico/wiring.rs `Wiring::NEXT`).
+const BUTTON_PIN = 14;
 
 function run({ uf2, bootrom, frames = 1 }) {
   const board = new SiliconBoard();
@@ -24,6 +26,8 @@ function run({ uf2, bootrom, frames = 1 }) {
   mcu.logger = { debug() {}, info() {}, warn() {}, error() {} };
   const display = new Ssd1306(0x3c);
   board.attachI2c(0, display, { timed: true, listen: {} });
+  // The board's button (GP14 to ground, pulled up): nobody presses it here.
+  mcu.gpio[BUTTON_PIN].setInputValue(true);
   const ms = () => mcu.clock.nanos / 1e6;
   let shown = 0;
   // A frame runs while the board's LED is lit; it is on the panel when the LED goes out.
