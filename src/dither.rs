@@ -15,10 +15,50 @@
 //! straight below as well, rather than out of the image: no error is lost there either, and the
 //! border columns are lit as often as the rest (a dropped share drew a seam).
 
-use embedded_graphics_core::pixelcolor::BinaryColor;
+use embedded_graphics_core::pixelcolor::{BinaryColor, Gray2, GrayColor, PixelColor};
 
 /// Highest gray level (white).
 pub const LEVELS: u8 = 64;
+
+/// A pixel a dither writes: the shades a panel shows, `STEPS + 1` of them evenly spaced from
+/// dark (step 0) to lit (step `STEPS`). [`BinaryColor`] is the 1-bit panel's pixel (one step);
+/// [`Gray2`] the gray mode's four shades (three steps), shown on a 1-bit OLED as subframes.
+pub trait Shade: PixelColor {
+    /// Steps above dark (1: two shades, 3: four).
+    const STEPS: u8;
+    /// The dark pixel.
+    const DARK: Self;
+    /// The shade of step `k` (`0..=STEPS`; larger steps are lit).
+    fn from_step(k: u8) -> Self;
+    /// This pixel's step, `0..=STEPS`: the subframes (of `STEPS`) it is lit in.
+    fn step(self) -> u8;
+}
+
+impl Shade for BinaryColor {
+    const STEPS: u8 = 1;
+    const DARK: Self = BinaryColor::Off;
+    #[inline(always)]
+    fn from_step(k: u8) -> Self {
+        BinaryColor::from(k != 0)
+    }
+    #[inline(always)]
+    fn step(self) -> u8 {
+        u8::from(self.is_on())
+    }
+}
+
+impl Shade for Gray2 {
+    const STEPS: u8 = 3;
+    const DARK: Self = Gray2::BLACK;
+    #[inline(always)]
+    fn from_step(k: u8) -> Self {
+        Gray2::new(k.min(3))
+    }
+    #[inline(always)]
+    fn step(self) -> u8 {
+        self.luma()
+    }
+}
 
 /// A dithering mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,15 +108,24 @@ pub fn ordered(level: u8, x: u32, y: u32, n: u8) -> BinaryColor {
     ordered_by(level, x, y, n.clamp(1, 8) as u32)
 }
 
+/// A level's place between two shades of `C`: the step below it (`0..=STEPS`) and how far
+/// it is above that step, in 64ths of a step (a level of 64 with one step is step 1, 0 above).
+#[inline(always)]
+fn between<C: Shade>(level: u8) -> (u32, u32) {
+    let q = level.min(LEVELS) as u32 * C::STEPS as u32;
+    (q / LEVELS as u32, q % LEVELS as u32)
+}
+
 /// [`ordered`] with `n` already in 1..=8: inlined where `n` is a constant, its divisions are
 /// shifts.
 #[inline(always)]
-fn ordered_by(level: u8, x: u32, y: u32, n: u32) -> BinaryColor {
+fn ordered_by<C: Shade>(level: u8, x: u32, y: u32, n: u32) -> C {
     let cells = n * n;
-    let q = (level.min(LEVELS) as u32 * cells + 32) / 64; // 0..=cells
+    let (base, above) = between::<C>(level);
+    let q = (above * cells + 32) / 64; // 0..=cells
     let shift = 64 / cells;
     let t = BAYER8[(y % n) as usize][(x % n) as usize] as u32 / shift;
-    BinaryColor::from(q > t)
+    C::from_step((base + u32::from(q > t)) as u8)
 }
 
 // BLUE_NOISE and GAMMA, made by the crate's build.rs.
@@ -148,19 +197,27 @@ fn row_seed(y: usize) -> i16 {
 // per pixel: the weights are constants, the divisor a shift, and no index is checked at run
 // time.
 
-/// A pixel of level `level` (0..=64) with error `arriving`: whether it is set, and its error.
+/// A pixel of level `level` (0..=64) with error `arriving`: the shade of `C` nearest it, and
+/// its error. With one step that is lit or not at half the range; with `STEPS` steps, step `k`
+/// stands for `k / STEPS` of the range (rounded to error units) and the nearest is taken.
 #[inline(always)]
-fn quantize(level: u8, arriving: i16) -> (bool, i16) {
+fn quantize<C: Shade>(level: u8, arriving: i16) -> (C, i16) {
     let v = level as i16 * SCALE + arriving;
-    let on = v >= (LEVELS as i16 / 2) * SCALE;
-    (on, v - if on { LEVELS as i16 * SCALE } else { 0 })
+    if C::STEPS == 1 {
+        let on = v >= (LEVELS as i16 / 2) * SCALE;
+        return (C::from_step(u8::from(on)), v - if on { LEVELS as i16 * SCALE } else { 0 });
+    }
+    let (n, full) = (i32::from(C::STEPS), i32::from(LEVELS as i16 * SCALE));
+    // `full` is a power of two: the floor of the division is an arithmetic shift.
+    let k = ((i32::from(v) * n + full / 2) >> full.trailing_zeros()).clamp(0, n);
+    (C::from_step(k as u8), (i32::from(v) - (k * full + n / 2) / n) as i16)
 }
 
 /// Floyd-Steinberg: 7/16 right, 3/16 below left, 5/16 below, 1/16 below right. The error going
 /// right and the two entries of the row below still taking shares are carried in locals along
 /// the row: per pixel one entry of each row is read and one of the row below written.
 #[inline(always)]
-fn floyd_steinberg(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColor]) {
+fn floyd_steinberg<C: Shade>(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [C]) {
     let w = levels.len().min(out.len()).min(MAX_TILE + 2 * EDGE_PAD);
     let (above, below) = acc.split_at_mut(y + 1);
     let (row, below) = (&mut above[y], &mut below[0]);
@@ -171,8 +228,8 @@ fn floyd_steinberg(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColo
     // sign-extending every step, and stored back as they were: the same values.
     let (mut right, mut b0, mut b1) = (i32::from(row[1]), i32::from(below[0]), i32::from(below[1]));
     for x in 0..w {
-        let (on, err) = quantize(levels[x], right as i16);
-        out[x] = BinaryColor::from(on);
+        let (px, err) = quantize::<C>(levels[x], right as i16);
+        out[x] = px;
         let err = i32::from(err);
         right = i32::from(row[x + 2]) + err * 7 / 16;
         below[x] = (b0 + err * 3 / 16) as i16;
@@ -186,10 +243,10 @@ fn floyd_steinberg(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColo
 
 /// Atkinson: 1/8 to each of two right, three below and one two rows below (6/8 of the error).
 #[inline(always)]
-fn atkinson(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [BinaryColor]) {
+fn atkinson<C: Shade>(acc: &mut Acc, y: usize, levels: &[u8], out: &mut [C]) {
     for (x, (&l, px)) in levels.iter().zip(out.iter_mut()).enumerate().take(MAX_TILE + 2 * EDGE_PAD) {
-        let (on, err) = quantize(l, acc[y][x + 1]);
-        *px = BinaryColor::from(on);
+        let (shade, err) = quantize::<C>(l, acc[y][x + 1]);
+        *px = shade;
         let (e, c) = (err / 8, x + 1);
         acc[y][c + 1] += e;
         acc[y][c + 2] += e;
@@ -253,21 +310,21 @@ impl<'c> Carry<'c> {
     /// Never inlined: its accumulators then take stack only while a tile is dithered, not for
     /// the whole of its caller's render loop (the deepest stack is the tracer's, below it).
     #[inline(never)]
-    pub fn tile(
+    pub fn tile<C: Shade>(
         &mut self,
         mode: Dither,
         (x0, y0): (usize, usize),
         w: usize,
         h: usize,
         levels: &[u8],
-        out: &mut [BinaryColor],
+        out: &mut [C],
     ) {
         // Each kernel inlined as a constant: its weights unrolled and its divisor a shift, not
         // a division call per neighbour (a Cortex-M0+ has no divide instruction).
         if mode == Dither::Atkinson {
-            self.diffuse(atkinson, (x0, y0), w, h, levels, out);
+            self.diffuse(atkinson::<C>, (x0, y0), w, h, levels, out);
         } else {
-            self.diffuse(floyd_steinberg, (x0, y0), w, h, levels, out);
+            self.diffuse(floyd_steinberg::<C>, (x0, y0), w, h, levels, out);
         }
     }
 
@@ -282,14 +339,14 @@ impl<'c> Carry<'c> {
     /// [`EDGE_PAD`] columns beyond it too, as pixels that are not drawn; at the left edge each
     /// row starts with its `row_seed`.
     #[inline(always)]
-    fn diffuse(
+    fn diffuse<C: Shade>(
         &mut self,
-        kernel: impl Fn(&mut Acc, usize, &[u8], &mut [BinaryColor]),
+        kernel: impl Fn(&mut Acc, usize, &[u8], &mut [C]),
         (x0, y0): (usize, usize),
         w: usize,
         h: usize,
         levels: &[u8],
-        out: &mut [BinaryColor],
+        out: &mut [C],
     ) {
         // No tile is larger (the render's tiles are at most MAX_TILE on a side); saying so lets
         // the kernel's indices go unchecked.
@@ -331,7 +388,7 @@ impl<'c> Carry<'c> {
                 let mut padded = [row[0]; MAX_TILE + 2 * EDGE_PAD];
                 padded[lead..lead + w].copy_from_slice(row);
                 padded[lead + w..span].fill(row[w - 1]);
-                let mut drawn = [BinaryColor::Off; MAX_TILE + 2 * EDGE_PAD];
+                let mut drawn = [C::DARK; MAX_TILE + 2 * EDGE_PAD];
                 kernel(&mut acc, y, &padded[..span], &mut drawn[..span]);
                 px.copy_from_slice(&drawn[lead..lead + w]);
             }
@@ -400,7 +457,7 @@ impl<'c> Ditherer<'c> {
     }
 
     /// Dithers the `w x h` tile of `levels` (row-major) at `(x0, y0)` into `out`.
-    pub fn tile(&mut self, x0: usize, y0: usize, w: usize, h: usize, levels: &[u8], out: &mut [BinaryColor]) {
+    pub fn tile<C: Shade>(&mut self, x0: usize, y0: usize, w: usize, h: usize, levels: &[u8], out: &mut [C]) {
         // Without the `diffusion` feature no ditherer has carries, and their code is not linked.
         match self.carry.as_mut().filter(|_| cfg!(feature = "diffusion")) {
             Some(c) => c.tile(self.mode, (x0, y0), w, h, levels, out),
@@ -410,8 +467,9 @@ impl<'c> Ditherer<'c> {
                     let mask = &BLUE_NOISE[(y0 + y) % 16];
                     for x in 0..w {
                         let l = *crate::bounds::at(levels, y * w + x);
+                        let (base, above) = between::<C>(l);
                         *crate::bounds::at_mut(out, y * w + x) =
-                            BinaryColor::from((mask[(x0 + x) % 16] as u32) < l.min(LEVELS) as u32 * 4);
+                            C::from_step((base + u32::from((mask[(x0 + x) % 16] as u32) < above * 4)) as u8);
                     }
                 }
             }
@@ -623,5 +681,58 @@ mod tests {
         // Row 0 is all on (the pads beside it, at the same gray, hand on errors too small to
         // turn a pixel off); the negative error it leaves turns pixels of the next rows off.
         assert_eq!(art(4, &out), "####\n.#..\n.###\n#.##\n");
+    }
+
+    /// A `w x h` flat field of `level` dithered to four shades by `mode` in `t x t` tiles, as
+    /// the render orders them: each pixel's step (0..=3).
+    fn gray_steps(mode: Dither, w: usize, h: usize, t: usize, level: u8) -> std::vec::Vec<u8> {
+        let mut store = std::vec![0i16; Ditherer::rows_len(mode, w)];
+        let mut d = Ditherer::new(mode, w, &mut store).unwrap();
+        let mut steps = std::vec![0u8; w * h];
+        for y0 in (0..h).step_by(t) {
+            d.next_band();
+            for x0 in (0..w).step_by(t) {
+                let (tw, th) = (t.min(w - x0), t.min(h - y0));
+                let mut out = [Gray2::BLACK; MAX_TILE * MAX_TILE];
+                d.tile(x0, y0, tw, th, &[level; MAX_TILE * MAX_TILE][..tw * th], &mut out[..tw * th]);
+                for (i, px) in out[..tw * th].iter().enumerate() {
+                    steps[(y0 + i / tw) * w + x0 + i % tw] = px.step();
+                }
+            }
+        }
+        steps
+    }
+
+    #[test]
+    fn four_shades_keep_every_level_between_its_two_steps() {
+        // Every level of 64, in every mode: each pixel is one of the two steps around the
+        // level (or the level's own step), and the field's mean is the level within half a
+        // level (Floyd-Steinberg; ordered modes within a level, their masks' quantization).
+        // Atkinson diffuses 6/8 of each error by design, which pulls a field towards its
+        // nearest step: only its steps are checked.
+        for mode in [Dither::FloydSteinberg, Dither::Atkinson, Dither::Bayer, Dither::BlueNoise] {
+            for level in 0..=LEVELS {
+                let (w, h) = (48, 32);
+                let steps = gray_steps(mode, w, h, 16, level);
+                let exact = f64::from(level) * 3.0 / 64.0;
+                let (lo, hi) = (exact.floor() as u8, exact.ceil() as u8);
+                assert!(steps.iter().all(|&k| k == lo || k == hi), "{mode:?} level {level}: {steps:?}");
+                let mean = steps.iter().map(|&k| f64::from(k)).sum::<f64>() / (w * h) as f64 * 64.0 / 3.0;
+                if mode != Dither::Atkinson {
+                    assert!((mean - f64::from(level)).abs() <= 1.0, "{mode:?} level {level}: mean {mean}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn four_shades_show_their_own_levels_flat() {
+        // The levels the shades stand for (0, 21.3, 42.7, 64 of 64, rounded) come out as one
+        // flat step: no dither noise where the panel can show the gray itself.
+        for (level, step) in [(0u8, 0u8), (21, 1), (43, 2), (64, 3)] {
+            let steps = gray_steps(Dither::FloydSteinberg, 40, 24, 8, level);
+            let off = steps.iter().filter(|&&k| k != step).count();
+            assert!(off * 50 <= steps.len(), "level {level}: {off} pixels off step {step}");
+        }
     }
 }

@@ -60,7 +60,7 @@
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
 //                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
 //                     [--sda-stuck START_MS:PULSES] [--nack-at MS] [--panel NAME]
-//                     [--press MS[:LEN_MS]]
+//                     [--press MS[:LEN_MS]] [--scan] [--osc-error PERCENT]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306, GLASSES } from './ssd1306.mjs';
@@ -77,9 +77,9 @@ const SHARP_SPI = { cs: 17, disp: 20, csActiveHigh: true };
  * alone with its own.
  */
 const PANELS = {
-  ssd1306: { make: () => new Ssd1306(0x3c) },
-  'ssd1306-128x32': { make: () => new Ssd1306(0x3c, GLASSES['128x32']) },
-  'ssd1306-72x40': { make: () => new Ssd1306(0x3c, GLASSES['72x40']) },
+  ssd1306: { make: (now) => new Ssd1306(0x3c, GLASSES['128x64'], now) },
+  'ssd1306-128x32': { make: (now) => new Ssd1306(0x3c, GLASSES['128x32'], now) },
+  'ssd1306-72x40': { make: (now) => new Ssd1306(0x3c, GLASSES['72x40'], now) },
   sh1106: { make: () => new Sh1106(0x3c) },
   ssd1309: { make: () => new Ssd1309(0x3c) },
   'sharp-400x240': { make: (now) => new SharpMemoryLcd(400, 240, now), spi: SHARP_SPI },
@@ -121,6 +121,12 @@ function parseArgs(argv) {
     else if (a === '--no-cache') o.cache = false;
     else if (a === '--pass-bytes') o.passBytes = Number(next());
     else if (a === '--untimed-bus') o.timedBus = false;
+    else if (a === '--scan') o.scan = true;
+    else if (a === '--osc-error') {
+      const v = next();
+      if (!/^-?\d+(\.\d+)?$/.test(v)) throw new Error(`--osc-error ${v}: a percentage expected`);
+      o.oscError = Number(v);
+    }
     else if (a === '--panel-off') {
       const v = next();
       const m = /^(\d+(?:\.\d+)?):(\d+(?:\.\d+)?)$/.exec(v);
@@ -251,6 +257,28 @@ function main() {
   // when the bus would deliver them.
   const panel = PANELS[opt.panel];
   const display = opt.display ? panel.make(() => mcu.clock.nanos + epoch.nanos) : null;
+  // --scan: every refresh the panel makes, as the row scan drove it (ssd1306.mjs `scan`). Each
+  // distinct picture once ('image'), then a 'refresh' line wherever the picture changes from
+  // the refresh before; --osc-error runs the panel's oscillator that many percent fast (or slow).
+  let refreshes = 0;
+  if (opt.scan || opt.oscError !== undefined) {
+    if (!display?.scan) throw new Error(`--scan: the ${opt.panel} model has no refresh`);
+    display.oscScale = 1 + (opt.oscError ?? 0) / 100;
+    const images = new Map();
+    let last = -1;
+    display.scan((pixels, nanos) => {
+      const hex = toHex(pixels);
+      let id = images.get(hex);
+      if (id === undefined) {
+        id = images.size;
+        images.set(hex, id);
+        emit({ event: 'image', id, pixels: hex });
+      }
+      if (id !== last) emit({ event: 'refresh', index: refreshes, ms: nanos / 1e6, image: id });
+      last = id;
+      refreshes++;
+    });
+  }
   let busBytes = 0; // bytes the display heard (on I2C, those after an address byte)
   let i2cTransfers = 0; // address bytes sent (each START or repeated START)
   let naks = 0;
@@ -510,6 +538,7 @@ function main() {
     ledToggles,
     displayInitialised: display ? display.everOn : false,
     displayCommands: display ? display.commands : 0,
+    refreshes,
     warnings: warnings.slice(0, 20),
   });
   process.exitCode = ok ? 0 : 1;

@@ -8,6 +8,16 @@
 //
 // Anything the model does not understand is an error, never silently ignored: an unknown
 // command byte, a command cut off by a STOP, a data byte before any display set-up, a read.
+//
+// The refresh (`scan`): the controller drives its rows one at a time, each for a row period of
+// D x (phase 1 + phase 2 + 50) display clocks (datasheet section 8.3: the divide ratio D and
+// the oscillator's setting from 0xD5, the phases from 0xD9), the row counter running from 0 to
+// the multiplex ratio and back to 0 (past it, on to 63 first), and each row shows the GDDRAM row
+// it maps to as the counter reaches it. The scan starts at row 0 when the display is switched
+// on and stops when it is switched off. The oscillator runs at its typical frequency (370 kHz at
+// the reset setting 0x8, 530 kHz at 0xF, even steps between; `oscScale` for a panel whose clock
+// is off). With `scan(onRefresh)` the model hands every finished refresh (every row of the glass
+// as it was when driven) to `onRefresh`: what the eye integrates.
 
 export const WIDTH = 128; // columns of RAM
 export const HEIGHT = 64; // rows of RAM
@@ -67,7 +77,10 @@ function argumentCount(cmd) {
 export const hex = (b) => '0x' + b.toString(16).padStart(2, '0');
 
 export class Ssd1306 {
-  constructor(address = 0x3c, glass = GLASSES['128x64']) {
+  constructor(address = 0x3c, glass = GLASSES['128x64'], now = null) {
+    this.now = now; // emulated nanoseconds, for the refresh (`scan`)
+    this.oscScale = 1; // the oscillator's frequency against its typical one
+    this.onRefresh = null;
     this.address = address;
     this.glass = glass;
     this.gddram = new Uint8Array(this.ramColumns * PAGES); // [page * columns + column], bit k = COM row 8*page + k
@@ -129,6 +142,9 @@ export class Ssd1306 {
     this.entireOn = false;
     this.scrolling = false;
     this.comPins = 0x12;
+    this.clock = 0x80; // 0xD5: oscillator setting, divide ratio - 1
+    this.precharge = 0x22; // 0xD9: phase 2, phase 1
+    this.scanAt = null; // when the next row is driven (null: not scanning)
     this.endTransfer();
     this.cmd = null;
   }
@@ -166,6 +182,7 @@ export class Ssd1306 {
   /** A byte written to the addressed device: whether it is ACKed. */
   write(byte) {
     if (!this.selected) return false;
+    this.advance();
     this.bytes++;
     if (this.expectControl) {
       if ((byte & 0x3f) !== 0) this.fail(`control byte ${hex(byte)}: its low six bits must be 0`);
@@ -186,6 +203,7 @@ export class Ssd1306 {
    */
   spiByte(byte, isData) {
     if (this.absent) return;
+    this.advance();
     this.bytes++;
     if (isData) {
       if (this.cmd !== null) this.fail(`data byte while command ${hex(this.cmd)} waits for ${this.argumentCount(this.cmd) - this.args.length} more argument bytes`);
@@ -262,10 +280,19 @@ export class Ssd1306 {
           if (a[0] < 15 || a[0] > 63) this.fail(`multiplex ratio ${a[0] + 1} (16..64)`);
           this.multiplex = a[0] & 0x3f;
           break;
-        case 0xae: this.displayOn = false; break;
+        case 0xae:
+          this.displayOn = false;
+          this.scanAt = null;
+          break;
         case 0xaf:
+          if (!this.displayOn) this.startScan();
           this.displayOn = true;
           if (this.chargePump) this.everOn = true;
+          break;
+        case 0xd5: this.clock = a[0]; break;
+        case 0xd9:
+          if ((a[0] & 0x0f) === 0 || (a[0] & 0xf0) === 0) this.fail(`pre-charge periods ${hex(a[0])}: phase 1 and phase 2 are 1..15 clocks`);
+          this.precharge = a[0];
           break;
         case 0xc0: case 0xc8: this.comReverse = c === 0xc8; break;
         case 0xad:
@@ -300,6 +327,52 @@ export class Ssd1306 {
     }
   }
 
+  /** The oscillator's frequency in Hz (typical, times `oscScale`). */
+  oscillatorHz() {
+    return (370_000 + ((this.clock >> 4) - 8) * (160_000 / 7)) * this.oscScale;
+  }
+
+  /** A row period in nanoseconds, from the display clock and pre-charge registers. */
+  rowNanos() {
+    const clocks = ((this.clock & 0x0f) + 1) * ((this.precharge & 0x0f) + (this.precharge >> 4) + 50);
+    return (clocks * 1e9) / this.oscillatorHz();
+  }
+
+  /** Hands every finished refresh to `onRefresh(pixels, startNanos)` (packed like `shown()`). */
+  scan(onRefresh) {
+    this.onRefresh = onRefresh;
+  }
+
+  startScan() {
+    if (!this.now || !this.onRefresh) return;
+    this.scanAt = this.now();
+    this.scanRow = 0;
+    this.refreshAt = this.scanAt;
+    this.refresh = new Uint8Array(Math.ceil(this.glass.width / 8) * this.glass.height);
+  }
+
+  /** Drives every row due by now (before a byte changes what rows show, and on `tick`). */
+  advance() {
+    if (this.scanAt === null || !this.now) return;
+    const t = this.now();
+    while (this.scanAt <= t) {
+      const r = this.scanRow;
+      const y = this.comReverse ? r : this.glass.height - 1 - r;
+      if (y >= 0 && y < this.glass.height) this.rowPixels(y, this.refresh);
+      this.scanRow = r === this.multiplex ? 0 : (r + 1) % HEIGHT;
+      if (this.scanRow === 0) {
+        this.onRefresh(this.refresh, this.refreshAt);
+        this.refresh = new Uint8Array(this.refresh.length);
+        this.refreshAt = this.scanAt + this.rowNanos();
+      }
+      this.scanAt += this.rowNanos();
+    }
+  }
+
+  tick() {
+    this.advance();
+  }
+
   /** Why what the panel shows is not a plain picture, or null. */
   notShowable() {
     if (this.error) return this.error;
@@ -325,18 +398,23 @@ export class Ssd1306 {
    */
   shown() {
     const { width, height } = this.glass;
-    const stride = Math.ceil(width / 8);
-    const out = new Uint8Array(stride * height);
-    for (let y = 0; y < height; y++) {
-      const com = this.comReverse ? y : height - 1 - y;
-      const row = (com + this.startLine + this.offset) % HEIGHT;
-      for (let x = 0; x < width; x++) {
-        let on = (this.gddram[(row >> 3) * this.ramColumns + this.glassColumn(x)] >> (row & 7)) & 1;
-        if (this.entireOn) on = 1;
-        if (this.inverse) on ^= 1;
-        if (on) out[y * stride + (x >> 3)] |= 0x80 >> (x & 7);
-      }
-    }
+    const out = new Uint8Array(Math.ceil(width / 8) * height);
+    for (let y = 0; y < height; y++) this.rowPixels(y, out);
     return out;
+  }
+
+  /** Row `y` of the glass as it shows now, into `out` (packed as `shown()`'s). */
+  rowPixels(y, out) {
+    const { width, height } = this.glass;
+    const stride = Math.ceil(width / 8);
+    const com = this.comReverse ? y : height - 1 - y;
+    const row = (com + this.startLine + this.offset) % HEIGHT;
+    out.fill(0, y * stride, (y + 1) * stride);
+    for (let x = 0; x < width; x++) {
+      let on = (this.gddram[(row >> 3) * this.ramColumns + this.glassColumn(x)] >> (row & 7)) & 1;
+      if (this.entireOn) on = 1;
+      if (this.inverse) on ^= 1;
+      if (on) out[y * stride + (x >> 3)] |= 0x80 >> (x & 7);
+    }
   }
 }

@@ -3,7 +3,11 @@
 use crate::schedule::{Schedule, Take, TraceTile, Traced1};
 use core::fmt;
 use embedded_graphics_core::draw_target::DrawTarget;
+#[cfg(not(feature = "gray"))]
 use embedded_graphics_core::pixelcolor::BinaryColor;
+#[cfg(feature = "gray")]
+use embedded_graphics_core::pixelcolor::Gray2;
+use lattice_rt::dither::Shade;
 use lattice_rt::dither::{Carry, Ditherer};
 #[cfg(not(baked_scenes))]
 use lattice_rt::lattice::LatticeError;
@@ -45,12 +49,22 @@ pub const BUILD: Build = Build {
     } else {
         Glass::Oled128x64
     },
+    gray: cfg!(feature = "gray"),
 };
 
 /// The frame the firmware renders ([`rendered`]): on the Raspberry Pi boards' panel a still in
 /// Floyd-Steinberg with silhouette lines, orbit and progressive frames in blue noise with lines;
 /// elsewhere [`FRAME`].
 pub const RENDERED: lattice_rt::Frame = rendered(BUILD);
+
+/// The pixel the panel shows: one bit, or with the `gray` feature one of four shades (shown as
+/// three subframes: the display's `gray` module).
+#[cfg(not(feature = "gray"))]
+pub type Shown = BinaryColor;
+/// The pixel the panel shows: one bit, or with the `gray` feature one of four shades (shown as
+/// three subframes: the display's `gray` module).
+#[cfg(feature = "gray")]
+pub type Shown = Gray2;
 
 /// The frame's width in pixels: the panel's glass ([`Glass`]), or 128 without a panel.
 pub const WIDTH: u16 = RENDERED.width;
@@ -201,7 +215,7 @@ pub const TRACED: usize = if cfg!(feature = "progressive") && !SECOND_CORE {
 
 /// Parses `text`, builds its lattice and renders [`RENDERED`] into `target`, tile by tile.
 #[cfg(not(baked_scenes))]
-pub fn render_scene<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+pub fn render_scene<'t, R: Real, D: DrawTarget<Color = Shown, Error: Send> + Send>(
     text: &'t str,
     st: &mut Storage<R>,
     target: &mut D,
@@ -317,7 +331,7 @@ pub struct ShareMemory {
     kept: [KeptTile; dithered(RING)],
     rays: [[Traced; TILE_RAYS]; TILES],
     above: [(u16, u16); dithered(WIDTH as usize)],
-    band: [BinaryColor; dithered(WIDTH as usize * RENDERED.tile as usize)],
+    band: [Shown; dithered(WIDTH as usize * RENDERED.tile as usize)],
     carries: [i16; dithered(Carry::len(WIDTH as usize))],
 }
 
@@ -332,7 +346,7 @@ impl ShareMemory {
             kept: [KeptTile::EMPTY; dithered(RING)],
             rays: [[NONE; TILE_RAYS]; TILES],
             above: [(0, 0); dithered(WIDTH as usize)],
-            band: [BinaryColor::Off; dithered(WIDTH as usize * RENDERED.tile as usize)],
+            band: [Shown::DARK; dithered(WIDTH as usize * RENDERED.tile as usize)],
             carries: [0; dithered(Carry::len(WIDTH as usize))],
         }
     }
@@ -350,7 +364,7 @@ impl Default for ShareMemory {
 /// times each core's work. The frame is shown in [`PASSES`]; the board's `shown` is called with
 /// each pass once it is on `target`.
 #[cfg(not(baked_scenes))]
-pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+pub fn render_scene_at<'t, R: Real, D: DrawTarget<Color = Shown, Error: Send> + Send>(
     text: &'t str,
     st: &mut Storage<R>,
     target: &mut D,
@@ -390,7 +404,7 @@ impl Default for BakedMemory {
 /// [`render_scene_at`] for a scene baked into flash (the `baked` feature: `build.rs` wrote it
 /// and its lattice as tables), which is neither parsed nor built. Its camera is the scene's
 /// own: `shot.turn` must be 0 (an orbit needs the camera set up at run time).
-pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+pub fn render_baked_at<'t, R: Real, D: DrawTarget<Color = Shown, Error: Send> + Send>(
     baked: &lattice_rt::Baked<R>,
     memory: &mut BakedMemory,
     target: &mut D,
@@ -436,7 +450,7 @@ pub static EMBEDDED: [(&str, Embedded); SCENES.len()] = baked::BAKED;
 
 /// A frame of an embedded scene: [`render_scene_at`] for its text, or [`render_baked_at`] for
 /// its tables.
-pub fn render_embedded_at<D: DrawTarget<Color = BinaryColor, Error: Send> + Send>(
+pub fn render_embedded_at<D: DrawTarget<Color = Shown, Error: Send> + Send>(
     scene: Embedded,
     memory: &mut SceneMemory,
     target: &mut D,
@@ -452,12 +466,7 @@ pub fn render_embedded_at<D: DrawTarget<Color = BinaryColor, Error: Send> + Send
 
 /// The frame of a scene loaded or baked: its tracer (over `accel`, with `lattice_bytes` of
 /// lattice), then every pass of both tile shares.
-fn render_loaded<
-    't,
-    R: Real,
-    A: Accelerator<R> + Sync + ?Sized,
-    D: DrawTarget<Color = BinaryColor, Error: Send> + Send,
->(
+fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<Color = Shown, Error: Send> + Send>(
     scene: &lattice_rt::Scene<'_, R>,
     (accel, lattice_bytes): (&A, usize),
     mut scratch: lattice_rt::Scratch<'_>,
@@ -534,7 +543,7 @@ struct DitherMemory<'m> {
     kept: &'m mut [KeptTile],
     rays: &'m mut [[Traced; TILE_RAYS]],
     above: &'m mut [(u16, u16)],
-    band: &'m mut [BinaryColor],
+    band: &'m mut [Shown],
     carries: &'m mut [i16],
 }
 
@@ -555,7 +564,7 @@ fn trace_then_dither<
     't,
     R: Real,
     A: Accelerator<R> + Sync + ?Sized,
-    D: DrawTarget<Color = BinaryColor, Error: Send> + Send,
+    D: DrawTarget<Color = Shown, Error: Send> + Send,
 >(
     tracer: &Tracer<'_, '_, R, A, EFFECTS>,
     frame: &Frame,
@@ -633,7 +642,7 @@ fn tile_tracer<'h, R: Real, A: Accelerator<R> + ?Sized>(
 struct BandDither<'f, 'm> {
     frame: &'f Frame,
     above: &'m mut [(u16, u16)],
-    band: &'m mut [BinaryColor],
+    band: &'m mut [Shown],
     carries: &'m mut [i16],
 }
 
@@ -642,7 +651,7 @@ impl BandDither<'_, '_> {
     /// frame's last band in parts, as its tiles come), its tiles freed for the next pass; while
     /// no band is ready, core 0 traces the next tile (`work`: its scratch, its trace and its
     /// statistics).
-    fn pass<'t, D: DrawTarget<Color = BinaryColor>>(
+    fn pass<'t, D: DrawTarget<Color = Shown>>(
         &mut self,
         schedule: &FrameSchedule<'_>,
         pass: u8,
@@ -703,7 +712,7 @@ fn trace_tile<R: Real, A: Accelerator<R> + ?Sized>(
 /// without the `progressive` feature (whose only pass is 0), the whole frame at once
 /// (`render_share`).
 #[allow(clippy::too_many_arguments)]
-fn draw<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>>(
+fn draw<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = Shown>>(
     tracer: &Tracer<'_, '_, R, A, EFFECTS>,
     frame: &Frame,
     share: Share,

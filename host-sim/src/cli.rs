@@ -180,6 +180,11 @@ pub struct RenderArgs {
     /// Also write the 1-bit frame as PBM (FILE.pbm).
     #[arg(long)]
     pub pbm: Option<PathBuf>,
+    /// Shades the panel shows: 2 (a 1-bit frame) or 4 (the gray mode: error diffusion over
+    /// black, two grays and white, each pixel lit in 0 to 3 of the panel's three subframes;
+    /// the PNG shows the shades as the eye sees them). A 4-shade frame is not written as PBM.
+    #[arg(long, default_value_t = 2, value_parser = parse_levels)]
+    pub levels: u8,
     /// Tile side in pixels.
     #[arg(long, default_value_t = 8)]
     pub tile: u8,
@@ -216,6 +221,15 @@ pub struct RenderArgs {
     /// sh1106, ssd1309: 128x64; ssd1306-128x32; ssd1306-72x40; sharp-400x240; sharp-128x128).
     #[arg(long, value_parser = parse_panel, requires = "board")]
     pub panel: Option<board_records::frame::Panel>,
+}
+
+/// `--levels`: 2 or 4.
+fn parse_levels(s: &str) -> Result<u8, String> {
+    match s {
+        "2" => Ok(2),
+        "4" => Ok(4),
+        _ => Err(format!("{s}: 2 (a 1-bit frame) or 4 (the gray mode's shades)")),
+    }
 }
 
 /// A panel's name as `--panel` takes it.

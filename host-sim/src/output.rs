@@ -83,24 +83,36 @@ impl PngLook {
 /// The RGB bytes (row-major) of a 1-bit frame drawn with `look`, and their width and height.
 pub fn rgb_pixels(frame: &BitFrame<'_>, look: PngLook) -> (u32, u32, Vec<u8>) {
     let size = frame.size();
-    let (w, h) = look.size(size.width, size.height);
-    let [lit, unlit, grid] = look.theme.colours();
+    rgb_shaded(size.width, size.height, look, |x, y| if frame.get(x, y) { 1.0 } else { 0.0 })
+}
+
+/// The RGB bytes of a `w x h` frame whose pixel `(x, y)` is lit for the share `lit(x, y)`
+/// (0: unlit, 1: lit; between them, a gray shade of the theme), drawn with `look`.
+fn rgb_shaded(w: u32, h: u32, look: PngLook, lit: impl Fn(u32, u32) -> f64) -> (u32, u32, Vec<u8>) {
+    let (pw, ph) = look.size(w, h);
+    let [on, off, grid] = look.theme.colours();
+    let mix = |s: f64| -> [u8; 3] {
+        core::array::from_fn(|c| (f64::from(off[c]) + (f64::from(on[c]) - f64::from(off[c])) * s).round() as u8)
+    };
     let (scale, pitch) = (look.scale.max(1), look.scale.max(1) + u32::from(look.grid));
-    let mut out = Vec::with_capacity(w as usize * h as usize * 3);
-    for y in 0..h {
-        for x in 0..w {
-            let (fx, fy) = (x / pitch, y / pitch);
-            let colour = if x % pitch >= scale || y % pitch >= scale {
-                grid
-            } else if frame.get(fx, fy) {
-                lit
-            } else {
-                unlit
-            };
+    let mut out = Vec::with_capacity(pw as usize * ph as usize * 3);
+    for y in 0..ph {
+        for x in 0..pw {
+            let colour = if x % pitch >= scale || y % pitch >= scale { grid } else { mix(lit(x / pitch, y / pitch)) };
             out.extend_from_slice(&colour);
         }
     }
-    (w, h, out)
+    (pw, ph, out)
+}
+
+/// The bytes of a PNG of a frame of shades: `steps` (row-major, `w x h`) each `0..=top`, a
+/// pixel of step `k` lit for `k / top` of the time (the gray mode's subframes), drawn with
+/// `look` in the theme's colours and the shades between them.
+pub fn shades_png_bytes(w: u32, h: u32, steps: &[u8], top: u8, look: PngLook) -> Result<Vec<u8>> {
+    check_png_size(w, h, look.scale)?;
+    let share = |x: u32, y: u32| f64::from(steps[(y * w + x) as usize]) / f64::from(top.max(1));
+    let (pw, ph, rgb) = rgb_shaded(w, h, look, share);
+    encode_rgb(pw, ph, &rgb)
 }
 
 /// Writes a 1-bit frame as PNG with a display theme and pixel scale (no grid).
@@ -118,12 +130,17 @@ pub fn png_bytes(frame: &BitFrame<'_>, look: PngLook) -> Result<Vec<u8>> {
     let size = frame.size();
     check_png_size(size.width, size.height, look.scale)?;
     let (w, h, rgb) = rgb_pixels(frame, look);
+    encode_rgb(w, h, &rgb)
+}
+
+/// RGB bytes as a PNG file's bytes.
+fn encode_rgb(w: u32, h: u32, rgb: &[u8]) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
     let mut enc = png::Encoder::new(&mut bytes, w, h);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     let mut writer = enc.write_header().context("PNG header")?;
-    writer.write_image_data(&rgb).context("PNG data")?;
+    writer.write_image_data(rgb).context("PNG data")?;
     writer.finish().context("PNG end")?;
     Ok(bytes)
 }

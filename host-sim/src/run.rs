@@ -6,6 +6,8 @@ use crate::output::{write_gray_png, write_pbm, write_pgm};
 use crate::report::{print_json, LatticeSize, MethodRender, MethodWork, RenderReport, StatsReport, Work};
 use crate::shared::median;
 use anyhow::{anyhow, bail, Context, Result};
+use embedded_graphics::pixelcolor::{BinaryColor, Gray2};
+use lattice_rt::dither::Shade;
 use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::{Effects, EyeRays};
 use lattice_rt::{
@@ -17,8 +19,11 @@ use std::time::{Duration, Instant};
 
 /// A finished render on the host.
 pub struct Rendered {
-    /// Packed 1-bit frame (see `BitFrame`).
+    /// Packed 1-bit frame (see `BitFrame`): the pixels lit in any subframe.
     pub bits: Vec<u8>,
+    /// Each pixel's shade, row-major: its step, `0..=C::STEPS` of the `Shade` it was rendered
+    /// in (1: the 1-bit frame; 3: the gray mode's four shades).
+    pub shades: Vec<u8>,
     /// Gray levels 0..=64, row-major.
     pub gray: Vec<u8>,
     /// Work counted by the core.
@@ -67,11 +72,20 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
     frame: &Frame,
     progress: bool,
 ) -> Result<Rendered> {
+    render_with_in::<R, A, BinaryColor>(tracer, frame, progress)
+}
+
+/// [`render_with`] in the shades of `C` (a [`Gray2`] frame: the gray mode's).
+pub fn render_with_in<R: Real, A: Accelerator<R> + ?Sized + Sync, C: Shade>(
+    tracer: &Tracer<'_, '_, R, A>,
+    frame: &Frame,
+    progress: bool,
+) -> Result<Rendered> {
     let start = Instant::now();
     let tiles_y = (frame.height as usize).div_ceil(frame.tile.max(1) as usize);
     let threads = rayon::current_num_threads().min(tiles_y).max(1);
     if !frame.bands_independent() || threads == 1 {
-        let mut r = render_band(tracer, frame, progress)?;
+        let mut r = render_band_in::<R, A, C>(tracer, frame, progress)?;
         r.elapsed = start.elapsed();
         return Ok(r);
     }
@@ -81,12 +95,13 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
         .into_par_iter()
         .map(|i| {
             let rows = ((i * per) as u16, ((i + 1) * per).min(tiles_y) as u16);
-            render_band(tracer, &Frame { rows, ..*frame }, false)
+            render_band_in::<R, A, C>(tracer, &Frame { rows, ..*frame }, false)
         })
         .collect();
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut out = Rendered {
         bits: vec![0; BitFrame::bytes(w as u32, h as u32)],
+        shades: vec![0; w * h],
         gray: vec![0; w * h],
         stats: Stats::default(),
         elapsed: Duration::ZERO,
@@ -96,6 +111,7 @@ pub fn render_with<R: Real, A: Accelerator<R> + ?Sized + Sync>(
         let band = band?;
         out.bits.iter_mut().zip(&band.bits).for_each(|(a, b)| *a |= b);
         out.gray.iter_mut().zip(&band.gray).for_each(|(a, b)| *a |= b);
+        out.shades.iter_mut().zip(&band.shades).for_each(|(a, b)| *a |= b);
         out.stats.add(&band.stats);
     }
     out.elapsed = start.elapsed();
@@ -109,9 +125,45 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(
     frame: &Frame,
     progress: bool,
 ) -> Result<Rendered> {
+    render_band_in::<R, A, BinaryColor>(tracer, frame, progress)
+}
+
+/// A frame of shades on the host: each pixel's step.
+struct ShadeFrame<C> {
+    width: u32,
+    height: u32,
+    steps: Vec<u8>,
+    shade: core::marker::PhantomData<C>,
+}
+
+impl<C> embedded_graphics::geometry::OriginDimensions for ShadeFrame<C> {
+    fn size(&self) -> embedded_graphics::geometry::Size {
+        embedded_graphics::geometry::Size::new(self.width, self.height)
+    }
+}
+
+impl<C: Shade> embedded_graphics::draw_target::DrawTarget for ShadeFrame<C> {
+    type Color = C;
+    type Error = core::convert::Infallible;
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics::Pixel<C>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+        for embedded_graphics::Pixel(p, c) in pixels {
+            if (0..self.width as i32).contains(&p.x) && (0..self.height as i32).contains(&p.y) {
+                self.steps[p.y as usize * self.width as usize + p.x as usize] = c.step();
+            }
+        }
+        Ok(())
+    }
+}
+
+/// [`render_band`] in the shades of `C`.
+pub fn render_band_in<R: Real, A: Accelerator<R> + ?Sized, C: Shade>(
+    tracer: &Tracer<'_, '_, R, A>,
+    frame: &Frame,
+    progress: bool,
+) -> Result<Rendered> {
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
-    let mut target = BitFrame::new(w as u32, h as u32, &mut bits).expect("sized above");
+    let mut target =
+        ShadeFrame::<C> { width: w as u32, height: h as u32, steps: vec![0; w * h], shade: core::marker::PhantomData };
     let mut scratch = HeapScratch::new(tracer.scene(), frame);
     let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, bar: None };
     let start = Instant::now();
@@ -120,7 +172,12 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(
         other => anyhow!("{other}"),
     })?;
     let elapsed = start.elapsed();
-    Ok(Rendered { bits, gray: hooks.gray, stats, elapsed, lattice: None })
+    let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
+    let stride = w.div_ceil(8);
+    for (i, _) in target.steps.iter().enumerate().filter(|(_, &k)| k > 0) {
+        bits[(i / w) * stride + (i % w) / 8] |= 0x80 >> (i % w % 8);
+    }
+    Ok(Rendered { bits, shades: target.steps, gray: hooks.gray, stats, elapsed, lattice: None })
 }
 
 /// Parses scene text, builds its default lattice and hands `work` a tracer on it, after `tune`
@@ -151,6 +208,16 @@ pub fn render_text<R: Real>(
     tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>),
 ) -> Result<Rendered> {
     with_tracer(path, text, frame, tune, |tracer| render_band(tracer, frame, false))
+}
+
+/// [`render_text`] in the shades of `C` (`Gray2`: the gray mode's frame).
+pub fn render_text_in<R: Real, C: Shade>(
+    path: &Path,
+    text: &str,
+    frame: &lattice_rt::Frame,
+    tune: impl FnOnce(&mut lattice_rt::Tracer<'_, '_, R, lattice_rt::Lattice<'_, R>>),
+) -> Result<Rendered> {
+    with_tracer(path, text, frame, tune, |tracer| render_band_in::<R, _, C>(tracer, frame, false))
 }
 
 /// One pass of a progressive frame as the panel shows it once the pass is drawn.
@@ -213,6 +280,19 @@ pub fn render_accel<R: Real>(
     progress: bool,
     parallel: bool,
 ) -> Result<Rendered> {
+    render_accel_in::<R, BinaryColor>(scene, accel, cfg, frame, tune, progress, parallel)
+}
+
+/// [`render_accel`] in the shades of `C`.
+pub fn render_accel_in<R: Real, C: Shade>(
+    scene: &Scene<'_, R>,
+    accel: Accel,
+    cfg: &LatticeConfig,
+    frame: &Frame,
+    tune: impl Fn(&mut Tracer<'_, '_, R, dyn Accelerator<R> + Sync + '_>),
+    progress: bool,
+    parallel: bool,
+) -> Result<Rendered> {
     let mut bufs;
     let lattice;
     let mut size = None;
@@ -228,7 +308,11 @@ pub fn render_accel<R: Real>(
     };
     let mut tracer = Tracer::new(scene, a);
     tune(&mut tracer);
-    let mut out = if parallel { render_with(&tracer, frame, progress) } else { render_band(&tracer, frame, progress) }?;
+    let mut out = if parallel {
+        render_with_in::<R, _, C>(&tracer, frame, progress)
+    } else {
+        render_band_in::<R, _, C>(&tracer, frame, progress)
+    }?;
     out.lattice = size;
     Ok(out)
 }
@@ -258,15 +342,19 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let frame = a.frame();
     let mut storage = object_storage::<R>(&text)?;
     let scene = parse_scene::<R>(&a.scene, &text, &mut storage, &frame)?;
-    let mut out =
-        render_accel(&scene, a.accel, &crate::cli::lattice_config(a.cells, a.budget), &frame, |_| {}, true, true)
-            .map_err(|e| {
-                // Only render chooses its method: say how to trace without a lattice.
-                match e.downcast_ref::<crate::load::BudgetTooSmall>() {
-                    Some(b) => anyhow!("{b}, or render with --accel bbox (no lattice)"),
-                    None => e,
-                }
-            })?;
+    let cfg = crate::cli::lattice_config(a.cells, a.budget);
+    let rendered = if a.levels == 4 {
+        render_accel_in::<R, Gray2>(&scene, a.accel, &cfg, &frame, |_| {}, true, true)
+    } else {
+        render_accel(&scene, a.accel, &cfg, &frame, |_| {}, true, true)
+    };
+    let mut out = rendered.map_err(|e| {
+        // Only render chooses its method: say how to trace without a lattice.
+        match e.downcast_ref::<crate::load::BudgetTooSmall>() {
+            Some(b) => anyhow!("{b}, or render with --accel bbox (no lattice)"),
+            None => e,
+        }
+    })?;
     let frame_bits = BitFrame::wrap(frame.width as u32, frame.height as u32, &mut out.bits).expect("sized by render");
     let look = crate::output::PngLook { theme: a.theme, scale: a.scale, grid: a.grid };
     let (w, h) = (frame.width as u32, frame.height as u32);
@@ -274,13 +362,19 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     let mut staged = crate::output::Staged::default();
     let mut stdout = None;
     for &(path, kind) in &files {
+        let png = || -> Result<Vec<u8>> {
+            match a.levels {
+                4 => crate::output::shades_png_bytes(w, h, &out.shades, 3, look),
+                _ => crate::output::png_bytes(&frame_bits, look),
+            }
+        };
         if path == Path::new("-") {
-            stdout = Some(crate::output::png_bytes(&frame_bits, look)?);
+            stdout = Some(png()?);
             continue;
         }
         let tmp = staged.stage(path)?;
         match kind {
-            Output::Png => crate::output::write_png_look(&frame_bits, &tmp, look),
+            Output::Png => png().and_then(|bytes| std::fs::write(&tmp, bytes).map_err(Into::into)),
             Output::Pbm => write_pbm(&frame_bits, &tmp),
             Output::Pgm => write_pgm(w, h, &out.gray, &tmp),
             Output::GrayPng => write_gray_png(w, h, &out.gray, &tmp, a.scale),
@@ -343,6 +437,9 @@ fn outputs(a: &RenderArgs) -> Result<Vec<(&Path, Output)>> {
             _ => bail!("-o {}: the extension names the format: .png (the frame in --theme), .pbm (the 1-bit frame) or .pgm (gray levels); - writes a PNG to standard output", a.output.display()),
         },
     ));
+    if a.levels == 4 && (out[0].1 == Output::Pbm || a.pbm.is_some()) {
+        bail!("--levels 4: a PBM holds one bit per pixel; write the four shades as PNG (-o FILE.png)");
+    }
     if let Some(p) = &a.pbm {
         if ext(p) != "pbm" {
             bail!("--pbm {}: writes a PBM file, so its name must end in .pbm (-o FILE.png writes a PNG)", p.display());

@@ -205,6 +205,10 @@ pub struct Build {
     pub exact_sampling: bool,
     /// The panel's glass, whose size the frame takes (boards without a panel: [`FRAME`]'s).
     pub glass: Glass,
+    /// The gray mode (`gray`): four shades, shown as subframes. Its frames have no silhouette
+    /// lines unless asked for (`outline`): with grays the thin parts show without them, and
+    /// the lines cost legibility (docs/display.md, *Four shades*).
+    pub gray: bool,
 }
 
 impl Build {
@@ -225,6 +229,7 @@ impl Build {
             lines,
             exact_sampling: has("exact-sampling"),
             glass: Glass::of(&has),
+            gray: has("gray"),
         }
     }
 }
@@ -237,7 +242,7 @@ pub const fn rendered(b: Build) -> Frame {
     let dither = if b.panel && !b.orbit && !b.progressive { STILL_DITHER } else { MOTION_DITHER };
     let outline = match b.lines {
         Some(on) => on,
-        None => b.panel,
+        None => b.panel && !b.gray,
     };
     let sampling = match (b.exact_sampling, b.panel) {
         (true, _) => Sampling::Center,
@@ -256,6 +261,7 @@ pub const PICO: Build = Build {
     lines: None,
     exact_sampling: false,
     glass: Glass::Oled128x64,
+    gray: false,
 };
 
 /// Frames per turn of the camera in orbit mode (the firmware's `orbit` feature, `host-sim orbit`).

@@ -7,14 +7,13 @@ use super::frame::{Frame, RenderError, Share, TileAt};
 use super::tiles::{render_tiles, KeptTile, Nowhere, Out};
 use super::Hooks;
 use crate::accel::{Accelerator, Stats};
-use crate::dither::{Ditherer, MAX_TILE};
+use crate::dither::{Ditherer, Shade, MAX_TILE};
 use crate::outline::Apron;
 use crate::scalar::Real;
 use crate::storage::Scratch;
 use crate::trace::Tracer;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
-use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::Rectangle;
 
 /// The first half of a frame rendered **trace, then dither**: one share's tiles in the frame's
@@ -53,11 +52,11 @@ pub fn trace_share<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 /// tile), from `band`, at least the frame's width times the tile side of pixels. `ditherer`
 /// carries error between bands: make it once per frame ([`Ditherer::new`] over
 /// [`Ditherer::rows_len`] entries). [`dither_tiles`] dithers a band in parts.
-pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
+pub fn dither_band<'l, D: DrawTarget<Color: Shade>>(
     frame: &Frame,
     ty: usize,
     tile: impl Fn(usize) -> Option<&'l KeptTile>,
-    (above, band): (&mut [(u16, u16)], &mut [BinaryColor]),
+    (above, band): (&mut [(u16, u16)], &mut [D::Color]),
     ditherer: &mut Ditherer<'_>,
     target: &mut D,
 ) -> Result<(), RenderError<D::Error>> {
@@ -67,7 +66,8 @@ pub fn dither_band<'l, D: DrawTarget<Color = BinaryColor>>(
 
 /// What [`dither_tiles`] keeps between the parts of a band and between bands: the row above
 /// the band's hits, the band's pixels and the right column's hits of the last tile dithered.
-pub type BandRows<'a> = (&'a mut [(u16, u16)], &'a mut [BinaryColor], &'a mut [(u16, u16); MAX_TILE]);
+/// `C` is the panel's pixel ([`Shade`]).
+pub type BandRows<'a, C> = (&'a mut [(u16, u16)], &'a mut [C], &'a mut [(u16, u16); MAX_TILE]);
 
 /// [`dither_band`] in parts, as the tiles of a band come in: dithers tile row `ty` of `frame`
 /// from tile `from` on, as far as `tile` has them (`tile(tx)`: tile `tx` of the row, `None`
@@ -77,11 +77,11 @@ pub type BandRows<'a> = (&'a mut [(u16, u16)], &'a mut [BinaryColor], &'a mut [(
 /// ended, is bit for bit the band [`dither_band`] draws. `left` holds, between the parts, the
 /// right column's hits of the last tile dithered (the silhouette lines' apron); `above` and
 /// `band` are as for [`dither_band`].
-pub fn dither_tiles<'l, D: DrawTarget<Color = BinaryColor>>(
+pub fn dither_tiles<'l, D: DrawTarget<Color: Shade>>(
     frame: &Frame,
     (ty, from): (usize, usize),
     tile: impl Fn(usize) -> Option<&'l KeptTile>,
-    (above, band, left): BandRows<'_>,
+    (above, band, left): BandRows<'_, D::Color>,
     ditherer: &mut Ditherer<'_>,
     target: &mut D,
 ) -> Result<usize, RenderError<D::Error>> {
@@ -95,7 +95,7 @@ pub fn dither_tiles<'l, D: DrawTarget<Color = BinaryColor>>(
         return Err(RenderError::ScratchTooSmall { needed: w * rows });
     };
     let (tiles, start) = (grid.tiles().0, from * t);
-    let mut bits = [BinaryColor::Off; MAX_TILE * MAX_TILE];
+    let mut bits = [D::Color::DARK; MAX_TILE * MAX_TILE];
     let mut levels = [0u8; MAX_TILE * MAX_TILE];
     if from == 0 {
         ditherer.next_band();

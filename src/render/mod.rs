@@ -28,10 +28,10 @@ pub use progressive::{render_pass, trace_pass};
 pub use tiles::KeptTile;
 
 use crate::accel::{Accelerator, Stats};
+use crate::dither::Shade;
 use crate::scalar::Real;
 use crate::trace::Tracer;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::pixelcolor::BinaryColor;
 use tiles::{render_tiles, Out};
 
 /// Callbacks between tiles.
@@ -54,7 +54,7 @@ impl Hooks for NoHooks {}
 /// `scratch` comes from the storage the scene was loaded into ([`crate::storage`]); its rows
 /// must hold [`Frame::scratch_len`] entries (none for Bayer or patterning with one ray per
 /// pixel).
-pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color: Shade>, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     target: &mut D,
@@ -70,7 +70,7 @@ pub fn render<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryC
 /// Kept out of line so the firmware report can check that nothing it calls uses floating point
 /// when the scalar is fixed point.
 #[inline(never)]
-pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+pub fn render_share<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color: Shade>, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     share: Share,

@@ -7,11 +7,11 @@ use super::pass::{Pass, Traced};
 use super::tiles::{render_tiles, KeptTile, Nowhere, Out};
 use super::Hooks;
 use crate::accel::{Accelerator, Stats};
+use crate::dither::Shade;
 use crate::scalar::Real;
 use crate::storage::Scratch;
 use crate::trace::Tracer;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::pixelcolor::BinaryColor;
 
 /// One pass of a progressive frame ([`Frame::progressive`]) over one share of its tiles: pass
 /// 8, 4 or 2 shows one ray per block of that side (the ray through the block's top-left pixel,
@@ -21,7 +21,7 @@ use embedded_graphics_core::pixelcolor::BinaryColor;
 /// Returns the statistics of this pass alone.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+pub fn render_pass<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color: Shade>, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     share: Share,

@@ -6,7 +6,7 @@ use super::frame::{check, resolves, Frame, RenderError, Share, TileAt};
 use super::pass::{pass_tile, Pass};
 use super::Hooks;
 use crate::accel::{Accelerator, Query, Stats};
-use crate::dither::{Dither, Ditherer, MAX_TILE};
+use crate::dither::{Dither, Ditherer, Shade, MAX_TILE};
 use crate::outline::Apron;
 use crate::sample::{Hits, Sampler, Sampling, Shot};
 use crate::scalar::Real;
@@ -47,7 +47,7 @@ impl DrawTarget for Nowhere {
 /// The tile loop of [`render_share`](super::render_share), [`trace_share`](super::trace_share)
 /// and the progressive passes: the frame checked, the scratch cut into its rows, then per tile
 /// of the share in the frame's band of rows, [`cull`], [`sample`], [`finish`] and [`emit`].
-pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color = BinaryColor>, const E: u8>(
+pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Color: Shade>, const E: u8>(
     tracer: &Tracer<'_, '_, R, A, E>,
     frame: &Frame,
     share: Share,
@@ -82,7 +82,7 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
     let (w4, h4) = (4 * grid.w as i32, 4 * grid.h as i32);
     let mut eyes = crate::camera::EyeRayCache::<R>::new(tracer.scene().camera(), w4, h4);
     let mut tile =
-        TileWork { levels: [0; MAX_TILE * MAX_TILE], hits: Hits::new(), bits: [BinaryColor::Off; MAX_TILE * MAX_TILE] };
+        TileWork { levels: [0; MAX_TILE * MAX_TILE], hits: Hits::new(), bits: [D::Color::DARK; MAX_TILE * MAX_TILE] };
     let (mut done, mut kept) = (0, 0);
     for ty in first..end {
         dither.next_band();
@@ -143,10 +143,10 @@ struct Looks {
 }
 
 /// A tile's working buffers: its gray levels, what its pixels hit, and its pixels once dithered.
-struct TileWork {
+struct TileWork<C> {
     levels: [u8; MAX_TILE * MAX_TILE],
     hits: Hits,
-    bits: [BinaryColor; MAX_TILE * MAX_TILE],
+    bits: [C; MAX_TILE * MAX_TILE],
 }
 
 /// The eye rays of a render: each made by the camera's cache and traced with its window
@@ -221,7 +221,7 @@ fn sample<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     candidates: u64,
     looks: Looks,
     traced: Option<(u8, &mut [super::Traced])>,
-    tile: &mut TileWork,
+    tile: &mut TileWork<impl Shade>,
 ) {
     let tracer = eye.tracer;
     let size = eye.cache.size();
@@ -248,7 +248,7 @@ fn finish<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     sampler: &Sampler<'_>,
     at: TileAt,
     (frame, looks): (&Frame, Looks),
-    (tile, sides): (&mut TileWork, &mut KeptTile),
+    (tile, sides): (&mut TileWork<impl Shade>, &mut KeptTile),
 ) {
     let TileAt { x0, y0, tw, th, .. } = at;
     let TileWork { levels, hits, .. } = tile;
@@ -285,11 +285,11 @@ fn finish<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
 
 /// Step four, emit: the tile dithered and drawn, or kept (as tile `kept`, which then counts it).
 #[inline(always)]
-fn emit<D: DrawTarget<Color = BinaryColor>>(
+fn emit<D: DrawTarget<Color: Shade>>(
     out: &mut Out<'_, D>,
     dither: &mut Ditherer<'_>,
     at: TileAt,
-    (tile, sides): (&mut TileWork, &KeptTile),
+    (tile, sides): (&mut TileWork<D::Color>, &KeptTile),
     kept: &mut usize,
 ) -> Result<(), RenderError<D::Error>> {
     let TileAt { x0, y0, tw, th, .. } = at;

@@ -204,6 +204,7 @@ pub fn display_cmd(scenes: &[PathBuf], out: &Path, images: &Path, board: &Path) 
         .position(|l| DITHERS[l.dither].1 == board_frame::STILL_DITHER && l.outline && l.gamma == 10)
         .context("the board's look is in the grid")?;
     md.push_str(&panel_section(&names, board, &references, &frames, still)?);
+    md.push_str(&gray_section(scenes, &names, &references, &frames, still, out, images)?);
     write_atomic(out, md.as_bytes())?;
     println!("wrote {} (best: {}), contact sheets and passes in {}", out.display(), best.label(), images.display());
     Ok(())
@@ -261,6 +262,73 @@ fn panel_section(
         write!(md, "![{name} on the Pico's panel](images/board-{name}.png) ")?;
     }
     md.push('\n');
+    Ok(md)
+}
+
+/// Steps of a four-shade frame (0..=3) as levels of 64: a pixel lit in `k` of the three
+/// subframes shows `64 k / 3`.
+fn shade_levels(steps: &[u8]) -> Vec<f64> {
+    steps.iter().map(|&k| f64::from(k) * 64.0 / 3.0).collect()
+}
+
+/// The gray mode (`--levels 4`, the firmware's `gray` feature): each scene's frame in four
+/// shades, with and without silhouette lines, scored like the looks above, beside the 1-bit
+/// frame of the board's still look (`still`); the section of docs/display.md and a picture of
+/// each four-shade frame.
+fn gray_section(
+    scenes: &[PathBuf],
+    names: &[String],
+    references: &[Vec<f64>],
+    frames: &[Vec<Vec<u8>>],
+    still: usize,
+    out: &Path,
+    images: &Path,
+) -> Result<String> {
+    let (w, h) = PANEL;
+    let (wu, hu) = (w as usize, h as usize);
+    let score = |img: &[f64], i: usize| {
+        SIGMAS.map(|s| {
+            let (a, b) = (blur(img, wu, hu, s), blur(&references[i], wu, hu, s));
+            ssim(&a, &b, wu, hu)
+        })
+    };
+    let mut md = String::from("\n## Four shades (the gray mode)\n\n");
+    writeln!(md, "The same frames in four shades (`host-sim render --levels 4`; the firmware's `gray` feature,")?;
+    writeln!(md, "docs/board.md): Floyd-Steinberg error diffusion over black, two grays and white, a pixel of")?;
+    writeln!(md, "step k lit in k of the panel's three subframes, so it shows 64 k / 3. Scored as above; the")?;
+    writeln!(md, "1-bit column is the board's still frame (floyd-steinberg + outline), the gain the four-shade")?;
+    writeln!(md, "frame's SSIM (sigma 1) less the 1-bit frame's.\n")?;
+    writeln!(md, "| scene | 1-bit, SSIM (sigma 1) | 4 shades + outline, SSIM (sigma 1) | gain | 4 shades + outline, SSIM (sigma 2) | 4 shades, no outline (the gray mode), SSIM (sigma 1) | gain |\n|---|---:|---:|---:|---:|---:|---:|")?;
+    let mut pictures = String::new();
+    for (i, path) in scenes.iter().enumerate() {
+        let text = read(path)?;
+        let one_bit = score(&unpack(&frames[i][still], wu, hu), i)[0];
+        let mut row = Vec::new();
+        for outline in [true, false] {
+            let frame = Frame { outline, ..board_frame::rendered(board_frame::PICO) };
+            let r =
+                host_sim::run::render_text_in::<Fx, embedded_graphics::pixelcolor::Gray2>(path, &text, &frame, |_| {})?;
+            row.push(score(&shade_levels(&r.shades), i));
+            if outline {
+                let look =
+                    host_sim::output::PngLook { theme: host_sim::output::Theme::OledWhite, scale: 3, grid: false };
+                let file = images.join(format!("display-gray-{}.png", names[i]));
+                write_atomic(&file, &host_sim::output::shades_png_bytes(w as u32, h as u32, &r.shades, 3, look)?)?;
+                write!(pictures, "![{} in four shades]({}) ", names[i], link(out, &file))?;
+            }
+        }
+        writeln!(
+            md,
+            "| {} | {one_bit:.3} | {:.3} | {:+.3} | {:.3} | {:.3} | {:+.3} |",
+            names[i],
+            row[0][0],
+            row[0][0] - one_bit,
+            row[0][1],
+            row[1][0],
+            row[1][0] - one_bit
+        )?;
+    }
+    writeln!(md, "\n{pictures}")?;
     Ok(md)
 }
 

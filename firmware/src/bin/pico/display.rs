@@ -14,10 +14,12 @@ pub mod controller;
 mod i2c;
 #[cfg(not(feature = "spi"))]
 pub use i2c::{flush, reset, Pump, QueuedI2c};
-#[cfg(not(feature = "sharp"))]
+#[cfg(not(any(feature = "sharp", feature = "gray")))]
 mod pages;
-#[cfg(not(feature = "sharp"))]
+#[cfg(not(any(feature = "sharp", feature = "gray")))]
 pub use pages::PageTiles;
+#[cfg(feature = "gray")]
+pub mod gray;
 #[cfg(feature = "sharp")]
 pub mod sharp;
 #[cfg(feature = "spi")]
@@ -26,14 +28,18 @@ mod spi;
 pub use spi::{flush, reset, Pump};
 
 use display_interface::DisplayError;
-use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Size};
-use embedded_graphics_core::pixelcolor::BinaryColor;
-use embedded_graphics_core::primitives::Rectangle;
-use embedded_graphics_core::Pixel;
-use firmware::app::{HEIGHT, WIDTH};
+#[cfg(not(feature = "gray"))]
+use {
+    embedded_graphics_core::draw_target::DrawTarget,
+    embedded_graphics_core::geometry::{OriginDimensions, Size},
+    embedded_graphics_core::pixelcolor::BinaryColor,
+    embedded_graphics_core::primitives::Rectangle,
+    embedded_graphics_core::Pixel,
+    firmware::app::{HEIGHT, WIDTH},
+};
 
 /// The most rows drawn at once: a band of tiles.
+#[cfg(not(feature = "gray"))]
 const BAND_ROWS: usize = firmware::app::RENDERED.tile as usize;
 
 /// The panel's name in the log.
@@ -62,6 +68,7 @@ pub trait SetUp {
 
 /// A panel that takes an area of one band of tiles at a time: at most [`BAND_ROWS`] rows from a
 /// row that is a multiple of 8, within the frame, its pixels row by row.
+#[cfg(not(feature = "gray"))]
 pub trait Band {
     /// Sends `colors` (row by row) for the area of size `size` (width, height) at `at` (x, y).
     fn band(
@@ -75,8 +82,10 @@ pub trait Band {
 /// A [`Band`] panel as the render loop's draw target: the areas it takes are passed on; nothing
 /// else is supported (there is no framebuffer to merge single pixels into), and anything else is
 /// refused with an error.
+#[cfg(not(feature = "gray"))]
 pub struct Bands<T>(pub T);
 
+#[cfg(not(feature = "gray"))]
 impl<T: SetUp> SetUp for Bands<T> {
     fn set_up(&mut self) -> Result<(), DisplayError> {
         self.0.set_up()
@@ -91,12 +100,14 @@ impl<T: SetUp> SetUp for Bands<T> {
     }
 }
 
+#[cfg(not(feature = "gray"))]
 impl<T> OriginDimensions for Bands<T> {
     fn size(&self) -> Size {
         Size::new(WIDTH as u32, HEIGHT as u32)
     }
 }
 
+#[cfg(not(feature = "gray"))]
 impl<T: Band> DrawTarget for Bands<T> {
     type Color = BinaryColor;
     type Error = DisplayError;

@@ -118,8 +118,10 @@ fn main() -> ! {
     let (timer, mut alarm) = sleep::start(timer_block, &mut pac.RESETS, &clocks);
 
     display::reset(&mut reset, &mut { timer });
-    #[cfg(not(feature = "sharp"))]
+    #[cfg(not(any(feature = "sharp", feature = "gray")))]
     let mut target = display::Bands(display::PageTiles { interface });
+    #[cfg(feature = "gray")]
+    let mut target = display::gray::Gray::new(interface);
     #[cfg(feature = "sharp")]
     let mut target = display::Bands(display::sharp::LineTiles::new(interface));
     while target.set_up().is_err() {

@@ -9,13 +9,13 @@ use board_records::FrameDone;
 use board_records::{Channel, Record};
 use display_interface::DisplayError;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_hal::digital::OutputPin;
 #[cfg(not(any(feature = "ladder", feature = "slot")))]
 use firmware::app::EMBEDDED;
-use firmware::app::{render_embedded_at, AppError, Board, Embedded, Report, SceneMemory, ShareMemory, Shot};
+use firmware::app::{render_embedded_at, AppError, Board, Embedded, Report, SceneMemory, ShareMemory, Shot, Shown};
 #[cfg(not(any(feature = "ladder", feature = "slot")))]
 use firmware::stack;
+use lattice_rt::dither::Shade;
 use lattice_rt::render::RenderError;
 
 /// The pause between two scenes.
@@ -81,7 +81,7 @@ pub struct Panel<'m, T, L> {
     pub second: &'m mut ShareMemory,
 }
 
-impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin> Panel<'_, T, L> {
+impl<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: OutputPin> Panel<'_, T, L> {
     /// One frame, with the LED lit while it renders; its report and its microseconds, whole and
     /// up to the first tile (the set-up). The passes of
     /// a progressive frame (the `progressive` feature) follow each other without waiting for the
@@ -92,6 +92,8 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
         self.set_up_panel();
         let timer = self.timer;
         let t0 = timer.get_counter();
+        #[cfg(feature = "gray")]
+        let refresh0 = crate::display::gray::refresh_us();
         let _ = self.led.set_high();
         let now = || timer.get_counter().ticks();
         let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut |_| {} };
@@ -99,6 +101,11 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
         // The frame is on the panel once the bus has sent its last queued byte.
         let sent = self.target.flush();
         let _ = self.led.set_low();
+        #[cfg(feature = "gray")]
+        defmt::info!(
+            "the gray refresh took {} us of core 0 during the frame",
+            crate::display::gray::refresh_us().wrapping_sub(refresh0)
+        );
         let result = result.and_then(|r| {
             sent.map(|()| r).map_err(|_| AppError::Render(RenderError::Draw(DisplayError::BusWriteError)))
         });
@@ -154,7 +161,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
             let rows = band.min(h - y0);
             let colors = (y0..y0 + rows)
                 .flat_map(|y| (0..w).map(move |x| (x, y)))
-                .map(|(x, y)| BinaryColor::from(frame.get(x, y)));
+                .map(|(x, y)| Shown::from_step(u8::from(frame.get(x, y)) * Shown::STEPS));
             self.target.fill_contiguous(&Rectangle::new(Point::new(0, y0 as i32), Size::new(w, rows)), colors)?;
         }
         let sent = self.target.flush();
@@ -206,7 +213,7 @@ impl<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L:
 /// panel that says why there is none (the slot empty or corrupt, the scene refused at its line
 /// and column or too big for the image's storage), also logged.
 #[cfg(feature = "slot")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     use firmware::slot::Message;
@@ -240,7 +247,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Se
 
 /// The embedded scenes in turn, each frame's time and statistics logged.
 #[cfg(not(any(feature = "orbit", feature = "ladder", feature = "slot")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     loop {
@@ -255,7 +262,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Se
 /// Scene `i`'s frame, drawn again while the display does not take it, then the pause after it:
 /// true when the panel lost it in the pause ([`Panel::pause`]).
 #[cfg(not(any(feature = "orbit", feature = "ladder", feature = "slot")))]
-fn show_scene<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
+fn show_scene<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     panel: &mut Panel<'_, T, L>,
     i: usize,
     name: &str,
@@ -282,7 +289,7 @@ fn show_scene<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp +
 
 /// Orbit mode: the camera circles each scene, frame after frame, for one turn.
 #[cfg(all(feature = "orbit", not(feature = "ladder")))]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     use firmware::app::ORBIT_FRAMES;
@@ -315,7 +322,7 @@ pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Se
 
 /// The ladder: the first scene once per rung, from the paper's method to the default.
 #[cfg(feature = "ladder")]
-pub fn run<T: DrawTarget<Color = BinaryColor, Error = DisplayError> + SetUp + Send, L: OutputPin>(
+pub fn run<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     use firmware::app::{EMBEDDED, LADDER};

@@ -37,14 +37,22 @@ pub struct Controller {
     pub column_offset: u8,
 }
 
-/// Display off and the oscillator at its reset frequency: every set-up's first commands.
-const HEAD: &[&[u8]] = &[&[0xae], &[0xd5, 0x80]];
+/// The display clock (0xD5): the oscillator setting in the high nibble, the divide ratio less
+/// one in the low. Its reset value (0x80) on the 1-bit images; the gray mode's subframes want the
+/// fastest refresh, so it runs the oscillator at its highest setting, undivided (0xF0), as the
+/// Thumby's grayscale library does.
+pub const CLOCK: u8 = if cfg!(feature = "gray") { 0xf0 } else { 0x80 };
+/// The SSD1306's pre-charge periods (0xD9): phase 2 in the high nibble, phase 1 in the low, in
+/// display clocks (the `ssd1306` crate's 0x21).
+pub const PRECHARGE: u8 = 0x21;
+/// Display off and the oscillator at [`CLOCK`]: every set-up's first commands.
+const HEAD: &[&[u8]] = &[&[0xae], &[0xd5, CLOCK]];
 /// No offset, start line 0, the SSD1306's charge pump on and horizontal addressing.
 const SSD1306_PUMP: &[&[u8]] = &[&[0xd3, 0], &[0x40], &[0x8d, 0x14], &[0x20, 0x00]];
 /// Segment remap and reversed COM scan (upright), the SSD1306's pre-charge, contrast and VCOMH
 /// (the `ssd1306` crate's), the RAM shown as it is, no scrolling, display on.
 const SSD1306_TAIL: &[&[u8]] =
-    &[&[0xa1], &[0xc8], &[0xd9, 0x21], &[0x81, 0x5f], &[0xdb, 0x40], &[0xa4], &[0xa6], &[0x2e], &[0xaf]];
+    &[&[0xa1], &[0xc8], &[0xd9, PRECHARGE], &[0x81, 0x5f], &[0xdb, 0x40], &[0xa4], &[0xa6], &[0x2e], &[0xaf]];
 
 /// The SSD1306, 128x64 (the `ssd1306` crate's set-up: horizontal addressing, charge pump on,
 /// segment remap and reversed COM scan, contrast 0x5F).
