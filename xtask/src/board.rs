@@ -13,6 +13,7 @@
 
 mod button;
 mod faults;
+mod gray;
 mod panels;
 mod slot;
 
@@ -210,6 +211,9 @@ struct RunEnd {
     naks: u64,
     #[serde(default)]
     warnings: Vec<String>,
+    /// Refreshes the panel made (`--scan`).
+    #[serde(default)]
+    refreshes: u64,
 }
 
 /// What run.mjs prints, one JSON object a line, told apart by its `event` field. (Not a serde
@@ -224,6 +228,10 @@ enum Event {
     Bus(String, f64),
     /// The button pressed (run.mjs's `button` event: when).
     Button(f64),
+    /// A picture a refresh showed for the first time (`--scan`): its number and pixels.
+    Image(usize, Vec<u8>),
+    /// From this refresh on (its index), the panel shows picture number ... (`--scan`).
+    Refresh(u64, usize),
     End(RunEnd),
 }
 
@@ -239,6 +247,14 @@ impl Event {
             }
             Some("bus") => Event::Bus(v["what"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0)),
             Some("button") => Event::Button(v["ms"].as_f64().unwrap_or(0.0)),
+            Some("image") => Event::Image(
+                v["id"].as_u64().context("an image without its number")? as usize,
+                hex_bytes(v["pixels"].as_str().context("an image without pixels")?),
+            ),
+            Some("refresh") => Event::Refresh(
+                v["index"].as_u64().context("a refresh without its index")?,
+                v["image"].as_u64().context("a refresh without its picture")? as usize,
+            ),
             _ => bail!("emulator printed an unknown event: {line}"),
         };
         Ok(event)
@@ -277,6 +293,12 @@ struct BoardRun {
     bus: Vec<(String, f64)>,
     /// When the button was pressed.
     presses: Vec<f64>,
+    /// The pictures the panel's refreshes showed (`--scan`), by number.
+    images: Vec<Vec<u8>>,
+    /// Where the refreshes' picture changed: from refresh index on, picture number.
+    refresh_changes: Vec<(u64, usize)>,
+    /// Refreshes in all.
+    refreshes: u64,
 }
 
 /// One decoded defmt log line.
@@ -353,6 +375,11 @@ fn run_emulator(
                 eprintln!("  button pressed at {ms:.1} ms");
                 run.presses.push(ms);
             }
+            Event::Image(id, pixels) => {
+                run.images.resize(run.images.len().max(id + 1), Vec::new());
+                run.images[id] = pixels;
+            }
+            Event::Refresh(index, id) => run.refresh_changes.push((index, id)),
             Event::End(e) => {
                 run.ok = e.ok;
                 run.reason = e.reason;
@@ -365,6 +392,7 @@ fn run_emulator(
                 run.led_toggles = e.led_toggles;
                 run.naks = e.naks;
                 run.warnings = e.warnings;
+                run.refreshes = e.refreshes;
             }
         }
     }
@@ -520,6 +548,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let fault_rows = s.fault_runs(&rows)?;
     let button_row = s.button_run(&rows)?;
     let panel_rows = s.panel_runs()?;
+    let gray_run = s.gray_runs()?;
     if let Some(images) = out.parent().map(|p| p.join("images")) {
         panels::save_pictures(&panel_rows, &images)?;
     }
@@ -569,6 +598,9 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     md.push_str(&faults::fault_report(&fault_rows)?);
     md.push_str(&button::button_report(button_row.as_ref())?);
     md.push_str(&panels::panel_report(&panel_rows, s.scenes.first().map_or("", String::as_str), run.clk_sys_hz)?);
+    let spi_chair = levers.iter().find(|(feature, ..)| *feature == "spi").map(|(_, _, f, _)| f.cycles);
+    let gray_picture = out.parent().unwrap_or(Path::new(".")).join("images/board-gray-chair.png");
+    md.push_str(&gray::gray_report(&gray_run, spi_chair, &gray_picture)?);
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     let Checks { passed, failures } = s.checks;
