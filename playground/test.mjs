@@ -134,12 +134,28 @@ async function main() {
     await page.click('#lines');
     await page.select('#gamma', '8');
     await page.select('#sampling', 'one');
-    await page.waitForFunction(() => JSON.stringify(window.playground.settings) === JSON.stringify({ scalar: 'f32', dither: 'blue-noise', lines: false, gamma: 8, sampling: 'one', turn: 0 }));
+    await page.waitForFunction(() => JSON.stringify(window.playground.settings) === JSON.stringify({ scalar: 'f32', dither: 'blue-noise', lines: false, gamma: 8, sampling: 'one', turn: 0, shades: 2 }));
     const other = ['--scalar', 'f32', '--sampling', 'one', '--dither', 'blue-noise', '--no-outline', '--gamma', '8', '--tile', '16', '--cutoff', '7'];
     const wantOther = hostFrame(o.hostSim, 'desk', other, work);
     const gotOther = await readCanvas(page, 'panel');
     check(differing(gotOther, wantOther) === 0, `desk: the panel equals host-sim render ${other.join(' ')} (${differing(gotOther, wantOther)} pixels differ)`);
     await page.click('#pico-settings');
+
+    // Four shades (the gray mode; the core's unit test holds them to host-sim's): the page
+    // draws each pixel's step as its share of the panel's white.
+    await page.select('#shades', '4');
+    await page.waitForFunction(() => window.playground.settings?.shades === 4 && window.playground.error === null);
+    const gray = await page.evaluate(() => {
+      const data = document.getElementById('panel').getContext('2d').getImageData(0, 0, 128, 64).data;
+      const steps = window.playground.shades;
+      const seen = new Set(steps);
+      let wrong = 0;
+      for (let p = 0; p < 128 * 64; p++) if (data[p * 4] !== Math.round((235 * steps[p]) / 3)) wrong++;
+      return { wrong, seen: [...seen].sort().join(', ') };
+    });
+    check(gray.wrong === 0 && gray.seen === '0, 1, 2, 3', `four shades: the panel draws every pixel's step (${gray.wrong} pixels wrong; steps ${gray.seen})`);
+    await page.select('#shades', '2');
+    await page.waitForFunction(() => window.playground.settings?.shades === 2);
 
     // A mistake typed into the editor.
     await page.$eval('#text', (t) => { t.value = ''; });

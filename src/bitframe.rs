@@ -5,8 +5,9 @@
 //! bytes. The renderer never needs it; it is one possible [`DrawTarget`].
 
 use crate::bounds::{at_mut, span_mut};
+use crate::dither::Shade;
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Size};
+use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use embedded_graphics_core::primitives::{PointsIter, Rectangle};
 use embedded_graphics_core::Pixel;
@@ -170,6 +171,58 @@ impl DrawTarget for BitFrame<'_> {
     }
 }
 
+/// A frame of shades over caller storage, one byte a pixel, row-major: each pixel's step
+/// ([`Shade::step`]: `0..=C::STEPS`), as an `embedded_graphics` draw target of `C`. What the
+/// gray mode's four shades ([`embedded_graphics_core::pixelcolor::Gray2`]) are drawn into on
+/// a host; a 1-bit frame drawn into it holds 0 and 1.
+#[derive(Debug)]
+pub struct ShadeFrame<'s, C> {
+    width: u32,
+    height: u32,
+    steps: &'s mut [u8],
+    shade: core::marker::PhantomData<C>,
+}
+
+impl<'s, C: Shade> ShadeFrame<'s, C> {
+    /// A dark frame over `steps`, or `None` if it is shorter than `width * height`.
+    pub fn new(width: u32, height: u32, steps: &'s mut [u8]) -> Option<Self> {
+        let steps = steps.get_mut(..width as usize * height as usize)?;
+        steps.iter_mut().for_each(|k| *k = 0);
+        Some(ShadeFrame { width, height, steps, shade: core::marker::PhantomData })
+    }
+
+    /// Draws into `frame` which pixels are lit at all (a step above 0), in any subframe.
+    pub fn lit(&self, frame: &mut BitFrame<'_>) {
+        let w = self.width.max(1) as usize;
+        let pixels = self
+            .steps
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| Pixel(Point::new((i % w) as i32, (i / w) as i32), BinaryColor::from(k > 0)));
+        let Ok(()) = frame.draw_iter(pixels);
+    }
+}
+
+impl<C> OriginDimensions for ShadeFrame<'_, C> {
+    fn size(&self) -> Size {
+        Size::new(self.width, self.height)
+    }
+}
+
+impl<C: Shade> DrawTarget for ShadeFrame<'_, C> {
+    type Color = C;
+    type Error = core::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = Pixel<C>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+        for Pixel(p, c) in pixels {
+            if p.x >= 0 && p.y >= 0 && (p.x as u32) < self.width && (p.y as u32) < self.height {
+                *at_mut(self.steps, p.y as usize * self.width as usize + p.x as usize) = c.step();
+            }
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,5 +270,19 @@ mod tests {
                 .unwrap();
             assert_eq!(a, b, "{n} colors");
         }
+    }
+
+    #[test]
+    fn a_shade_frame_keeps_each_pixels_step_and_lights_the_nonzero_ones() {
+        use embedded_graphics_core::pixelcolor::Gray2;
+        let mut steps = [9u8; 6];
+        let mut f = ShadeFrame::<Gray2>::new(3, 2, &mut steps).unwrap();
+        let px = |x, y, k| Pixel(Point::new(x, y), Gray2::new(k));
+        f.draw_iter([px(0, 0, 3), px(2, 1, 1), px(1, 0, 2), px(5, 5, 3), px(-1, 0, 3)]).unwrap();
+        let mut bits = [0u8; 2];
+        f.lit(&mut BitFrame::new(3, 2, &mut bits).unwrap());
+        assert_eq!(steps, [3, 2, 0, 0, 0, 1], "outside pixels dropped, the rest cleared");
+        assert_eq!(bits, [0b1100_0000, 0b0010_0000]);
+        assert!(ShadeFrame::<Gray2>::new(4, 2, &mut [0; 7]).is_none());
     }
 }

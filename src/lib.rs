@@ -108,4 +108,4 @@ pub use render::{
     NoHooks, Sampling, Scratch, Share, Traced,
 };
 pub mod bitframe;
-pub use bitframe::BitFrame;
+pub use bitframe::{BitFrame, ShadeFrame};

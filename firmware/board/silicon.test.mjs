@@ -314,3 +314,41 @@ test('Sharp memory LCD: SCS active high, LSB-first mode and addresses, whole lin
   f.select(false);
   assert.match(f.error, /no dummy byte after the last line/);
 });
+
+test('SSD1306 refresh: a row every D x (phase 1 + phase 2 + 50) clocks, each showing its RAM row as it is then', async () => {
+  const { Ssd1306 } = await import('./ssd1306.mjs');
+  let t = 0;
+  const d = new Ssd1306(0x3c, undefined, () => t);
+  const refreshes = [];
+  d.scan((pixels, at) => refreshes.push({ pixels: pixels.slice(), at }));
+  const cmd = (...bytes) => bytes.forEach((b) => d.spiByte(b, false));
+  // The gray image's set-up: oscillator 0xF (530 kHz typical), D = 1, phases 1 and 2: 53 clocks.
+  cmd(0xae, 0xd5, 0xf0, 0xa8, 63, 0xd3, 0, 0x40, 0x8d, 0x14, 0x20, 0x00, 0xda, 0x12, 0xa1, 0xc8, 0xd9, 0x21, 0xaf);
+  assert.equal(Math.round(d.rowNanos()), 100_000);
+  // Page 0 lit while row 0 is driven (50 us after the display came on): rows 1..7 show it in
+  // this refresh, row 0 from the next.
+  t = 50_000;
+  cmd(0x21, 0, 127, 0x22, 0, 0);
+  for (let i = 0; i < 128; i++) d.spiByte(0xff, true);
+  t = 2 * 6_400_000 + 1;
+  d.tick();
+  assert.equal(refreshes.length, 2, 'two refreshes of 64 rows in 12.8 ms');
+  const lit = (px, y) => px.subarray(y * 16, y * 16 + 16).every((b) => b === 0xff);
+  const [first, second] = refreshes.map((r) => r.pixels);
+  assert.deepEqual([0, 1, 7, 8].map((y) => lit(first, y)), [false, true, true, false], 'the first refresh is torn at row 1');
+  assert.deepEqual([0, 7, 8].map((y) => lit(second, y)), [true, true, false]);
+  assert.equal(Math.round(refreshes[1].at), 6_400_000);
+  // Halving the divide ratio's clock (D = 2) doubles the row period; 3 % fast shortens it.
+  cmd(0xd5, 0xf1);
+  assert.equal(Math.round(d.rowNanos()), 200_000);
+  d.oscScale = 1.03;
+  assert.equal(Math.round(d.rowNanos()), Math.round(200_000 / 1.03));
+  // Display off stops the scan; a pre-charge phase of 0 clocks does not exist.
+  cmd(0xae);
+  t += 50_000_000;
+  d.tick();
+  assert.equal(refreshes.length, 2, 'no refresh while the display is off');
+  assert.equal(d.error, null);
+  cmd(0xd9, 0x20);
+  assert.match(d.error ?? '', /pre-charge/);
+});

@@ -214,7 +214,8 @@ pub struct RenderArgs {
     pub json: bool,
     /// Exactly the frame this board's default image shows: 128x64, its scalar (the Pico fixed
     /// point, the Pico 2 f32), coarse sampling, 16x16 tiles, Floyd-Steinberg with lines and
-    /// cutoff 7 (the frame options above cannot be given with it).
+    /// cutoff 7 (the frame options above cannot be given with it); with `--levels 4`, the gray
+    /// image's (`--features gray`: the same without lines).
     #[arg(long, value_enum, conflicts_with_all = ["size", "dither", "sampling", "scalar", "tile", "no_outline", "gamma", "cutoff"])]
     pub board: Option<crate::uf2::Board>,
     /// With --board: the panel the image drives, whose glass sets the frame's size (ssd1306,
@@ -255,7 +256,13 @@ impl RenderArgs {
     pub fn frame(&self) -> lattice_rt::Frame {
         if self.board.is_some() {
             let glass = self.panel.unwrap_or_default().glass();
-            return board_records::frame::rendered(board_records::frame::Build { glass, ..board_records::frame::PICO });
+            // Four shades are the gray image's frame (the `gray` feature: no silhouette lines).
+            let gray = self.levels == 4;
+            return board_records::frame::rendered(board_records::frame::Build {
+                glass,
+                gray,
+                ..board_records::frame::PICO
+            });
         }
         lattice_rt::Frame {
             tile: self.tile,

@@ -12,7 +12,7 @@ use lattice_rt::render::{Hooks, RenderError};
 use lattice_rt::trace::{Effects, EyeRays};
 use lattice_rt::{
     render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, Lattice, LatticeConfig, Real, Scene,
-    Stats, Tracer,
+    ShadeFrame, Stats, Tracer,
 };
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -128,33 +128,6 @@ pub fn render_band<R: Real, A: Accelerator<R> + ?Sized>(
     render_band_in::<R, A, BinaryColor>(tracer, frame, progress)
 }
 
-/// A frame of shades on the host: each pixel's step.
-struct ShadeFrame<C> {
-    width: u32,
-    height: u32,
-    steps: Vec<u8>,
-    shade: core::marker::PhantomData<C>,
-}
-
-impl<C> embedded_graphics::geometry::OriginDimensions for ShadeFrame<C> {
-    fn size(&self) -> embedded_graphics::geometry::Size {
-        embedded_graphics::geometry::Size::new(self.width, self.height)
-    }
-}
-
-impl<C: Shade> embedded_graphics::draw_target::DrawTarget for ShadeFrame<C> {
-    type Color = C;
-    type Error = core::convert::Infallible;
-    fn draw_iter<I: IntoIterator<Item = embedded_graphics::Pixel<C>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
-        for embedded_graphics::Pixel(p, c) in pixels {
-            if (0..self.width as i32).contains(&p.x) && (0..self.height as i32).contains(&p.y) {
-                self.steps[p.y as usize * self.width as usize + p.x as usize] = c.step();
-            }
-        }
-        Ok(())
-    }
-}
-
 /// [`render_band`] in the shades of `C`.
 pub fn render_band_in<R: Real, A: Accelerator<R> + ?Sized, C: Shade>(
     tracer: &Tracer<'_, '_, R, A>,
@@ -162,8 +135,8 @@ pub fn render_band_in<R: Real, A: Accelerator<R> + ?Sized, C: Shade>(
     progress: bool,
 ) -> Result<Rendered> {
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let mut target =
-        ShadeFrame::<C> { width: w as u32, height: h as u32, steps: vec![0; w * h], shade: core::marker::PhantomData };
+    let mut steps = vec![0u8; w * h];
+    let mut target = ShadeFrame::<C>::new(w as u32, h as u32, &mut steps).expect("sized above");
     let mut scratch = HeapScratch::new(tracer.scene(), frame);
     let mut hooks = HostHooks { width: w, gray: vec![0; w * h], start: Instant::now(), progress, bar: None };
     let start = Instant::now();
@@ -173,11 +146,8 @@ pub fn render_band_in<R: Real, A: Accelerator<R> + ?Sized, C: Shade>(
     })?;
     let elapsed = start.elapsed();
     let mut bits = vec![0u8; BitFrame::bytes(w as u32, h as u32)];
-    let stride = w.div_ceil(8);
-    for (i, _) in target.steps.iter().enumerate().filter(|(_, &k)| k > 0) {
-        bits[(i / w) * stride + (i % w) / 8] |= 0x80 >> (i % w % 8);
-    }
-    Ok(Rendered { bits, shades: target.steps, gray: hooks.gray, stats, elapsed, lattice: None })
+    target.lit(&mut BitFrame::new(w as u32, h as u32, &mut bits).expect("sized"));
+    Ok(Rendered { bits, shades: steps, gray: hooks.gray, stats, elapsed, lattice: None })
 }
 
 /// Parses scene text, builds its default lattice and hands `work` a tracer on it, after `tune`

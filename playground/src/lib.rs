@@ -7,12 +7,15 @@
 //! tests), [`ScriptError`] the line and column of a scene's mistake.
 
 use board_records::frame::{self as board_frame, Build, PICO};
+use embedded_graphics_core::pixelcolor::{BinaryColor, Gray2};
+use lattice_rt::dither::Shade;
 use lattice_rt::render::{RenderError, Sampling};
 use lattice_rt::scene::Object;
 use lattice_rt::scene::{object_count, parse_with};
 use lattice_rt::trace::Effects;
 use lattice_rt::{
-    render, BitFrame, Dither, Frame, Fx, HeapScratch, HeapStorage, LatticeConfig, NoHooks, Real, Sizes, Tone, Tracer,
+    render, BitFrame, Dither, Frame, Fx, HeapScratch, HeapStorage, LatticeConfig, NoHooks, Real, ShadeFrame, Sizes,
+    Tone, Tracer,
 };
 use std::fmt::Write;
 use wasm_bindgen::prelude::*;
@@ -52,6 +55,8 @@ pub struct Settings {
     pub sampling: String,
     /// The camera's turn around the scene (0..1), as `host-sim orbit` turns it.
     pub turn: f64,
+    /// Shades the panel shows: 2 (1-bit) or 4 (the gray mode, `host-sim render --levels 4`).
+    pub shades: u8,
 }
 
 impl Default for Settings {
@@ -64,6 +69,7 @@ impl Default for Settings {
             gamma: f.tone.gamma_tenths,
             sampling: sampling_name(f.sampling).into(),
             turn: 0.0,
+            shades: 2,
         }
     }
 }
@@ -116,8 +122,10 @@ pub struct Mistake {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Output {
     /// The 1-bit frame, packed as `BitFrame` packs it (rows of 16 bytes, most significant bit
-    /// first, 1 lit).
+    /// first, 1 lit): the pixels lit in any subframe.
     pub bits: Vec<u8>,
+    /// Each pixel's shade, row-major: its step, 0..=1 (two shades) or 0..=3 (four).
+    pub shades: Vec<u8>,
     /// The report as JSON (see [`render_panel`]).
     pub report: String,
 }
@@ -129,15 +137,19 @@ pub struct Output {
 pub fn render_panel(text: &str, settings: &Settings) -> Result<Output, Mistake> {
     let unplaced = |message: String| Mistake { line: 0, col: 0, message };
     let frame = settings.frame().map_err(unplaced)?;
-    match settings.scalar.as_str() {
-        "fixed" => render_in::<Fx>(text, settings.turn, &frame),
-        "f32" => render_in::<f32>(text, settings.turn, &frame),
-        "f64" => render_in::<f64>(text, settings.turn, &frame),
-        other => Err(unplaced(format!("unknown scalar `{other}` (fixed, f32 or f64)"))),
+    match (settings.scalar.as_str(), settings.shades) {
+        ("fixed", 2) => render_in::<Fx, BinaryColor>(text, settings.turn, &frame),
+        ("f32", 2) => render_in::<f32, BinaryColor>(text, settings.turn, &frame),
+        ("f64", 2) => render_in::<f64, BinaryColor>(text, settings.turn, &frame),
+        ("fixed", 4) => render_in::<Fx, Gray2>(text, settings.turn, &frame),
+        ("f32", 4) => render_in::<f32, Gray2>(text, settings.turn, &frame),
+        ("f64", 4) => render_in::<f64, Gray2>(text, settings.turn, &frame),
+        (_, 2 | 4) => Err(unplaced(format!("unknown scalar `{}` (fixed, f32 or f64)", settings.scalar))),
+        (_, n) => Err(unplaced(format!("{n} shades: the panel shows 2 or 4"))),
     }
 }
 
-fn render_in<R: Real>(text: &str, turn: f64, frame: &Frame) -> Result<Output, Mistake> {
+fn render_in<R: Real, C: Shade>(text: &str, turn: f64, frame: &Frame) -> Result<Output, Mistake> {
     let unplaced = |message: String| Mistake { line: 0, col: 0, message };
     let n = object_count(text);
     if n > MAX_OBJECTS {
@@ -161,8 +173,8 @@ fn render_in<R: Real>(text: &str, turn: f64, frame: &Frame) -> Result<Output, Mi
     let (lattice, _) = storage.view().split().1.lattice(&scene, &cfg).map_err(|e| unplaced(e.to_string()))?;
     let tracer = Tracer::new(&scene, &lattice);
     let (w, h) = (frame.width as u32, frame.height as u32);
-    let mut bits = vec![0u8; BitFrame::bytes(w, h)];
-    let mut target = BitFrame::new(w, h, &mut bits).expect("sized by BitFrame::bytes");
+    let mut shades = vec![0u8; w as usize * h as usize];
+    let mut target = ShadeFrame::<C>::new(w, h, &mut shades).expect("sized above");
     let mut scratch = HeapScratch::new(&scene, frame);
     let stats = render(&tracer, frame, &mut target, &mut scratch.scratch(), &mut NoHooks).map_err(|e| match e {
         RenderError::Draw(never) => match never {},
@@ -192,7 +204,9 @@ fn render_in<R: Real>(text: &str, turn: f64, frame: &Frame) -> Result<Output, Mi
         stats.culled,
     )
     .expect("writing to a String");
-    Ok(Output { bits, report })
+    let mut bits = vec![0u8; BitFrame::bytes(w, h)];
+    target.lit(&mut BitFrame::new(w, h, &mut bits).expect("sized by BitFrame::bytes"));
+    Ok(Output { bits, shades, report })
 }
 
 /// The scenes the page starts from: the paper's four and the Whitted showcase, by name.
@@ -213,6 +227,10 @@ impl Panel {
     /// The packed 1-bit frame (16 bytes a row, most significant bit first, 1 lit).
     pub fn bits(&self) -> Vec<u8> {
         self.0.bits.clone()
+    }
+    /// Each pixel's step, row-major (0..=1 with two shades, 0..=3 with four).
+    pub fn shades(&self) -> Vec<u8> {
+        self.0.shades.clone()
     }
     /// What the lattice did, as JSON.
     pub fn report(&self) -> String {
@@ -240,8 +258,10 @@ impl ScriptError {
     }
 }
 
-/// Renders `text` for the page: [`render_panel`] with the settings given one by one.
+/// Renders `text` for the page: [`render_panel`] with the settings given one by one (plain
+/// values cross the WebAssembly boundary without glue of their own, a struct would not).
 #[wasm_bindgen]
+#[allow(clippy::too_many_arguments)]
 pub fn panel(
     text: &str,
     scalar: &str,
@@ -250,9 +270,17 @@ pub fn panel(
     gamma: u8,
     sampling: &str,
     turn: f64,
+    shades: u8,
 ) -> Result<Panel, ScriptError> {
-    let settings =
-        Settings { scalar: scalar.into(), dither: dither.into(), lines, gamma, sampling: sampling.into(), turn };
+    let settings = Settings {
+        scalar: scalar.into(),
+        dither: dither.into(),
+        lines,
+        gamma,
+        sampling: sampling.into(),
+        turn,
+        shades,
+    };
     render_panel(text, &settings).map(Panel).map_err(ScriptError)
 }
 
@@ -280,12 +308,13 @@ pub fn scene_text(name: &str) -> String {
 pub fn default_settings() -> String {
     let s = Settings::default();
     format!(
-        r#"{{"scalar":"{}","dither":"{}","lines":{},"gamma":{},"sampling":"{}","turn":0,"dithers":"{}"}}"#,
+        r#"{{"scalar":"{}","dither":"{}","lines":{},"gamma":{},"sampling":"{}","turn":0,"shades":{},"dithers":"{}"}}"#,
         s.scalar,
         s.dither,
         s.lines,
         s.gamma,
         s.sampling,
+        s.shades,
         DITHERS.map(|d| d.0).join(",")
     )
 }
@@ -306,6 +335,20 @@ mod tests {
                 out.report.contains(r#""objectTests":"#) && out.report.starts_with('{') && out.report.ends_with('}')
             );
         }
+    }
+
+    #[test]
+    fn four_shades_are_host_sims_gray_frame() {
+        let s = Settings { shades: 4, ..Settings::default() };
+        for (name, text) in SCENES {
+            let out = render_panel(text, &s).unwrap();
+            let frame = s.frame().unwrap();
+            let want = host_sim::run::render_text_in::<Fx, Gray2>(Path::new(name), text, &frame, |_| {}).unwrap();
+            assert_eq!(out.shades, want.shades, "{name}");
+            assert!(out.shades.iter().any(|&k| k == 1 || k == 2), "{name}: no gray in four shades");
+        }
+        let e = render_panel(SCENES[0].1, &Settings { shades: 3, ..Settings::default() }).unwrap_err();
+        assert!(e.message.contains("2 or 4"), "{}", e.message);
     }
 
     #[test]

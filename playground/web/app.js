@@ -17,17 +17,25 @@ function readBits(canvas) {
   return bits;
 }
 
-/** Draws a packed 1-bit frame (16 bytes a row, MSB first, 1 lit) on a 128x64 canvas. */
-function draw(canvas, bits) {
+/** The colour of a pixel lit `share` of the time (0: dark, 1: the panel's white). */
+const shade = (share) => [235, 242, 255].map((c) => Math.round(c * share));
+
+/**
+ * Draws a frame on a 128x64 canvas: a packed 1-bit frame (16 bytes a row, MSB first, 1 lit),
+ * or with `steps` (a step per pixel, 0..=top) its shades, a pixel of step k lit k / top of the
+ * time (the gray mode's subframes, as the eye sums them).
+ */
+function draw(canvas, bits, steps = null, top = 1) {
   const ctx = canvas.getContext('2d');
   const img = ctx.createImageData(W, H);
   for (let y = 0; y < H; y++) {
     for (let x = 0; x < W; x++) {
       const on = (bits[y * (W / 8) + (x >> 3)] >> (7 - (x & 7))) & 1;
+      const [r, g, b] = shade(steps ? steps[y * W + x] / top : on);
       const i = (y * W + x) * 4;
-      img.data[i] = on ? 235 : 0;
-      img.data[i + 1] = on ? 242 : 0;
-      img.data[i + 2] = on ? 255 : 0;
+      img.data[i] = r;
+      img.data[i + 1] = g;
+      img.data[i + 2] = b;
       img.data[i + 3] = 255;
     }
   }
@@ -42,6 +50,7 @@ function settings() {
     gamma: Number($('gamma').value),
     sampling: $('sampling').value,
     turn: Number($('orbit').value) / 36,
+    shades: Number($('shades').value),
   };
 }
 
@@ -52,6 +61,7 @@ function applySettings(s) {
   $('gamma').value = String(s.gamma);
   $('sampling').value = s.sampling;
   $('orbit').value = String(Math.round(s.turn * 36));
+  $('shades').value = String(s.shades);
 }
 
 const fmt = (n) => n.toLocaleString('en-US');
@@ -119,15 +129,16 @@ function rerender(cost) {
   $('orbit-at').textContent = `${$('orbit').value} / 36`;
   const t0 = performance.now();
   try {
-    const p = panel($('text').value, s.scalar, s.dither, s.lines, s.gamma, s.sampling, s.turn);
+    const p = panel($('text').value, s.scalar, s.dither, s.lines, s.gamma, s.sampling, s.turn, s.shades);
     const ms = performance.now() - t0;
     state.bits = p.bits();
+    state.shades = Array.from(p.shades());
     state.report = JSON.parse(p.report());
     state.error = null;
     state.renderMs = ms;
     state.settings = s;
     p.free();
-    draw($('panel'), state.bits);
+    draw($('panel'), state.bits, s.shades === 4 ? state.shades : null, s.shades - 1);
     showReport(state.report, ms, cost);
     showError(null);
   } catch (err) {
@@ -243,7 +254,7 @@ async function main() {
     localStorage.setItem(KEPT_TEXT, $('text').value);
     soon();
   });
-  for (const id of ['dither', 'lines', 'gamma', 'scalar', 'sampling', 'orbit']) $(id).addEventListener('input', soon);
+  for (const id of ['dither', 'lines', 'gamma', 'scalar', 'sampling', 'orbit', 'shades']) $(id).addEventListener('input', soon);
   let shown = $('scene').value;
   $('scene').addEventListener('change', () => {
     const edited = loaded === null ? $('text').value.trim() !== '' : $('text').value !== loaded;

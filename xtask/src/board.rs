@@ -308,6 +308,50 @@ struct LogLine {
     text: String,
 }
 
+impl BoardRun {
+    /// What one line the runner printed adds to the run.
+    fn take(&mut self, event: Event) {
+        let run = self;
+        match event {
+            Event::Frame(f) => {
+                eprintln!("  frame {} shown: {:.1} M cycles", run.frames.len() + 1, f.cycles as f64 / 1e6);
+                run.frames.push(f);
+            }
+            Event::Reset(why, ms) => {
+                eprintln!("  reset ({why}) at {ms:.1} ms");
+                run.resets.push((why, ms));
+            }
+            Event::Bus(what, ms) => {
+                eprintln!("  bus: {what} at {ms:.1} ms");
+                run.bus.push((what, ms));
+            }
+            Event::Button(ms) => {
+                eprintln!("  button pressed at {ms:.1} ms");
+                run.presses.push(ms);
+            }
+            Event::Image(id, pixels) => {
+                run.images.resize(run.images.len().max(id + 1), Vec::new());
+                run.images[id] = pixels;
+            }
+            Event::Refresh(index, id) => run.refresh_changes.push((index, id)),
+            Event::End(e) => {
+                run.ok = e.ok;
+                run.reason = e.reason;
+                run.clk_sys_hz = e.clk_sys_hz;
+                run.xip_miss_cycles = e.xip_miss_cycles;
+                run.scl_period = e.scl_period_cycles;
+                run.emulated_ms = e.emulated_ms;
+                run.idle_ms = e.idle_ms;
+                run.display_initialised = e.display_initialised;
+                run.led_toggles = e.led_toggles;
+                run.naks = e.naks;
+                run.warnings = e.warnings;
+                run.refreshes = e.refreshes;
+            }
+        }
+    }
+}
+
 /// Runs `uf2` in the emulator (with `models` switches such as `--no-cache`) and decodes its log
 /// with the ELF's defmt table.
 #[allow(clippy::too_many_arguments)]
@@ -358,43 +402,7 @@ fn run_emulator(
     let stdout = child.stdout.take().context("no stdout from the emulator")?;
     for line in BufReader::new(stdout).lines() {
         let line = line?;
-        match Event::parse(&line).with_context(|| format!("emulator printed `{line}`"))? {
-            Event::Frame(f) => {
-                eprintln!("  frame {} shown: {:.1} M cycles", run.frames.len() + 1, f.cycles as f64 / 1e6);
-                run.frames.push(f);
-            }
-            Event::Reset(why, ms) => {
-                eprintln!("  reset ({why}) at {ms:.1} ms");
-                run.resets.push((why, ms));
-            }
-            Event::Bus(what, ms) => {
-                eprintln!("  bus: {what} at {ms:.1} ms");
-                run.bus.push((what, ms));
-            }
-            Event::Button(ms) => {
-                eprintln!("  button pressed at {ms:.1} ms");
-                run.presses.push(ms);
-            }
-            Event::Image(id, pixels) => {
-                run.images.resize(run.images.len().max(id + 1), Vec::new());
-                run.images[id] = pixels;
-            }
-            Event::Refresh(index, id) => run.refresh_changes.push((index, id)),
-            Event::End(e) => {
-                run.ok = e.ok;
-                run.reason = e.reason;
-                run.clk_sys_hz = e.clk_sys_hz;
-                run.xip_miss_cycles = e.xip_miss_cycles;
-                run.scl_period = e.scl_period_cycles;
-                run.emulated_ms = e.emulated_ms;
-                run.idle_ms = e.idle_ms;
-                run.display_initialised = e.display_initialised;
-                run.led_toggles = e.led_toggles;
-                run.naks = e.naks;
-                run.warnings = e.warnings;
-                run.refreshes = e.refreshes;
-            }
-        }
+        run.take(Event::parse(&line).with_context(|| format!("emulator printed `{line}`"))?);
     }
     let status = child.wait()?;
     if run.reason.is_empty() {

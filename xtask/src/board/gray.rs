@@ -217,7 +217,7 @@ impl Session<'_> {
         self.checks.check(s.out_of_order == 0, || {
             format!("{what}: {} refreshes out of the low, high, high order", s.out_of_order)
         });
-        self.checks.check(s.held.len() > scenes.min(1), || format!("{what}: {} scenes shown", s.held.len()));
+        self.checks.check(s.held.len() >= scenes, || format!("{what}: {} scenes shown of {scenes}", s.held.len()));
         for (i, &(k, n, same)) in s.held.iter().enumerate().take(scenes) {
             self.checks.check(n >= HELD, || format!("{what}: scene {k} held {n} refreshes, not {HELD}"));
             self.checks
