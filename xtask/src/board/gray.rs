@@ -10,7 +10,7 @@
 
 use super::{build_image, m3, pico_built, run_emulator, write_uf2, BoardRun, Session, PICO};
 use anyhow::Result;
-use board_records::frame::{rendered, Build};
+use board_records::frame::{rendered, Build, Glass};
 use host_sim::uf2::Scenes;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -27,11 +27,12 @@ const ROW_NS: f64 = 100_000.0;
 struct Shades {
     steps: Vec<u8>,
     planes: [Vec<u8>; 2],
+    width: usize,
 }
 
 impl Shades {
-    fn of(scenes: &Path, name: &str) -> Result<Shades> {
-        let frame = rendered(Build { gray: true, ..PICO });
+    fn of(scenes: &Path, name: &str, glass: Glass) -> Result<Shades> {
+        let frame = rendered(Build { gray: true, glass, ..PICO });
         let path = scenes.join(format!("{name}.scene"));
         let r = host_sim::run::render_text_in::<lattice_rt::Fx, embedded_graphics::pixelcolor::Gray2>(
             &path,
@@ -49,7 +50,7 @@ impl Shades {
                 }
             }
         }
-        Ok(Shades { steps: r.shades, planes })
+        Ok(Shades { steps: r.shades, planes, width: w })
     }
 }
 
@@ -139,14 +140,15 @@ fn current_image(run: &BoardRun, i: u64) -> usize {
 /// A scene's run of refreshes: the scene, how many, and whether its first cycle's pictures sum
 /// to host-sim's steps.
 fn finish((k, n, first): (usize, u64, Vec<usize>), want: &[Shades], run: &BoardRun) -> (usize, u64, bool) {
-    (k, n, first.len() == 3 && steps_of(run, &first, want[k].steps.len()) == want[k].steps)
+    (k, n, first.len() == 3 && steps_of(run, &first, &want[k]) == want[k].steps)
 }
 
-/// Each pixel's lit count over the pictures `ids` (a cycle: its step as the eye sees it).
-fn steps_of(run: &BoardRun, ids: &[usize], pixels: usize) -> Vec<u8> {
-    let w = usize::from(PICO.glass.size().0);
+/// Each pixel's lit count over the pictures `ids` (a cycle: its step as the eye sees it), on
+/// the glass of `like`.
+fn steps_of(run: &BoardRun, ids: &[usize], like: &Shades) -> Vec<u8> {
+    let w = like.width;
     let stride = w.div_ceil(8);
-    (0..pixels)
+    (0..like.steps.len())
         .map(|i| {
             ids.iter()
                 .filter(|&&id| {
@@ -163,7 +165,7 @@ fn steps_of(run: &BoardRun, ids: &[usize], pixels: usize) -> Vec<u8> {
 fn perceive(run: &BoardRun, k: usize, want: &[Shades]) -> Option<Vec<u8>> {
     let lo = run.images.iter().position(|p| *p == want[k].planes[0])?;
     let hi = run.images.iter().position(|p| *p == want[k].planes[1])?;
-    Some(steps_of(run, &[lo, hi, hi], want[k].steps.len()))
+    Some(steps_of(run, &[lo, hi, hi], &want[k]))
 }
 
 /// The gray section's figures.
@@ -173,6 +175,8 @@ pub(super) struct GrayReport {
     frames: Vec<(String, u64, u64)>,
     /// The panel 3 % fast: the typical image's scan, the calibrated image's.
     fast: Option<(Scan, Scan)>,
+    /// The Thumby's 72x40 panel: its scan and its chair's cycles.
+    thumby: (Scan, u64),
     clk_hz: f64,
 }
 
@@ -180,7 +184,7 @@ impl Session<'_> {
     /// The gray image on every scene, then a fast panel with the typical and the calibrated
     /// image.
     pub(super) fn gray_runs(&mut self) -> Result<GrayReport> {
-        let want: Vec<Shades> = self.scenes.iter().map(|n| Shades::of(&self.scenes_dir, n)).collect::<Result<_>>()?;
+        let want = self.shades(Glass::Oled128x64)?;
         // One frame more than the scenes: every scene's pause is then scanned whole.
         let (run, dir) = self.variant("gray", true, self.scenes.len() + 1, &["--scan"])?;
         self.checks.check(run.ok, || format!("gray: the run did not finish: {}", run.reason));
@@ -202,9 +206,28 @@ impl Session<'_> {
             self.checks
                 .check(checked.perceived == shown.steps, || "gray: the perceived chair is not host-sim's".into());
         }
-        save_shades(&checked.perceived, &dir.join("perceived.png"))?;
+        save_shades(&checked.perceived, Glass::Oled128x64, &dir.join("perceived.png"))?;
         let fast = self.fast_panel_runs(&want)?;
-        Ok(GrayReport { scan: checked, frames, fast: Some(fast), clk_hz: run.clk_sys_hz })
+        let thumby = self.thumby_run()?;
+        Ok(GrayReport { scan: checked, frames, fast: Some(fast), thumby, clk_hz: run.clk_sys_hz })
+    }
+
+    /// Every scene's four-shade frame on `glass`, as host-sim renders it for the gray image.
+    fn shades(&self, glass: Glass) -> Result<Vec<Shades>> {
+        self.scenes.iter().map(|n| Shades::of(&self.scenes_dir, n, glass)).collect()
+    }
+
+    /// The gray mode on the Thumby's panel (72x40, SPI): every scene's refreshes checked as
+    /// the 128x64 panel's are; the chair's first cycle and the run's first frame's cycles.
+    fn thumby_run(&mut self) -> Result<(Scan, u64)> {
+        let want = self.shades(Glass::Oled72x40)?;
+        let args = ["--scan", "--panel", "ssd1306-72x40"];
+        let (run, dir) = self.variant("oled-72x40,gray", true, self.scenes.len() + 1, &args)?;
+        self.checks.check(run.ok, || format!("gray on 72x40: the run did not finish: {}", run.reason));
+        let checked = scan(&run, &want);
+        self.check_scan("gray on the 72x40 panel", &checked, self.scenes.len());
+        save_shades(&checked.perceived, Glass::Oled72x40, &dir.join("perceived.png"))?;
+        Ok((checked, run.frames.first().map_or(0, |f| f.cycles)))
     }
 
     /// The checks of one scan: no torn refresh, every cycle in order, `scenes` scenes each held
@@ -263,12 +286,12 @@ impl Session<'_> {
     }
 }
 
-/// Saves steps 0..=3 of the glass as a PNG in the panel's white, 4x.
-pub(super) fn save_shades(steps: &[u8], path: &Path) -> Result<()> {
+/// Saves steps 0..=3 of `glass` as a PNG in the panel's white, 4x.
+pub(super) fn save_shades(steps: &[u8], glass: Glass, path: &Path) -> Result<()> {
     if steps.is_empty() {
         return Ok(());
     }
-    let (w, h) = PICO.glass.size();
+    let (w, h) = glass.size();
     let look = host_sim::output::PngLook { theme: host_sim::output::Theme::OledWhite, scale: 4, grid: false };
     let png = host_sim::output::shades_png_bytes(u32::from(w), u32::from(h), steps, 3, look)?;
     host_sim::output::write_atomic(path, &png)
@@ -276,7 +299,9 @@ pub(super) fn save_shades(steps: &[u8], path: &Path) -> Result<()> {
 
 /// The report's section on the gray mode; the perceived chair saved as `picture`.
 pub(super) fn gray_report(g: &GrayReport, spi_chair: Option<u64>, picture: &Path) -> Result<String> {
-    save_shades(&g.scan.perceived, picture)?;
+    save_shades(&g.scan.perceived, Glass::Oled128x64, picture)?;
+    let thumby_picture = picture.with_file_name("board-gray-chair-72x40.png");
+    save_shades(&g.thumby.0.perceived, Glass::Oled72x40, &thumby_picture)?;
     let mut md = String::new();
     writeln!(md, "\n## Four shades: the gray mode\n")?;
     writeln!(md, "Written by `cargo xtask board`: the image with the `gray` feature (SSD1306 128x64 on SPI) runs every scene with the panel's refresh emulated (firmware/board/ssd1306.mjs: each row driven for D x (phase 1 + phase 2 + 50) clocks of its oscillator, 530 kHz at the setting 0xF0, the rows in turn; `run.mjs --scan` reports each refresh as its rows were driven). Every refresh must show one subframe whole, the low or high plane of a scene's four-shade frame as host-sim renders it (`host-sim render --board pico --levels 4`), never rows of two (tearing); each scene's refreshes must run low, high, high, so the eye, which sums each pixel's lit share over a cycle, sees host-sim's frame; each scene must hold for {HELD} refreshes or more.\n")?;
@@ -301,6 +326,9 @@ pub(super) fn gray_report(g: &GrayReport, spi_chair: Option<u64>, picture: &Path
     if let Some((typical, calibrated)) = &g.fast {
         writeln!(md, "\n**A panel whose oscillator runs {OSC_ERROR} % fast** (`run.mjs --osc-error {OSC_ERROR}`): the image that assumes the typical clock tears {} of {} refreshes; the image built with `FIRMWARE_GRAY_ROW_NS={}` (the row period measured for that panel) tears {} of {}, and holds the chair {} refreshes.", typical.torn, typical.refreshes, (ROW_NS / (1.0 + OSC_ERROR / 100.0)).round(), calibrated.torn, calibrated.refreshes, calibrated.held.first().map_or(0, |h| h.1))?;
     }
-    writeln!(md, "\nThe chair as the eye sees it on the emulated panel (each pixel's lit share of a cycle, from the panel's own refreshes):\n\n![the chair in four shades on the emulated panel](images/{})", picture.file_name().and_then(|n| n.to_str()).unwrap_or(""))?;
+    let (t, cycles) = &g.thumby;
+    writeln!(md, "\n**The Thumby's panel** (SSD1306 72x40 on SPI, `--features oled-72x40,gray`, 40 rows a refresh, 4 ms): {} scenes each held at least {} refreshes, their cycles host-sim's frames: {}; {} refreshes, {} torn, {} out of order; the chair's frame {} cycles.", t.held.len().min(g.frames.len()), t.held.iter().take(g.frames.len()).map(|h| h.1).min().unwrap_or(0), if t.held.iter().take(g.frames.len()).all(|h| h.2) { "all" } else { "**not all**" }, t.refreshes, t.torn, t.out_of_order, m3(*cycles))?;
+    let name = |p: &Path| p.file_name().and_then(|n| n.to_str()).unwrap_or("").to_string();
+    writeln!(md, "\nThe chair as the eye sees it on the emulated panels (each pixel's lit share of a cycle, from the panel's own refreshes), 128x64 and 72x40:\n\n![the chair in four shades on the emulated panel](images/{}) ![the chair in four shades on the 72x40 panel](images/{})", name(picture), name(&thumby_picture))?;
     Ok(md)
 }

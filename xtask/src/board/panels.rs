@@ -7,38 +7,34 @@
 
 use super::{host_frame, m3, save_frame_sized, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
-use board_records::frame::{Build, Glass};
+use board_records::frame::{Build, Panel};
 use std::fmt::Write as _;
 
-/// An image checked: its features, the emulated panel, what the module is, its glass.
-type Panel = (&'static str, &'static str, &'static str, Glass);
+/// An image checked: its panel (whose feature, glass and emulated model it takes), the bus
+/// feature it adds (`i2c-1mhz`, `spi`; none: the panel's own default) and what the module is.
+type Image = (Panel, Option<&'static str>, &'static str);
 
 /// The images checked.
-const PANELS: [Panel; 8] = [
-    ("sh1106,i2c-1mhz", "sh1106", "SH1106 (1.3\" 128x64), I2C at 1 MHz", Glass::Oled128x64),
-    ("sh1106,spi", "sh1106", "SH1106 (1.3\" 128x64), SPI at 10 MHz", Glass::Oled128x64),
-    ("ssd1309,i2c-1mhz", "ssd1309", "SSD1309 (2.42\" 128x64), I2C at 1 MHz", Glass::Oled128x64),
-    ("ssd1309,spi", "ssd1309", "SSD1309 (2.42\" 128x64), SPI at 10 MHz", Glass::Oled128x64),
-    ("oled-128x32", "ssd1306-128x32", "SSD1306 (0.91\" 128x32), I2C at 400 kHz", Glass::Oled128x32),
-    ("oled-72x40,spi", "ssd1306-72x40", "SSD1306 (0.42\" 72x40, the Thumby's), SPI at 10 MHz", Glass::Oled72x40),
-    (
-        "sharp-400x240",
-        "sharp-400x240",
-        "Sharp memory LCD LS027B7DH01 (2.7\" 400x240), SPI at 2 MHz",
-        Glass::Sharp400x240,
-    ),
-    (
-        "sharp-128x128",
-        "sharp-128x128",
-        "Sharp memory LCD LS013B7DH03 (1.28\" 128x128), SPI at 1 MHz",
-        Glass::Sharp128x128,
-    ),
+const PANELS: [Image; 8] = [
+    (Panel::Sh1106, Some("i2c-1mhz"), "SH1106 (1.3\" 128x64), I2C at 1 MHz"),
+    (Panel::Sh1106, Some("spi"), "SH1106 (1.3\" 128x64), SPI at 10 MHz"),
+    (Panel::Ssd1309, Some("i2c-1mhz"), "SSD1309 (2.42\" 128x64), I2C at 1 MHz"),
+    (Panel::Ssd1309, Some("spi"), "SSD1309 (2.42\" 128x64), SPI at 10 MHz"),
+    (Panel::Ssd1306x32, None, "SSD1306 (0.91\" 128x32), I2C at 400 kHz"),
+    (Panel::Ssd1306x40, Some("spi"), "SSD1306 (0.42\" 72x40, the Thumby's), SPI at 10 MHz"),
+    (Panel::Sharp400x240, None, "Sharp memory LCD LS027B7DH01 (2.7\" 400x240), SPI at 2 MHz"),
+    (Panel::Sharp128x128, None, "Sharp memory LCD LS013B7DH03 (1.28\" 128x128), SPI at 1 MHz"),
 ];
+
+/// An image's firmware features: its panel's, then its bus's.
+fn features((panel, bus, _): Image) -> String {
+    panel.feature().into_iter().chain(bus).collect::<Vec<_>>().join(",")
+}
 
 /// What one panel's run did, for the report.
 pub(super) struct PanelRow {
     what: &'static str,
-    features: &'static str,
+    features: String,
     /// Frames bit-identical to host-sim's, of the scenes run.
     same: usize,
     scenes: usize,
@@ -70,10 +66,12 @@ impl Session<'_> {
     /// Every panel's image on every embedded scene.
     pub(super) fn panel_runs(&mut self) -> Result<Vec<PanelRow>> {
         let mut rows = Vec::new();
-        for (features, panel, what, glass) in PANELS {
+        for image in PANELS {
+            let (panel, _, what) = image;
+            let (features, glass) = (features(image), panel.glass());
             let build = Build { glass, ..PICO };
             let (w, h) = glass.size();
-            let (run, dir) = self.variant(features, true, self.scenes.len(), &["--panel", panel])?;
+            let (run, dir) = self.variant(&features, true, self.scenes.len(), &["--panel", panel.name()])?;
             self.checks.check(run.ok, || format!("{what}: the run did not finish: {}", run.reason));
             let mut same = 0;
             for (name, frame) in self.scenes.clone().iter().zip(&run.frames) {
