@@ -24,6 +24,8 @@ pub mod gray;
 pub mod sharp;
 #[cfg(feature = "spi")]
 mod spi;
+#[cfg(feature = "gray")]
+mod spi_dma;
 #[cfg(feature = "spi")]
 pub use spi::{flush, reset, Pump};
 

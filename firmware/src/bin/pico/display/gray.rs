@@ -10,8 +10,8 @@
 //! rows per refresh, and takes each row from RAM as it comes to it. Without its FR pin the
 //! firmware cannot see the scan, so it keeps its own copy of it: the scan starts at row 0 when
 //! the display is switched on (0xAF), and from then every refresh takes `ROWS` row periods of
-//! [`ROW_NS`]. A timer interrupt (alarm 1, on core 0, while both cores trace) writes each page
-//! of the next subframe half a refresh ahead of the row scan: after the scan has left the page
+//! [`ROW_NS`]. A timer interrupt (alarm 1, on core 0, while both cores trace) addresses each
+//! page of the next subframe and starts its bytes by DMA, half a refresh ahead of the row scan: after the scan has left the page
 //! in the refresh before and well before it comes back, so every refresh shows one subframe
 //! whole, with (ROWS - 8) / 2 rows of slack either side for a clock that runs a little off.
 //! A new frame is taken at the start of a three-subframe cycle only, so no refresh and no cycle
@@ -26,7 +26,7 @@
 use super::controller::{self, CLOCK, PANEL, PRECHARGE};
 use super::SetUp;
 use crate::hal::pac;
-use crate::wiring::Interface;
+use crate::wiring::{Interface, Wiring};
 use core::cell::{RefCell, UnsafeCell};
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 use cortex_m::interrupt::Mutex;
@@ -79,6 +79,9 @@ const fn parse_ns(s: &str) -> u64 {
     assert!(v >= 10_000 && v <= 1_000_000, "FIRMWARE_GRAY_ROW_NS: 10000..=1000000 ns");
     v
 }
+
+/// The DMA channel the pages go by (the Sharp LCD's is 0; an image drives one panel).
+const CHANNEL: usize = 1;
 
 /// Rows ahead of the scan a page is written: half the slack between the scan leaving the page
 /// and coming back to it, and one more for the write itself.
@@ -159,6 +162,7 @@ impl SetUp for Gray {
         }
         // Every byte has left the bus (each SPI write waits for it): the scan starts now.
         let on_ns = now_us() * 1000;
+        super::spi_dma::enable();
         cortex_m::interrupt::free(|cs| {
             REFRESH.borrow(cs).replace(Some(Refresh { bus, on_ns, next: 0 }));
         });
@@ -240,6 +244,19 @@ fn put(planes: &mut [[u8; PLANE]; 2], x: usize, y: usize, k: u8) {
     }
 }
 
+/// Drives the pins in `high` high and those in `low` low (the display's chip select and
+/// data/command lines, between the interface's transfers).
+fn set_pins(high: u32, low: u32) {
+    // SAFETY: SIO's atomic set and clear registers, for pins the interface leaves as they are
+    // between its transfers.
+    #[allow(unsafe_code)]
+    unsafe {
+        let sio = &*pac::SIO::ptr();
+        sio.gpio_out_set().write(|w| w.bits(high));
+        sio.gpio_out_clr().write(|w| w.bits(low));
+    }
+}
+
 /// When page write `j` is due, from the scan's start: page `j % PAGES` of refresh
 /// `1 + j / PAGES`, [`LEAD_ROWS`] rows before the scan reaches it.
 fn first_write_ns(j: u64) -> u64 {
@@ -306,11 +323,21 @@ fn TIMER_IRQ_1() {
         let plane = &planes[SUBFRAMES[subframe]];
         let bytes = &plane[page as usize * WIDTH as usize..(page as usize + 1) * WIDTH as usize];
         let (columns, rows) = controller::window(0, WIDTH as u8, page, page);
-        // SPI has no acknowledge: these cannot fail on a working bus, and a lost write is
-        // healed by the same page's write a refresh later.
+        // The last page's bytes have left: its chip select goes up, and the bus is the
+        // interface's for the window's commands (SPI has no acknowledge: they cannot fail on a
+        // working bus, and a lost page is written again a cycle later).
+        super::spi_dma::finish(CHANNEL);
+        set_pins(1 << Wiring::CS, 0);
         let _ = r.bus.send_commands(DataFormat::U8(&columns));
         let _ = r.bus.send_commands(DataFormat::U8(&rows));
-        let _ = r.bus.send_data(DataFormat::U8(bytes));
+        // Data, selected: the page's bytes go by DMA while core 0 traces on.
+        set_pins(1 << Wiring::DC, 1 << Wiring::CS);
+        // SAFETY: frame SHOWN's planes stay as they are until the next interrupt has seen the
+        // channel stop (`finish` above), before any new frame is shown.
+        #[allow(unsafe_code)]
+        unsafe {
+            super::spi_dma::start(CHANNEL, bytes.as_ptr(), bytes.len())
+        };
         r.next = j + 1;
         schedule(r.on_ns + first_write_ns(r.next));
     });
