@@ -167,7 +167,7 @@ impl SetUp for Gray {
             REFRESH.borrow(cs).replace(Some(Refresh { bus, on_ns, next: 0 }));
         });
         RUNNING.store(true, Ordering::Relaxed);
-        schedule(on_ns + first_write_ns(0));
+        schedule(on_ns + write_ns(0));
         // SAFETY: the handler only touches the refresh's own state, behind its mutex.
         #[allow(unsafe_code)]
         unsafe {
@@ -259,7 +259,7 @@ fn set_pins(high: u32, low: u32) {
 
 /// When page write `j` is due, from the scan's start: page `j % PAGES` of refresh
 /// `1 + j / PAGES`, [`LEAD_ROWS`] rows before the scan reaches it.
-fn first_write_ns(j: u64) -> u64 {
+fn write_ns(j: u64) -> u64 {
     let (refresh, page) = (1 + j / PAGES as u64, j % PAGES as u64);
     (refresh * ROWS + page * 8 - LEAD_ROWS) * ROW_NS
 }
@@ -339,7 +339,7 @@ fn TIMER_IRQ_1() {
             super::spi_dma::start(CHANNEL, bytes.as_ptr(), bytes.len())
         };
         r.next = j + 1;
-        schedule(r.on_ns + first_write_ns(r.next));
+        schedule(r.on_ns + write_ns(r.next));
     });
     let spent = now_us().saturating_sub(start) as u32;
     REFRESH_US.store(REFRESH_US.load(Ordering::Relaxed).wrapping_add(spent), Ordering::Relaxed);
