@@ -39,7 +39,14 @@ use embedded_graphics_core::Pixel;
 use firmware::app::{HEIGHT, WIDTH};
 use pac::interrupt;
 
-#[cfg(any(feature = "pico2", feature = "sh1106", feature = "ssd1309", feature = "progressive", feature = "orbit"))]
+#[cfg(any(
+    feature = "pico2",
+    feature = "sh1106",
+    feature = "ssd1309",
+    feature = "sharp",
+    feature = "progressive",
+    feature = "orbit"
+))]
 compile_error!("the gray mode is for the Pico with an SSD1306 on SPI, showing stills");
 
 /// Rows the panel scans per refresh: its multiplex ratio, the glass's height.
