@@ -67,9 +67,12 @@ import { Ssd1306, GLASSES } from './ssd1306.mjs';
 import { Sh1106 } from './sh1106.mjs';
 import { Ssd1309 } from './ssd1309.mjs';
 import { SharpMemoryLcd } from './sharp.mjs';
+import { Uc8151 } from './uc8151.mjs';
 
 /** A Sharp memory LCD's wiring (the `sharp` builds'): SCS (active high) on GP17, DISP on GP20. */
 const SHARP_SPI = { cs: 17, disp: 20, csActiveHigh: true };
+/** The Badger 2040's e-paper: the SPI modules' CS, DC and RES, and BUSY (the panel's output) on GP26. */
+const BUSY_PIN = 26;
 
 /**
  * The panels --panel chooses from (the image must drive the same one): each made with the
@@ -84,6 +87,12 @@ const PANELS = {
   ssd1309: { make: () => new Ssd1309(0x3c) },
   'sharp-400x240': { make: (now) => new SharpMemoryLcd(400, 240, now), spi: SHARP_SPI },
   'sharp-128x128': { make: (now) => new SharpMemoryLcd(128, 128, now), spi: SHARP_SPI },
+  uc8151: {
+    make: (now, mcu) =>
+      new Uc8151(now, (ns, fn) => mcu().clock.createAlarm(fn).schedule(ns), (high) => mcu()?.gpio[BUSY_PIN].setInputValue(high)),
+    busyPin: BUSY_PIN,
+    spi: { cs: 17, dc: 20, res: 21 },
+  },
 };
 
 const LED_PIN = 25;
@@ -256,7 +265,7 @@ function main() {
   // The display model on I2C0 and SPI0 (or nothing: every I2C address NACKs), bytes delivered
   // when the bus would deliver them.
   const panel = PANELS[opt.panel];
-  const display = opt.display ? panel.make(() => mcu.clock.nanos + epoch.nanos) : null;
+  const display = opt.display ? panel.make(() => mcu.clock.nanos + epoch.nanos, () => mcu) : null;
   // --scan: every refresh the panel makes, as the row scan drove it (ssd1306.mjs `scan`). Each
   // distinct picture once ('image'), then a 'refresh' line wherever the picture changes from
   // the refresh before; --osc-error runs the panel's oscillator that many percent fast (or slow).
@@ -412,6 +421,7 @@ function main() {
     board.gpio(LED_PIN).addListener(onLed);
     // Nobody presses the button at power-on: its pull-up holds it high.
     mcu.gpio[BUTTON_PIN].setInputValue(true);
+    if (display && panel.busyPin !== undefined) mcu.gpio[panel.busyPin].setInputValue(display.busyHigh());
     const watchdog = mcu.peripherals[0x40058];
     // The watchdog resets the chip: its timer stops here (rp2040js would re-arm it at 0 and
     // fire again at once), and the board boots again after this step.
@@ -511,6 +521,7 @@ function main() {
   if (records) records.save(opt.recordsLog);
   if (profile) writeFileSync(opt.profile, JSON.stringify([...profile.entries()]));
   const total = board.snapshot();
+  for (const r of display?.refreshes ?? []) emit({ event: 'epaper', startMs: r.start / 1e6, endMs: r.end / 1e6, dataMs: r.dataAt / 1e6 });
   emit({
     event: 'end',
     ok,

@@ -352,3 +352,80 @@ test('SSD1306 refresh: a row every D x (phase 1 + phase 2 + 50) clocks, each sho
   cmd(0xd9, 0x20);
   assert.match(d.error ?? '', /pre-charge/);
 });
+
+test('UC8151: BUSY low through PON and a refresh as long as its LUT, gate-ordered RAM, strict commands', async () => {
+  const { Uc8151 } = await import('./uc8151.mjs');
+  let now = 0;
+  const timers = [];
+  let busyHigh = null;
+  const advance = (to) => {
+    now = to;
+    for (const t of timers.splice(0)) (t[0] <= now ? t[1]() : timers.push(t));
+  };
+  // A controller and its command function: the command byte with D/C low, then its parameters.
+  const make = () => {
+    const d = new Uc8151(() => now, (ns, fn) => timers.push([now + ns, fn]), (level) => (busyHigh = level));
+    const cmd = (c, ...p) => {
+      d.spiByte(c, false);
+      for (const b of p) d.spiByte(b, true);
+    };
+    return [d, cmd];
+  };
+  // Three groups: (4+4+7)x1 + (12+12)x2 + (4+4+7)x2 = 93 frames: 930 ms at 100 Hz.
+  const groups = [[4, 4, 7, 0, 1], [12, 12, 0, 0, 2], [4, 4, 7, 0, 2]];
+  const setUp = (cmd) => {
+    cmd(0x00, 0xb7); // 128x296, LUT in registers, black and white, shift right, scan down
+    cmd(0x50, 0x4c);
+    cmd(0x30, 0x3a); // 100 Hz
+    cmd(0x20, ...groups.flatMap((g) => [0, ...g]), ...new Array(44 - 18).fill(0));
+  };
+  const [d, cmd] = make();
+  assert.equal(busyHigh, true);
+  assert.match(d.notShowable(), /no refresh/);
+  setUp(cmd);
+  cmd(0x04); // PON
+  assert.equal(busyHigh, false, 'BUSY low while the booster starts');
+  cmd(0x13);
+  assert.match(d.error, /while BUSY is low/);
+  const [e, ecmd] = make();
+  setUp(ecmd);
+  ecmd(0x12);
+  assert.match(e.error, /power off/, 'no refresh without PON');
+  const [f, fcmd] = make();
+  setUp(fcmd);
+  fcmd(0x04);
+  advance(now + 30e6);
+  assert.equal(busyHigh, true, 'BUSY high once the booster is up');
+  // Gate 0 (column 0): its first byte 0x80, the top pixel white; gate 1's last byte 0x01.
+  const ram = new Array(296 * 16).fill(0);
+  ram[0] = 0x80;
+  ram[16 + 15] = 0x01;
+  fcmd(0x13, ...ram);
+  // A partial window: sources 8..15 of gates 2..3 get 0xff.
+  fcmd(0x91);
+  fcmd(0x90, 8, 15, 0, 2, 0, 3, 1);
+  fcmd(0x13, 0xff, 0xff);
+  fcmd(0x92);
+  const start = now;
+  fcmd(0x12);
+  assert.equal(f.error, null);
+  assert.equal(busyHigh, false);
+  assert.equal(f.refreshes[0].end - start, 930e6, "the LUT's 93 frames at 100 Hz");
+  advance(start + 929e6);
+  assert.equal(busyHigh, false);
+  advance(start + 930e6);
+  assert.equal(busyHigh, true);
+  const shown = f.shown();
+  const px = (x, y) => (shown[y * 37 + (x >> 3)] >> (7 - (x & 7))) & 1;
+  assert.equal(px(0, 0), 1);
+  assert.equal(px(1, 127), 1);
+  assert.equal(px(0, 1), 0);
+  for (let y = 8; y < 16; y++) assert.equal(px(2, y) + px(3, y), 2, 'the partial window');
+  assert.equal(px(4, 8), 0);
+  fcmd(0x05);
+  assert.match(f.error, /0x5: not one this model knows/);
+  const [g, gcmd] = make();
+  gcmd(0x01, 3, 0);
+  gcmd(0x04);
+  assert.match(g.error, /0x1 cut short: 2 of its 5/);
+});

@@ -46,6 +46,8 @@ pub const BUILD: Build = Build {
         Glass::Sharp400x240
     } else if cfg!(feature = "sharp-128x128") {
         Glass::Sharp128x128
+    } else if cfg!(feature = "uc8151") {
+        Glass::Epaper296x128
     } else {
         Glass::Oled128x64
     },

@@ -219,7 +219,8 @@ pub struct RenderArgs {
     #[arg(long, value_enum, conflicts_with_all = ["size", "dither", "sampling", "scalar", "tile", "no_outline", "gamma", "cutoff"])]
     pub board: Option<crate::uf2::Board>,
     /// With --board: the panel the image drives, whose glass sets the frame's size (ssd1306,
-    /// sh1106, ssd1309: 128x64; ssd1306-128x32; ssd1306-72x40; sharp-400x240; sharp-128x128).
+    /// sh1106, ssd1309: 128x64; ssd1306-128x32; ssd1306-72x40; sharp-400x240; sharp-128x128;
+    /// uc8151: 296x128).
     #[arg(long, value_parser = parse_panel, requires = "board")]
     pub panel: Option<board_records::frame::Panel>,
 }

@@ -82,6 +82,8 @@ pub enum Glass {
     Sharp400x240,
     /// 128x128, the Sharp memory LCD LS013B7DH03 (1.28"; `sharp-128x128`).
     Sharp128x128,
+    /// 296x128, the Badger 2040's 2.9" e-paper (UC8151; `uc8151`).
+    Epaper296x128,
 }
 
 impl Glass {
@@ -93,6 +95,7 @@ impl Glass {
             Glass::Oled72x40 => (72, 40),
             Glass::Sharp400x240 => (400, 240),
             Glass::Sharp128x128 => (128, 128),
+            Glass::Epaper296x128 => (296, 128),
         }
     }
 
@@ -106,6 +109,8 @@ impl Glass {
             Glass::Sharp400x240
         } else if has("sharp-128x128") {
             Glass::Sharp128x128
+        } else if has("uc8151") {
+            Glass::Epaper296x128
         } else {
             Glass::Oled128x64
         }
@@ -131,11 +136,13 @@ pub enum Panel {
     Sharp400x240,
     /// Sharp memory LCD LS013B7DH03, 128x128.
     Sharp128x128,
+    /// UC8151 e-paper, 296x128 (the Badger 2040's).
+    Uc8151,
 }
 
 impl Panel {
     /// Every panel.
-    pub const ALL: [Panel; 7] = [
+    pub const ALL: [Panel; 8] = [
         Panel::Ssd1306,
         Panel::Sh1106,
         Panel::Ssd1309,
@@ -143,6 +150,7 @@ impl Panel {
         Panel::Ssd1306x40,
         Panel::Sharp400x240,
         Panel::Sharp128x128,
+        Panel::Uc8151,
     ];
 
     /// Its name: `host-sim --panel`'s and the emulated board's (`run.mjs --panel`).
@@ -155,6 +163,7 @@ impl Panel {
             Panel::Ssd1306x40 => "ssd1306-72x40",
             Panel::Sharp400x240 => "sharp-400x240",
             Panel::Sharp128x128 => "sharp-128x128",
+            Panel::Uc8151 => "uc8151",
         }
     }
 
@@ -168,6 +177,7 @@ impl Panel {
             Panel::Ssd1306x40 => Some("oled-72x40"),
             Panel::Sharp400x240 => Some("sharp-400x240"),
             Panel::Sharp128x128 => Some("sharp-128x128"),
+            Panel::Uc8151 => Some("uc8151"),
         }
     }
 
@@ -179,6 +189,7 @@ impl Panel {
             Panel::Ssd1306x40 => Glass::Oled72x40,
             Panel::Sharp400x240 => Glass::Sharp400x240,
             Panel::Sharp128x128 => Glass::Sharp128x128,
+            Panel::Uc8151 => Glass::Epaper296x128,
         }
     }
 

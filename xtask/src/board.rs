@@ -12,6 +12,7 @@
 //! `--board pico2`, a Pico 2) in BOOTSEL mode.
 
 mod button;
+mod epaper;
 mod faults;
 mod gray;
 mod panels;
@@ -232,6 +233,8 @@ enum Event {
     Image(usize, Vec<u8>),
     /// From this refresh on (its index), the panel shows picture number ... (`--scan`).
     Refresh(u64, usize),
+    /// An e-paper refresh: its start and end, and when its frame's bytes began.
+    Epaper(epaper::Refresh),
     End(RunEnd),
 }
 
@@ -255,6 +258,7 @@ impl Event {
                 v["index"].as_u64().context("a refresh without its index")?,
                 v["image"].as_u64().context("a refresh without its picture")? as usize,
             ),
+            Some("epaper") => Event::Epaper(serde_json::from_value(v)?),
             _ => bail!("emulator printed an unknown event: {line}"),
         };
         Ok(event)
@@ -299,6 +303,8 @@ struct BoardRun {
     refresh_changes: Vec<(u64, usize)>,
     /// Refreshes in all.
     refreshes: u64,
+    /// An e-paper's refreshes, in order.
+    epaper: Vec<epaper::Refresh>,
 }
 
 /// One decoded defmt log line.
@@ -334,6 +340,7 @@ impl BoardRun {
                 run.images[id] = pixels;
             }
             Event::Refresh(index, id) => run.refresh_changes.push((index, id)),
+            Event::Epaper(r) => run.epaper.push(r),
             Event::End(e) => {
                 run.ok = e.ok;
                 run.reason = e.reason;
@@ -555,7 +562,8 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     }
     let fault_rows = s.fault_runs(&rows)?;
     let button_row = s.button_run(&rows)?;
-    let panel_rows = s.panel_runs()?;
+    let (panel_rows, epaper_run) = s.panel_runs()?;
+    let epaper = epaper_run.map(|r| s.epaper_runs(&r)).transpose()?;
     let gray_run = s.gray_runs()?;
     if let Some(images) = out.parent().map(|p| p.join("images")) {
         panels::save_pictures(&panel_rows, &images)?;
@@ -609,6 +617,9 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let spi_chair = levers.iter().find(|(feature, ..)| *feature == "spi").map(|(_, _, f, _)| f.cycles);
     let gray_picture = out.parent().unwrap_or(Path::new(".")).join("images/board-gray-chair.png");
     md.push_str(&gray::gray_report(&gray_run, spi_chair, &gray_picture)?);
+    if let Some(e) = &epaper {
+        md.push_str(&epaper::epaper_report(e, run.clk_sys_hz)?);
+    }
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     let Checks { passed, failures } = s.checks;

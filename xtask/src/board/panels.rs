@@ -5,7 +5,7 @@
 //! datasheets (firmware/board/sh1106.mjs, ssd1309.mjs, ssd1306.mjs's glasses): a command the
 //! controller does not have fails the run.
 
-use super::{host_frame, m3, save_frame_sized, Session, PICO, PICO_SCALAR};
+use super::{host_frame, m3, save_frame_sized, BoardRun, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
 use board_records::frame::{Build, Panel};
 use std::fmt::Write as _;
@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 type Image = (Panel, Option<&'static str>, &'static str);
 
 /// The images checked.
-const PANELS: [Image; 8] = [
+const PANELS: [Image; 9] = [
     (Panel::Sh1106, Some("i2c-1mhz"), "SH1106 (1.3\" 128x64), I2C at 1 MHz"),
     (Panel::Sh1106, Some("spi"), "SH1106 (1.3\" 128x64), SPI at 10 MHz"),
     (Panel::Ssd1309, Some("i2c-1mhz"), "SSD1309 (2.42\" 128x64), I2C at 1 MHz"),
@@ -24,6 +24,7 @@ const PANELS: [Image; 8] = [
     (Panel::Ssd1306x40, Some("spi"), "SSD1306 (0.42\" 72x40, the Thumby's), SPI at 10 MHz"),
     (Panel::Sharp400x240, None, "Sharp memory LCD LS027B7DH01 (2.7\" 400x240), SPI at 2 MHz"),
     (Panel::Sharp128x128, None, "Sharp memory LCD LS013B7DH03 (1.28\" 128x128), SPI at 1 MHz"),
+    (Panel::Uc8151, None, "UC8151 e-paper (2.9\" 296x128, the Badger 2040's), SPI at 10 MHz"),
 ];
 
 /// An image's firmware features: its panel's, then its bus's.
@@ -63,9 +64,9 @@ pub(super) fn save_pictures(rows: &[PanelRow], images: &std::path::Path) -> Resu
 }
 
 impl Session<'_> {
-    /// Every panel's image on every embedded scene.
-    pub(super) fn panel_runs(&mut self) -> Result<Vec<PanelRow>> {
-        let mut rows = Vec::new();
+    /// Every panel's image on every embedded scene; with the e-paper's run, for its refreshes.
+    pub(super) fn panel_runs(&mut self) -> Result<(Vec<PanelRow>, Option<BoardRun>)> {
+        let (mut rows, mut epaper) = (Vec::new(), None);
         for image in PANELS {
             let (panel, _, what) = image;
             let (features, glass) = (features(image), panel.glass());
@@ -90,8 +91,11 @@ impl Session<'_> {
             let first = run.frames.first().map(|f| (f.cycles, f.bus_bytes));
             let picture = run.frames.first().map(|f| f.pixels.clone()).unwrap_or_default();
             rows.push(PanelRow { what, features, same, scenes: self.scenes.len(), first, size: (w, h), picture });
+            if panel == Panel::Uc8151 {
+                epaper = Some(run);
+            }
         }
-        Ok(rows)
+        Ok((rows, epaper))
     }
 }
 

@@ -3,20 +3,20 @@
 //! [`controller`]: SSD1306, SH1106, SSD1309) over I2C ([`i2c`]: a queue the bus drains while the
 //! cores trace, and a display that does not answer reported) or 4-wire SPI ([`spi`], the `spi`
 //! feature), or as line writes to a Sharp memory LCD on SPI ([`sharp`], the `sharp-*`
-//! features). Each bus gives the render loop the same two things: [`Pump`], its hooks, and
+//! features), or as a whole frame to the Badger 2040's e-paper ([`uc8151`]). Each bus gives the render loop the same two things: [`Pump`], its hooks, and
 //! [`flush`], the wait until the frame is on the panel.
 
 #[cfg(not(feature = "spi"))]
 mod bus_clear;
-#[cfg(not(feature = "sharp"))]
+#[cfg(not(any(feature = "sharp", feature = "uc8151")))]
 pub mod controller;
 #[cfg(not(feature = "spi"))]
 mod i2c;
 #[cfg(not(feature = "spi"))]
 pub use i2c::{flush, reset, Pump, QueuedI2c};
-#[cfg(not(any(feature = "sharp", feature = "gray")))]
+#[cfg(not(any(feature = "sharp", feature = "gray", feature = "uc8151")))]
 mod pages;
-#[cfg(not(any(feature = "sharp", feature = "gray")))]
+#[cfg(not(any(feature = "sharp", feature = "gray", feature = "uc8151")))]
 pub use pages::PageTiles;
 #[cfg(feature = "gray")]
 pub mod gray;
@@ -26,6 +26,8 @@ pub mod sharp;
 mod spi;
 #[cfg(feature = "gray")]
 mod spi_dma;
+#[cfg(feature = "uc8151")]
+pub mod uc8151;
 #[cfg(feature = "spi")]
 pub use spi::{flush, reset, Pump};
 
@@ -45,8 +47,11 @@ use {
 const BAND_ROWS: usize = firmware::app::RENDERED.tile as usize;
 
 /// The panel's name in the log.
-#[cfg(not(feature = "sharp"))]
+#[cfg(not(any(feature = "sharp", feature = "uc8151")))]
 pub const NAME: &str = controller::PANEL.name;
+/// The panel's name in the log.
+#[cfg(feature = "uc8151")]
+pub const NAME: &str = "UC8151 e-paper";
 /// The panel's name in the log.
 #[cfg(feature = "sharp")]
 pub const NAME: &str = "Sharp memory LCD";

@@ -118,12 +118,14 @@ fn main() -> ! {
     let (timer, mut alarm) = sleep::start(timer_block, &mut pac.RESETS, &clocks);
 
     display::reset(&mut reset, &mut { timer });
-    #[cfg(not(any(feature = "sharp", feature = "gray")))]
+    #[cfg(not(any(feature = "sharp", feature = "gray", feature = "uc8151")))]
     let mut target = display::Bands(display::PageTiles { interface });
     #[cfg(feature = "gray")]
     let mut target = display::gray::Gray::new(interface);
     #[cfg(feature = "sharp")]
     let mut target = display::Bands(display::sharp::LineTiles::new(interface));
+    #[cfg(feature = "uc8151")]
+    let mut target = display::Bands(display::uc8151::Gates::new(interface));
     while target.set_up().is_err() {
         defmt::error!(
             "no {} answers on I2C0 (SDA GP{}, SCL GP{}, address {=u8:#x}): check the wiring; retrying in 1 s",

@@ -38,6 +38,11 @@ impl Wiring {
     /// The GPIO a Sharp memory LCD's DISP (display on) is on (`sharp`; its SCS, active high, is
     /// on [`Wiring::CS`], its SCLK and SI on SPI0's).
     pub const DISP: u8 = 20;
+    /// The GPIO the e-paper's BUSY (its output, low while it works) is on (`uc8151`).
+    pub const BUSY: u8 = 26;
+    /// The Badger 2040's 3V3_EN: held high, or the board switches itself off on battery
+    /// (`uc8151`).
+    pub const POWER_ON: u8 = 10;
     /// The SPI clock asked for: 10 MHz, the SSD1306's fastest serial clock (100 ns a cycle); for
     /// a Sharp memory LCD 2 MHz on the LS027B7DH01 (what Adafruit's and micropython-nano-gui's
     /// drivers run it at) and 1 MHz on the smaller LS013B7DH03. rp2040-hal sets the nearest clock
@@ -169,6 +174,11 @@ pub fn connect(
     // The button's pin: an input with its pull-up (read by `button::pressed`); the pin's
     // setting stays when its value is dropped.
     let _ = pins.gpio14.into_pull_up_input();
+    #[cfg(feature = "uc8151")]
+    {
+        let _ = pins.gpio26.into_pull_up_input();
+        let _ = pins.gpio10.into_push_pull_output_in_state(hal::gpio::PinState::High);
+    }
     Connected { display, led: pins.gpio25.into_push_pull_output(), reset }
 }
 
@@ -192,4 +202,6 @@ pub fn log() {
         Wiring::DC,
         Wiring::RES
     );
+    #[cfg(feature = "uc8151")]
+    defmt::info!("the e-paper's BUSY on GP{}, 3V3_EN held high on GP{}", Wiring::BUSY, Wiring::POWER_ON);
 }

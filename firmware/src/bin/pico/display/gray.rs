@@ -44,6 +44,7 @@ use pac::interrupt;
     feature = "sh1106",
     feature = "ssd1309",
     feature = "sharp",
+    feature = "uc8151",
     feature = "progressive",
     feature = "orbit"
 ))]

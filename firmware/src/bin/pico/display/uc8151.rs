@@ -1,0 +1,181 @@
+//! The Badger 2040's e-paper, a UC8151 (IL0373) with 296x128 glass, on SPI0 (the `uc8151`
+//! feature; its CS, DC and RES where the SPI modules have theirs, BUSY on GP26). The glass keeps
+//! its picture without power and a refresh takes most of a second, so the frame is gathered in
+//! RAM in the controller's order (for each of the 296 gates, the glass's columns, 16 bytes of
+//! its rows, 1 white) and sent whole when it is finished: then the refresh starts and the cores
+//! go on with the next frame while it runs; the next frame's bytes wait for BUSY to go high.
+//! The waveform is in registers (a short one: 93 frames at 100 Hz, 0.93 s), so the refresh's
+//! length is known and not the OTP's 4.5 s.
+
+use super::{Band, SetUp};
+use crate::wiring::{Interface, Wiring};
+use display_interface::{DataFormat, DisplayError, WriteOnlyDataCommand};
+use embedded_graphics_core::pixelcolor::BinaryColor;
+use firmware::app::{HEIGHT, WIDTH};
+
+/// Bytes of one gate (one column of the glass).
+const STRIDE: usize = HEIGHT as usize / 8;
+/// Bytes of the controller's RAM: the whole frame.
+const RAM: usize = WIDTH as usize * STRIDE;
+
+const _: () = assert!(WIDTH == 296 && HEIGHT == 128, "the UC8151's glass is 296x128");
+
+/// Panel setting: 128x296, the waveform from registers, black and white, shift right and scan
+/// down (the Badger's upright picture), booster on, no soft reset.
+const PSR: u8 = 0x80 | 0x20 | 0x10 | 0x04 | 0x02 | 0x01;
+/// A waveform group's phase times in frames and its repeat count (the LUT's bytes 1 to 5).
+const PHASES: [[u8; 5]; 3] = [[4, 4, 7, 0, 1], [12, 12, 0, 0, 2], [4, 4, 7, 0, 2]];
+
+/// A LUT of the three groups of [`PHASES`] with the level selections `levels`, `N` bytes long
+/// (the VCOM LUT has two more than the others).
+const fn lut<const N: usize>(levels: [u8; 3]) -> [u8; N] {
+    let mut out = [0u8; N];
+    let mut g = 0;
+    while g < 3 {
+        out[g * 6] = levels[g];
+        let mut i = 0;
+        while i < 5 {
+            out[g * 6 + 1 + i] = PHASES[g][i];
+            i += 1;
+        }
+        g += 1;
+    }
+    out
+}
+
+/// VCOM's waveform.
+const LUT_VCOM: [u8; 44] = lut([0, 0, 0]);
+/// A pixel that ends white (from white or black).
+const LUT_TO_WHITE: [u8; 42] = lut([0x54, 0x60, 0xa8]);
+/// A pixel that ends black.
+const LUT_TO_BLACK: [u8; 42] = lut([0xa8, 0x60, 0x54]);
+
+/// The set-up after the reset, command by command with its parameters; then PON.
+const SET_UP: [(u8, &[u8]); 13] = [
+    (0x00, &[PSR]),
+    // Power: internal source and gate voltages, VGH/VGL 16 V, VSH/VSL and VSHR 11 V.
+    (0x01, &[0x03, 0x00, 0x2b, 0x2b, 0x2b]),
+    // Booster soft start: 10 ms, strength 3, off time 6.58 us, for each phase.
+    (0x06, &[0x17, 0x17, 0x17]),
+    // Power off sequence: one frame.
+    (0x03, &[0x00]),
+    // The internal temperature sensor.
+    (0x41, &[0x00]),
+    // Source and gate non-overlap.
+    (0x60, &[0x22]),
+    // VCOM and data interval; data polarity as written (1 white).
+    (0x50, &[0x4c]),
+    // 100 frames a second.
+    (0x30, &[0x3a]),
+    (0x20, &LUT_VCOM),
+    (0x21, &LUT_TO_WHITE),
+    (0x22, &LUT_TO_WHITE),
+    (0x23, &LUT_TO_BLACK),
+    (0x24, &LUT_TO_BLACK),
+];
+/// Power on.
+const PON: u8 = 0x04;
+/// Data start transmission 2 (the new picture).
+const DTM2: u8 = 0x13;
+/// Data stop.
+const DSP: u8 = 0x11;
+/// Display refresh.
+const DRF: u8 = 0x12;
+
+/// The e-paper: the frame gathered in RAM, sent at its end.
+pub struct Gates {
+    bus: Interface,
+    /// The frame in the controller's order (a static: 4.6 KiB off core 0's stack).
+    ram: &'static mut [u8; RAM],
+    /// Set up and powered on since reset.
+    ready: bool,
+}
+
+/// Whether the controller works (BUSY low: powering on or refreshing).
+fn busy() -> bool {
+    // SAFETY: a read of SIO's GPIO inputs, which has no side effects.
+    #[allow(unsafe_code)]
+    let levels = unsafe { (*crate::hal::pac::SIO::ptr()).gpio_in().read().bits() };
+    levels & (1 << Wiring::BUSY) == 0
+}
+
+/// Waits until BUSY is high, the watchdog fed.
+fn wait() {
+    while busy() {
+        crate::guard::feed();
+    }
+}
+
+impl Gates {
+    /// The e-paper on `bus`, not yet set up.
+    pub fn new(bus: Interface) -> Self {
+        let Some(ram) = cortex_m::singleton!(: [u8; RAM] = [0; RAM]) else {
+            defmt::panic!("the e-paper's frame is taken");
+        };
+        Gates { bus, ram, ready: false }
+    }
+
+    /// Command `c` with its parameters `p`.
+    fn command(&mut self, c: u8, p: &[u8]) -> Result<(), DisplayError> {
+        self.bus.send_commands(DataFormat::U8(&[c]))?;
+        if p.is_empty() {
+            return Ok(());
+        }
+        self.bus.send_data(DataFormat::U8(p))
+    }
+}
+
+impl SetUp for Gates {
+    /// Once after reset: the panel's settings and waveform, and power on. Later frames need
+    /// nothing: the glass keeps its picture, and a command now could land in a refresh.
+    fn set_up(&mut self) -> Result<(), DisplayError> {
+        if self.ready {
+            return Ok(());
+        }
+        wait();
+        for (c, p) in SET_UP {
+            self.command(c, p)?;
+        }
+        self.command(PON, &[])?;
+        wait();
+        self.ready = true;
+        Ok(())
+    }
+
+    /// SPI cannot tell; the glass keeps its picture without power.
+    fn answers(&mut self) -> bool {
+        true
+    }
+
+    /// The frame to the controller once the last refresh has ended, and its refresh started:
+    /// the cores go on while it runs.
+    fn flush(&mut self) -> Result<(), DisplayError> {
+        wait();
+        self.bus.send_commands(DataFormat::U8(&[DTM2]))?;
+        self.bus.send_data(DataFormat::U8(&self.ram[..]))?;
+        self.command(DSP, &[])?;
+        self.command(DRF, &[])
+    }
+}
+
+impl Band for Gates {
+    fn band(
+        &mut self,
+        (x0, y0): (usize, usize),
+        (w, h): (usize, usize),
+        mut colors: impl Iterator<Item = BinaryColor>,
+    ) -> Result<(), DisplayError> {
+        for y in y0..y0 + h {
+            let (byte, bit) = (y / 8, 0x80u8 >> (y % 8));
+            for x in x0..x0 + w {
+                let at = &mut self.ram[x * STRIDE + byte];
+                if colors.next().is_some_and(|c| c.is_on()) {
+                    *at |= bit;
+                } else {
+                    *at &= !bit;
+                }
+            }
+        }
+        Ok(())
+    }
+}
