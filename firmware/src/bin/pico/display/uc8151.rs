@@ -20,6 +20,10 @@ const RAM: usize = WIDTH as usize * STRIDE;
 
 const _: () = assert!(WIDTH == 296 && HEIGHT == 128, "the UC8151's glass is 296x128");
 
+// Orbit mode's image at 296x128 leaves core 0 3.5 KiB of stack on the RP2040: it faults at boot.
+#[cfg(feature = "orbit")]
+compile_error!("orbit mode at the e-paper's 296x128 does not fit the RP2040's RAM");
+
 /// Panel setting: 128x296, the waveform from registers, black and white, shift right and scan
 /// down (the Badger's upright picture), booster on, no soft reset.
 const PSR: u8 = 0x80 | 0x20 | 0x10 | 0x04 | 0x02 | 0x01;
