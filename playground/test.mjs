@@ -50,25 +50,31 @@ function args() {
   return o;
 }
 
-/** host-sim's 1-bit frame of `scene` with `flags`, packed as the page packs it (1 lit). */
-function hostFrame(hostSim, scene, flags, work, file = join(ROOT, `scenes/${scene}.scene`)) {
+/** host-sim's `w` x `h` 1-bit frame of `scene` with `flags`, packed as the page packs it (1 lit). */
+function hostFrame(hostSim, scene, flags, work, [w, h] = [128, 64], file = join(ROOT, `scenes/${scene}.scene`)) {
   const pbm = join(work, `${scene}.pbm`);
   execFileSync(hostSim, ['render', file, '-o', join(work, `${scene}.png`), '--pbm', pbm, ...flags], { stdio: ['ignore', 'ignore', 'inherit'] });
   const bytes = readFileSync(pbm);
-  const header = '128 64\n';
+  const header = `${w} ${h}\n`;
   const start = bytes.indexOf(header) + header.length;
-  if (!bytes.subarray(0, 3).equals(Buffer.from('P4\n')) || start < header.length) throw new Error(`${pbm}: not a 128x64 P4 file`);
-  return Array.from(bytes.subarray(start, start + 1024), (b) => b ^ 0xff); // PBM: 1 is black
+  if (!bytes.subarray(0, 3).equals(Buffer.from('P4\n')) || start < header.length) throw new Error(`${pbm}: not a ${w}x${h} P4 file`);
+  return Array.from(bytes.subarray(start, start + Math.ceil(w / 8) * h), (b) => b ^ 0xff); // PBM: 1 is black
 }
 
-/** The canvas `id` read back as a packed 1-bit frame (a pixel is lit when it is bright). */
-const readCanvas = (page, id) =>
-  page.evaluate((id) => {
-    const data = document.getElementById(id).getContext('2d').getImageData(0, 0, 128, 64).data;
-    const bits = new Array(1024).fill(0);
-    for (let p = 0; p < 128 * 64; p++) if (data[p * 4] > 127) bits[p >> 3] |= 0x80 >> (p & 7);
-    return bits;
-  }, id);
+/** The `w` x `h` canvas `id` read back as a packed 1-bit frame (a pixel is lit when it is bright). */
+const readCanvas = (page, id, w = 128, h = 64) =>
+  page.evaluate(
+    (id, w, h) => {
+      const data = document.getElementById(id).getContext('2d').getImageData(0, 0, w, h).data;
+      const stride = Math.ceil(w / 8);
+      const bits = new Array(stride * h).fill(0);
+      for (let y = 0; y < h; y++) for (let x = 0; x < w; x++) if (data[(y * w + x) * 4] > 127) bits[y * stride + (x >> 3)] |= 0x80 >> (x & 7);
+      return bits;
+    },
+    id,
+    w,
+    h,
+  );
 
 const differing = (a, b) => a.reduce((n, x, i) => n + popcount(x ^ b[i]), 0);
 const popcount = (x) => x.toString(2).split('1').length - 1;
@@ -134,7 +140,7 @@ async function main() {
     await page.click('#lines');
     await page.select('#gamma', '8');
     await page.select('#sampling', 'one');
-    await page.waitForFunction(() => JSON.stringify(window.playground.settings) === JSON.stringify({ scalar: 'f32', dither: 'blue-noise', lines: false, gamma: 8, sampling: 'one', turn: 0, shades: 2 }));
+    await page.waitForFunction(() => JSON.stringify(window.playground.settings) === JSON.stringify({ scalar: 'f32', dither: 'blue-noise', lines: false, gamma: 8, sampling: 'one', turn: 0, shades: 2, panel: 'ssd1306' }));
     const other = ['--scalar', 'f32', '--sampling', 'one', '--dither', 'blue-noise', '--no-outline', '--gamma', '8', '--tile', '16', '--cutoff', '7'];
     const wantOther = hostFrame(o.hostSim, 'desk', other, work);
     const gotOther = await readCanvas(page, 'panel');
@@ -156,6 +162,20 @@ async function main() {
     check(gray.wrong === 0 && gray.seen === '0, 1, 2, 3', `four shades: the panel draws every pixel's step (${gray.wrong} pixels wrong; steps ${gray.seen})`);
     await page.select('#shades', '2');
     await page.waitForFunction(() => window.playground.settings?.shades === 2);
+
+    // The other panels: the frame takes each glass's size (host-sim render --board pico
+    // --panel NAME gives that image's frame) and the panel's look.
+    await page.select('#scene', 'chair');
+    for (const [name, w, h] of [['uc8151', 296, 128], ['sharp-400x240', 400, 240], ['ssd1306-72x40', 72, 40]]) {
+      await page.select('#glass', name);
+      await page.waitForFunction((name) => window.playground.settings?.panel === name && window.playground.error === null, {}, name);
+      const size = await page.evaluate(() => window.playground.size.join('x'));
+      const wantGlass = hostFrame(o.hostSim, 'chair', ['--board', 'pico', '--panel', name], work, [w, h]);
+      const gotGlass = await readCanvas(page, 'panel', w, h);
+      check(size === `${w}x${h}` && differing(gotGlass, wantGlass) === 0, `${name}: a ${size} panel equal to host-sim render --board pico --panel ${name} (${differing(gotGlass, wantGlass)} pixels differ)`);
+    }
+    await page.select('#glass', 'ssd1306');
+    await page.waitForFunction(() => window.playground.settings?.panel === 'ssd1306');
 
     // A mistake typed into the editor.
     await page.$eval('#text', (t) => { t.value = ''; });
@@ -198,7 +218,7 @@ async function main() {
     if (slot.frames.length === 0) {
       check(false, `my scene on the emulated Pico showed no frame: ${slot.status}`);
     } else {
-      const wantMine = hostFrame(o.hostSim, 'mine', pico, work, mineFile);
+      const wantMine = hostFrame(o.hostSim, 'mine', pico, work, [128, 64], mineFile);
       const f = slot.frames[0];
       check(differing(f.pixels, wantMine) === 0, `my scene in the slot image on the emulated Pico (${(f.cycles / 1e6).toFixed(1)} M cycles, after ${((Date.now() - mineStart) / 1000).toFixed(0)} s) equals host-sim's (${differing(f.pixels, wantMine)} pixels differ)`);
     }

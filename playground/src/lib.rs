@@ -6,7 +6,7 @@
 //! JSON report (the lattice's shape and bytes, the effects the scene calls for, rays and object
 //! tests), [`ScriptError`] the line and column of a scene's mistake.
 
-use board_records::frame::{self as board_frame, Build, PICO};
+use board_records::frame::{self as board_frame, Build, Glass, PICO};
 use embedded_graphics_core::pixelcolor::{BinaryColor, Gray2};
 use lattice_rt::dither::Shade;
 use lattice_rt::render::{RenderError, Sampling};
@@ -57,6 +57,9 @@ pub struct Settings {
     pub turn: f64,
     /// Shades the panel shows: 2 (1-bit) or 4 (the gray mode, `host-sim render --levels 4`).
     pub shades: u8,
+    /// The panel, by the firmware's names (`board_records::frame::Panel::name`): its glass
+    /// sets the frame's size.
+    pub panel: String,
 }
 
 impl Default for Settings {
@@ -70,6 +73,7 @@ impl Default for Settings {
             sampling: sampling_name(f.sampling).into(),
             turn: 0.0,
             shades: 2,
+            panel: board_frame::Panel::default().name().into(),
         }
     }
 }
@@ -87,8 +91,17 @@ fn sampling_name(s: Sampling) -> &'static str {
 }
 
 impl Settings {
-    /// The frame these settings render (128x64, 16x16 tiles, as the Pico's panel).
+    /// The frame these settings render (the panel's glass, 16x16 tiles, as the Pico's image
+    /// for that panel renders it).
     pub fn frame(&self) -> Result<Frame, String> {
+        let panel = board_frame::Panel::of(&self.panel).ok_or_else(|| {
+            let names: Vec<&str> = board_frame::Panel::ALL.iter().map(|p| p.name()).collect();
+            format!("unknown panel `{}` (one of {})", self.panel, names.join(", "))
+        })?;
+        let glass = panel.glass();
+        if self.shades == 4 && !matches!(glass, Glass::Oled128x64 | Glass::Oled72x40) {
+            return Err(format!("the gray mode is for the SSD1306 128x64 and 72x40 panels, not {}", self.panel));
+        }
         let dither =
             DITHERS.iter().find(|(n, _)| *n == self.dither).map(|(_, d)| *d).ok_or_else(|| {
                 format!("unknown dither `{}` (one of {})", self.dither, DITHERS.map(|d| d.0).join(", "))
@@ -102,7 +115,7 @@ impl Settings {
         if !(0.0..=1.0).contains(&self.turn) {
             return Err(format!("turn {} is outside 0..1", self.turn));
         }
-        let build = Build { lines: Some(self.lines), ..PICO };
+        let build = Build { lines: Some(self.lines), glass, ..PICO };
         Ok(Frame { dither, sampling, tone: Tone { gamma_tenths: self.gamma }, ..board_frame::rendered(build) })
     }
 }
@@ -121,8 +134,10 @@ pub struct Mistake {
 /// What [`render_panel`] gives: the panel and what the lattice did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Output {
-    /// The 1-bit frame, packed as `BitFrame` packs it (rows of 16 bytes, most significant bit
-    /// first, 1 lit): the pixels lit in any subframe.
+    /// The frame's width and height in pixels (the panel's glass).
+    pub size: (u32, u32),
+    /// The 1-bit frame, packed as `BitFrame` packs it (rows of width / 8 bytes rounded up,
+    /// most significant bit first, 1 lit): the pixels lit in any subframe.
     pub bits: Vec<u8>,
     /// Each pixel's shade, row-major: its step, 0..=1 (two shades) or 0..=3 (four).
     pub shades: Vec<u8>,
@@ -156,11 +171,11 @@ fn render_in<R: Real, C: Shade>(text: &str, turn: f64, frame: &Frame) -> Result<
         return Err(unplaced(format!("the scene declares {n} objects; the playground takes at most {MAX_OBJECTS}")));
     }
     let (mut objects, mut parts) = (vec![Object::<R>::default(); n.max(1)], lattice_rt::Parts::new());
-    let scene = parse_with::<R>(text, &mut objects, &mut parts, |c| *c = c.orbit(turn)).map_err(|e| Mistake {
-        line: e.line,
-        col: e.col,
-        message: e.to_string(),
-    })?;
+    let scene = parse_with::<R>(text, &mut objects, &mut parts, |c| {
+        c.frame = frame.size();
+        *c = c.orbit(turn);
+    })
+    .map_err(|e| Mistake { line: e.line, col: e.col, message: e.to_string() })?;
     let cfg = LatticeConfig::default();
     let sizes = Sizes { objects: 0, rows: 0, ..Sizes::of(&scene, Some(&cfg), &Frame::new(1, 1)) };
     if sizes.bytes::<R>() > MAX_LATTICE_BYTES {
@@ -206,7 +221,7 @@ fn render_in<R: Real, C: Shade>(text: &str, turn: f64, frame: &Frame) -> Result<
     .expect("writing to a String");
     let mut bits = vec![0u8; BitFrame::bytes(w, h)];
     target.lit(&mut BitFrame::new(w, h, &mut bits).expect("sized by BitFrame::bytes"));
-    Ok(Output { bits, shades, report })
+    Ok(Output { size: (w, h), bits, shades, report })
 }
 
 /// The scenes the page starts from: the paper's four and the Whitted showcase, by name.
@@ -224,7 +239,16 @@ pub struct Panel(Output);
 
 #[wasm_bindgen]
 impl Panel {
-    /// The packed 1-bit frame (16 bytes a row, most significant bit first, 1 lit).
+    /// The frame's width in pixels.
+    pub fn width(&self) -> u32 {
+        self.0.size.0
+    }
+    /// The frame's height in pixels.
+    pub fn height(&self) -> u32 {
+        self.0.size.1
+    }
+    /// The packed 1-bit frame (rows of width / 8 bytes rounded up, most significant bit first,
+    /// 1 lit).
     pub fn bits(&self) -> Vec<u8> {
         self.0.bits.clone()
     }
@@ -271,6 +295,7 @@ pub fn panel(
     sampling: &str,
     turn: f64,
     shades: u8,
+    panel_name: &str,
 ) -> Result<Panel, ScriptError> {
     let settings = Settings {
         scalar: scalar.into(),
@@ -280,6 +305,7 @@ pub fn panel(
         sampling: sampling.into(),
         turn,
         shades,
+        panel: panel_name.into(),
     };
     render_panel(text, &settings).map(Panel).map_err(ScriptError)
 }
@@ -308,13 +334,14 @@ pub fn scene_text(name: &str) -> String {
 pub fn default_settings() -> String {
     let s = Settings::default();
     format!(
-        r#"{{"scalar":"{}","dither":"{}","lines":{},"gamma":{},"sampling":"{}","turn":0,"shades":{},"dithers":"{}"}}"#,
+        r#"{{"scalar":"{}","dither":"{}","lines":{},"gamma":{},"sampling":"{}","turn":0,"shades":{},"panel":"{}","dithers":"{}"}}"#,
         s.scalar,
         s.dither,
         s.lines,
         s.gamma,
         s.sampling,
         s.shades,
+        s.panel,
         DITHERS.map(|d| d.0).join(",")
     )
 }
@@ -378,6 +405,29 @@ mod tests {
             want[1],
             "a quarter turn is host-sim orbit's frame 1 of 4"
         );
+    }
+
+    #[test]
+    fn each_panel_is_its_images_frame_host_sim_renders() {
+        for p in board_frame::Panel::ALL {
+            let s = Settings { panel: p.name().into(), ..Settings::default() };
+            let (name, text) = SCENES[0];
+            let out = render_panel(text, &s).unwrap();
+            let want = host_sim::run::render_text::<Fx>(
+                Path::new(name),
+                text,
+                &board_frame::rendered(Build { glass: p.glass(), ..PICO }),
+                |_| {},
+            )
+            .unwrap();
+            let (w, h) = p.glass().size();
+            assert_eq!(out.size, (u32::from(w), u32::from(h)), "{}", p.name());
+            assert_eq!(out.bits, want.bits, "{}", p.name());
+        }
+        let e = render_panel(SCENES[0].1, &Settings { panel: "crt".into(), ..Settings::default() }).unwrap_err();
+        assert!(e.message.contains("unknown panel `crt`") && e.message.contains("uc8151"), "{}", e.message);
+        let gray = Settings { panel: "sharp-400x240".into(), shades: 4, ..Settings::default() };
+        assert!(render_panel(SCENES[0].1, &gray).unwrap_err().message.contains("gray mode"));
     }
 
     #[test]

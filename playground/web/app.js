@@ -3,6 +3,7 @@
 // `window.playground` holds what the browser test (playground/test.mjs) reads.
 import init, { panel, scene_names, scene_text, default_settings, slot_uf2 } from './pkg/playground.js';
 
+/** The emulated Pico's panel (the board's image drives the SSD1306 128x64). */
 const W = 128;
 const H = 64;
 const $ = (id) => document.getElementById(id);
@@ -17,22 +18,45 @@ function readBits(canvas) {
   return bits;
 }
 
-/** The colour of a pixel lit `share` of the time (0: dark, 1: the panel's white). */
-const shade = (share) => [235, 242, 255].map((c) => Math.round(c * share));
+/**
+ * How each kind of panel looks: its dark and its lit (white) pixel. An OLED lights its pixels
+ * on black; a Sharp memory LCD reflects the room where a pixel is white; e-paper is ink on paper.
+ */
+const LOOKS = {
+  oled: { dark: [0, 0, 0], lit: [235, 242, 255], frame: '#111' },
+  sharp: { dark: [38, 40, 38], lit: [196, 202, 194], frame: '#555' },
+  epaper: { dark: [28, 28, 30], lit: [236, 233, 222], frame: '#ddd' },
+};
+/** A panel's look, by the firmware's panel name. */
+const lookOf = (panel) => (panel.startsWith('sharp') ? LOOKS.sharp : panel === 'uc8151' ? LOOKS.epaper : LOOKS.oled);
+
+/** The colour of a pixel lit `share` of the time (0: dark, 1: the panel's white) in `look`. */
+const shade = (share, look = LOOKS.oled) => look.dark.map((d, i) => Math.round(d + (look.lit[i] - d) * share));
 
 /**
- * Draws a frame on a 128x64 canvas: a packed 1-bit frame (16 bytes a row, MSB first, 1 lit),
- * or with `steps` (a step per pixel, 0..=top) its shades, a pixel of step k lit k / top of the
- * time (the gray mode's subframes, as the eye sums them).
+ * Draws a frame of `w` x `h` pixels on a canvas (sized to it): a packed 1-bit frame (rows of
+ * w / 8 bytes, MSB first, 1 lit), or with `steps` (a step per pixel, 0..=top) its shades, a
+ * pixel of step k lit k / top of the time (the gray mode's subframes, as the eye sums them),
+ * in the panel's `look`.
  */
-function draw(canvas, bits, steps = null, top = 1) {
+function draw(canvas, bits, steps = null, top = 1, w = W, h = H, look = LOOKS.oled) {
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+  }
+  // Shown at 4x, or 2x when the glass is wider than the OLEDs'.
+  const scale = w > 128 ? 2 : 4;
+  canvas.style.width = `${w * scale}px`;
+  canvas.style.height = `${h * scale}px`;
+  canvas.style.borderColor = look.frame;
   const ctx = canvas.getContext('2d');
-  const img = ctx.createImageData(W, H);
-  for (let y = 0; y < H; y++) {
-    for (let x = 0; x < W; x++) {
-      const on = (bits[y * (W / 8) + (x >> 3)] >> (7 - (x & 7))) & 1;
-      const [r, g, b] = shade(steps ? steps[y * W + x] / top : on);
-      const i = (y * W + x) * 4;
+  const img = ctx.createImageData(w, h);
+  const stride = Math.ceil(w / 8);
+  for (let y = 0; y < h; y++) {
+    for (let x = 0; x < w; x++) {
+      const on = (bits[y * stride + (x >> 3)] >> (7 - (x & 7))) & 1;
+      const [r, g, b] = shade(steps ? steps[y * w + x] / top : on, look);
+      const i = (y * w + x) * 4;
       img.data[i] = r;
       img.data[i + 1] = g;
       img.data[i + 2] = b;
@@ -51,6 +75,7 @@ function settings() {
     sampling: $('sampling').value,
     turn: Number($('orbit').value) / 36,
     shades: Number($('shades').value),
+    panel: $('glass').value,
   };
 }
 
@@ -62,6 +87,7 @@ function applySettings(s) {
   $('sampling').value = s.sampling;
   $('orbit').value = String(Math.round(s.turn * 36));
   $('shades').value = String(s.shades);
+  $('glass').value = s.panel ?? 'ssd1306';
 }
 
 const fmt = (n) => n.toLocaleString('en-US');
@@ -129,7 +155,8 @@ function rerender(cost) {
   $('orbit-at').textContent = `${$('orbit').value} / 36`;
   const t0 = performance.now();
   try {
-    const p = panel($('text').value, s.scalar, s.dither, s.lines, s.gamma, s.sampling, s.turn, s.shades);
+    const p = panel($('text').value, s.scalar, s.dither, s.lines, s.gamma, s.sampling, s.turn, s.shades, s.panel);
+    const [w, h] = [p.width(), p.height()];
     const ms = performance.now() - t0;
     state.bits = p.bits();
     state.shades = Array.from(p.shades());
@@ -138,7 +165,8 @@ function rerender(cost) {
     state.renderMs = ms;
     state.settings = s;
     p.free();
-    draw($('panel'), state.bits, s.shades === 4 ? state.shades : null, s.shades - 1);
+    state.size = [w, h];
+    draw($('panel'), state.bits, s.shades === 4 ? state.shades : null, s.shades - 1, w, h, lookOf(s.panel));
     showReport(state.report, ms, cost);
     showError(null);
   } catch (err) {
@@ -254,7 +282,7 @@ async function main() {
     localStorage.setItem(KEPT_TEXT, $('text').value);
     soon();
   });
-  for (const id of ['dither', 'lines', 'gamma', 'scalar', 'sampling', 'orbit', 'shades']) $(id).addEventListener('input', soon);
+  for (const id of ['dither', 'lines', 'gamma', 'scalar', 'sampling', 'orbit', 'shades', 'glass']) $(id).addEventListener('input', soon);
   let shown = $('scene').value;
   $('scene').addEventListener('change', () => {
     const edited = loaded === null ? $('text').value.trim() !== '' : $('text').value !== loaded;
