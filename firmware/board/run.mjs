@@ -90,7 +90,6 @@ const PANELS = {
   uc8151: {
     make: (now, mcu) =>
       new Uc8151(now, (ns, fn) => mcu().clock.createAlarm(fn).schedule(ns), (high) => mcu()?.gpio[BUSY_PIN].setInputValue(high)),
-    busyPin: BUSY_PIN,
     spi: { cs: 17, dc: 20, res: 21 },
   },
 };
@@ -421,7 +420,7 @@ function main() {
     board.gpio(LED_PIN).addListener(onLed);
     // Nobody presses the button at power-on: its pull-up holds it high.
     mcu.gpio[BUTTON_PIN].setInputValue(true);
-    if (display && panel.busyPin !== undefined) mcu.gpio[panel.busyPin].setInputValue(display.busyHigh());
+    display?.drive?.();
     const watchdog = mcu.peripherals[0x40058];
     // The watchdog resets the chip: its timer stops here (rp2040js would re-arm it at 0 and
     // fire again at once), and the board boots again after this step.
@@ -465,7 +464,7 @@ function main() {
     ledOn = false;
     frameStart = null;
     firstByteOfFrame = null;
-    display?.endTransfer();
+    display?.endTransfer?.();
     boot(kept);
   };
 

@@ -111,9 +111,14 @@ export class Uc8151 {
     if (!this.absent) this.resetState();
   }
 
-  /** BUSY's level: high when the controller is idle. */
-  busyHigh() {
-    return this.now() >= this.busyUntil;
+  /**
+   * BUSY driven again on a chip that just booted (a reset of the RP2040 does not reset the
+   * panel): its level now and, while the controller works, its rise when the work ends.
+   */
+  drive() {
+    const left = this.busyUntil - this.now();
+    if (left <= 0) return this.busyPin(true);
+    this.work(left);
   }
 
   /** Low BUSY for `nanos` from now. */
