@@ -3,8 +3,9 @@
 //! [`controller`]: SSD1306, SH1106, SSD1309) over I2C ([`i2c`]: a queue the bus drains while the
 //! cores trace, and a display that does not answer reported) or 4-wire SPI ([`spi`], the `spi`
 //! feature), or as line writes to a Sharp memory LCD on SPI ([`sharp`], the `sharp-*`
-//! features), or as a whole frame to the Badger 2040's e-paper ([`uc8151`]). Each bus gives the render loop the same two things: [`Pump`], its hooks, and
-//! [`flush`], the wait until the frame is on the panel.
+//! features), or as a whole frame to the Badger 2040's e-paper ([`uc8151`]). Each bus gives the
+//! render loop the same two things: [`Pump`], its hooks, and [`flush`], the wait until the
+//! frame is on the panel.
 
 #[cfg(not(feature = "spi"))]
 mod bus_clear;
