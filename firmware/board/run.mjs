@@ -10,6 +10,8 @@
 //                           took, each core's busy and idle cycles, the XIP cache's hits,
 //                           misses and stall, the display bus's bytes and busy cycles, and the
 //                           panel's pixels as hex rows
+//   {"event":"epaper", ...} with --panel uc8151, before the end: each refresh's start and end
+//                           and when its frame's bytes began (emulated ms)
 //   {"event":"end", ...}    why the run ended, with totals
 // The device's defmt log (the RTT up channel, read as a probe reads it) goes to --log as raw
 // bytes for people, and its typed records (the board_records channel at --records ADDR) to
@@ -24,7 +26,8 @@
 // modules: 132 columns of RAM, page addressing only), ssd1309 (the 2.42" modules: no charge
 // pump), ssd1306-128x32 or ssd1306-72x40 (smaller glass: the frame's pixels are its size); the
 // image must be built for it (its `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature);
-// sharp-400x240 or sharp-128x128 puts a Sharp memory LCD on SPI0 alone (its own wiring).
+// sharp-400x240 or sharp-128x128 puts a Sharp memory LCD on SPI0 alone (its own wiring); uc8151
+// the Badger 2040's e-paper on SPI0 (the SPI modules' CS, DC and RES; its BUSY drives GP26).
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
 // --panel-off START_MS:LEN_MS (repeatable) cuts the display's power at START_MS of emulated
