@@ -41,14 +41,17 @@ fn main() {
     let mut windows_only = baked && !has("ladder");
     // The slot image embeds no scene: it reads one from flash at run time.
     let names = if has("slot") { String::new() } else { names };
-    let scenes: Vec<(&str, PathBuf, String)> = names
+    let scenes: Vec<(String, PathBuf, String)> = names
         .split(',')
         .map(str::trim)
         .filter(|n| !n.is_empty())
-        .map(|name| {
-            let path = PathBuf::from(format!("../scenes/{name}.scene"));
+        .map(|entry| {
+            let (name, path) = scene_file(entry);
             println!("cargo:rerun-if-changed={}", path.display());
             let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
+            if !baked && lattice_rt::scene::Format::of(&text) == lattice_rt::scene::Format::Nff {
+                panic!("FIRMWARE_SCENES: {}: an NFF scene is baked into the image only (this build parses its scenes on the board: leave out `parse` and `orbit`)", path.display());
+            }
             (name, path, text)
         })
         .collect();
@@ -67,9 +70,12 @@ fn main() {
     if baked {
         // Baked once it is known whether the tracer asks the lattices: where it never does,
         // they are left out of flash.
+        let mut footprints = Vec::new();
         for (name, path, text) in &scenes {
-            plan_in_scalar(path, text, Some((name, !windows_only, &mut tables)));
+            let bake = Bake { name, with_lattice: !windows_only, out: &mut tables, footprints: &mut footprints };
+            plan_in_scalar(path, text, Some(bake));
         }
+        check_fits(&footprints, &sizes);
     }
     if has("effects-all") {
         effects = lattice_rt::Effects::ALL.bits();
@@ -137,7 +143,7 @@ fn link(out: &std::path::Path) {
     // The slot image keeps its code below the scene slot (`board_records::slot::ADDRESS`).
     if has("slot") {
         let below = board_records::slot::ADDRESS - 0x1000_0000;
-        map = map.replace("LENGTH = 1536K - 0x100", &format!("LENGTH = {}K - 0x100", below / 1024));
+        map = map.replace("LENGTH = 1920K - 0x100", &format!("LENGTH = {}K - 0x100", below / 1024));
     }
     fs::write(out.join("memory.x"), map).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
@@ -179,6 +185,95 @@ fn link(out: &std::path::Path) {
     }
 }
 
+/// What baking a scene asks of [`plan`]: its name, whether its lattice goes into flash, the
+/// source its tables are appended to and the list its footprint is added to.
+struct Bake<'a> {
+    name: &'a str,
+    with_lattice: bool,
+    out: &'a mut String,
+    footprints: &'a mut Vec<Footprint>,
+}
+
+/// The flash a baked scene's tables take: its objects (each a full record: shape, placement and
+/// its inverse, bounds, where it can appear) and its lattice.
+struct Footprint {
+    scene: String,
+    objects: usize,
+    object_bytes: usize,
+    lattice_bytes: usize,
+}
+
+/// Flash of the Pico image besides the baked scenes' tables, at most: its code in flash, the
+/// other read-only data, the vector table (about 40 KiB today; its hot code runs from SRAM and
+/// is loaded from the last 128 KiB of flash, outside the region).
+const PICO_CODE_FLASH: usize = 64 * 1024;
+/// RAM of the Pico image besides the mailboxes, at most: the code run from SRAM (about 62 KiB),
+/// core 1's stack (32 KiB), the tile buffers, the panel's frame, and room for core 0's stack.
+const PICO_OTHER_RAM: usize = 160 * 1024;
+
+/// Refuses, with the figure needed and the figure available, baked scenes whose tables do not
+/// fit the Pico's flash or whose mailboxes (a word per object and lattice, for each core) do not
+/// fit its RAM, before the linker would say so less clearly. Other boards are left to their
+/// linker scripts.
+fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
+    let (flash, ram) = match (has("pico"), has("pico2")) {
+        (true, _) => (1920 * 1024 - 0x100, 256 * 1024),
+        (_, true) => (2048 * 1024, 512 * 1024),
+        _ => return,
+    };
+    let kib = |b: usize| format!("{:.0} KiB", b as f64 / 1024.0);
+    let tables: usize = footprints.iter().map(|f| f.objects * f.object_bytes + f.lattice_bytes).sum();
+    if tables + PICO_CODE_FLASH > flash {
+        let each: Vec<String> = footprints
+            .iter()
+            .map(|f| {
+                format!(
+                    "{}: {} objects of {} bytes, a lattice of {}",
+                    f.scene,
+                    f.objects,
+                    f.object_bytes,
+                    kib(f.lattice_bytes)
+                )
+            })
+            .collect();
+        panic!(
+            "FIRMWARE_SCENES: the baked scenes' tables need {} of flash ({}), and the image has {} for them ({} of flash less {} for its code): bake fewer or smaller scenes",
+            kib(tables),
+            each.join("; "),
+            kib(flash - PICO_CODE_FLASH),
+            kib(flash),
+            kib(PICO_CODE_FLASH)
+        );
+    }
+    let mailboxes = 2 * 4 * (sizes.objects + sizes.lattices);
+    if mailboxes + PICO_OTHER_RAM > ram {
+        panic!(
+            "FIRMWARE_SCENES: the largest baked scene's mailboxes need {} of RAM (a word per object and lattice on each core: {} objects, {} lattices), and the image has {} for them ({} of RAM less {} for the rest)",
+            kib(mailboxes),
+            sizes.objects,
+            sizes.lattices,
+            kib(ram - PICO_OTHER_RAM),
+            kib(ram),
+            kib(PICO_OTHER_RAM)
+        );
+    }
+}
+
+/// A `FIRMWARE_SCENES` entry's name and file: a name from `scenes/` (`chair`), or a path to a
+/// scene or NFF file (it has a `/` or an extension; relative to the firmware's folder), named
+/// by its file's stem (`balls-3` for `/tmp/balls-3.nff`).
+fn scene_file(entry: &str) -> (String, PathBuf) {
+    if !entry.contains('/') && !entry.contains('.') {
+        return (entry.to_string(), PathBuf::from(format!("../scenes/{entry}.scene")));
+    }
+    let path = PathBuf::from(entry);
+    let stem = path.file_stem().and_then(|s| s.to_str()).filter(|s| !s.is_empty());
+    let name = stem.unwrap_or_else(|| {
+        panic!("FIRMWARE_SCENES: {entry}: a path names its scene by its file's stem, and this one has none")
+    });
+    (name.to_string(), path)
+}
+
 /// Whether the firmware is built with Cargo feature `feature` (its name as in Cargo.toml).
 fn has(feature: &str) -> bool {
     env::var_os(format!("CARGO_FEATURE_{}", feature.to_uppercase().replace('-', "_"))).is_some()
@@ -190,7 +285,7 @@ fn table_name(scene: &str) -> String {
 }
 
 /// [`plan`] in the scalar the firmware's features choose.
-fn plan_in_scalar(path: &std::path::Path, text: &str, bake: Option<(&str, bool, &mut String)>) -> (Sizes, u8, bool) {
+fn plan_in_scalar(path: &std::path::Path, text: &str, bake: Option<Bake<'_>>) -> (Sizes, u8, bool) {
     if has("scalar-fixed") {
         plan::<lattice_rt::Fx>(path, text, bake)
     } else if has("scalar-micromath") {
@@ -205,11 +300,7 @@ fn plan_in_scalar(path: &std::path::Path, text: &str, bake: Option<(&str, bool, 
 /// Storage and effects of one scene in the firmware's scalar, and whether its windows serve
 /// every ray; with `bake`, its tables too (the scene as parsed and, if asked for, its lattice
 /// as built in that scalar, as the firmware would).
-fn plan<R: Real + Literal>(
-    path: &std::path::Path,
-    text: &str,
-    bake: Option<(&str, bool, &mut String)>,
-) -> (Sizes, u8, bool) {
+fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<Bake<'_>>) -> (Sizes, u8, bool) {
     let mut storage = vec![Object::<R>::default(); lattice_rt::object_count(text).max(1)];
     let mut parts = lattice_rt::Parts::default();
     // The frame this build renders, from its features (as `app::RENDERED` has it): the view is
@@ -221,13 +312,18 @@ fn plan<R: Real + Literal>(
     for (i, o) in scene.objects().iter().enumerate() {
         let Some(feature) = o.shape().feature() else { continue };
         if !has(feature) {
-            panic!("{}: object {i} is a {}, which this build leaves out (the firmware's feature `{feature}`, a default one)", path.display(), lattice_rt::shape::SHAPE_NAMES[o.shape().kind()]);
+            let default = if feature == "triangles" { "" } else { ", a default one" };
+            panic!(
+                "{}: object {i} is a {}, which this build leaves out (the firmware's feature `{feature}`{default})",
+                path.display(),
+                lattice_rt::shape::SHAPE_NAMES[o.shape().kind()]
+            );
         }
     }
     let effects = lattice_rt::Effects::of(&scene).bits();
     let cfg = LatticeConfig::default();
     let sizes = Sizes::of(&scene, Some(&cfg), &frame);
-    if let Some((name, with_lattice, out)) = bake {
+    if let Some(Bake { name, with_lattice, out, footprints }) = bake {
         let s = Lattice::plan(&scene, &cfg);
         let (mut lattices, mut coords, mut words) =
             (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);
@@ -239,6 +335,12 @@ fn plan<R: Real + Literal>(
             &scene,
             Some(&lattice).filter(|_| with_lattice),
         ));
+        footprints.push(Footprint {
+            scene: name.to_string(),
+            objects: scene.objects().len(),
+            object_bytes: size_of::<Object<R>>(),
+            lattice_bytes: if with_lattice { lattice.bytes() } else { 0 },
+        });
     }
     (sizes, effects, lattice_rt::EyeRays::serve_every_ray(&scene))
 }

@@ -17,6 +17,7 @@ mod faults;
 mod gray;
 mod panels;
 mod slot;
+mod spd;
 
 use crate::firmware::{board_frame, elf_sizes, host_frame};
 use anyhow::{bail, Context, Result};
@@ -530,6 +531,17 @@ impl Checks {
     fn fail(&mut self, why: String) {
         self.failures.push(why);
     }
+    /// Prints the failures and the tally; an error if any check failed.
+    fn verdict(self) -> Result<()> {
+        for f in &self.failures {
+            eprintln!("FAIL {f}");
+        }
+        println!("board: {} passed, {} failed", self.passed, self.failures.len());
+        if !self.failures.is_empty() {
+            bail!("{} board checks failed", self.failures.len());
+        }
+        Ok(())
+    }
 }
 
 /// One `cargo xtask board` run: the image, where its frames go, the emulator, the checks.
@@ -550,8 +562,13 @@ struct Session<'a> {
 /// The command `cargo xtask board`: the default image on every embedded scene, then each
 /// variant (a model left out, a build-time lever, orbit, ladder, progressive, outline) as a
 /// row of the report, every frame checked against host-sim's.
-pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> Result<()> {
+pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd_only: bool) -> Result<()> {
     let mut s = Session::prepare(root, frames_dir, no_build)?;
+    if spd_only {
+        let rows = s.spd_runs()?;
+        print!("{}", spd::spd_report(&rows)?);
+        return s.checks.verdict();
+    }
     let (run, rows) = s.scenes_run()?;
     // The panel's frame of every scene, for README and the display study.
     if let Some(images) = out.parent().map(|p| p.join("images")) {
@@ -580,6 +597,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     let plain_run = s.variant("no-outline", false, 1, &[])?;
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
     let slot_rows = s.slot_runs()?;
+    let spd_rows = s.spd_runs()?;
 
     let spi_byte = levers
         .iter()
@@ -620,17 +638,10 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool) -> 
     if let Some(e) = &epaper {
         md.push_str(&epaper::epaper_report(e, run.clk_sys_hz)?);
     }
+    md.push_str(&spd::spd_report(&spd_rows)?);
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
-    let Checks { passed, failures } = s.checks;
-    for f in &failures {
-        eprintln!("FAIL {f}");
-    }
-    println!("board: {passed} passed, {} failed", failures.len());
-    if !failures.is_empty() {
-        bail!("{} board checks failed", failures.len());
-    }
-    Ok(())
+    s.checks.verdict()
 }
 
 /// Passes of a progressive frame (8x8, 4x4, 2x2 blocks, every pixel).

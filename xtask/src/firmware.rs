@@ -332,21 +332,25 @@ fn run_qemu(elf: &Path, machine: &str) -> Result<Run> {
 /// The frame the boards render (the records crate the firmware compiles too).
 pub use board_records::frame as board_frame;
 
-/// The host's 1-bit frame of scene `name` as `frame`, in scalar `R`.
-fn host_frame_in<R: lattice_rt::Real>(scenes: &Path, name: &str, frame: &lattice_rt::Frame) -> Result<Vec<u8>> {
-    let path = scenes.join(format!("{name}.scene"));
-    Ok(render_text::<R>(&path, &read(&path)?, frame, |_| {})?.bits)
+/// The host's 1-bit frame of the scene file at `path` as `frame`, in scalar `R`.
+fn host_frame_in<R: lattice_rt::Real>(path: &Path, frame: &lattice_rt::Frame) -> Result<Vec<u8>> {
+    Ok(render_text::<R>(path, &read(path)?, frame, |_| {})?.bits)
 }
 
-/// The host's 1-bit frame of scene `name` as the firmware `build` renders it
-/// (`board_frame::rendered`), in a scalar named as in [`SCALARS`].
+/// The host's 1-bit frame of scene `name` (from the folder `scenes`) as the firmware `build`
+/// renders it (`board_frame::rendered`), in a scalar named as in [`SCALARS`].
 pub fn host_frame(scenes: &Path, name: &str, scalar: &str, build: board_frame::Build) -> Result<Vec<u8>> {
+    host_frame_of(&scenes.join(format!("{name}.scene")), scalar, build)
+}
+
+/// [`host_frame`] of the scene or NFF file at `path`.
+pub fn host_frame_of(path: &Path, scalar: &str, build: board_frame::Build) -> Result<Vec<u8>> {
     let frame = board_frame::rendered(build);
     match scalar {
-        "fixed" => host_frame_in::<lattice_rt::Fx>(scenes, name, &frame),
-        "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(scenes, name, &frame),
-        "f32-micromath-newton" => host_frame_in::<lattice_rt::F32MicroNewton>(scenes, name, &frame),
-        _ => host_frame_in::<f32>(scenes, name, &frame),
+        "fixed" => host_frame_in::<lattice_rt::Fx>(path, &frame),
+        "f32-micromath" => host_frame_in::<lattice_rt::F32Micro>(path, &frame),
+        "f32-micromath-newton" => host_frame_in::<lattice_rt::F32MicroNewton>(path, &frame),
+        _ => host_frame_in::<f32>(path, &frame),
     }
 }
 

@@ -51,6 +51,10 @@ enum Command {
         /// Use the image already built instead of running `cargo pico-build`.
         #[arg(long)]
         no_build: bool,
+        /// Run only the Standard Procedural Databases' images and print their section (the
+        /// report is not written).
+        #[arg(long)]
+        spd_only: bool,
     },
     /// Build the firmware, run it in QEMU, check its frames against the host bit for bit,
     /// and write the flash/RAM/instruction budgets to a report.
@@ -243,7 +247,9 @@ fn main() {
 fn real_main() -> Result<()> {
     let root = std::env::current_dir()?;
     match Cli::parse().command {
-        Command::Board { out, frames, no_build } => board::board_cmd(&root, &out, &frames, no_build),
+        Command::Board { out, frames, no_build, spd_only } => {
+            board::board_cmd(&root, &out, &frames, no_build, spd_only)
+        }
         Command::Playground { out, serve, check, screenshot, no_build } => {
             playground::playground_cmd(&root, &playground::PlaygroundArgs { out, serve, check, screenshot, no_build })
         }

@@ -1,0 +1,200 @@
+//! The Standard Procedural Databases on the board: each scene generated as NFF (`host-sim spd`),
+//! baked into its own Pico image (`FIRMWARE_SCENES` takes the file's path; objects, lattice and
+//! windows in flash, read through the XIP cache), run on the emulated board and checked bit for
+//! bit against host-sim's frame of the same file. A scene whose tables do not fit the image is
+//! refused by `firmware/build.rs` with the figures; the report gives its message.
+
+use super::{elf_sizes, m3, reported_frame, run_emulator, save_frame, Session, PICO, PICO_SCALAR};
+use crate::firmware::host_frame_of;
+use anyhow::{Context, Result};
+use host_sim::spd::Generator;
+use host_sim::uf2::{build_image, kept_image, pico_built, write_uf2, Scenes};
+use std::fmt::Write as _;
+use std::path::Path;
+use std::process::Command;
+
+/// The scenes run: the sphereflake at sizes 1 to 3 (3: 820 spheres and the floor, the target's),
+/// the small jacks, and every curve scene at its default size (the published figures' size).
+pub(super) const SCENES: [(Generator, Option<u32>); 9] = [
+    (Generator::Balls, Some(1)),
+    (Generator::Balls, Some(2)),
+    (Generator::Balls, Some(3)),
+    (Generator::Jacks, None),
+    (Generator::Balls, None),
+    (Generator::Rings, None),
+    (Generator::Tree, None),
+    (Generator::Lattice, None),
+    (Generator::Shells, None),
+];
+
+/// Cycles a frame of `balls` at size 3 may take: 2 frames per second at 125 MHz.
+const BALLS_3_TARGET: u64 = 62_500_000;
+
+/// What one scene's image did.
+pub(super) struct SpdRow {
+    /// `NAME-SIZE`.
+    name: String,
+    objects: usize,
+    /// The image's flash and static RAM (bytes), or why it was not built.
+    built: Result<(u64, u64), String>,
+    /// The frame, as run (none if the image was refused or the run showed none).
+    frame: Option<SpdFrame>,
+}
+
+/// A frame of an SPD image.
+struct SpdFrame {
+    same: bool,
+    cycles: u64,
+    /// The board's clock (Hz).
+    clk_hz: f64,
+    xip_misses: u64,
+    xip_stall: u64,
+    /// Rays by kind (eye, shadow, reflection, refraction), object tests, bytes of lattice.
+    rays: [u64; 4],
+    object_tests: u64,
+    lattice_bytes: u32,
+}
+
+impl Session<'_> {
+    /// Every scene of [`SCENES`] in its own image.
+    pub(super) fn spd_runs(&mut self) -> Result<Vec<SpdRow>> {
+        let dir = self.frames_dir.join("spd");
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let dir = dir.canonicalize()?;
+        let mut rows = Vec::new();
+        for (g, size) in SCENES {
+            let size = size.unwrap_or_else(|| g.default_size());
+            rows.push(self.spd_run(g, size, &dir)?);
+        }
+        Ok(rows)
+    }
+
+    /// One scene: its NFF, its image (or the build's refusal), its frame against host-sim's.
+    fn spd_run(&mut self, g: Generator, size: u32, dir: &Path) -> Result<SpdRow> {
+        let name = format!("{}-{size}", g.name());
+        let nff = dir.join(format!("{name}.nff"));
+        let text = g.nff(size)?;
+        host_sim::output::write_atomic(&nff, text.as_bytes())?;
+        let objects = lattice_rt::object_count(&text);
+        let image = format!("pico-spd-{name}");
+        let args = ["pico-build", "--features", "triangles"];
+        let scenes = nff.to_str().context("the frames folder's path is not UTF-8")?;
+        eprintln!("building the Pico image with {name} ({objects} objects) baked");
+        let elf = if self.no_build {
+            let kept = kept_image(self.root, &image);
+            if kept.exists() {
+                Ok(kept)
+            } else {
+                Err(format!("no image kept in {} (run without --no-build)", kept.display()))
+            }
+        } else {
+            build_image(self.root, &image, &args, Scenes::Listed(scenes), &pico_built())
+                .map_err(|_| refusal(self.root, &args, scenes))
+        };
+        let elf = match elf {
+            Ok(elf) => elf,
+            Err(why) => return Ok(SpdRow { name, objects, built: Err(why), frame: None }),
+        };
+        let built = Ok(elf_sizes(&elf)?);
+        let uf2 = dir.join(format!("lattice-rt-{image}.uf2"));
+        write_uf2(&elf, &uf2)?;
+        let work = dir.join(&name);
+        std::fs::create_dir_all(&work)?;
+        let run = run_emulator(self.root, &elf, &uf2, &self.bootrom, 1, true, &work, &[])?;
+        self.checks.check(run.ok, || format!("SPD {name}: the run did not finish: {}", run.reason));
+        let want = host_frame_of(&nff, PICO_SCALAR, PICO)?;
+        let frame = run.frames.first().map(|f| {
+            let reported = reported_frame(&run.records, 0);
+            SpdFrame {
+                same: f.error.is_none() && f.pixels == want,
+                cycles: f.cycles,
+                clk_hz: run.clk_sys_hz,
+                xip_misses: f.xip_misses,
+                xip_stall: f.xip_stall,
+                rays: reported.map_or([0; 4], |r| r.rays),
+                object_tests: reported.map_or(0, |r| r.object_tests),
+                lattice_bytes: reported.map_or(0, |r| r.lattice_bytes),
+            }
+        });
+        if let Some(f) = run.frames.first() {
+            save_frame(&f.pixels, &work.join(format!("{name}.png")))?;
+        }
+        self.checks.check(frame.as_ref().is_some_and(|f| f.same), || {
+            format!("SPD {name}: the board's frame is not host-sim's (see {})", work.display())
+        });
+        Ok(SpdRow { name, objects, built, frame })
+    }
+}
+
+/// Why the image with `scenes` baked was not built: `firmware/build.rs`'s message (the build is
+/// run again to read it), or the build's failure.
+fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
+    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .args(args)
+        .env("FIRMWARE_SCENES", scenes)
+        .output();
+    let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
+    // The build script's panic message is the line after its `panicked at`.
+    let mut lines = text.lines().map(str::trim);
+    let message = lines.by_ref().find(|l| l.contains("panicked at")).and(lines.next());
+    let folder = Path::new(scenes).parent().map(|p| format!("{}/", p.display())).unwrap_or_default();
+    message.map_or_else(
+        || "the image did not build".into(),
+        |m| m.trim_start_matches("FIRMWARE_SCENES: ").replace(&folder, ""),
+    )
+}
+
+/// The report's section on the SPD scenes.
+pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
+    let mut md = String::new();
+    writeln!(md, "\n## The Standard Procedural Databases from flash\n")?;
+    writeln!(
+        md,
+        "Written by `cargo xtask board`: each scene of Eric Haines' SPD is generated as NFF (`host-sim spd NAME --size N`), baked into its own Pico image (`FIRMWARE_SCENES=/path/NAME-N.nff cargo pico-build --features triangles`: objects, lattice and windows as tables in flash, read through the 16 KiB XIP cache; RAM holds what a frame writes) and run on the emulated board, its frame checked against host-sim's render of the same file with the board's settings (`host-sim render FILE --board pico`). Object tests per ray and rays are the board's own counts. Target: balls at size 3 (820 spheres and the floor) in at most 62.5 M cycles; every curve scene at its default size fitting the Pico's flash and drawn in at most 250 M cycles, with the XIP stall at most a quarter of the frame.\n"
+    )?;
+    writeln!(md, "| scene | objects | flash (image) | lattice bytes | RAM (static) | frame: cycles | fps at 125 MHz | XIP misses per ray | XIP stall | eye rays | all rays | object tests per ray | bit-identical to host-sim |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")?;
+    let kib = |b: u64| format!("{:.0} KiB", b as f64 / 1024.0);
+    let mut refused = Vec::new();
+    for r in rows {
+        let (flash, ram) = match &r.built {
+            Ok((flash, ram)) => (kib(*flash), kib(*ram)),
+            Err(why) => {
+                refused.push(format!("- **{}**: {why}", r.name));
+                ("does not fit".into(), "-".into())
+            }
+        };
+        let Some(f) = &r.frame else {
+            writeln!(md, "| {} | {} | {flash} | - | {ram} | - | - | - | - | - | - | - | - |", r.name, r.objects)?;
+            continue;
+        };
+        let rays: u64 = f.rays.iter().sum();
+        let per_ray = |n: u64| format!("{:.2}", n as f64 / rays.max(1) as f64);
+        writeln!(
+            md,
+            "| {} | {} | {flash} | {} | {ram} | {} | {:.2} | {} | {:.1} % | {} | {rays} | {} | {} |",
+            r.name,
+            r.objects,
+            f.lattice_bytes,
+            m3(f.cycles),
+            f.clk_hz / f.cycles.max(1) as f64,
+            per_ray(f.xip_misses),
+            100.0 * f.xip_stall as f64 / f.cycles.max(1) as f64,
+            f.rays[0],
+            per_ray(f.object_tests),
+            if f.same { "yes" } else { "**no**" }
+        )?;
+    }
+    if !refused.is_empty() {
+        writeln!(md, "\nRefused by `firmware/build.rs` (each object is a full record today: shape, placement and its inverse, bounds, its windows on the image and to the light):\n")?;
+        for r in &refused {
+            writeln!(md, "{r}")?;
+        }
+    }
+    if let Some(f) = rows.iter().find(|r| r.name == "balls-3").and_then(|r| r.frame.as_ref()) {
+        let met = if f.cycles <= BALLS_3_TARGET { "met" } else { "**missed**" };
+        writeln!(md, "\nballs at size 3: {} cycles against the target's 62.5 M: {met}.", m3(f.cycles))?;
+    }
+    Ok(md)
+}
