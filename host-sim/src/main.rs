@@ -114,6 +114,11 @@ enum Command {
         /// The slot image's UF2 file the scene is written beside.
         #[arg(long, default_value = "out/lattice-rt-pico-slot.uf2", requires = "scene")]
         image: PathBuf,
+        /// Scene or NFF files (comma-separated) to bake into the image in place of the default
+        /// scenes: objects, lattice and windows as tables in flash, thousands of objects
+        /// (`host-sim spd balls --size 3`); NFF's polygons need `--features triangles`.
+        #[arg(long, value_name = "FILES", value_delimiter = ',', conflicts_with = "scene")]
+        bake: Vec<PathBuf>,
     },
 }
 
@@ -172,11 +177,11 @@ fn real_main() -> Result<()> {
             Ok(())
         }
         Some(Command::Orbit { scene, output, frames }) => orbit::orbit_cmd(&scene, &output, frames),
-        Some(Command::Uf2 { board, features, panel, output, scene, image }) => match scene {
+        Some(Command::Uf2 { board, features, panel, output, scene, image, bake }) => match scene {
             Some(scene) => uf2::scene_cmd(board, &scene, &image, output.as_deref()),
             None => {
                 let features = uf2::with_panel(features.as_deref(), panel);
-                uf2::uf2_cmd(&std::env::current_dir()?, board, features.as_deref(), output.as_deref())
+                uf2::uf2_cmd(&std::env::current_dir()?, board, features.as_deref(), &bake, output.as_deref())
             }
         },
         Some(Command::Stats(a)) => match a.scalar {

@@ -79,6 +79,11 @@ pub fn build_pico(root: &Path) -> Result<PathBuf> {
 /// `cargo pico2-build`), so it is the image `cargo pico` / `cargo pico2` flashes; with
 /// `features` (the firmware's, comma-separated) it is kept as `<board>-<features>`.
 pub fn build_board(root: &Path, board: Board, features: Option<&str>) -> Result<PathBuf> {
+    build_board_with(root, board, features, Scenes::Inherited)
+}
+
+/// [`build_board`] with `scenes` embedded.
+pub fn build_board_with(root: &Path, board: Board, features: Option<&str>, scenes: Scenes) -> Result<PathBuf> {
     let alias = format!("{}-build", board.name());
     let mut args = vec![alias.as_str()];
     let name = match features {
@@ -89,8 +94,8 @@ pub fn build_board(root: &Path, board: Board, features: Option<&str>) -> Result<
         None => board.name().to_string(),
     };
     eprintln!("building the {} image (cargo {})", board.name(), args.join(" "));
-    build_image(root, &name, &args, Scenes::Inherited, &board.built())
-        .with_context(|| format!("`cargo {alias}` failed (it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target()))
+    build_image(root, &name, &args, scenes, &board.built())
+        .with_context(|| format!("`cargo {alias}` failed (its own message is above; it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target()))
 }
 
 /// The scenes an image embeds (the firmware's build script reads `FIRMWARE_SCENES`).
@@ -100,7 +105,7 @@ pub enum Scenes<'a> {
     Inherited,
     /// The firmware's default list (`firmware/default-scenes.txt`), whatever the environment says.
     Default,
-    /// These, comma-separated names from `scenes/`.
+    /// These, comma-separated: names from `scenes/`, or paths of scene or NFF files.
     Listed(&'a str),
 }
 
@@ -160,11 +165,21 @@ pub fn with_panel(features: Option<&str>, panel: Option<board_records::frame::Pa
 
 /// The command `host-sim uf2`: the image with the firmware's `features` (comma-separated, such
 /// as `spi`), if any; `out` defaults to `out/lattice-rt-<board>[-<features>].uf2`.
-pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, out: Option<&Path>) -> Result<()> {
-    let elf = build_board(root, board, features)?;
-    let named = match features {
-        Some(f) => format!("out/lattice-rt-{}-{}.uf2", board.name(), f.replace(',', "-")),
-        None => format!("out/lattice-rt-{}.uf2", board.name()),
+pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, bake: &[PathBuf], out: Option<&Path>) -> Result<()> {
+    // The firmware's build script reads the files from its own folder: their paths go absolute.
+    let files = bake
+        .iter()
+        .map(|f| f.canonicalize().with_context(|| format!("cannot read the scene to bake {}", f.display())))
+        .collect::<Result<Vec<_>>>()?;
+    let list = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(",");
+    let scenes = if files.is_empty() { Scenes::Inherited } else { Scenes::Listed(&list) };
+    let elf = build_board_with(root, board, features, scenes)?;
+    let stems: Vec<String> =
+        files.iter().filter_map(|f| f.file_stem()).map(|s| s.to_string_lossy().to_string()).collect();
+    let parts: Vec<String> = features.map(|f| f.replace(',', "-")).into_iter().chain(stems).collect();
+    let named = match parts.is_empty() {
+        false => format!("out/lattice-rt-{}-{}.uf2", board.name(), parts.join("-")),
+        true => format!("out/lattice-rt-{}.uf2", board.name()),
     };
     let out = out.map_or_else(|| PathBuf::from(named), Path::to_path_buf);
     board.write_uf2(&elf, &out)?;
