@@ -207,6 +207,8 @@ struct Footprint {
 /// other read-only data, the vector table (about 40 KiB today; its hot code runs from SRAM and
 /// is loaded from the last 128 KiB of flash, outside the region).
 const PICO_CODE_FLASH: usize = 64 * 1024;
+/// The same for the Pico 2's image, all of whose code stays in flash (about 110 KiB today).
+const PICO2_CODE_FLASH: usize = 128 * 1024;
 /// RAM of the Pico image besides the mailboxes, at most: the code run from SRAM (about 62 KiB),
 /// core 1's stack (32 KiB), the tile buffers, the panel's frame, and room for core 0's stack.
 const PICO_OTHER_RAM: usize = 160 * 1024;
@@ -216,14 +218,14 @@ const PICO_OTHER_RAM: usize = 160 * 1024;
 /// fit its RAM, before the linker would say so less clearly. Other boards are left to their
 /// linker scripts.
 fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
-    let (flash, ram) = match (has("pico"), has("pico2")) {
-        (true, _) => (1920 * 1024 - 0x100, 256 * 1024),
-        (_, true) => (2048 * 1024, 512 * 1024),
+    let (flash, code, ram) = match (has("pico"), has("pico2")) {
+        (true, _) => (1920 * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024),
+        (_, true) => (2048 * 1024, PICO2_CODE_FLASH, 512 * 1024),
         _ => return,
     };
     let kib = |b: usize| format!("{:.0} KiB", b as f64 / 1024.0);
     let tables: usize = footprints.iter().map(|f| f.objects * f.object_bytes + f.lattice_bytes).sum();
-    if tables + PICO_CODE_FLASH > flash {
+    if tables + code > flash {
         let each: Vec<String> = footprints
             .iter()
             .map(|f| {
@@ -240,9 +242,9 @@ fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
             "FIRMWARE_SCENES: the baked scenes' tables need {} of flash ({}), and the image has {} for them ({} of flash less {} for its code): bake fewer or smaller scenes",
             kib(tables),
             each.join("; "),
-            kib(flash - PICO_CODE_FLASH),
+            kib(flash - code),
             kib(flash),
-            kib(PICO_CODE_FLASH)
+            kib(code)
         );
     }
     let mailboxes = 2 * 4 * (sizes.objects + sizes.lattices);
