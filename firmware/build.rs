@@ -143,7 +143,7 @@ fn link(out: &std::path::Path) {
     // The slot image keeps its code below the scene slot (`board_records::slot::ADDRESS`).
     if has("slot") {
         let below = board_records::slot::ADDRESS - 0x1000_0000;
-        map = map.replace("LENGTH = 1920K - 0x100", &format!("LENGTH = {}K - 0x100", below / 1024));
+        map = map.replace("LENGTH = 1792K - 0x100", &format!("LENGTH = {}K - 0x100", below / 1024));
     }
     fs::write(out.join("memory.x"), map).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
@@ -205,7 +205,7 @@ struct Footprint {
 
 /// Flash of the Pico image besides the baked scenes' tables, at most: its code in flash, the
 /// other read-only data, the vector table (about 40 KiB today; its hot code runs from SRAM and
-/// is loaded from the last 128 KiB of flash, outside the region).
+/// is loaded from the last 256 KiB of flash, outside the region).
 const PICO_CODE_FLASH: usize = 64 * 1024;
 /// The same for the Pico 2's image, all of whose code stays in flash (about 110 KiB today).
 const PICO2_CODE_FLASH: usize = 128 * 1024;
@@ -219,7 +219,7 @@ const PICO_OTHER_RAM: usize = 160 * 1024;
 /// linker scripts.
 fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
     let (flash, code, ram) = match (has("pico"), has("pico2")) {
-        (true, _) => (1920 * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024),
+        (true, _) => (1792 * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024),
         (_, true) => (2048 * 1024, PICO2_CODE_FLASH, 512 * 1024),
         _ => return,
     };
