@@ -27,7 +27,9 @@
 // pump), ssd1306-128x32 or ssd1306-72x40 (smaller glass: the frame's pixels are its size); the
 // image must be built for it (its `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature);
 // sharp-400x240 or sharp-128x128 puts a Sharp memory LCD on SPI0 alone (its own wiring); uc8151
-// the Badger 2040's e-paper on SPI0 (the SPI modules' CS, DC and RES; its BUSY drives GP26).
+// the Badger 2040's e-paper on SPI0 (the SPI modules' CS, DC and RES; its BUSY drives GP26);
+// thumby the Thumby's 72x40 SSD1306 on SPI0 on its own pins (CS GP16, DC GP17, RES GP20), its A
+// button (GP27) the one --press presses (the `thumby` image).
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
 // --panel-off START_MS:LEN_MS (repeatable) cuts the display's power at START_MS of emulated
@@ -95,6 +97,8 @@ const PANELS = {
       new Uc8151(now, (ns, fn) => mcu().clock.createAlarm(fn).schedule(ns), (high) => mcu()?.gpio[BUSY_PIN].setInputValue(high)),
     spi: { cs: 17, dc: 20, res: 21 },
   },
+  // The Thumby: its 72x40 SSD1306 on SPI0 with its own control pins, its A button on GP27.
+  thumby: { make: (now) => new Ssd1306(0x3c, GLASSES['72x40'], now), spi: { cs: 16, dc: 17, res: 20 }, button: 27 },
 };
 
 const LED_PIN = 25;
@@ -102,7 +106,8 @@ const LED_PIN = 25;
 const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
 /** The I2C display's pins (wiring.rs): I2C0's SDA and SCL. */
 const I2C_PINS = { sda: 4, scl: 5 };
-/** The board's button (wiring.rs `Wiring::NEXT`): to ground when pressed, pulled up. */
+/** The board's button (wiring.rs `Wiring::NEXT`): to ground when pressed, pulled up (a panel's
+ * board may have it elsewhere: its `button`). */
 const BUTTON_PIN = 14;
 // Every how many instructions --profile samples the program counter (a prime, so no loop of
 // the renderer beats in step with it).
@@ -395,8 +400,8 @@ function main() {
   }
   for (const ms of display ? opt.nackAt : []) moments.push({ nanos: ms * 1e6, fn: () => board.nackNext(0) });
   for (const { startMs, lenMs } of opt.presses) {
-    moments.push({ nanos: startMs * 1e6, fn: () => (mcu.gpio[BUTTON_PIN].setInputValue(false), emit({ event: 'button', ms: startMs })) });
-    moments.push({ nanos: (startMs + lenMs) * 1e6, fn: () => mcu.gpio[BUTTON_PIN].setInputValue(true) });
+    moments.push({ nanos: startMs * 1e6, fn: () => (mcu.gpio[panel.button ?? BUTTON_PIN].setInputValue(false), emit({ event: 'button', ms: startMs })) });
+    moments.push({ nanos: (startMs + lenMs) * 1e6, fn: () => mcu.gpio[panel.button ?? BUTTON_PIN].setInputValue(true) });
   }
 
   /** A board from power-on (or, with `kept`, after a reset: SRAM and the watchdog's scratch and reason). */
@@ -422,7 +427,7 @@ function main() {
     board.attachSpi(0, display, { ...(panel.spi ?? SPI_DISPLAY), timed: opt.timedBus, listen: { byte } });
     board.gpio(LED_PIN).addListener(onLed);
     // Nobody presses the button at power-on: its pull-up holds it high.
-    mcu.gpio[BUTTON_PIN].setInputValue(true);
+    mcu.gpio[panel.button ?? BUTTON_PIN].setInputValue(true);
     display?.drive?.();
     const watchdog = mcu.peripherals[0x40058];
     // The watchdog resets the chip: its timer stops here (rp2040js would re-arm it at 0 and

@@ -100,7 +100,8 @@ enum Command {
         /// The panel the image drives (its firmware feature added to --features): ssd1306 (the
         /// default), sh1106 (1.3" modules), ssd1309 (2.42"), ssd1306-128x32, ssd1306-72x40,
         /// sharp-400x240 (Sharp memory LCD LS027B7DH01), sharp-128x128 (LS013B7DH03), uc8151
-        /// (the Badger 2040's 296x128 e-paper).
+        /// (the Badger 2040's 296x128 e-paper), thumby (the Thumby: its 72x40 SSD1306 and its A
+        /// button, on its own pins).
         #[arg(long, value_parser = host_sim::cli::parse_panel, conflicts_with = "scene")]
         panel: Option<board_records::frame::Panel>,
         /// UF2 file to write [default: out/lattice-rt-<board>.uf2; with --features,

@@ -138,11 +138,14 @@ pub enum Panel {
     Sharp128x128,
     /// UC8151 e-paper, 296x128 (the Badger 2040's).
     Uc8151,
+    /// The Thumby's own panel: an SSD1306 on 72x40 glass on SPI, wired to the Thumby's pins
+    /// (chip select GP16, data/command GP17, reset GP20; its A button on GP27).
+    Thumby,
 }
 
 impl Panel {
     /// Every panel.
-    pub const ALL: [Panel; 8] = [
+    pub const ALL: [Panel; 9] = [
         Panel::Ssd1306,
         Panel::Sh1106,
         Panel::Ssd1309,
@@ -151,6 +154,7 @@ impl Panel {
         Panel::Sharp400x240,
         Panel::Sharp128x128,
         Panel::Uc8151,
+        Panel::Thumby,
     ];
 
     /// Its name: `host-sim --panel`'s and the emulated board's (`run.mjs --panel`).
@@ -164,6 +168,7 @@ impl Panel {
             Panel::Sharp400x240 => "sharp-400x240",
             Panel::Sharp128x128 => "sharp-128x128",
             Panel::Uc8151 => "uc8151",
+            Panel::Thumby => "thumby",
         }
     }
 
@@ -178,6 +183,7 @@ impl Panel {
             Panel::Sharp400x240 => Some("sharp-400x240"),
             Panel::Sharp128x128 => Some("sharp-128x128"),
             Panel::Uc8151 => Some("uc8151"),
+            Panel::Thumby => Some("thumby"),
         }
     }
 
@@ -186,7 +192,7 @@ impl Panel {
         match self {
             Panel::Ssd1306 | Panel::Sh1106 | Panel::Ssd1309 => Glass::Oled128x64,
             Panel::Ssd1306x32 => Glass::Oled128x32,
-            Panel::Ssd1306x40 => Glass::Oled72x40,
+            Panel::Ssd1306x40 | Panel::Thumby => Glass::Oled72x40,
             Panel::Sharp400x240 => Glass::Sharp400x240,
             Panel::Sharp128x128 => Glass::Sharp128x128,
             Panel::Uc8151 => Glass::Epaper296x128,

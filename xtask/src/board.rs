@@ -95,6 +95,16 @@ fn variant_image(feature: &str) -> String {
     format!("pico-{}", variant_name(feature))
 }
 
+/// The name of the UF2 file [`run_variant`] writes for the image with `feature`.
+fn variant_uf2(feature: &str) -> String {
+    format!("lattice-rt-{}.uf2", variant_image(feature))
+}
+
+/// The ELF file [`run_variant`] runs for the image with `feature` (built or kept).
+fn run_variant_image(root: &Path, feature: &str) -> PathBuf {
+    kept_image(root, &variant_image(feature))
+}
+
 /// Builds (unless `no_build`) the image with `feature` and the chair alone (or `all_scenes`),
 /// writes its UF2 file into `frames_dir/<feature>` and runs it for `frames` frames (with `run.mjs`
 /// switches `extra`); returns the run and that folder.
@@ -113,7 +123,7 @@ fn run_variant(
         if no_build { kept_image(root, &variant_image(feature)) } else { build_pico_with(root, feature, all_scenes)? };
     let dir = frames_dir.join(variant_name(feature));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let uf2 = dir.join(format!("lattice-rt-{}.uf2", variant_image(feature)));
+    let uf2 = dir.join(variant_uf2(feature));
     write_uf2(&elf, &uf2)?;
     eprintln!("running {} ({frames} frames)", uf2.display());
     let run = run_emulator(root, &elf, &uf2, bootrom, frames, true, &dir, extra)?;
@@ -566,6 +576,10 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
     let mut s = Session::prepare(root, frames_dir, no_build)?;
     if spd_only {
         let rows = s.spd_runs()?;
+        if let Some(images) = out.parent().map(|p| p.join("images")) {
+            std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
+            spd::spd_plot(&rows, &images.join(spd::PLOT))?;
+        }
         print!("{}", spd::spd_report(&rows)?);
         return s.checks.verdict();
     }
@@ -578,8 +592,9 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
         }
     }
     let fault_rows = s.fault_runs(&rows)?;
-    let button_row = s.button_run(&rows)?;
-    let (panel_rows, epaper_run) = s.panel_runs()?;
+    let mut button_rows: Vec<_> = s.button_run(&rows)?.into_iter().collect();
+    let (panel_rows, epaper_run, thumby_button) = s.panel_runs()?;
+    button_rows.extend(thumby_button);
     let epaper = epaper_run.map(|r| s.epaper_runs(&r)).transpose()?;
     let gray_run = s.gray_runs()?;
     if let Some(images) = out.parent().map(|p| p.join("images")) {
@@ -598,6 +613,9 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
     let slot_rows = s.slot_runs()?;
     let spd_rows = s.spd_runs()?;
+    if let Some(images) = out.parent().map(|p| p.join("images")) {
+        spd::spd_plot(&spd_rows, &images.join(spd::PLOT))?;
+    }
 
     let spi_byte = levers
         .iter()
@@ -630,7 +648,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
     }
     md.push_str(&slot::slot_report(&slot_rows)?);
     md.push_str(&faults::fault_report(&fault_rows)?);
-    md.push_str(&button::button_report(button_row.as_ref())?);
+    md.push_str(&button::button_report(&button_rows)?);
     md.push_str(&panels::panel_report(&panel_rows, s.scenes.first().map_or("", String::as_str), run.clk_sys_hz)?);
     let spi_chair = levers.iter().find(|(feature, ..)| *feature == "spi").map(|(_, _, f, _)| f.cycles);
     let gray_picture = out.parent().unwrap_or(Path::new(".")).join("images/board-gray-chair.png");

@@ -51,8 +51,8 @@ enum Command {
         /// Use the image already built instead of running `cargo pico-build`.
         #[arg(long)]
         no_build: bool,
-        /// Run only the Standard Procedural Databases' images and print their section (the
-        /// report is not written).
+        /// Run only the Standard Procedural Databases' images, print their section and draw
+        /// their plot beside the report (the report itself is not written).
         #[arg(long)]
         spd_only: bool,
     },

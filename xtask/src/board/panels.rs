@@ -5,7 +5,8 @@
 //! datasheets (firmware/board/sh1106.mjs, ssd1309.mjs, ssd1306.mjs's glasses): a command the
 //! controller does not have fails the run.
 
-use super::{host_frame, m3, save_frame_sized, BoardRun, Session, PICO, PICO_SCALAR};
+use super::button::{ButtonRow, Pressed};
+use super::{host_frame, m3, run_variant_image, save_frame_sized, variant_uf2, BoardRun, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
 use board_records::frame::{Build, Panel};
 use std::fmt::Write as _;
@@ -15,7 +16,7 @@ use std::fmt::Write as _;
 type Image = (Panel, Option<&'static str>, &'static str);
 
 /// The images checked.
-const PANELS: [Image; 9] = [
+const PANELS: [Image; 10] = [
     (Panel::Sh1106, Some("i2c-1mhz"), "SH1106 (1.3\" 128x64), I2C at 1 MHz"),
     (Panel::Sh1106, Some("spi"), "SH1106 (1.3\" 128x64), SPI at 10 MHz"),
     (Panel::Ssd1309, Some("i2c-1mhz"), "SSD1309 (2.42\" 128x64), I2C at 1 MHz"),
@@ -25,6 +26,7 @@ const PANELS: [Image; 9] = [
     (Panel::Sharp400x240, None, "Sharp memory LCD LS027B7DH01 (2.7\" 400x240), SPI at 2 MHz"),
     (Panel::Sharp128x128, None, "Sharp memory LCD LS013B7DH03 (1.28\" 128x128), SPI at 1 MHz"),
     (Panel::Uc8151, None, "UC8151 e-paper (2.9\" 296x128, the Badger 2040's), SPI at 10 MHz"),
+    (Panel::Thumby, None, "the Thumby's SSD1306 (0.42\" 72x40; CS GP16, DC GP17, RES GP20), SPI at 10 MHz"),
 ];
 
 /// An image's firmware features: its panel's, then its bus's.
@@ -64,9 +66,10 @@ pub(super) fn save_pictures(rows: &[PanelRow], images: &std::path::Path) -> Resu
 }
 
 impl Session<'_> {
-    /// Every panel's image on every embedded scene; with the e-paper's run, for its refreshes.
-    pub(super) fn panel_runs(&mut self) -> Result<(Vec<PanelRow>, Option<BoardRun>)> {
-        let (mut rows, mut epaper) = (Vec::new(), None);
+    /// Every panel's image on every embedded scene; with the e-paper's run, for its refreshes,
+    /// and the Thumby's image with its A button pressed.
+    pub(super) fn panel_runs(&mut self) -> Result<(Vec<PanelRow>, Option<BoardRun>, Option<ButtonRow>)> {
+        let (mut rows, mut epaper, mut thumby) = (Vec::new(), None, None);
         for image in PANELS {
             let (panel, _, what) = image;
             let (features, glass) = (features(image), panel.glass());
@@ -90,22 +93,38 @@ impl Session<'_> {
             });
             let first = run.frames.first().map(|f| (f.cycles, f.bus_bytes));
             let picture = run.frames.first().map(|f| f.pixels.clone()).unwrap_or_default();
-            rows.push(PanelRow { what, features, same, scenes: self.scenes.len(), first, size: (w, h), picture });
+            rows.push(PanelRow {
+                what,
+                features: features.clone(),
+                same,
+                scenes: self.scenes.len(),
+                first,
+                size: (w, h),
+                picture,
+            });
+            if panel == Panel::Thumby {
+                if let Some(first) = run.frames.first() {
+                    let (elf, uf2) = (run_variant_image(self.root, &features), dir.join(variant_uf2(&features)));
+                    let extra = ["--panel", panel.name()];
+                    let image = Pressed { elf: &elf, uf2: &uf2, build, extra: &extra, what: "the Thumby's A (GP27)" };
+                    thumby = Some(self.press_run(&image, first.end_ms, "thumby-button")?);
+                }
+            }
             if panel == Panel::Uc8151 {
                 epaper = Some(run);
             }
         }
-        Ok((rows, epaper))
+        Ok((rows, epaper, thumby))
     }
 }
 
 /// The report's section on the panels.
 pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Result<String> {
     let mut md = String::new();
-    writeln!(md, "\n## Other panels: SH1106, SSD1309, 128x32, 72x40 and Sharp memory LCDs\n")?;
+    writeln!(md, "\n## Other panels: SH1106, SSD1309, 128x32, 72x40, the Thumby's, Sharp memory LCDs and e-paper\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask board`: each image is built for its panel's controller (`cargo pico-build --features ...`) and runs on the emulated board with that controller on the bus in place of the SSD1306 (`run.mjs --panel`), every scene's frame checked against host-sim's. The SH1106 model (firmware/board/sh1106.mjs) has the SH1106's 132 columns of RAM, page addressing only and the glass on columns 2 to 129; the SSD1309 model (ssd1309.mjs) has no charge pump command and a command lock; the smaller SSD1306 modules show part of the controller's RAM (128x32: 32 multiplexed rows, COM pins in sequence; 72x40: columns 28 to 99 and 40 rows) and the frame is traced at the glass's size. The Sharp memory LCD model (sharp.mjs) takes line writes with its chip select active high, the mode and addresses LSB first, a dummy byte after each line and one after the last, holds noise after power-on until cleared or written, and fails the run when VCOM is left uninverted for more than a second. A command a controller does not have fails the run. The firmware sends each controller its own set-up and addresses the SH1106 page by page (`firmware/src/bin/pico/display/controller.rs`); it gathers a band of tiles for the Sharp LCD and sends its lines by DMA while the cores trace on (`display/sharp.rs`), and on frames of more than 32 tiles keeps three bands of tiles between trace and dither, not the whole frame (a 400x240 frame: 75 of 375 tiles). Target for the Sharp LCD at 400x240: the {first} in at most 62.5 M cycles (2 frames per second).\n"
+        "Written by `cargo xtask board`: each image is built for its panel's controller (`cargo pico-build --features ...`) and runs on the emulated board with that controller on the bus in place of the SSD1306 (`run.mjs --panel`), every scene's frame checked against host-sim's. The SH1106 model (firmware/board/sh1106.mjs) has the SH1106's 132 columns of RAM, page addressing only and the glass on columns 2 to 129; the SSD1309 model (ssd1309.mjs) has no charge pump command and a command lock; the smaller SSD1306 modules show part of the controller's RAM (128x32: 32 multiplexed rows, COM pins in sequence; 72x40: columns 28 to 99 and 40 rows) and the frame is traced at the glass's size. The Thumby's image drives the same 72x40 SSD1306 on the Thumby's own pins (CS GP16, DC GP17, RES GP20), its A button (GP27) the next-scene button (*The button* above). The Sharp memory LCD model (sharp.mjs) takes line writes with its chip select active high, the mode and addresses LSB first, a dummy byte after each line and one after the last, holds noise after power-on until cleared or written, and fails the run when VCOM is left uninverted for more than a second. A command a controller does not have fails the run. The firmware sends each controller its own set-up and addresses the SH1106 page by page (`firmware/src/bin/pico/display/controller.rs`); it gathers a band of tiles for the Sharp LCD and sends its lines by DMA while the cores trace on (`display/sharp.rs`), and on frames of more than 32 tiles keeps three bands of tiles between trace and dither, not the whole frame (a 400x240 frame: 75 of 375 tiles). Target for the Sharp LCD at 400x240: the {first} in at most 62.5 M cycles (2 frames per second).\n"
     )?;
     writeln!(md, "| panel and bus | features | pixels | frames bit-identical to host-sim | {first}: cycles | fps at 125 MHz | bytes on the bus |")?;
     writeln!(md, "|---|---|---|---:|---:|---:|---:|")?;

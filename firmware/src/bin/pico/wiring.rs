@@ -1,6 +1,7 @@
 //! How the display is wired to the board: the one place for its pins, bus, address and clock
 //! (the Pico and the Pico 2 share the pin-out). The log messages and docs/flashing.md name what
-//! is here. A module on I2C is the default; the `spi` feature is for the 4-wire SPI modules.
+//! is here. A module on I2C is the default; the `spi` feature is for the 4-wire SPI modules,
+//! `thumby` for the Thumby's own panel and button, on its pins.
 
 use crate::hal;
 use hal::fugit::RateExtU32;
@@ -26,15 +27,16 @@ impl Wiring {
     pub const SCK: u8 = 18;
     /// The GPIO the display's D1 (SPI data in) is on (`spi`: SPI0 TX).
     pub const MOSI: u8 = 19;
-    /// The GPIO the display's CS is on (`spi`; active low).
-    pub const CS: u8 = 17;
-    /// The GPIO the display's DC (data/command) is on (`spi`).
-    pub const DC: u8 = 20;
-    /// The GPIO the display's RES (reset, active low) is on (`spi`).
-    pub const RES: u8 = 21;
+    /// The GPIO the display's CS is on (`spi`; active low; the Thumby's on GP16).
+    pub const CS: u8 = if cfg!(feature = "thumby") { 16 } else { 17 };
+    /// The GPIO the display's DC (data/command) is on (`spi`; the Thumby's on GP17).
+    pub const DC: u8 = if cfg!(feature = "thumby") { 17 } else { 20 };
+    /// The GPIO the display's RES (reset, active low) is on (`spi`; the Thumby's on GP20).
+    pub const RES: u8 = if cfg!(feature = "thumby") { 20 } else { 21 };
     /// The GPIO a push button to ground shows the next scene on (pulled up inside; pressed
-    /// during the pause between scenes, it ends the pause).
-    pub const NEXT: u8 = 14;
+    /// during the pause between scenes, it ends the pause): GP14, or the Thumby's A button on
+    /// GP27.
+    pub const NEXT: u8 = if cfg!(feature = "thumby") { 27 } else { 14 };
     /// The GPIO a Sharp memory LCD's DISP (display on) is on (`sharp`; its SCS, active high, is
     /// on [`Wiring::CS`], its SCLK and SI on SPI0's).
     pub const DISP: u8 = 20;
@@ -62,6 +64,25 @@ impl Wiring {
 
 /// An output pin as `connect` sets it up.
 type Output<P> = Pin<P, hal::gpio::FunctionSioOutput, PullDown>;
+
+/// The SPI display's chip select ([`Wiring::CS`]), data/command ([`Wiring::DC`]) and reset
+/// ([`Wiring::RES`]) pins, as types: GP17, GP20, GP21.
+#[cfg(all(feature = "spi", not(feature = "sharp"), not(feature = "thumby")))]
+mod spi_pins {
+    use super::bank0;
+    pub type Cs = bank0::Gpio17;
+    pub type Dc = bank0::Gpio20;
+    pub type Res = bank0::Gpio21;
+}
+/// The Thumby's chip select ([`Wiring::CS`]), data/command ([`Wiring::DC`]) and reset
+/// ([`Wiring::RES`]) pins, as types: GP16, GP17, GP20.
+#[cfg(feature = "thumby")]
+mod spi_pins {
+    use super::bank0;
+    pub type Cs = bank0::Gpio16;
+    pub type Dc = bank0::Gpio17;
+    pub type Res = bank0::Gpio20;
+}
 
 /// I2C0 on [`Wiring::SDA`] and [`Wiring::SCL`] at [`Wiring::I2C_HZ`], through the display's
 /// queue.
@@ -98,8 +119,8 @@ pub struct Interface {
 /// [`Wiring::CS`], data/command on [`Wiring::DC`].
 #[cfg(all(feature = "spi", not(feature = "sharp")))]
 pub type Interface = ssd1306::prelude::SPIInterface<
-    embedded_hal_bus::spi::ExclusiveDevice<Spi0, Output<bank0::Gpio17>, embedded_hal_bus::spi::NoDelay>,
-    Output<bank0::Gpio20>,
+    embedded_hal_bus::spi::ExclusiveDevice<Spi0, Output<spi_pins::Cs>, embedded_hal_bus::spi::NoDelay>,
+    Output<spi_pins::Dc>,
 >;
 
 /// The on-board LED as an output.
@@ -107,7 +128,7 @@ pub type Led = Output<bank0::Gpio25>;
 
 /// The display's reset line (`spi`: [`Wiring::RES`]; an I2C module resets itself at power-on).
 #[cfg(all(feature = "spi", not(feature = "sharp")))]
-pub type Reset = Output<bank0::Gpio21>;
+pub type Reset = Output<spi_pins::Res>;
 /// The display's reset line (none on an I2C module, which resets itself at power-on, nor on a
 /// Sharp memory LCD).
 #[cfg(any(not(feature = "spi"), feature = "sharp"))]
@@ -155,15 +176,16 @@ pub fn connect(
             embedded_hal::spi::MODE_0,
         )
     };
+    #[cfg(all(feature = "spi", not(feature = "sharp"), not(feature = "thumby")))]
+    let (cs, dc, res) = (pins.gpio17, pins.gpio20, pins.gpio21);
+    #[cfg(feature = "thumby")]
+    let (cs, dc, res) = (pins.gpio16, pins.gpio17, pins.gpio20);
     #[cfg(all(feature = "spi", not(feature = "sharp")))]
     let (display, reset) = {
-        let cs = pins.gpio17.into_push_pull_output_in_state(hal::gpio::PinState::High);
+        let cs = cs.into_push_pull_output_in_state(hal::gpio::PinState::High);
         let Ok(device) = embedded_hal_bus::spi::ExclusiveDevice::new_no_delay(spi, cs);
-        let dc = pins.gpio20.into_push_pull_output();
-        (
-            ssd1306::prelude::SPIInterface::new(device, dc),
-            pins.gpio21.into_push_pull_output_in_state(hal::gpio::PinState::High),
-        )
+        let dc = dc.into_push_pull_output();
+        (ssd1306::prelude::SPIInterface::new(device, dc), res.into_push_pull_output_in_state(hal::gpio::PinState::High))
     };
     #[cfg(feature = "sharp")]
     let (display, reset) = {
@@ -173,7 +195,10 @@ pub fn connect(
     };
     // The button's pin: an input with its pull-up (read by `button::pressed`); the pin's
     // setting stays when its value is dropped.
+    #[cfg(not(feature = "thumby"))]
     let _ = pins.gpio14.into_pull_up_input();
+    #[cfg(feature = "thumby")]
+    let _ = pins.gpio27.into_pull_up_input();
     #[cfg(feature = "uc8151")]
     {
         let _ = pins.gpio26.into_pull_up_input();
@@ -205,3 +230,6 @@ pub fn log() {
     #[cfg(feature = "uc8151")]
     defmt::info!("the e-paper's BUSY on GP{}, 3V3_EN held high on GP{}", Wiring::BUSY, Wiring::POWER_ON);
 }
+
+#[cfg(all(feature = "thumby", any(feature = "sharp", feature = "uc8151")))]
+compile_error!("the Thumby has its own panel on its own pins: leave out `sharp` and `uc8151`");
