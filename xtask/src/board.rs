@@ -576,10 +576,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
     let mut s = Session::prepare(root, frames_dir, no_build)?;
     if spd_only {
         let rows = s.spd_runs()?;
-        if let Some(images) = out.parent().map(|p| p.join("images")) {
-            std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
-            spd::spd_plot(&rows, &images.join(spd::PLOT))?;
-        }
+        spd::spd_plot(&rows, out)?;
         print!("{}", spd::spd_report(&rows)?);
         return s.checks.verdict();
     }
@@ -613,9 +610,7 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
     let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
     let slot_rows = s.slot_runs()?;
     let spd_rows = s.spd_runs()?;
-    if let Some(images) = out.parent().map(|p| p.join("images")) {
-        spd::spd_plot(&spd_rows, &images.join(spd::PLOT))?;
-    }
+    spd::spd_plot(&spd_rows, out)?;
 
     let spi_byte = levers
         .iter()

@@ -146,8 +146,11 @@ fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
 }
 
 /// The plot of the sphereflake's images (`balls` at each size run): flash and static RAM (KiB),
-/// cycles per frame (millions) and XIP misses per ray against its objects, written to `path`.
-pub(super) fn spd_plot(rows: &[SpdRow], path: &Path) -> Result<()> {
+/// cycles per frame (millions) and XIP misses per ray against its objects, written as [`PLOT`]
+/// into the folder `images` beside the report `out`.
+pub(super) fn spd_plot(rows: &[SpdRow], out: &Path) -> Result<()> {
+    let images = out.parent().unwrap_or(Path::new(".")).join("images");
+    std::fs::create_dir_all(&images).with_context(|| format!("cannot create {}", images.display()))?;
     let names = ["flash of the image (KiB)", "static RAM (KiB)", "cycles per frame (M)", "XIP misses per ray"];
     let mut series: Vec<(String, Vec<(f64, f64)>)> = names.iter().map(|n| (n.to_string(), Vec::new())).collect();
     for r in rows.iter().filter(|r| r.name.starts_with("balls-")) {
@@ -160,7 +163,7 @@ pub(super) fn spd_plot(rows: &[SpdRow], path: &Path) -> Result<()> {
         }
     }
     crate::plot::loglog(
-        path,
+        &images.join(PLOT),
         "The sphereflake baked into the Pico's flash (emulated board)",
         "objects (balls at sizes 1, 2, 3)",
         "KiB, M cycles, misses per ray",
