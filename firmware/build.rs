@@ -220,7 +220,7 @@ const PICO_OTHER_RAM: usize = 160 * 1024;
 fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
     let (flash, code, ram) = match (has("pico"), has("pico2")) {
         (true, _) => (1792 * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024),
-        (_, true) => (2048 * 1024, PICO2_CODE_FLASH, 512 * 1024),
+        (_, true) => (4096 * 1024, PICO2_CODE_FLASH, 512 * 1024),
         _ => return,
     };
     let kib = |b: usize| format!("{:.0} KiB", b as f64 / 1024.0);
