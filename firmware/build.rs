@@ -55,6 +55,11 @@ fn main() {
             (name, path, text)
         })
         .collect();
+    for (i, (name, path, _)) in scenes.iter().enumerate() {
+        if let Some((other, ..)) = scenes[..i].iter().find(|(n, ..)| table_name(n) == table_name(name)) {
+            panic!("FIRMWARE_SCENES: {} is named `{name}`, as `{other}` before it is (scenes are told apart by name: rename the file)", path.display());
+        }
+    }
     for (name, path, text) in &scenes {
         let (s, e, serves) = plan_in_scalar(path, text, None);
         effects |= e;
@@ -283,7 +288,14 @@ fn has(feature: &str) -> bool {
 
 /// The static a baked scene's tables are named by.
 fn table_name(scene: &str) -> String {
-    scene.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect()
+    let name: String =
+        scene.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect();
+    // A file's stem may start with a digit, which no Rust name does.
+    if name.starts_with(|c: char| c.is_ascii_digit()) {
+        format!("_{name}")
+    } else {
+        name
+    }
 }
 
 /// [`plan`] in the scalar the firmware's features choose.
