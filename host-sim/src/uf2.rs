@@ -177,9 +177,10 @@ pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, bake: &[PathBu
     let stems: Vec<String> =
         files.iter().filter_map(|f| f.file_stem()).map(|s| s.to_string_lossy().to_string()).collect();
     let parts: Vec<String> = features.map(|f| f.replace(',', "-")).into_iter().chain(stems).collect();
-    let named = match parts.is_empty() {
-        false => format!("out/lattice-rt-{}-{}.uf2", board.name(), parts.join("-")),
-        true => format!("out/lattice-rt-{}.uf2", board.name()),
+    let named = if parts.is_empty() {
+        format!("out/lattice-rt-{}.uf2", board.name())
+    } else {
+        format!("out/lattice-rt-{}-{}.uf2", board.name(), parts.join("-"))
     };
     let out = out.map_or_else(|| PathBuf::from(named), Path::to_path_buf);
     board.write_uf2(&elf, &out)?;

@@ -119,8 +119,7 @@ fn run_variant(
     frames: usize,
     extra: &[&str],
 ) -> Result<(BoardRun, PathBuf)> {
-    let elf =
-        if no_build { kept_image(root, &variant_image(feature)) } else { build_pico_with(root, feature, all_scenes)? };
+    let elf = if no_build { run_variant_image(root, feature) } else { build_pico_with(root, feature, all_scenes)? };
     let dir = frames_dir.join(variant_name(feature));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let uf2 = dir.join(variant_uf2(feature));
