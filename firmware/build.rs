@@ -26,10 +26,7 @@ fn main() {
     let mut list = String::new();
     let mut sizes = Sizes { objects: 1, lattices: 1, coords: 1, words: 1, rows: 0 };
     let mut effects = 0u8;
-    // Baked scenes: asked for (`baked`), or the Raspberry Pi boards' default: their frames are
-    // shown from the scenes' own cameras, so nothing needs parsing on the board, unless the
-    // camera moves (`orbit`) or run-time parsing is asked for (`parse`).
-    let baked = has("baked") || (has("rp") && !has("orbit") && !has("parse"));
+    let baked = bakes();
     println!("cargo::rustc-check-cfg=cfg(baked_scenes)");
     if baked {
         println!("cargo:rustc-cfg=baked_scenes");
@@ -145,10 +142,12 @@ fn link(out: &std::path::Path) {
             kib.trim().parse().unwrap_or_else(|_| panic!("FIRMWARE_FLASH_KIB is not a number of KiB: {kib:?}"));
         map = map.replace("LENGTH = 16K", &format!("LENGTH = {kib}K"));
     }
-    // The slot image keeps its code below the scene slot (`board_records::slot::ADDRESS`).
-    if has("slot") {
-        let below = board_records::slot::ADDRESS - 0x1000_0000;
-        map = map.replace("LENGTH = 1792K - 0x100", &format!("LENGTH = {}K - 0x100", below / 1024));
+    // The Pico's flash as this image divides it (`pico_flash_kib`, `pico_code_load_kib`).
+    if pico {
+        let (flash, load) = (pico_flash_kib(), pico_code_load_kib());
+        map = replace_line(&map, "FLASH     :", &format!("FLASH     : ORIGIN = 0x10000100, LENGTH = {flash}K - 0x100"));
+        let origin = 0x1000_0000 + (2048 - load) * 1024;
+        map = replace_line(&map, "CODE_LOAD :", &format!("CODE_LOAD : ORIGIN = {origin:#X}, LENGTH = {load}K"));
     }
     fs::write(out.join("memory.x"), map).expect("memory.x");
     println!("cargo:rustc-link-search={}", out.display());
@@ -190,6 +189,16 @@ fn link(out: &std::path::Path) {
     }
 }
 
+/// `map` with its line that starts (after indentation) with `start` replaced by `line`.
+fn replace_line(map: &str, start: &str, line: &str) -> String {
+    assert!(map.lines().any(|l| l.trim_start().starts_with(start)), "memory.x has no line `{start}`");
+    let lines: Vec<String> = map
+        .lines()
+        .map(|l| if l.trim_start().starts_with(start) { format!("    {line}") } else { l.to_string() })
+        .collect();
+    lines.join("\n") + "\n"
+}
+
 /// What baking a scene asks of [`plan`]: its name, whether its lattice goes into flash, the
 /// source its tables are appended to and the list its footprint is added to.
 struct Bake<'a> {
@@ -210,7 +219,7 @@ struct Footprint {
 
 /// Flash of the Pico image besides the baked scenes' tables, at most: its code in flash, the
 /// other read-only data, the vector table (about 40 KiB today; its hot code runs from SRAM and
-/// is loaded from the last 256 KiB of flash, outside the region).
+/// is loaded from the top of flash, outside the region: `pico_code_load_kib`).
 const PICO_CODE_FLASH: usize = 64 * 1024;
 /// The same for the Pico 2's image, all of whose code stays in flash (about 110 KiB today).
 const PICO2_CODE_FLASH: usize = 128 * 1024;
@@ -224,7 +233,7 @@ const PICO_OTHER_RAM: usize = 160 * 1024;
 /// linker scripts.
 fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
     let (flash, code, ram) = match (has("pico"), has("pico2")) {
-        (true, _) => (1792 * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024),
+        (true, _) => (pico_flash_kib() * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024),
         (_, true) => (4096 * 1024, PICO2_CODE_FLASH, 512 * 1024),
         _ => return,
     };
@@ -279,6 +288,37 @@ fn scene_file(entry: &str) -> (String, PathBuf) {
         panic!("FIRMWARE_SCENES: {entry}: a path names its scene by its file's stem, and this one has none")
     });
     (name.to_string(), path)
+}
+
+/// Whether the image bakes its scenes: asked for (`baked`), or the Raspberry Pi boards' default:
+/// their frames are shown from the scenes' own cameras, so nothing needs parsing on the board,
+/// unless the camera moves (`orbit`) or run-time parsing is asked for (`parse`).
+fn bakes() -> bool {
+    has("baked") || (has("rp") && !has("orbit") && !has("parse"))
+}
+
+/// The Pico's flash (KiB, after the 256-byte second-stage bootloader) that the image's code and
+/// read-only data, baked scenes' tables included, may take: all of the 2 MiB but the region
+/// its SRAM code is loaded from at the top (`PICO_CODE_LOAD_KIB`), and for the slot image all
+/// below the scene slot.
+fn pico_flash_kib() -> usize {
+    if has("slot") {
+        (board_records::slot::ADDRESS - 0x1000_0000) as usize / 1024
+    } else {
+        2048 - pico_code_load_kib()
+    }
+}
+
+/// The Pico's region (KiB, at the top of flash) the code that runs from SRAM is loaded from: as
+/// much as the images that parse scenes and build lattices on the board need (180 KiB, `parse`;
+/// 256 KiB, the SRAM's size), and 128 KiB for the images that bake their scenes (about 64 KiB
+/// of code), whose tables take the flash this leaves.
+fn pico_code_load_kib() -> usize {
+    if bakes() {
+        128
+    } else {
+        256
+    }
 }
 
 /// Whether the firmware is built with Cargo feature `feature` (its name as in Cargo.toml).

@@ -110,6 +110,11 @@ mod writer {
         out.push_str(" }");
     }
 
+    impl Literal for crate::cull::HullEdge {
+        fn literal(&self, out: &mut String) {
+            let _ = write!(out, "HullEdge::new({}, {}, {})", self.a, self.b, self.c);
+        }
+    }
     impl<R: Literal> Literal for crate::scalar::Pow2<R> {
         fn literal(&self, out: &mut String) {
             out.push_str("Pow2(");
@@ -351,7 +356,7 @@ pub mod prelude {
     pub use crate::math::{Aabb, Affine, Linear, Vec3};
     pub use crate::scalar::Pow2;
     pub use crate::scene::Scene;
-    pub use crate::scene::{Camera, Composite, Light, Material, Object, Smooth};
+    pub use crate::scene::{Camera, Composite, HullEdge, Light, Material, Object, Smooth};
     pub use crate::shape::Shape;
     pub use crate::trace::Effects;
     pub use crate::{F32Micro, F32MicroNewton, Fx};

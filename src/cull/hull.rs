@@ -13,7 +13,7 @@
 //! where the eye's rays graze the sphere).
 
 use super::projection::Projection;
-use super::region::{EyeHull, NO_HULL};
+use super::region::{EyeHull, HullEdge, NO_HULL};
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
 use crate::scene::Object;
@@ -120,9 +120,9 @@ pub(crate) fn eye_hull<R: Real>(o: &Object<R>, projection: &Projection, pad: f64
         let c = libm::ceil(far + MARGIN * (a.abs() + b.abs())) + 1.0;
         // An edge whose bound leaves `i32` culls nothing; one far below only widens to -2^30.
         *edge = if c < (1u32 << 30) as f64 {
-            [a as i32, b as i32, c.max(-((1u32 << 30) as f64)) as i32]
+            HullEdge { a: a as i16, b: b as i16, c: c.max(-((1u32 << 30) as f64)) as i32 }
         } else {
-            NO_HULL[0]
+            HullEdge::EVERYWHERE
         };
     }
     hull

@@ -3,7 +3,7 @@
 use super::block::{behind, block_directions};
 #[cfg(feature = "eye-hulls")]
 use super::hull::convex_hull;
-use super::region::{hull_meets, NO_HULL};
+use super::region::{hull_meets, HullEdge, NO_HULL};
 use crate::camera::Camera;
 use crate::math::Vec3;
 use crate::scalar::Real;
@@ -52,10 +52,10 @@ fn over_generated(mut each: impl FnMut(&Scene<'_, crate::Fx>, &str) -> usize) ->
 #[test]
 fn a_rectangle_outside_an_edge_is_culled() {
     // The diamond |u| + |v| <= 1 (units of 2^-10: 1024), as four edges with a, b = 2^14.
-    let n = 1 << 14;
+    let n: i16 = 1 << 14;
     let mut hull = NO_HULL;
     for (k, (a, b)) in [(n, n), (-n, n), (-n, -n), (n, -n)].into_iter().enumerate() {
-        hull[k] = [a, b, n * 1024];
+        hull[k] = HullEdge::new(a, b, i32::from(n) * 1024);
     }
     let unit = 1 << 16;
     assert!(hull_meets(&hull, [0, 0], [0, 0]));
@@ -82,8 +82,8 @@ fn no_eye_ray_just_outside_a_hull_edge_hits_the_object() {
             // where the window is the tighter bound; for an object seen well in front of
             // the eye, as in the paper's scenes, not every edge).
             let before = rays;
-            let edges = o.region.eye_hull.iter().filter(|e| e[2] != i32::MAX).count();
-            for &[a, b, c] in o.region.eye_hull.iter().filter(|e| e[2] != i32::MAX) {
+            let edges = o.region.eye_hull.iter().filter(|e| !e.is_everywhere()).count();
+            for &HullEdge { a, b, c } in o.region.eye_hull.iter().filter(|e| !e.is_everywhere()) {
                 let (a, b) = (f64::from(a), f64::from(b));
                 let n2 = a * a + b * b;
                 // The foot of the line a U + b V = c + 1 (units of 2^-10), and its direction.
