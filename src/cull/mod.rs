@@ -21,7 +21,9 @@ pub mod region;
 mod tests;
 pub(crate) mod tiles;
 
-pub use region::{Culled, EyeHull, EyeWindow, HullEdge, Region, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE};
+pub use region::{
+    Culled, EyeHull, EyeWindow, HullEdge, Region, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE,
+};
 
 /// Calls `f` with each object of a mask (bit `i`: object `i`, of the first 64) that a scene of
 /// `n` objects has, lowest first, until `f` answers true; returns whether it did. The mask is

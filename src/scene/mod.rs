@@ -21,7 +21,9 @@ pub mod polygon;
 pub mod text;
 
 pub use crate::camera::{lowest_terms, Camera, CameraDesc, FieldOfView, DEFAULT_FRAME, VIEW_MARGIN};
-pub use crate::cull::{Culled, EyeHull, EyeWindow, HullEdge, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE};
+pub use crate::cull::{
+    Culled, EyeHull, EyeWindow, HullEdge, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE,
+};
 pub use builder::{check_value, SceneBuilder, IOR};
 pub use error::SceneError;
 pub use model::{

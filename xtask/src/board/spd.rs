@@ -29,6 +29,8 @@ pub(super) const SCENES: [(Generator, Option<u32>); 9] = [
 
 /// Cycles a frame of `balls` at size 3 may take: 2 frames per second at 125 MHz.
 const BALLS_3_TARGET: u64 = 62_500_000;
+/// Cycles a frame of an SPD scene at its default size may take: 2 seconds at 125 MHz.
+const DEFAULT_TARGET: u64 = 250_000_000;
 
 /// What one scene's image did.
 pub(super) struct SpdRow {
@@ -165,10 +167,61 @@ pub(super) fn spd_plot(rows: &[SpdRow], out: &Path) -> Result<()> {
     crate::plot::loglog(
         &images.join(PLOT),
         "The sphereflake baked into the Pico's flash (emulated board)",
-        "objects (balls at sizes 1, 2, 3)",
+        &format!("objects (balls at sizes {})", balls_sizes(rows)),
         "KiB, M cycles, misses per ray",
         &series,
     )
+}
+
+/// The sizes of the sphereflake whose images ran (for the plot's labels), as `1, 2, 3`.
+fn balls_sizes(rows: &[SpdRow]) -> String {
+    let sizes: Vec<&str> =
+        rows.iter().filter(|r| r.frame.is_some()).filter_map(|r| r.name.strip_prefix("balls-")).collect();
+    sizes.join(", ")
+}
+
+/// What one object's record in flash is made of (bytes, in fixed point as the Pico bakes it):
+/// every shape takes the same record.
+fn record_parts() -> String {
+    use lattice_rt::scene::{EyeHull, EyeWindow, Object, ShadowWindow};
+    use lattice_rt::{Aabb, Affine, Fx, Linear, Vec3};
+    use std::mem::size_of;
+    let parts = [
+        ("placement's inverse", size_of::<Linear<Fx>>()),
+        ("placement", size_of::<Affine<Fx>>()),
+        ("bounds", size_of::<Aabb<Fx>>()),
+        ("eye and light in object space", 2 * size_of::<Vec3<Fx>>()),
+        ("eye window", size_of::<EyeWindow>()),
+        ("eye hull", size_of::<EyeHull>()),
+        ("shadow window", size_of::<ShadowWindow<Fx>>()),
+    ];
+    let total = size_of::<Object<Fx>>();
+    let named: usize = parts.iter().map(|p| p.1).sum();
+    let each: Vec<String> = parts.iter().map(|(n, b)| format!("{n} {b}")).collect();
+    format!(
+        "Each object, whatever its shape, is one record of {total} bytes in flash: {}, and {} for its shape, scales, material and composite",
+        each.join(", "),
+        total - named
+    )
+}
+
+/// Whether an SPD scene at its default size met the targets (fits the Pico's flash, a frame in
+/// at most [`DEFAULT_TARGET`] cycles, the XIP stall at most a quarter of it), as a phrase.
+fn default_verdict(r: &SpdRow) -> String {
+    match (&r.built, &r.frame) {
+        (Err(_), _) => "does not fit the Pico's flash (**missed**)".into(),
+        (Ok(_), None) => "fits, but showed no frame (**missed**)".into(),
+        (Ok(_), Some(f)) => {
+            let stall = f.xip_stall as f64 / f.cycles.max(1) as f64;
+            let met = f.cycles <= DEFAULT_TARGET && stall <= 0.25;
+            format!(
+                "fits; {} cycles, XIP stall {:.1} % ({})",
+                m3(f.cycles),
+                100.0 * stall,
+                if met { "met" } else { "**missed**" }
+            )
+        }
+    }
 }
 
 /// The picture [`spd_plot`] draws, in docs/images.
@@ -182,9 +235,10 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
         md,
         "Written by `cargo xtask board`: each scene of Eric Haines' SPD is generated as NFF (`host-sim spd NAME --size N`), baked into its own Pico image (`FIRMWARE_SCENES=/path/NAME-N.nff cargo pico-build --features triangles`: objects, lattice and windows as tables in flash, read through the 16 KiB XIP cache; RAM holds what a frame writes) and run on the emulated board, its frame checked against host-sim's render of the same file with the board's settings (`host-sim render FILE --board pico`). Object tests per ray and rays are the board's own counts. Target: balls at size 3 (820 spheres and the floor) in at most 62.5 M cycles; every curve scene at its default size fitting the Pico's flash and drawn in at most 250 M cycles, with the XIP stall at most a quarter of the frame.\n"
     )?;
-    writeln!(md, "| scene | objects | flash (image) | lattice bytes | RAM (static) | frame: cycles | fps at 125 MHz | XIP misses per ray | XIP stall | eye rays | all rays | object tests per ray | bit-identical to host-sim |")?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")?;
+    writeln!(md, "| scene | objects | flash (image) | object records | lattice bytes | RAM (static) | frame: cycles | fps at 125 MHz | XIP misses per ray | XIP stall | eye rays | all rays | object tests per ray | bit-identical to host-sim |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")?;
     let kib = |b: u64| format!("{:.0} KiB", b as f64 / 1024.0);
+    let record = std::mem::size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>() as u64;
     let mut refused = Vec::new();
     for r in rows {
         let (flash, ram) = match &r.built {
@@ -195,16 +249,22 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
             }
         };
         let Some(f) = &r.frame else {
-            writeln!(md, "| {} | {} | {flash} | - | {ram} | - | - | - | - | - | - | - | - |", r.name, r.objects)?;
+            let records = kib(r.objects as u64 * record);
+            writeln!(
+                md,
+                "| {} | {} | {flash} | {records} | - | {ram} | - | - | - | - | - | - | - | - |",
+                r.name, r.objects
+            )?;
             continue;
         };
         let rays: u64 = f.rays.iter().sum();
         let per_ray = |n: u64| format!("{:.2}", n as f64 / rays.max(1) as f64);
         writeln!(
             md,
-            "| {} | {} | {flash} | {} | {ram} | {} | {:.2} | {} | {:.1} % | {} | {rays} | {} | {} |",
+            "| {} | {} | {flash} | {} | {} | {ram} | {} | {:.2} | {} | {:.1} % | {} | {rays} | {} | {} |",
             r.name,
             r.objects,
+            kib(r.objects as u64 * record),
             f.lattice_bytes,
             m3(f.cycles),
             f.clk_hz / f.cycles.max(1) as f64,
@@ -215,13 +275,21 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
             if f.same { "yes" } else { "**no**" }
         )?;
     }
+    writeln!(md, "\n{}.", record_parts())?;
     if !refused.is_empty() {
-        writeln!(md, "\nRefused by `firmware/build.rs` (each object is a full record today: shape, placement and its inverse, bounds, its windows on the image and to the light):\n")?;
+        writeln!(md, "\nRefused by `firmware/build.rs`:\n")?;
         for r in &refused {
             writeln!(md, "{r}")?;
         }
     }
-    writeln!(md, "\nThe sphereflake's images by size (`balls` 1 to 3; at 4, its default, it does not fit):\n\n![flash, RAM, cycles and XIP misses per ray of balls at sizes 1 to 3](images/{PLOT})")?;
+    let sizes = balls_sizes(rows);
+    writeln!(md, "\nThe sphereflake's images by size (`balls` at {sizes}):\n\n![flash, RAM, cycles and XIP misses per ray of balls at sizes {sizes}](images/{PLOT})")?;
+    writeln!(md, "\nAt their default sizes (target: fits the Pico's 2 MiB, a frame in at most 250 M cycles, XIP stall at most a quarter):\n")?;
+    for (r, (g, size)) in rows.iter().zip(SCENES) {
+        if size.is_none() && g != Generator::Jacks {
+            writeln!(md, "- {}: {}", r.name, default_verdict(r))?;
+        }
+    }
     if let Some(f) = rows.iter().find(|r| r.name == "balls-3").and_then(|r| r.frame.as_ref()) {
         let met = if f.cycles <= BALLS_3_TARGET { "met" } else { "**missed**" };
         writeln!(md, "\nballs at size 3: {} cycles against the target's 62.5 M: {met}.", m3(f.cycles))?;
