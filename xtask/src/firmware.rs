@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod spd;
+
 /// One firmware build.
 pub(crate) struct Variant {
     pub(crate) name: String,
@@ -216,6 +218,26 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
     host_sim::uf2::build_image(root, &v.name, &args, scenes, &built)
         .with_context(|| format!("building firmware variant {} failed", v.name))?;
     Ok(())
+}
+
+/// Why the image built by `cargo ARGS` with `scenes` baked was not built: `firmware/build.rs`'s
+/// message (the build is run again to read it, its folder left out of the paths it names), or
+/// the build's failure.
+pub(crate) fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
+    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .args(args)
+        .env("FIRMWARE_SCENES", scenes)
+        .output();
+    let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
+    // The build script's panic message is the line after its `panicked at`.
+    let mut lines = text.lines().map(str::trim);
+    let message = lines.by_ref().find(|l| l.contains("panicked at")).and(lines.next());
+    let folder = Path::new(scenes).parent().map(|p| format!("{}/", p.display())).unwrap_or_default();
+    message.map_or_else(
+        || "the image did not build".into(),
+        |m| m.trim_start_matches("FIRMWARE_SCENES: ").replace(&folder, ""),
+    )
 }
 
 /// Flash bytes (every allocated section with contents, `.data` counted at its load address)
@@ -606,9 +628,9 @@ fn baked_flash_parts(md: &mut String, root: &Path, v: &Variant, r: &Run, allfx: 
 }
 
 /// The command.
-pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
+pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool, with_spd: bool) -> Result<()> {
     let mut md = String::new();
-    writeln!(md, "# Firmware budgets\n\nWritten by `cargo xtask firmware` (also run by `.ci/run`).\nFrames are 128x64, lattice, blue-noise dither, each scene's own effects and depth.\n")?;
+    writeln!(md, "# Firmware budgets\n\nWritten by `cargo xtask firmware` (also run by `.ci/run`; `--spd` adds the last section).\nFrames are 128x64, lattice, blue-noise dither, each scene's own effects and depth.\n")?;
     let variants = variants();
     let runs = build_and_run(root, &variants, skip_build, &mut md)?;
     let mut tally = Tally::default();
@@ -621,6 +643,9 @@ pub fn firmware_cmd(root: &Path, out: &Path, skip_build: bool) -> Result<()> {
     tiny_section(&mut md, root, &runs, &identical, &mut tally)?;
     table.smallest(&mut md)?;
     float_audit_section(root, &variants, &mut md, &mut tally)?;
+    if with_spd {
+        spd::spd_section(root, &mut md, &mut tally)?;
+    }
     std::fs::create_dir_all(out.parent().unwrap_or(Path::new(".")))?;
     std::fs::write(out, md).with_context(|| format!("cannot write {}", out.display()))?;
     let csv_path = out.with_extension("csv");

@@ -65,6 +65,11 @@ enum Command {
         /// Use the firmware already built instead of building it.
         #[arg(long)]
         no_build: bool,
+        /// Also bake the SPD's curve scenes at their default sizes (7,383 to 8,402 objects)
+        /// into the image of the Pico 2's core, one image each, run them in QEMU and check their
+        /// frames (about 10 minutes more; not run by CI).
+        #[arg(long)]
+        spd: bool,
     },
     /// Build the browser playground (the core in WebAssembly, the panel, the exact Pico image
     /// on an emulated RP2040) into a folder to serve; `--serve` serves it, `--check` tests it in
@@ -253,7 +258,7 @@ fn real_main() -> Result<()> {
         Command::Playground { out, serve, check, screenshot, no_build } => {
             playground::playground_cmd(&root, &playground::PlaygroundArgs { out, serve, check, screenshot, no_build })
         }
-        Command::Firmware { out, no_build } => firmware::firmware_cmd(&root, &out, no_build),
+        Command::Firmware { out, no_build, spd } => firmware::firmware_cmd(&root, &out, no_build, spd),
         Command::Bench { quick, runs, out, plot } => bench::bench_cmd(quick, runs, &out, &plot),
         Command::Spd { out, runs, no_povray } => spd::spd_cmd(&out, runs, !no_povray),
         Command::Versus { scenes, runs, no_povray } => bench::versus_cmd(&scenes, runs, !no_povray),

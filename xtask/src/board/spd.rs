@@ -5,13 +5,12 @@
 //! refused by `firmware/build.rs` with the figures; the report gives its message.
 
 use super::{elf_sizes, m3, reported_frame, run_emulator, save_frame, Session, PICO, PICO_SCALAR};
-use crate::firmware::host_frame_of;
+use crate::firmware::{host_frame_of, refusal};
 use anyhow::{Context, Result};
 use host_sim::spd::Generator;
 use host_sim::uf2::{build_image, kept_image, pico_built, write_uf2, Scenes};
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::Command;
 
 /// The scenes run: the sphereflake at sizes 1 to 3 (3: 820 spheres and the floor, the target's),
 /// the small jacks, and every curve scene at its default size (the published figures' size).
@@ -126,25 +125,6 @@ impl Session<'_> {
         });
         Ok(SpdRow { name, objects, built, frame })
     }
-}
-
-/// Why the image with `scenes` baked was not built: `firmware/build.rs`'s message (the build is
-/// run again to read it), or the build's failure.
-fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
-    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(root)
-        .args(args)
-        .env("FIRMWARE_SCENES", scenes)
-        .output();
-    let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
-    // The build script's panic message is the line after its `panicked at`.
-    let mut lines = text.lines().map(str::trim);
-    let message = lines.by_ref().find(|l| l.contains("panicked at")).and(lines.next());
-    let folder = Path::new(scenes).parent().map(|p| format!("{}/", p.display())).unwrap_or_default();
-    message.map_or_else(
-        || "the image did not build".into(),
-        |m| m.trim_start_matches("FIRMWARE_SCENES: ").replace(&folder, ""),
-    )
 }
 
 /// The plot of the sphereflake's images (`balls` at each size run): flash and static RAM (KiB),
