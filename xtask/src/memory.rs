@@ -298,6 +298,19 @@ fn short(c: &Choice) -> String {
     format!("{x}x{y}x{z}{shape}, {}-bit", if c.sizes.narrow { 16 } else { 32 })
 }
 
+/// The board's side of the study: written by `cargo xtask board`, shown here (docs/images).
+const BOARD_SECTION: &str = "
+## On the board: the sphereflake from the Pico's flash
+
+The same question on the board: `cargo xtask board` bakes the SPD's sphereflake (`balls`, sizes 1
+to 4: 12 to 7,383 objects) into the Pico's flash, objects and lattice read through the 16 KiB XIP
+cache, and runs each image on the emulated board: the image's flash and static RAM against
+cycles per frame and XIP misses per ray (figures: docs/board.md, *The Standard Procedural
+Databases from flash*).
+
+![flash, RAM, cycles and XIP misses per ray of the sphereflake on the Pico](images/board-spd-balls.svg)
+";
+
 /// The command.
 pub fn memory_cmd(a: &MemoryArgs) -> Result<()> {
     let runs = if a.quick { 1 } else { a.runs.max(1) };
@@ -341,6 +354,7 @@ pub fn memory_cmd(a: &MemoryArgs) -> Result<()> {
     let met = quarter_section(&mut md, &summaries)?;
     let n = summaries.len();
     grid_section(&mut md, &summaries)?;
+    md.push_str(BOARD_SECTION);
     writeln!(md, "\n## Every budget\n\nx automatic: time per ray over the automatic lattice's. The zero-byte rows keep no lattice.\n\n![object tests per ray against lattice bytes]({})\n", plot_link(&a.out, &a.tests_plot))?;
     md.push_str(&sections);
     let series = |f: fn(&Summary) -> &Vec<(f64, f64)>| {
