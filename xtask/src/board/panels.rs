@@ -129,9 +129,14 @@ pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Resul
     writeln!(md, "| panel and bus | features | pixels | frames bit-identical to host-sim | {first}: cycles | fps at 125 MHz | bytes on the bus |")?;
     writeln!(md, "|---|---|---|---:|---:|---:|---:|")?;
     for r in rows {
-        let (cycles, fps, bytes) = r.first.map_or(("-".into(), "-".into(), "-".into()), |(c, b)| {
+        let (cycles, mut fps, bytes) = r.first.map_or(("-".into(), "-".into(), "-".into()), |(c, b)| {
             (m3(c), format!("{:.2}", clk_hz / c as f64), b.to_string())
         });
+        // The e-paper's rate is the trace's: the panel changes its picture at most once a
+        // refresh, whose length the e-paper section gives.
+        if r.features.split(',').any(|f| f == "uc8151") && r.first.is_some() {
+            fps.push_str(" traced; shown at most one per refresh (*E-paper* below)");
+        }
         let (w, h) = r.size;
         writeln!(
             md,
