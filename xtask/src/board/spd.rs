@@ -185,11 +185,18 @@ fn record_parts() -> String {
     )
 }
 
+/// Whether the build's refusal `why` is for the flash the tables need (not, say, a scene that
+/// fixed point cannot hold).
+fn too_big(why: &str) -> bool {
+    why.contains("of flash")
+}
+
 /// Whether an SPD scene at its default size met the targets (fits the Pico's flash, a frame in
 /// at most [`DEFAULT_TARGET`] cycles, the XIP stall at most a quarter of it), as a phrase.
 fn default_verdict(r: &SpdRow) -> String {
     match (&r.built, &r.frame) {
-        (Err(_), _) => "does not fit the Pico's flash (**missed**)".into(),
+        (Err(why), _) if too_big(why) => "does not fit the Pico's flash (**missed**)".into(),
+        (Err(_), _) => "refused by the build, as said above (**missed**)".into(),
         (Ok(_), None) => "fits, but showed no frame (**missed**)".into(),
         (Ok(_), Some(f)) => {
             let stall = f.xip_stall as f64 / f.cycles.max(1) as f64;
@@ -225,7 +232,8 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
             Ok((flash, ram)) => (kib(*flash), kib(*ram)),
             Err(why) => {
                 refused.push(format!("- **{}**: {why}", r.name));
-                ("does not fit".into(), "-".into())
+                let cell = if too_big(why) { "does not fit" } else { "refused" };
+                (cell.into(), "-".into())
             }
         };
         let Some(f) = &r.frame else {
