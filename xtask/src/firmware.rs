@@ -221,8 +221,8 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
 }
 
 /// Why the image built by `cargo ARGS` with `scenes` baked was not built: `firmware/build.rs`'s
-/// message (the build is run again to read it, its folder left out of the paths it names), or
-/// the build's failure.
+/// message (the build is run again to read it, its folder left out of the paths it names), the
+/// linker's when a region overflowed, or the build's failure.
 pub(crate) fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
     let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .current_dir(root)
@@ -230,9 +230,16 @@ pub(crate) fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
         .env("FIRMWARE_SCENES", scenes)
         .output();
     let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
-    // The build script's panic message is the line after its `panicked at`.
+    // The build script's panic message is the line after its `panicked at`; without one, the
+    // linker's complaint about the region the image overflowed.
     let mut lines = text.lines().map(str::trim);
-    let message = lines.by_ref().find(|l| l.contains("panicked at")).and(lines.next());
+    let message =
+        lines.by_ref().find(|l| l.contains("panicked at")).and(lines.next()).map(str::to_string).or_else(|| {
+            text.lines().find(|l| l.contains("will not fit in region")).map(|l| {
+                let what = l.trim().trim_start_matches("rust-lld: ").trim_start_matches("error: ");
+                format!("the linker: {what}")
+            })
+        });
     let folder = Path::new(scenes).parent().map(|p| format!("{}/", p.display())).unwrap_or_default();
     message.map_or_else(
         || "the image did not build".into(),

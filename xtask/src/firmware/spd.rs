@@ -70,7 +70,7 @@ pub(super) fn spd_section(root: &Path, md: &mut String, tally: &mut Tally) -> Re
         )?;
     }
     if !refused.is_empty() {
-        writeln!(md, "\nRefused by `firmware/build.rs`:\n\n{}", refused.join("\n"))?;
+        writeln!(md, "\nRefused by the build:\n\n{}", refused.join("\n"))?;
     }
     Ok(())
 }
