@@ -299,7 +299,7 @@ fn bakes() -> bool {
 
 /// The Pico's flash (KiB, after the 256-byte second-stage bootloader) that the image's code and
 /// read-only data, baked scenes' tables included, may take: all of the 2 MiB but the region
-/// its SRAM code is loaded from at the top (`PICO_CODE_LOAD_KIB`), and for the slot image all
+/// its SRAM code is loaded from at the top (`pico_code_load_kib`), and for the slot image all
 /// below the scene slot.
 fn pico_flash_kib() -> usize {
     if has("slot") {
