@@ -36,6 +36,7 @@ fn features((panel, bus, _): Image) -> String {
 
 /// What one panel's run did, for the report.
 pub(super) struct PanelRow {
+    panel: Panel,
     what: &'static str,
     features: String,
     /// Frames bit-identical to host-sim's, of the scenes run.
@@ -94,6 +95,7 @@ impl Session<'_> {
             let first = run.frames.first().map(|f| (f.cycles, f.bus_bytes));
             let picture = run.frames.first().map(|f| f.pixels.clone()).unwrap_or_default();
             rows.push(PanelRow {
+                panel,
                 what,
                 features: features.clone(),
                 same,
@@ -134,7 +136,7 @@ pub(super) fn panel_report(rows: &[PanelRow], first: &str, clk_hz: f64) -> Resul
         });
         // The e-paper's rate is the trace's: the panel changes its picture at most once a
         // refresh, whose length the e-paper section gives.
-        if r.features.split(',').any(|f| f == "uc8151") && r.first.is_some() {
+        if r.panel == Panel::Uc8151 && r.first.is_some() {
             fps.push_str(" traced; shown at most one per refresh (*E-paper* below)");
         }
         let (w, h) = r.size;

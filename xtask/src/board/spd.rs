@@ -236,8 +236,8 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
                 (cell.into(), "-".into())
             }
         };
+        let records = kib(r.objects as u64 * record);
         let Some(f) = &r.frame else {
-            let records = kib(r.objects as u64 * record);
             writeln!(
                 md,
                 "| {} | {} | {flash} | {records} | - | {ram} | - | - | - | - | - | - | - | - |",
@@ -249,10 +249,9 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
         let per_ray = |n: u64| format!("{:.2}", n as f64 / rays.max(1) as f64);
         writeln!(
             md,
-            "| {} | {} | {flash} | {} | {} | {ram} | {} | {:.2} | {} | {:.1} % | {} | {rays} | {} | {} |",
+            "| {} | {} | {flash} | {records} | {} | {ram} | {} | {:.2} | {} | {:.1} % | {} | {rays} | {} | {} |",
             r.name,
             r.objects,
-            kib(r.objects as u64 * record),
             f.lattice_bytes,
             m3(f.cycles),
             f.clk_hz / f.cycles.max(1) as f64,

@@ -28,6 +28,7 @@ pub(super) fn spd_section(root: &Path, md: &mut String, tally: &mut Tally) -> Re
     writeln!(md, "Written by `cargo xtask firmware --spd`: each curve scene of the SPD at its default size, generated as NFF (`host-sim spd NAME`), baked into the image of the Pico 2's core in the Pico 2 image's frame (`FIRMWARE_SCENES=/path/NAME-N.nff`, features `{FEATURES}`, profile `speed`; 4 MiB of flash as the Pico 2 has) and run in QEMU's mps2-an505 (Cortex-M33) with `-icount shift=0`; its frame checked against `host-sim render FILE --board pico2`. Instructions, not cycles: there is no RP2350 emulator here. The Pico's own runs of these scenes are in docs/board.md.\n")?;
     writeln!(md, "| scene | objects | flash (image) | instructions per frame | bit-identical to host-sim |\n|---|---:|---:|---:|---|")?;
     let mut refused = Vec::new();
+    let frame = board_frame::Build::of(|f| FEATURES.split(',').any(|g| g == f));
     for g in SCENES {
         let name = format!("{}-{}", g.name(), g.default_size());
         let nff = dir.join(format!("{name}.nff"));
@@ -44,15 +45,14 @@ pub(super) fn spd_section(root: &Path, md: &mut String, tally: &mut Tally) -> Re
         eprintln!("building the Pico 2 core's image with {name} ({objects} objects) baked");
         if build(root, &v).is_err() {
             refused.push(format!("- **{name}**: {}", refusal(root, &super::cargo_args(&v), path)));
-            writeln!(md, "| {name} | {objects} | does not fit | - | - |")?;
+            writeln!(md, "| {name} | {objects} | refused | - | - |")?;
             continue;
         }
         let elf = elf_path(root, &v);
         let (flash, _) = elf_sizes(&elf)?;
         let run = run_qemu(&elf, M33.1)?;
         let scene = run.scenes.first();
-        let build = board_frame::Build::of(|f| FEATURES.split(',').any(|g| g == f));
-        let want = host_frame_of(&nff, "f32", build)?;
+        let want = host_frame_of(&nff, "f32", frame)?;
         let same = run.errors.is_empty() && scene.is_some_and(|s| s.rows == want);
         if same {
             tally.passed += 1;
