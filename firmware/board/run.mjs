@@ -29,7 +29,8 @@
 // sharp-400x240 or sharp-128x128 puts a Sharp memory LCD on SPI0 alone (its own wiring); uc8151
 // the Badger 2040's e-paper on SPI0 (the SPI modules' CS, DC and RES; its BUSY drives GP26);
 // thumby the Thumby's 72x40 SSD1306 on SPI0 on its own pins (CS GP16, DC GP17, RES GP20), its A
-// button (GP27) the one --press presses (the `thumby` image).
+// button (GP27) the one --press presses and its B button (GP24) --press-turn's (the `thumby`
+// image). The Badger's buttons close to 3V3 (its C on GP14, up on GP15), the others to ground.
 // --no-cache and --untimed-bus leave a model out (to measure what each adds); --no-core1
 // leaves core 1 in reset (the firmware then waits for it forever: a deadlock the run reports).
 // --panel-off START_MS:LEN_MS (repeatable) cuts the display's power at START_MS of emulated
@@ -47,9 +48,11 @@
 // it through the pins (I2C0's SDA on GP4, SCL on GP5). --nack-at MS (repeatable): the display
 // does not acknowledge the first byte written to it after MS. Each gives an {"event":"bus"}
 // line when it happens (what: "sda held", "sda released", "nack").
-// --press MS[:LEN_MS] (repeatable) presses the board's button (GP14 to ground, the firmware's
-// `Wiring::NEXT`; pulled up, so high while nobody presses) at MS for LEN_MS (100 by default),
-// with an {"event":"button"} line.
+// --press MS[:LEN_MS] (repeatable) presses the board's next-scene button (GP14 to ground, the
+// firmware's `Wiring::NEXT`) at MS for LEN_MS (100 by default), with an {"event":"button",
+// "which":"next"} line; --press-turn MS[:LEN_MS] the camera-turn button (GP15, `Wiring::TURN`),
+// with "which":"turn". A released button's pin reads what its pad's pull gives it (a pull-up
+// high, a pull-down low), as on silicon: a firmware that pulls it the wrong way sees it pressed.
 // --panic-at MS with --panic-request ADDR writes 1 to the word at ADDR (the firmware's
 // PANIC_REQUEST) at MS: the firmware panics at its next check between frames.
 // --pass-bytes N shows a picture every N GDDRAM bytes the display receives while the LED is lit
@@ -65,7 +68,7 @@
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
 //                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
 //                     [--sda-stuck START_MS:PULSES] [--nack-at MS] [--panel NAME]
-//                     [--press MS[:LEN_MS]] [--scan] [--osc-error PERCENT]
+//                     [--press MS[:LEN_MS]] [--press-turn MS[:LEN_MS]] [--scan] [--osc-error PERCENT]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
 import { Ssd1306, GLASSES } from './ssd1306.mjs';
@@ -96,9 +99,16 @@ const PANELS = {
     make: (now, mcu) =>
       new Uc8151(now, (ns, fn) => mcu().clock.createAlarm(fn).schedule(ns), (high) => mcu()?.gpio[BUSY_PIN].setInputValue(high)),
     spi: { cs: 17, dc: 20, res: 21 },
+    // Its buttons close to 3V3 (Pimoroni's examples read them with pull-downs, on rising edges).
+    buttons: { next: 14, turn: 15, activeHigh: true },
   },
-  // The Thumby: its 72x40 SSD1306 on SPI0 with its own control pins, its A button on GP27.
-  thumby: { make: (now) => new Ssd1306(0x3c, GLASSES['72x40'], now), spi: { cs: 16, dc: 17, res: 20 }, button: 27 },
+  // The Thumby: its 72x40 SSD1306 on SPI0 with its own control pins, its A and B buttons on
+  // GP27 and GP24 (to ground).
+  thumby: {
+    make: (now) => new Ssd1306(0x3c, GLASSES['72x40'], now),
+    spi: { cs: 16, dc: 17, res: 20 },
+    buttons: { next: 27, turn: 24, activeHigh: false },
+  },
 };
 
 const LED_PIN = 25;
@@ -106,9 +116,39 @@ const LED_PIN = 25;
 const SPI_DISPLAY = { cs: 17, dc: 20, res: 21 };
 /** The I2C display's pins (wiring.rs): I2C0's SDA and SCL. */
 const I2C_PINS = { sda: 4, scl: 5 };
-/** The board's button (wiring.rs `Wiring::NEXT`): to ground when pressed, pulled up (a panel's
- * board may have it elsewhere: its `button`). */
-const BUTTON_PIN = 14;
+/** The board's buttons (wiring.rs `Wiring::NEXT` and `Wiring::TURN`): push buttons to ground (a
+ * panel's board may have them elsewhere, or to 3V3: its `buttons`). */
+const BUTTONS = { next: 14, turn: 15, activeHigh: false };
+/**
+ * A push button from a GPIO to a rail: ground, or 3V3 when `activeHigh`. Pressed, the pin reads
+ * the rail; released, what the pad's pull gives it (the PADS_BANK0 register the firmware sets): a
+ * pull-up high, a pull-down low, both (the bus keeper) or neither its last level.
+ */
+class PushButton {
+  constructor(gpio, activeHigh) {
+    this.gpio = gpio;
+    this.activeHigh = activeHigh;
+    this.down = false;
+    gpio.addListener(() => this.settle());
+    this.settle();
+  }
+
+  /** Presses (`down`) or releases the button. */
+  press(down) {
+    this.down = down;
+    this.settle();
+  }
+
+  /** Sets the pin's input level from the button and the pad's pull. */
+  settle() {
+    const { gpio } = this;
+    let level = gpio.rawInputValue;
+    if (this.down) level = this.activeHigh;
+    else if (gpio.pullupEnabled !== gpio.pulldownEnabled) level = gpio.pullupEnabled;
+    if (level !== gpio.rawInputValue) gpio.setInputValue(level);
+  }
+}
+
 // Every how many instructions --profile samples the program counter (a prime, so no loop of
 // the renderer beats in step with it).
 const PROFILE_EVERY = 97;
@@ -154,11 +194,12 @@ function parseArgs(argv) {
       if (!m) throw new Error(`--sda-stuck ${v}: START_MS:PULSES expected (PULSES 1 to 9)`);
       o.sdaStuck.push({ startMs: Number(m[1]), pulses: Number(m[2]) });
     } else if (a === '--nack-at') o.nackAt.push(Number(next()));
-    else if (a === '--press') {
+    else if (a === '--press' || a === '--press-turn') {
       const v = next();
       const m = /^(\d+(?:\.\d+)?)(?::(\d+(?:\.\d+)?))?$/.exec(v);
-      if (!m) throw new Error(`--press ${v}: MS or MS:LEN_MS expected`);
-      o.presses.push({ startMs: Number(m[1]), lenMs: m[2] === undefined ? 100 : Number(m[2]) });
+      if (!m) throw new Error(`${a} ${v}: MS or MS:LEN_MS expected`);
+      const which = a === '--press' ? 'next' : 'turn';
+      o.presses.push({ which, startMs: Number(m[1]), lenMs: m[2] === undefined ? 100 : Number(m[2]) });
     } else if (a === '--panel') {
       o.panel = next();
       if (!PANELS[o.panel]) throw new Error(`--panel ${o.panel}: one of ${Object.keys(PANELS).join(', ')} expected`);
@@ -256,6 +297,8 @@ function main() {
   const opt = parseArgs(process.argv);
   let board = null;
   let mcu = null;
+  /** The board's buttons by name ('next', 'turn'), made at each boot. */
+  const buttons = {};
   let core = null;
   const bootrom = readFileSync(opt.bootrom);
   if (bootrom.length !== 16384) throw new Error(`${opt.bootrom}: ${bootrom.length} bytes, a bootrom is 16384`);
@@ -399,9 +442,9 @@ function main() {
     moments.push({ nanos: startMs * 1e6, fn: () => (board.holdSda(0, pulses), busEvent('sda held')) });
   }
   for (const ms of display ? opt.nackAt : []) moments.push({ nanos: ms * 1e6, fn: () => board.nackNext(0) });
-  for (const { startMs, lenMs } of opt.presses) {
-    moments.push({ nanos: startMs * 1e6, fn: () => (mcu.gpio[panel.button ?? BUTTON_PIN].setInputValue(false), emit({ event: 'button', ms: startMs })) });
-    moments.push({ nanos: (startMs + lenMs) * 1e6, fn: () => mcu.gpio[panel.button ?? BUTTON_PIN].setInputValue(true) });
+  for (const { which, startMs, lenMs } of opt.presses) {
+    moments.push({ nanos: startMs * 1e6, fn: () => (buttons[which].press(true), emit({ event: 'button', which, ms: startMs })) });
+    moments.push({ nanos: (startMs + lenMs) * 1e6, fn: () => buttons[which].press(false) });
   }
 
   /** A board from power-on (or, with `kept`, after a reset: SRAM and the watchdog's scratch and reason). */
@@ -426,8 +469,9 @@ function main() {
     });
     board.attachSpi(0, display, { ...(panel.spi ?? SPI_DISPLAY), timed: opt.timedBus, listen: { byte } });
     board.gpio(LED_PIN).addListener(onLed);
-    // Nobody presses the button at power-on: its pull-up holds it high.
-    mcu.gpio[panel.button ?? BUTTON_PIN].setInputValue(true);
+    // The buttons, released at power-on (their pins read what the pads' pulls give them).
+    const wired = panel.buttons ?? BUTTONS;
+    for (const which of ['next', 'turn']) buttons[which] = new PushButton(mcu.gpio[wired[which]], wired.activeHigh);
     display?.drive?.();
     const watchdog = mcu.peripherals[0x40058];
     // The watchdog resets the chip: its timer stops here (rp2040js would re-arm it at 0 and

@@ -22,7 +22,9 @@ use lattice_rt::{
     Share, Stats, Traced, Tracer,
 };
 
-pub use board_records::frame::{rendered, Build, Glass, Tuning, FRAME, LADDER, ORBIT_FRAMES, SHARES, TUNING};
+pub use board_records::frame::{
+    rendered, Build, Glass, Tuning, FRAME, LADDER, ORBIT_FRAMES, SHARES, TUNING, TURN_STEPS,
+};
 
 /// What this build asks of its frame (its features; `board_records::frame::Build::of` reads
 /// the same names for build.rs and the checks).
@@ -244,6 +246,14 @@ impl Default for Shot {
     }
 }
 
+impl Shot {
+    /// The scene's own frame with the camera turned `step` of [`TURN_STEPS`] around it (the
+    /// camera-turn button's frames).
+    pub fn turned(step: u32) -> Self {
+        Shot { turn: f64::from(step % TURN_STEPS) / f64::from(TURN_STEPS), ..Shot::default() }
+    }
+}
+
 /// Runs two pieces of work, on two cores where there are two.
 pub trait Cores {
     /// Runs `there` on the other core while `here` runs on this one and returns when both are
@@ -442,6 +452,10 @@ pub type SceneMemory = Storage<Scalar>;
 /// The memory a frame of an [`Embedded`] scene needs: the render's query scratch.
 #[cfg(baked_scenes)]
 pub type SceneMemory = BakedMemory;
+
+/// Whether this build can turn the camera around its scenes: not when it bakes them, whose eye
+/// windows and hulls were computed at build time for the scene's own camera.
+pub const CAMERA_TURNS: bool = cfg!(not(baked_scenes));
 
 /// The embedded scenes by name, as this build holds them.
 #[cfg(not(baked_scenes))]

@@ -28,16 +28,37 @@ pub fn orbit_renders<R: Real>(
     let mut out = Vec::new();
     for i in 0..frames {
         let turn = i as f64 / frames as f64;
-        let scene = parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| *c = c.orbit(turn))
-            .map_err(|e| anyhow!("{}: frame {i} of the orbit: {e}", path.display()))?;
-        let cfg = LatticeConfig::default();
-        let mut bufs = lattice_storage(&scene, &cfg)?;
-        let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
-        out.push(crate::run::render_band(&Tracer::new(&scene, &lattice), frame, false)?);
+        let rendered = render_turned::<R>(text, turn, frame, &mut storage)
+            .map_err(|e| anyhow!("{}: frame {i} of the orbit: {e:#}", path.display()))?;
+        out.push(rendered);
         bar.inc(1);
     }
     bar.finish_and_clear();
     Ok(out)
+}
+
+/// The 1-bit frame (packed rows) of the scene at `path` in scalar `R` with its camera turned
+/// `turn` of a circle around the point it looks at, as the board's camera-turn button draws it.
+pub fn turned_frame<R: Real>(path: &Path, text: &str, turn: f64, frame: &Frame) -> Result<Vec<u8>> {
+    let mut storage = object_storage::<R>(text)?;
+    let rendered = render_turned::<R>(text, turn, frame, &mut storage)
+        .map_err(|e| anyhow!("{}: turned {turn} of a circle: {e:#}", path.display()))?;
+    Ok(rendered.bits)
+}
+
+/// One frame of the scene `text` with its camera turned `turn` of a circle, parsed into `storage`.
+fn render_turned<R: Real>(
+    text: &str,
+    turn: f64,
+    frame: &Frame,
+    storage: &mut crate::load::SceneStore<R>,
+) -> Result<crate::run::Rendered> {
+    let scene = parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| *c = c.orbit(turn))
+        .map_err(|e| anyhow!("{e}"))?;
+    let cfg = LatticeConfig::default();
+    let mut bufs = lattice_storage(&scene, &cfg)?;
+    let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+    crate::run::render_band(&Tracer::new(&scene, &lattice), frame, false)
 }
 
 /// The 1-bit frames (packed rows, see `BitFrame`) of [`orbit_renders`].

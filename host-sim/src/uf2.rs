@@ -94,7 +94,7 @@ pub fn build_board_with(root: &Path, board: Board, features: Option<&str>, scene
         None => board.name().to_string(),
     };
     eprintln!("building the {} image (cargo {})", board.name(), args.join(" "));
-    build_image(root, &name, &args, scenes, &board.built())
+    build_image(root, &name, &args, (scenes, &[]), &board.built())
         .with_context(|| format!("`cargo {alias}` failed (its own message is above; it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target()))
 }
 
@@ -109,13 +109,25 @@ pub enum Scenes<'a> {
     Listed(&'a str),
 }
 
-/// Runs `cargo <args>` from the repository's root with `scenes` and keeps the image it wrote, `built` (a path inside
-/// `firmware/target`), as [`kept_image`]`(name)`; returns that copy.
+/// Runs `cargo <args>` from the repository's root with `scenes` and the variables `env` and keeps
+/// the image it wrote, `built` (a path inside `firmware/target`), as [`kept_image`]`(name)`;
+/// returns that copy.
 ///
 /// Every image builds in the firmware's one target folder, so a dependency compiles once per
 /// target and feature set, not once per image (a folder per image took 14 GB for the project's
 /// checks); the copy keeps an image from being overwritten by the next build of the same binary.
-pub fn build_image(root: &Path, name: &str, args: &[&str], scenes: Scenes, built: &Path) -> Result<PathBuf> {
+pub fn build_image(
+    root: &Path,
+    name: &str,
+    args: &[&str],
+    (scenes, env): (Scenes, &[(&str, &str)]),
+    built: &Path,
+) -> Result<PathBuf> {
+    // One build at a time, to its copy: cargo writes every variant of a board's image to the
+    // same `built` path, so two threads building (`cargo xtask board` runs sections side by
+    // side) could each keep the other's image.
+    static BUILDING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = BUILDING.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cmd.current_dir(root).args(args).env_remove("RUSTFLAGS").env_remove("FIRMWARE_FLASH_KIB");
     match scenes {
@@ -127,6 +139,7 @@ pub fn build_image(root: &Path, name: &str, args: &[&str], scenes: Scenes, built
             cmd.env("FIRMWARE_SCENES", list);
         }
     }
+    cmd.envs(env.iter().copied());
     let status = cmd.status().context("cannot run cargo")?;
     if !status.success() {
         bail!("`cargo {}` failed", args.join(" "));

@@ -284,6 +284,10 @@ pub const PICO: Build = Build {
 /// Frames per turn of the camera in orbit mode (the firmware's `orbit` feature, `host-sim orbit`).
 pub const ORBIT_FRAMES: u32 = 36;
 
+/// Steps per circle of the camera-turn button (the firmware's `Wiring::TURN`): each press draws
+/// the scene from an eighth of a circle further around it.
+pub const TURN_STEPS: u32 = 8;
+
 /// How a frame is traced: the real-time levers that can be switched at run time, so one image
 /// measures them one by one (the `ladder` feature) with every frame still checked against
 /// host-sim.

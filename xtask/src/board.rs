@@ -78,7 +78,7 @@ fn build_pico_with(root: &Path, feature: &str, all_scenes: bool) -> Result<PathB
     let args: &[&str] = if feature == CHAIR_ALONE { &["pico-build"] } else { &["pico-build", "--features", feature] };
     eprintln!("building the Pico image `{}` (cargo {}, {which})", variant_name(feature), args.join(" "));
     let scenes = if all_scenes { Scenes::Inherited } else { Scenes::Listed("chair") };
-    build_image(root, &variant_image(feature), args, scenes, &pico_built())
+    build_image(root, &variant_image(feature), args, (scenes, &[]), &pico_built())
 }
 
 /// What the variant with `feature` is called in folders and messages.
@@ -237,8 +237,8 @@ enum Event {
     Reset(String, f64),
     /// A fault on the display's bus (run.mjs's `bus` event: what, and when).
     Bus(String, f64),
-    /// The button pressed (run.mjs's `button` event: when).
-    Button(f64),
+    /// A button pressed (run.mjs's `button` event: which, "next" or "turn", and when).
+    Button(String, f64),
     /// A picture a refresh showed for the first time (`--scan`): its number and pixels.
     Image(usize, Vec<u8>),
     /// From this refresh on (its index), the panel shows picture number ... (`--scan`).
@@ -259,7 +259,9 @@ impl Event {
                 Event::Reset(v["reason"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0))
             }
             Some("bus") => Event::Bus(v["what"].as_str().unwrap_or("").to_string(), v["ms"].as_f64().unwrap_or(0.0)),
-            Some("button") => Event::Button(v["ms"].as_f64().unwrap_or(0.0)),
+            Some("button") => {
+                Event::Button(v["which"].as_str().unwrap_or("next").to_string(), v["ms"].as_f64().unwrap_or(0.0))
+            }
             Some("image") => Event::Image(
                 v["id"].as_u64().context("an image without its number")? as usize,
                 hex_bytes(v["pixels"].as_str().context("an image without pixels")?),
@@ -305,8 +307,8 @@ struct BoardRun {
     resets: Vec<(String, f64)>,
     /// The faults on the display's bus as they happened: what, and when.
     bus: Vec<(String, f64)>,
-    /// When the button was pressed.
-    presses: Vec<f64>,
+    /// The buttons pressed ("next", "turn"), and when.
+    presses: Vec<(String, f64)>,
     /// The pictures the panel's refreshes showed (`--scan`), by number.
     images: Vec<Vec<u8>>,
     /// Where the refreshes' picture changed: from refresh index on, picture number.
@@ -341,9 +343,9 @@ impl BoardRun {
                 eprintln!("  bus: {what} at {ms:.1} ms");
                 run.bus.push((what, ms));
             }
-            Event::Button(ms) => {
-                eprintln!("  button pressed at {ms:.1} ms");
-                run.presses.push(ms);
+            Event::Button(which, ms) => {
+                eprintln!("  button {which} pressed at {ms:.1} ms");
+                run.presses.push((which, ms));
             }
             Event::Image(id, pixels) => {
                 run.images.resize(run.images.len().max(id + 1), Vec::new());
@@ -540,6 +542,11 @@ impl Checks {
     fn fail(&mut self, why: String) {
         self.failures.push(why);
     }
+    /// Adds `other`'s tally (checks made on another thread) to this one.
+    fn absorb(&mut self, other: Checks) {
+        self.passed += other.passed;
+        self.failures.extend(other.failures);
+    }
     /// Prints the failures and the tally; an error if any check failed.
     fn verdict(self) -> Result<()> {
         for f in &self.failures {
@@ -587,29 +594,17 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
             save_frame(&r.frame.pixels, &images.join(format!("board-{}.png", r.name)))?;
         }
     }
-    let fault_rows = s.fault_runs(&rows)?;
-    let mut button_rows: Vec<_> = s.button_run(&rows)?.into_iter().collect();
-    let (panel_rows, epaper_run, thumby_button) = s.panel_runs()?;
-    button_rows.extend(thumby_button);
-    let epaper = epaper_run.map(|r| s.epaper_runs(&r)).transpose()?;
-    let gray_run = s.gray_runs()?;
+    let (m, side) = s.all_runs(&rows)?;
+    let (levers, alone) = (m.levers, m.alone);
+    let mut button_rows = m.button_rows;
+    button_rows.extend(side.thumby_button);
     if let Some(images) = out.parent().map(|p| p.join("images")) {
-        panels::save_pictures(&panel_rows, &images)?;
+        panels::save_pictures(&side.panel_rows, &images)?;
     }
-    let bare = s.no_display_run()?;
-    let (models, (alone, levers)) = (s.model_runs()?, s.lever_runs()?);
-    let (orun, orbit_same) = s.orbit_run()?;
-    let lrun = s.variant("ladder", false, LADDER.len(), &[])?.0;
-    let rungs = s.ladder_rows(&lrun)?;
-    // A progressive frame's passes follow each other without waiting for the bus: each is
-    // checked when a panel's worth of page bytes (128 x 8) has reached the display.
-    let prun = s.variant("progressive", true, PASSES * s.scenes.len(), &["--pass-bytes", "1024"])?;
-    let progressive = s.progressive_rows(&prun, &rows)?;
-    let plain_run = s.variant("no-outline", false, 1, &[])?;
-    let outline_row = s.outline_row(&plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
-    let slot_rows = s.slot_runs()?;
-    let spd_rows = s.spd_runs()?;
-    spd::spd_plot(&spd_rows, out)?;
+    let rungs = s.ladder_rows(&m.lrun)?;
+    let progressive = s.progressive_rows(&m.prun, &rows)?;
+    let outline_row = s.outline_row(&m.plain_run, out, alone.as_ref().map(|(_, rays, _)| *rays))?;
+    spd::spd_plot(&m.spd_rows, out)?;
 
     let spi_byte = levers
         .iter()
@@ -626,31 +621,31 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
     let profile = profile_shares(&s.elf, &frames_dir.join("profile.json"))?;
     let (flash, static_ram) = elf_sizes(&s.elf)?;
     let mut md =
-        report(&summary, &rows, (flash, static_ram, section_size(&s.elf, ".ram_code")?), &bare, &s.scenes, &profile)?;
+        report(&summary, &rows, (flash, static_ram, section_size(&s.elf, ".ram_code")?), &m.bare, &s.scenes, &profile)?;
     md.push_str(&silicon_report(
         &summary,
         rows.first().map(|r| &r.frame),
-        &models,
+        &m.models,
         alone.as_ref().map(|(f, _, setup)| (f, *setup)),
         &levers,
     )?);
-    md.push_str(&orbit_report(&orun.frames, orbit_same, run.clk_sys_hz)?);
+    md.push_str(&orbit_report(&m.orun.frames, m.orbit_same, run.clk_sys_hz)?);
     md.push_str(&ladder_report(&rungs, run.clk_sys_hz)?);
     md.push_str(&progressive_report(&progressive, run.clk_sys_hz)?);
     if let (Some((f, rays, same)), Some((lined, ..))) = (outline_row, &alone) {
         md.push_str(&outline_report(f, rays, same, lined, run.clk_sys_hz)?);
     }
-    md.push_str(&slot::slot_report(&slot_rows)?);
-    md.push_str(&faults::fault_report(&fault_rows)?);
+    md.push_str(&slot::slot_report(&m.slot_rows)?);
+    md.push_str(&faults::fault_report(&m.fault_rows)?);
     md.push_str(&button::button_report(&button_rows)?);
-    md.push_str(&panels::panel_report(&panel_rows, s.scenes.first().map_or("", String::as_str), run.clk_sys_hz)?);
+    md.push_str(&panels::panel_report(&side.panel_rows, s.scenes.first().map_or("", String::as_str), run.clk_sys_hz)?);
     let spi_chair = levers.iter().find(|(feature, ..)| *feature == "spi").map(|(_, _, f, _)| f.cycles);
     let gray_picture = out.parent().unwrap_or(Path::new(".")).join("images/board-gray-chair.png");
-    md.push_str(&gray::gray_report(&gray_run, spi_chair, &gray_picture)?);
-    if let Some(e) = &epaper {
+    md.push_str(&gray::gray_report(&side.gray_run, spi_chair, &gray_picture)?);
+    if let Some(e) = &side.epaper {
         md.push_str(&epaper::epaper_report(e, run.clk_sys_hz)?);
     }
-    md.push_str(&spd::spd_report(&spd_rows)?);
+    md.push_str(&spd::spd_report(&m.spd_rows)?);
     host_sim::output::write_atomic(out, md.as_bytes())?;
     println!("wrote {} (frames and UF2 in {})", out.display(), frames_dir.display());
     s.checks.verdict()
@@ -658,6 +653,104 @@ pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd
 
 /// Passes of a progressive frame (8x8, 4x4, 2x2 blocks, every pixel).
 const PASSES: usize = 4;
+
+/// The runs of the main thread after the clean run, for the report.
+struct MainRuns {
+    fault_rows: Vec<faults::FaultRow>,
+    button_rows: Vec<button::ButtonRow>,
+    bare: BoardRun,
+    models: Vec<(&'static str, PanelFrame)>,
+    alone: Option<(PanelFrame, Option<u64>, Option<u64>)>,
+    levers: Vec<(&'static str, &'static str, PanelFrame, Option<u64>)>,
+    orun: BoardRun,
+    orbit_same: usize,
+    lrun: BoardRun,
+    prun: (BoardRun, PathBuf),
+    plain_run: (BoardRun, PathBuf),
+    slot_rows: Vec<slot::SlotRow>,
+    spd_rows: Vec<spd::SpdRow>,
+}
+
+/// The runs of the second thread, for the report: the panels, the e-paper, the gray mode.
+struct SideRuns {
+    panel_rows: Vec<panels::PanelRow>,
+    epaper: Option<epaper::EpaperReport>,
+    thumby_button: Option<button::ButtonRow>,
+    gray_run: gray::GrayReport,
+}
+
+impl Session<'_> {
+    /// A session on the same image and folders with checks of its own, for a second thread
+    /// (its checks are added to this one's with [`Checks::absorb`]).
+    fn fork(&self) -> Self {
+        Session {
+            elf: self.elf.clone(),
+            uf2: self.uf2.clone(),
+            bootrom: self.bootrom.clone(),
+            scenes: self.scenes.clone(),
+            scenes_dir: self.scenes_dir.clone(),
+            chair: self.chair.clone(),
+            chair_text: self.chair_text.clone(),
+            checks: Checks::default(),
+            ..*self
+        }
+    }
+
+    /// Every run after the clean one: [`Session::main_runs`] on this thread and, beside them on
+    /// a second, [`Session::side_runs`], which need nothing from the runs before (an emulator
+    /// keeps one core busy, and this machine has two; the emulated cycles are the same either
+    /// way). Builds take turns (`host_sim::uf2::build_image`); every run has its own folder.
+    fn all_runs(&mut self, clean: &[SceneRow]) -> Result<(MainRuns, SideRuns)> {
+        let mut side = self.fork();
+        let (side_runs, main_runs) = std::thread::scope(|scope| {
+            let side_thread = scope.spawn(move || side.side_runs().map(|runs| (runs, side.checks)));
+            let main_runs = self.main_runs(clean);
+            (side_thread.join(), main_runs)
+        });
+        let (side_runs, side_checks) = side_runs.map_err(|_| anyhow::anyhow!("the panels' thread panicked"))??;
+        self.checks.absorb(side_checks);
+        Ok((main_runs?, side_runs))
+    }
+
+    /// The faults, the button, no display, the models, the levers, orbit, ladder, progressive,
+    /// no outline, the slot and the SPD: every run after the clean one but the side thread's.
+    fn main_runs(&mut self, clean: &[SceneRow]) -> Result<MainRuns> {
+        let fault_rows = self.fault_runs(clean)?;
+        let button_rows: Vec<_> = self.button_run(clean)?.into_iter().collect();
+        let bare = self.no_display_run()?;
+        let (models, (alone, levers)) = (self.model_runs()?, self.lever_runs()?);
+        let (orun, orbit_same) = self.orbit_run()?;
+        let lrun = self.variant("ladder", false, LADDER.len(), &[])?.0;
+        // A progressive frame's passes follow each other without waiting for the bus: each is
+        // checked when a panel's worth of page bytes (128 x 8) has reached the display.
+        let prun = self.variant("progressive", true, PASSES * self.scenes.len(), &["--pass-bytes", "1024"])?;
+        let plain_run = self.variant("no-outline", false, 1, &[])?;
+        let (slot_rows, spd_rows) = (self.slot_runs()?, self.spd_runs()?);
+        Ok(MainRuns {
+            fault_rows,
+            button_rows,
+            bare,
+            models,
+            alone,
+            levers,
+            orun,
+            orbit_same,
+            lrun,
+            prun,
+            plain_run,
+            slot_rows,
+            spd_rows,
+        })
+    }
+
+    /// Every panel's image, the e-paper's refreshes and the gray mode.
+    fn side_runs(&mut self) -> Result<SideRuns> {
+        let (panel_rows, epaper_run, thumby_button) = self.panel_runs()?;
+        let epaper = epaper_run.map(|r| self.epaper_runs(&r)).transpose()?;
+        let gray_run = self.gray_runs()?;
+        Ok(SideRuns { panel_rows, epaper, thumby_button, gray_run })
+    }
+}
 
 impl<'a> Session<'a> {
     /// Builds the default image (unless `no_build`), writes its UF2 file, fetches the emulator.

@@ -215,7 +215,7 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
     let args = cargo_args(v);
     let built = Path::new(v.target).join(v.profile).join(v.bin);
     let scenes = v.scenes.map_or(Scenes::Default, Scenes::Listed);
-    host_sim::uf2::build_image(root, &v.name, &args, scenes, &built)
+    host_sim::uf2::build_image(root, &v.name, &args, (scenes, &[]), &built)
         .with_context(|| format!("building firmware variant {} failed", v.name))?;
     Ok(())
 }

@@ -262,17 +262,14 @@ impl Session<'_> {
         let elf = if self.no_build {
             host_sim::uf2::kept_image(self.root, "pico-gray-calibrated")
         } else {
-            // SAFETY of the environment: xtask runs one build at a time, on this thread.
-            std::env::set_var("FIRMWARE_GRAY_ROW_NS", row_ns.to_string());
-            let built = build_image(
+            let row_ns = row_ns.to_string();
+            build_image(
                 self.root,
                 "pico-gray-calibrated",
                 &["pico-build", "--features", "gray"],
-                Scenes::Inherited,
+                (Scenes::Inherited, &[("FIRMWARE_GRAY_ROW_NS", &row_ns)]),
                 &pico_built(),
-            );
-            std::env::remove_var("FIRMWARE_GRAY_ROW_NS");
-            built?
+            )?
         };
         let dir = self.frames_dir.join("gray-calibrated");
         std::fs::create_dir_all(&dir)?;

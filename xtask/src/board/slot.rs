@@ -4,8 +4,10 @@
 //! a scene with a mistake each show their message on the panel (drawn as the host draws it,
 //! `board_records::message`) and in the log, never a fault.
 
+use super::button::{PRESS_AFTER_MS, RESPONSE_MS};
 use super::{build_pico_with, run_emulator, save_frame, Session, PANEL};
 use anyhow::{Context, Result};
+use board_records::frame::{ORBIT_FRAMES, TURN_STEPS};
 use board_records::slot::{self, SlotError};
 use host_sim::uf2::{kept_image, write_uf2};
 use lattice_rt::{BitFrame, Fx};
@@ -22,6 +24,9 @@ enum Expect {
     Frame(&'static str),
     /// This message (as the firmware words it, cut to the 160 bytes it keeps).
     Message(String),
+    /// The frame host-sim renders of this text with the camera turned a step
+    /// (`TURN_STEPS`), after the camera-turn button is pressed in the pause after the first.
+    Turned(&'static str),
 }
 
 /// One case: its name, what it is, the UF2 file's bytes and what the panel must show.
@@ -71,7 +76,7 @@ pub(super) fn message_frame(message: &str) -> Vec<u8> {
 /// The slot cases: the user's scene, the slot image alone, the user's file corrupted, and two
 /// scenes written past the host's check (too many objects, a misspelt attribute), each with
 /// what the board must show.
-fn cases(image: &[u8]) -> Result<[Case; 5]> {
+fn cases(image: &[u8]) -> Result<[Case; 6]> {
     let too_big: String = std::iter::once("camera eye 0 4 -30\n".to_string())
         .chain((0..70).map(|i| format!("sphere center {} {} 0 radius 0.4\n", i % 10 - 5, i / 10)))
         .collect();
@@ -88,8 +93,14 @@ fn cases(image: &[u8]) -> Result<[Case; 5]> {
         Case {
             name: "user",
             what: "a scene of the user's (`host-sim uf2 --scene`)",
-            uf2: user,
+            uf2: user.clone(),
             expect: Expect::Frame(USER_SCENE),
+        },
+        Case {
+            name: "turned",
+            what: "the user's scene, the camera-turn button (GP15) pressed after its first frame",
+            uf2: user,
+            expect: Expect::Turned(USER_SCENE),
         },
         Case {
             name: "empty",
@@ -131,15 +142,26 @@ impl Session<'_> {
         let image = std::fs::read(&base).with_context(|| format!("cannot read {}", base.display()))?;
         let cases = cases(&image)?;
         let mut rows = Vec::new();
+        // When the user's frame ended: the turned case presses its button in the pause after.
+        let mut first_end_ms = None;
         for case in cases {
-            rows.push(self.slot_case(&elf, &dir, case)?);
+            let (row, end_ms) = self.slot_case(&elf, &dir, case, first_end_ms)?;
+            first_end_ms = first_end_ms.or(end_ms);
+            rows.push(row);
         }
         Ok(rows)
     }
 
-    /// Runs one case's UF2 file for a frame (or the attempt and the message) and checks the
-    /// panel and the log.
-    fn slot_case(&mut self, elf: &Path, dir: &Path, case: Case) -> Result<SlotRow> {
+    /// Runs one case's UF2 file for a frame (or the attempt and the message, or the frame and
+    /// the turned frame, its button pressed [`PRESS_AFTER_MS`] after `first_end_ms`) and checks
+    /// the panel and the log; its row, and when its first panel ended.
+    fn slot_case(
+        &mut self,
+        elf: &Path,
+        dir: &Path,
+        case: Case,
+        first_end_ms: Option<f64>,
+    ) -> Result<(SlotRow, Option<f64>)> {
         let case_dir = dir.join(case.name);
         std::fs::create_dir_all(&case_dir).with_context(|| format!("cannot create {}", case_dir.display()))?;
         let file = case_dir.join(format!("lattice-rt-pico-slot-{}.uf2", case.name));
@@ -148,17 +170,32 @@ impl Session<'_> {
         // A scene the board refuses lights the LED for its attempt (a blank "frame" to the
         // runner) before the message: two LED cycles, the message the last.
         let frames = if matches!(case.expect, Expect::Frame(_)) { 1 } else { 2 };
-        let run = run_emulator(self.root, elf, &file, &self.bootrom, frames, true, &case_dir, &[])?;
+        let press_ms = first_end_ms.unwrap_or(0.0) + PRESS_AFTER_MS;
+        let press = format!("{press_ms:.3}");
+        let args: &[&str] = if matches!(case.expect, Expect::Turned(_)) { &["--press-turn", &press] } else { &[] };
+        let run = run_emulator(self.root, elf, &file, &self.bootrom, frames, true, &case_dir, args)?;
+        let frame = board_records::frame::rendered(board_records::frame::PICO);
         let (want, shown) = match &case.expect {
-            Expect::Frame(text) => {
-                let frame = board_records::frame::rendered(board_records::frame::PICO);
+            Expect::Frame(text) => (
+                host_sim::run::render_text::<Fx>(Path::new("slot"), text, &frame, |_| {})?.bits,
+                "the scene's frame".to_string(),
+            ),
+            Expect::Turned(text) => {
+                let turn = 1.0 / f64::from(TURN_STEPS);
                 (
-                    host_sim::run::render_text::<Fx>(Path::new("slot"), text, &frame, |_| {})?.bits,
-                    "the scene's frame".to_string(),
+                    host_sim::orbit::turned_frame::<Fx>(Path::new("slot"), text, turn, &frame)?,
+                    format!("the scene's frame, the camera turned 1/{TURN_STEPS} of a circle"),
                 )
             }
             Expect::Message(m) => (message_frame(&cut(m)), format!("\"{}\"", cut(m))),
         };
+        if matches!(case.expect, Expect::Turned(_)) {
+            let start = run.frames.get(1).map(|f| f.start_ms);
+            self.checks.check(
+                first_end_ms.is_some() && start.is_some_and(|s| s >= press_ms && s - press_ms <= RESPONSE_MS),
+                || format!("slot turned: pressed at {press_ms:.1} ms, the turned frame started at {start:?} ms (at most {RESPONSE_MS} ms later)"),
+            );
+        }
         let frame = run.frames.last();
         let same = frame.is_some_and(|f| f.pixels == want);
         if let Some(f) = frame {
@@ -172,14 +209,15 @@ impl Session<'_> {
             .check(same, || format!("slot {name}: the panel is not {shown} (see {}/panel.png)", case_dir.display()));
         let errors: Vec<&str> = run.log.iter().filter(|l| l.level == "ERROR").map(|l| l.text.as_str()).collect();
         match &case.expect {
-            Expect::Frame(_) => {
+            Expect::Frame(_) | Expect::Turned(_) => {
                 self.checks.check(errors.is_empty(), || format!("slot {name}: the device logged errors: {errors:?}"))
             }
             Expect::Message(m) => self.checks.check(errors.iter().any(|e| e.contains(&cut(m))), || {
                 format!("slot {name}: the log does not say `{m}`: {errors:?}")
             }),
         };
-        Ok(SlotRow { name, what: case.what, shown, cycles: frame.map(|f| f.cycles), same })
+        let first_end_ms = run.frames.first().map(|f| f.end_ms);
+        Ok((SlotRow { name, what: case.what, shown, cycles: frame.map(|f| f.cycles), same }, first_end_ms))
     }
 }
 
@@ -207,6 +245,6 @@ pub(super) fn slot_report(rows: &[SlotRow]) -> Result<String> {
             if r.same { "yes" } else { "**no**" }
         )?;
     }
-    writeln!(md, "\nCycles are those of the panel checked: for the scene, from the LED going on to its going out (the scene parsed, its lattice built, the frame traced and sent); for a message, its drawing and sending (a refused scene's attempt comes first, then the message; the empty and corrupt slots show theirs at once, again every 3 s).")?;
+    writeln!(md, "\nCycles are those of the panel checked: for the scene, from the LED going on to its going out (the scene parsed, its lattice built, the frame traced and sent); for a message, its drawing and sending (a refused scene's attempt comes first, then the message; the empty and corrupt slots show theirs at once, again every 3 s). The turned case presses the camera-turn button (GP15 to ground, `Wiring::TURN`; `run.mjs --press-turn`) {PRESS_AFTER_MS:.0} ms into the pause after the user's first frame: the next frame must start within {RESPONSE_MS:.0} ms and show the scene from 1/{TURN_STEPS} of a circle further round (`host-sim orbit` draws the same frame as its frame {} of {}); each press turns it a step further, and the next-scene button brings back the scene's own camera.", ORBIT_FRAMES / TURN_STEPS, ORBIT_FRAMES)?;
     Ok(md)
 }

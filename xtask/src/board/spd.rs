@@ -89,7 +89,7 @@ impl Session<'_> {
                 Err(format!("no image kept in {} (run without --no-build)", kept.display()))
             }
         } else {
-            build_image(self.root, &image, &args, Scenes::Listed(scenes), &pico_built())
+            build_image(self.root, &image, &args, (Scenes::Listed(scenes), &[]), &pico_built())
                 .map_err(|_| refusal(self.root, &args, scenes))
         };
         let elf = match elf {

@@ -1,20 +1,38 @@
-//! The board's one button: a push button from [`Wiring::NEXT`] to ground shows the next scene.
-//! It is read between scenes, every probe of the pause ([`crate::modes`]): a press (the pin
-//! going low after it was high) ends the pause. Holding it down skips one scene, not all.
+//! The board's two buttons, read between scenes at every probe of the pause ([`crate::modes`]):
+//! [`Wiring::NEXT`] shows the next scene, [`Wiring::TURN`] the same scene with the camera turned
+//! a step further around it. A press (the button going down after it was up) ends the pause;
+//! holding a button down counts once, not at every probe.
 
 use crate::hal;
 use crate::wiring::Wiring;
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::sync::atomic::{AtomicU32, Ordering};
 
-/// The button was up at the last read (a press is a change from up to down).
-static UP: AtomicBool = AtomicBool::new(true);
+/// A button pressed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Press {
+    /// The next scene ([`Wiring::NEXT`]).
+    Next,
+    /// The camera turned ([`Wiring::TURN`]).
+    Turn,
+}
 
-/// Whether the button has been pressed since the last call: it is down now and was up then.
-pub fn pressed() -> bool {
+/// The buttons' pins, in the order [`pressed`] reports them.
+const BUTTONS: [(u8, Press); 2] = [(Wiring::NEXT, Press::Next), (Wiring::TURN, Press::Turn)];
+
+/// The buttons down at the last read, as GPIO bits (a press is a change from up to down).
+static DOWN: AtomicU32 = AtomicU32::new(0);
+
+/// The button pressed since the last call, if any: down now and up then (the next-scene button
+/// first when both were).
+pub fn pressed() -> Option<Press> {
     // SAFETY: a read of SIO's GPIO_IN, which has no side effects.
     #[allow(unsafe_code)]
-    let up = unsafe { (*hal::pac::SIO::ptr()).gpio_in().read().bits() } & (1 << Wiring::NEXT) != 0;
-    let was_up = UP.load(Ordering::Relaxed);
-    UP.store(up, Ordering::Relaxed);
-    was_up && !up
+    let levels = unsafe { (*hal::pac::SIO::ptr()).gpio_in().read().bits() };
+    let mask = BUTTONS.iter().fold(0, |m, &(pin, _)| m | 1 << pin);
+    // A button pressed takes its pin to the level of the rail it closes to.
+    let down = if Wiring::BUTTONS_ACTIVE_HIGH { levels } else { !levels } & mask;
+    // A load and a store (the M0 has no atomic swap): only core 0 reads the buttons.
+    let was_down = DOWN.load(Ordering::Relaxed);
+    DOWN.store(down, Ordering::Relaxed);
+    BUTTONS.iter().find(|&&(pin, _)| down & !was_down & 1 << pin != 0).map(|&(_, press)| press)
 }

@@ -41,6 +41,19 @@ pub fn report(record: Record) {
     BOARD_RECORDS.send(&record);
 }
 
+/// How a pause between frames ended ([`Panel::pause`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Paused {
+    /// Its time ran out: on to the next scene (the `slot` image: its scene again, as it was).
+    Elapsed,
+    /// The next-scene button was pressed (the `slot` image: its scene from its own camera).
+    Next,
+    /// The panel lost power and answers again: it shows nothing, so the frame is drawn again.
+    Lost,
+    /// The camera-turn button was pressed: the scene again, from a step further around it.
+    Turn,
+}
+
 /// A frame's microseconds: the whole frame, and up to the first tile (its set-up).
 type Micros = (u64, u64);
 
@@ -183,29 +196,40 @@ impl<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: Outpu
         defmt::info!("the display answers again");
     }
 
-    /// Sleeps between scenes, asking the panel every [`PROBE_MS`] whether it answers. True, at
-    /// once, when it stopped answering and answers again: it lost power and shows nothing, so
-    /// the frame is to be drawn again. A press of the button ([`crate::button`]) ends it early.
-    pub fn pause(&mut self) -> bool {
+    /// Sleeps between scenes, asking the panel every [`PROBE_MS`] whether it answers: ends at
+    /// once when it stopped answering and answers again ([`Paused::Lost`]), or when a button
+    /// is pressed ([`crate::button`]).
+    pub fn pause(&mut self) -> Paused {
+        use crate::button::Press;
         let mut lost = false;
         for _ in 0..PAUSE_MS / PROBE_MS {
             sleep_ms(&mut self.alarm, PROBE_MS);
             crate::guard::feed();
             crate::guard::check_requests();
-            if crate::button::pressed() {
-                defmt::info!("the button: the next scene");
-                return false;
+            match crate::button::pressed() {
+                Some(Press::Next) => {
+                    defmt::info!("the button: the next scene");
+                    return Paused::Next;
+                }
+                Some(Press::Turn) if firmware::app::CAMERA_TURNS => {
+                    defmt::info!("the button: the camera turned");
+                    return Paused::Turn;
+                }
+                Some(Press::Turn) => {
+                    defmt::warn!("the button: this image bakes its scenes for their own cameras (build with `parse` to turn them)")
+                }
+                None => {}
             }
             match (self.target.answers(), lost) {
                 (false, _) => lost = true,
                 (true, true) => {
                     defmt::warn!("the display lost power and answers again: drawing the frame again");
-                    return true;
+                    return Paused::Lost;
                 }
                 (true, false) => {}
             }
         }
-        false
+        Paused::Elapsed
     }
 }
 
@@ -217,13 +241,17 @@ pub fn run<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L:
     mut panel: Panel<'_, T, L>,
 ) -> ! {
     use firmware::slot::Message;
+    // The camera's step around the scene (the camera-turn button).
+    let mut step = 0;
     loop {
         let failed = match firmware::slot::text() {
-            Ok(text) => match panel.show(text, &Shot::default()) {
+            Ok(text) => match panel.show(text, &Shot::turned(step)) {
                 Ok((r, micros)) => {
                     report(Record::Frame(frame_done(0, &r, micros)));
                     defmt::info!(
-                        "slot: {} ms, rays {}, object tests {}",
+                        "slot: turn {}/{}: {} ms, rays {}, object tests {}",
+                        step,
+                        firmware::app::TURN_STEPS,
                         micros.0 / 1000,
                         r.stats.total_rays(),
                         r.stats.object_tests
@@ -241,7 +269,11 @@ pub fn run<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L:
                 defmt::error!("the display did not take the message");
             }
         }
-        let _ = panel.pause();
+        step = match panel.pause() {
+            Paused::Turn => (step + 1) % firmware::app::TURN_STEPS,
+            Paused::Next => 0,
+            Paused::Elapsed | Paused::Lost => step,
+        };
     }
 }
 
@@ -253,27 +285,35 @@ pub fn run<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L:
     loop {
         for (i, (name, scene)) in EMBEDDED.iter().copied().enumerate() {
             // A frame the display did not take, or lost with its power, is drawn again once the
-            // panel answers.
-            while show_scene(&mut panel, i, name, scene) {}
+            // panel answers; the camera-turn button draws it from a step further around.
+            let mut step = 0;
+            loop {
+                match show_scene(&mut panel, i, name, scene, step) {
+                    Paused::Turn => step = (step + 1) % firmware::app::TURN_STEPS,
+                    Paused::Lost => {}
+                    Paused::Elapsed | Paused::Next => break,
+                }
+            }
         }
     }
 }
 
-/// Scene `i`'s frame, drawn again while the display does not take it, then the pause after it:
-/// true when the panel lost it in the pause ([`Panel::pause`]).
+/// Scene `i`'s frame from the camera's `step` around it, drawn again while the display does not
+/// take it, then the pause after it ([`Panel::pause`]).
 #[cfg(not(any(feature = "orbit", feature = "ladder", feature = "slot")))]
 fn show_scene<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: OutputPin>(
     panel: &mut Panel<'_, T, L>,
     i: usize,
     name: &str,
     scene: Embedded,
-) -> bool {
-    while let Err(e) = panel.show(scene, &Shot::default()).map(|(r, (us, setup_us))| {
+    step: u32,
+) -> Paused {
+    while let Err(e) = panel.show(scene, &Shot::turned(step)).map(|(r, (us, setup_us))| {
         report(Record::Frame(frame_done(i, &r, (us, setup_us))));
         let (s, shares) = (r.stats, r.share_us);
         defmt::info!(
-            "{}: {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
-            name, us / 1000, shares[0], shares[1], s.total_rays(), s.rays[1], s.rays[2], s.rays[3], s.object_tests, s.cells_visited,
+            "{} (turn {}): {} ms (tile shares {} us and {} us), rays {} (shadow {}, reflection {}, refraction {}), object tests {}, cells {}, lattice {} B, stack high-water {} B",
+            name, step, us / 1000, shares[0], shares[1], s.total_rays(), s.rays[1], s.rays[2], s.rays[3], s.object_tests, s.cells_visited,
             r.lattice_bytes, stack::high_water()
         );
     }) {

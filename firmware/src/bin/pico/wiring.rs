@@ -33,10 +33,17 @@ impl Wiring {
     pub const DC: u8 = if cfg!(feature = "thumby") { 17 } else { 20 };
     /// The GPIO the display's RES (reset, active low) is on (`spi`; the Thumby's on GP20).
     pub const RES: u8 = if cfg!(feature = "thumby") { 20 } else { 21 };
-    /// The GPIO a push button to ground shows the next scene on (pulled up inside; pressed
-    /// during the pause between scenes, it ends the pause): GP14, or the Thumby's A button on
-    /// GP27.
+    /// The GPIO a push button shows the next scene on (pressed during the pause between scenes,
+    /// it ends the pause): GP14 (the Badger's button C), or the Thumby's A button on GP27.
     pub const NEXT: u8 = if cfg!(feature = "thumby") { 27 } else { 14 };
+    /// The GPIO a push button turns the camera on (pressed during the pause, it draws the scene
+    /// again from a step further around it): GP15 (the Badger's up button), or the Thumby's B
+    /// button on GP24.
+    pub const TURN: u8 = if cfg!(feature = "thumby") { 24 } else { 15 };
+    /// Whether a button pressed takes its pin high: the Badger 2040's close to 3V3 and are read
+    /// with pull-downs; the others (a push button on a Pico, the Thumby's) close to ground and
+    /// are read with pull-ups.
+    pub const BUTTONS_ACTIVE_HIGH: bool = cfg!(feature = "uc8151");
     /// The GPIO a Sharp memory LCD's DISP (display on) is on (`sharp`; its SCS, active high, is
     /// on [`Wiring::CS`], its SCLK and SI on SPI0's).
     pub const DISP: u8 = 20;
@@ -193,12 +200,14 @@ pub fn connect(
         let disp = pins.gpio20.into_push_pull_output_in_state(hal::gpio::PinState::Low);
         (Interface { spi, cs, disp }, ())
     };
-    // The button's pin: an input with its pull-up (read by `button::pressed`); the pin's
-    // setting stays when its value is dropped.
-    #[cfg(not(feature = "thumby"))]
-    let _ = pins.gpio14.into_pull_up_input();
+    // The buttons' pins: inputs pulled away from the rail a press closes them to (read by
+    // `button::pressed`); a pin's setting stays when its value is dropped.
+    #[cfg(not(any(feature = "thumby", feature = "uc8151")))]
+    let _ = (pins.gpio14.into_pull_up_input(), pins.gpio15.into_pull_up_input());
+    #[cfg(feature = "uc8151")]
+    let _ = (pins.gpio14.into_pull_down_input(), pins.gpio15.into_pull_down_input());
     #[cfg(feature = "thumby")]
-    let _ = pins.gpio27.into_pull_up_input();
+    let _ = (pins.gpio27.into_pull_up_input(), pins.gpio24.into_pull_up_input());
     #[cfg(feature = "uc8151")]
     {
         let _ = pins.gpio26.into_pull_up_input();
