@@ -675,7 +675,7 @@ struct MainRuns {
 struct SideRuns {
     panel_rows: Vec<panels::PanelRow>,
     epaper: Option<epaper::EpaperReport>,
-    thumby_button: Option<button::ButtonRow>,
+    thumby_button: Vec<button::ButtonRow>,
     gray_run: gray::GrayReport,
 }
 

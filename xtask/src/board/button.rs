@@ -5,7 +5,8 @@
 
 use super::{host_frame, run_emulator, SceneRow, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
-use board_records::frame::Build;
+use board_records::frame::{rendered, Build, TURN_STEPS};
+use lattice_rt::Fx;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -29,12 +30,13 @@ pub(super) struct ButtonRow {
 }
 
 /// An image whose button is pressed: its ELF and UF2 files, the frame it renders, the run's
-/// switches (its panel), and what the report calls its button.
+/// switches (its panel), which button, and what the report calls it.
 pub(super) struct Pressed<'a> {
     pub elf: &'a Path,
     pub uf2: &'a Path,
     pub build: Build,
     pub extra: &'a [&'a str],
+    pub turn: bool,
     pub what: &'static str,
 }
 
@@ -46,36 +48,63 @@ impl Session<'_> {
             return Ok(None);
         };
         let (elf, uf2) = (self.elf.clone(), self.uf2.clone());
-        let image = Pressed { elf: &elf, uf2: &uf2, build: PICO, extra: &[], what: "GP14 (a push button to ground)" };
+        let image = Pressed {
+            elf: &elf,
+            uf2: &uf2,
+            build: PICO,
+            extra: &[],
+            turn: false,
+            what: "GP14 (a push button to ground)",
+        };
         self.press_run(&image, f0.frame.end_ms, "button").map(Some)
     }
 
     /// `image` with its button pressed [`PRESS_AFTER_MS`] after its first frame ended at
-    /// `first_end_ms`; its frames in the folder `name`.
+    /// `first_end_ms`; its frames in the folder `name`. The next-scene button's frames are the
+    /// scenes in turn; the camera-turn button's the first scene, the first scene turned a step
+    /// ([`TURN_STEPS`]), then the second scene from its own camera (after the pause).
     pub(super) fn press_run(&mut self, image: &Pressed<'_>, first_end_ms: f64, name: &str) -> Result<ButtonRow> {
         let press_ms = first_end_ms + PRESS_AFTER_MS;
         let dir = self.frames_dir.join(name);
         std::fs::create_dir_all(&dir)?;
-        let frames = 3.min(self.scenes.len());
+        let frames = 3.min(self.scenes.len() + usize::from(image.turn));
         eprintln!("{name}: the button pressed at {press_ms:.1} ms");
         let press = format!("{press_ms:.3}");
-        let mut args = vec!["--press", &press];
+        let (switch, which) = if image.turn { ("--press-turn", "turn") } else { ("--press", "next") };
+        let mut args = vec![switch, &press];
         args.extend(image.extra);
         let run = run_emulator(self.root, image.elf, image.uf2, &self.bootrom, frames, true, &dir, &args)?;
         self.checks.check(run.ok, || format!("{name}: the run did not finish: {}", run.reason));
-        self.checks.check(run.presses.iter().filter(|p| p.0 == "next").count() == 1, || {
-            format!("{name}: {} presses seen, 1 made", run.presses.len())
-        });
+        let made = run.presses.iter().filter(|p| p.0 == which).count();
+        self.checks.check(made == 1 && run.presses.len() == 1, || format!("{name}: {made} presses seen, 1 made"));
         let next_start_ms = run.frames.get(1).map(|f| f.start_ms);
         self.checks.check(next_start_ms.is_some_and(|s| s >= press_ms && s - press_ms <= RESPONSE_MS), || {
             format!("{name}: pressed at {press_ms:.1} ms, the next frame started at {next_start_ms:?} ms (at most {RESPONSE_MS} ms later)")
         });
+        // Each frame's scene and turn.
+        let shots: Vec<(&String, u32)> = if image.turn {
+            self.scenes
+                .iter()
+                .take(1)
+                .flat_map(|s| [(s, 0), (s, 1)])
+                .chain(self.scenes.iter().skip(1).map(|s| (s, 0)))
+                .collect()
+        } else {
+            self.scenes.iter().map(|s| (s, 0)).collect()
+        };
         let mut same = 0;
-        for (k, (frame, scene)) in run.frames.iter().zip(&self.scenes).enumerate() {
-            let want = host_frame(&self.scenes_dir, scene, PICO_SCALAR, image.build)?;
+        for (k, (frame, (scene, step))) in run.frames.iter().zip(shots).enumerate() {
+            let want = if step == 0 {
+                host_frame(&self.scenes_dir, scene, PICO_SCALAR, image.build)?
+            } else {
+                let path = self.scenes_dir.join(format!("{scene}.scene"));
+                let turn = f64::from(step) / f64::from(TURN_STEPS);
+                host_sim::orbit::turned_frame::<Fx>(&path, &host_sim::load::read(&path)?, turn, &rendered(image.build))?
+            };
             let ok = frame.error.is_none() && frame.pixels == want;
             same += usize::from(ok);
-            self.checks.check(ok, || format!("{name}: frame {k} is not {scene}'s frame as host-sim draws it"));
+            self.checks
+                .check(ok, || format!("{name}: frame {k} is not {scene}'s frame (turned {step}) as host-sim draws it"));
         }
         Ok(ButtonRow { what: image.what, press_ms, next_start_ms, same, checked: run.frames.len() })
     }
@@ -87,7 +116,7 @@ pub(super) fn button_report(rows: &[ButtonRow]) -> Result<String> {
     writeln!(md, "\n## The buttons: the next scene, the camera turned\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask board`: a push button from GP14 to ground (`Wiring::NEXT`, pulled up inside; the Thumby's A button on GP27 in the `thumby` image) ends the 3 s pause between scenes, so the next scene is drawn at once; the firmware reads it at every probe of the pause (20 ms). The emulated board presses it {PRESS_AFTER_MS:.0} ms into the pause after the first frame (`run.mjs --press`); the next frame must start within {RESPONSE_MS:.0} ms and every frame must be its scene's, bit-identical to host-sim's. A second button, from GP15 (`Wiring::TURN`; the Thumby's B on GP24, the Badger's up on GP15), draws the scene again from an eighth of a circle further round; it works where the scene is set up on the board (the `slot` and `parse` images), and *The scene slot* above presses it. The Badger 2040's buttons close to 3V3: its image reads them with pull-downs, and the emulated board's buttons read what the pad's pull gives a released pin, so an image that pulled them the wrong way would see a button held down (the e-paper's run below presses its button C).\n"
+        "Written by `cargo xtask board`: a push button from GP14 to ground (`Wiring::NEXT`, pulled up inside; the Thumby's A button on GP27 in the `thumby` image) ends the 3 s pause between scenes, so the next scene is drawn at once; the firmware reads it at every probe of the pause (20 ms). The emulated board presses it {PRESS_AFTER_MS:.0} ms into the pause after the first frame (`run.mjs --press`); the next frame must start within {RESPONSE_MS:.0} ms and every frame must be its scene's, bit-identical to host-sim's. A second button, from GP15 (`Wiring::TURN`; the Thumby's B on GP24), draws the scene again from an eighth of a circle further round; it works where the scene is set up on the board (the `slot` and `parse` images, `thumby,parse` on the Thumby; not on the Badger, whose image bakes its scenes: parsing at 296x128 does not fit the RP2040's RAM), and *The scene slot* above and the Thumby's B row below press it (the first scene, then that scene turned, then the next scene after the pause, each bit-identical to host-sim's). The Badger 2040's buttons close to 3V3: its image reads them with pull-downs, and the emulated board's buttons read what the pad's pull gives a released pin, so an image that pulled them the wrong way would see a button held down (the e-paper's run below presses its button C).\n"
     )?;
     writeln!(md, "| button | pressed at | the next frame started after | frames bit-identical to host-sim |")?;
     writeln!(md, "|---|---:|---:|---:|")?;

@@ -69,8 +69,8 @@ pub(super) fn save_pictures(rows: &[PanelRow], images: &std::path::Path) -> Resu
 impl Session<'_> {
     /// Every panel's image on every embedded scene; with the e-paper's run, for its refreshes,
     /// and the Thumby's image with its A button pressed.
-    pub(super) fn panel_runs(&mut self) -> Result<(Vec<PanelRow>, Option<BoardRun>, Option<ButtonRow>)> {
-        let (mut rows, mut epaper, mut thumby) = (Vec::new(), None, None);
+    pub(super) fn panel_runs(&mut self) -> Result<(Vec<PanelRow>, Option<BoardRun>, Vec<ButtonRow>)> {
+        let (mut rows, mut epaper, mut thumby) = (Vec::new(), None, Vec::new());
         for image in PANELS {
             let (panel, _, what) = image;
             let (features, glass) = (features(image), panel.glass());
@@ -108,8 +108,16 @@ impl Session<'_> {
                 if let Some(first) = run.frames.first() {
                     let (elf, uf2) = (run_variant_image(self.root, &features), dir.join(variant_uf2(&features)));
                     let extra = ["--panel", panel.name()];
-                    let image = Pressed { elf: &elf, uf2: &uf2, build, extra: &extra, what: "the Thumby's A (GP27)" };
-                    thumby = Some(self.press_run(&image, first.end_ms, "thumby-button")?);
+                    let image = Pressed {
+                        elf: &elf,
+                        uf2: &uf2,
+                        build,
+                        extra: &extra,
+                        turn: false,
+                        what: "the Thumby's A (GP27)",
+                    };
+                    thumby.push(self.press_run(&image, first.end_ms, "thumby-button")?);
+                    thumby.extend(self.thumby_turn_run(build)?);
                 }
             }
             if panel == Panel::Uc8151 {
@@ -117,6 +125,28 @@ impl Session<'_> {
             }
         }
         Ok((rows, epaper, thumby))
+    }
+
+    /// The Thumby's image that sets its scenes up on the board (`thumby,parse`), its B button
+    /// (GP24) pressed after the first frame: that scene again, turned a step.
+    fn thumby_turn_run(&mut self, build: Build) -> Result<Option<ButtonRow>> {
+        const FEATURES: &str = "thumby,parse";
+        let extra = ["--panel", Panel::Thumby.name()];
+        let (run, dir) = self.variant(FEATURES, true, 1, &extra)?;
+        let Some(first) = run.frames.first() else {
+            self.checks.fail(format!("{FEATURES}: no frame shown ({})", run.reason));
+            return Ok(None);
+        };
+        let (elf, uf2) = (run_variant_image(self.root, FEATURES), dir.join(variant_uf2(FEATURES)));
+        let image = Pressed {
+            elf: &elf,
+            uf2: &uf2,
+            build,
+            extra: &extra,
+            turn: true,
+            what: "the Thumby's B (GP24), `thumby,parse`",
+        };
+        self.press_run(&image, first.end_ms, "thumby-turn").map(Some)
     }
 }
 
