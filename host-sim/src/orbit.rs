@@ -6,7 +6,7 @@ use crate::output::write_atomic;
 use crate::progress;
 use anyhow::{anyhow, bail, Context, Result};
 use board_records::frame as board_frame;
-use lattice_rt::scene::parse_with;
+use lattice_rt::scene::{parse_with, CameraDesc};
 use lattice_rt::{BitFrame, Frame, LatticeConfig, Real, Tracer};
 use std::borrow::Cow;
 use std::path::Path;
@@ -53,8 +53,9 @@ fn render_turned<R: Real>(
     frame: &Frame,
     storage: &mut crate::load::SceneStore<R>,
 ) -> Result<crate::run::Rendered> {
-    let scene = parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| *c = c.orbit(turn))
-        .map_err(|e| anyhow!("{e}"))?;
+    // Turned, then fitted to the frame's shape, as the board sets its camera up.
+    let fitted = |c: &mut CameraDesc| *c = CameraDesc { frame: frame.size(), ..c.orbit(turn) };
+    let scene = parse_with::<R>(text, &mut storage.objects, &mut storage.parts, fitted).map_err(|e| anyhow!("{e}"))?;
     let cfg = LatticeConfig::default();
     let mut bufs = lattice_storage(&scene, &cfg)?;
     let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
