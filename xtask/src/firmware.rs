@@ -230,13 +230,19 @@ pub(crate) fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
         .env("FIRMWARE_SCENES", scenes)
         .output();
     let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
+    refusal_in(&text, scenes)
+}
+
+/// [`refusal`] read from the build's error output `text`.
+fn refusal_in(text: &str, scenes: &str) -> String {
     // The build script's panic message is the line after its `panicked at`; without one, the
-    // linker's complaint about the region the image overflowed.
+    // linker's complaint about the first region the image overflowed (cargo may set it after
+    // a `= note:`).
     let mut lines = text.lines().map(str::trim);
     let message =
         lines.by_ref().find(|l| l.contains("panicked at")).and(lines.next()).map(str::to_string).or_else(|| {
             text.lines().find(|l| l.contains("will not fit in region")).map(|l| {
-                let what = l.trim().trim_start_matches("rust-lld: ").trim_start_matches("error: ");
+                let what = l.split_once("error: ").map_or(l.trim(), |(_, what)| what);
                 format!("the linker: {what}")
             })
         });
@@ -1095,4 +1101,24 @@ pub fn float_audit(elf: &Path) -> Result<(Vec<String>, Vec<String>)> {
     setup.sort();
     setup.dedup();
     Ok((reached, setup))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::refusal_in;
+
+    #[test]
+    fn a_refusal_gives_the_linker_line_without_its_prefixes() {
+        let text = "error: linking with `flip-link` failed: exit status: 1\n  = note: rust-lld: error: section '.rodata' will not fit in region 'FLASH': overflowed by 2469876 bytes\n          rust-lld: error: section '.gnu.sgstubs' will not fit in region 'FLASH': overflowed by 2469888 bytes\n";
+        assert_eq!(
+            refusal_in(text, "/tmp/out/shells.nff"),
+            "the linker: section '.rodata' will not fit in region 'FLASH': overflowed by 2469876 bytes"
+        );
+    }
+
+    #[test]
+    fn a_refusal_gives_the_build_scripts_message_without_the_scenes_folder() {
+        let text = "  thread 'main' panicked at build.rs:255:9:\n  FIRMWARE_SCENES: /tmp/out/tree.nff:3:1: too big for fixed point\n";
+        assert_eq!(refusal_in(text, "/tmp/out/tree.nff"), "tree.nff:3:1: too big for fixed point");
+    }
 }
