@@ -1,7 +1,8 @@
-//! The board's button (GP14 to ground, `Wiring::NEXT`; the Thumby's A button): pressed in the
-//! pause after the first scene (run.mjs `--press`), the next scene's frame must start within a
-//! probe of the press and be bit-identical to host-sim's, and the scenes after it follow in
-//! order.
+//! The board's buttons (GP14 to ground, `Wiring::NEXT`; the Thumby's A button; and the
+//! camera-turn button, `Wiring::TURN`): pressed in the pause after the first scene (run.mjs
+//! `--press`, `--press-turn`), the next frame must start within a probe of the press and be
+//! bit-identical to host-sim's (the next scene's, or the same scene's turned a step), and the
+//! frames after it follow in order.
 
 use super::{host_frame, run_emulator, SceneRow, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
@@ -110,7 +111,7 @@ impl Session<'_> {
     }
 }
 
-/// The report's section on the buttons: the board's, and the Thumby's A button.
+/// The report's section on the buttons: the board's, and the Thumby's A and B buttons.
 pub(super) fn button_report(rows: &[ButtonRow]) -> Result<String> {
     let mut md = String::new();
     writeln!(md, "\n## The buttons: the next scene, the camera turned\n")?;

@@ -68,7 +68,7 @@ pub(super) fn save_pictures(rows: &[PanelRow], images: &std::path::Path) -> Resu
 
 impl Session<'_> {
     /// Every panel's image on every embedded scene; with the e-paper's run, for its refreshes,
-    /// and the Thumby's image with its A button pressed.
+    /// and the Thumby's image with its A button pressed, and its `thumby,parse` image with B.
     pub(super) fn panel_runs(&mut self) -> Result<(Vec<PanelRow>, Option<BoardRun>, Vec<ButtonRow>)> {
         let (mut rows, mut epaper, mut thumby) = (Vec::new(), None, Vec::new());
         for image in PANELS {
