@@ -682,16 +682,16 @@ struct Tally {
 /// QEMU runs at once while the variants build (this machine has two cores).
 const QEMU_AT_ONCE: usize = 2;
 
-/// A variant's QEMU run, waited for: the variant, its flash bytes and its run.
-type Finished<'v> = (&'v Variant, u64, Option<Run>);
+/// A variant's QEMU run, waited for: its place in the list, the variant, its flash bytes and
+/// its run.
+type Finished<'v> = (usize, &'v Variant, u64, Option<Run>);
 
-/// The QEMU run started first of those still running, once it has finished.
+/// A started QEMU run once it has finished.
 fn finished<'v>(
-    started: Option<(&'v Variant, u64, std::thread::ScopedJoinHandle<'_, Result<Run>>)>,
+    (i, v, flash, handle): (usize, &'v Variant, u64, std::thread::ScopedJoinHandle<'_, Result<Run>>),
 ) -> Result<Finished<'v>> {
-    let (v, flash, handle) = started.context("no QEMU run is running")?;
     let run = handle.join().map_err(|_| anyhow::anyhow!("{}: the QEMU thread panicked", v.name))??;
-    Ok((v, flash, Some(run)))
+    Ok((i, v, flash, Some(run)))
 }
 
 /// Builds (unless `skip_build`) every variant, runs those with a machine in QEMU, and writes
@@ -709,7 +709,7 @@ fn build_and_run<'v>(
     // clock), at most [`QEMU_AT_ONCE`] at a time; the rows are written in order once all ran.
     let built = std::thread::scope(|scope| -> Result<Vec<_>> {
         let (mut done, mut running) = (Vec::new(), std::collections::VecDeque::new());
-        for v in variants {
+        for (i, v) in variants.iter().enumerate() {
             bar.set_message(v.name.clone());
             bar.inc(1);
             if !skip_build {
@@ -719,24 +719,26 @@ fn build_and_run<'v>(
             let elf = elf_path(root, v);
             let (flash, _) = elf_sizes(&elf)?;
             let Some(m) = v.machine else {
-                done.push((v, flash, None));
+                done.push((i, v, flash, None));
                 continue;
             };
-            while running.len() >= QEMU_AT_ONCE {
-                done.push(finished(running.pop_front())?);
+            if running.len() == QEMU_AT_ONCE {
+                if let Some(oldest) = running.pop_front() {
+                    done.push(finished(oldest)?);
+                }
             }
             host_sim::progress::log(&bar, format_args!("  running {} on {m}", v.name));
-            running.push_back((v, flash, scope.spawn(move || run_qemu(&elf, m))));
+            running.push_back((i, v, flash, scope.spawn(move || run_qemu(&elf, m))));
         }
-        while !running.is_empty() {
-            done.push(finished(running.pop_front())?);
+        for started in running {
+            done.push(finished(started)?);
         }
         // In the variants' order, as the table lists them.
-        done.sort_by_key(|(v, ..)| variants.iter().position(|w| std::ptr::eq(w, *v)));
+        done.sort_by_key(|&(i, ..)| i);
         Ok(done)
     })?;
     let mut runs = Vec::new();
-    for (v, flash, run) in built {
+    for (_, v, flash, run) in built {
         match &run {
             Some(r) => writeln!(
                 md,

@@ -4,7 +4,7 @@
 //! bit-identical to host-sim's (the next scene's, or the same scene's turned a step), and the
 //! frames after it follow in order.
 
-use super::{host_frame, run_emulator, SceneRow, Session, PICO, PICO_SCALAR};
+use super::{host_frame, run_emulator, BoardRun, SceneRow, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
 use board_records::frame::{rendered, Build, TURN_STEPS};
 use lattice_rt::Fx;
@@ -78,10 +78,7 @@ impl Session<'_> {
         self.checks.check(run.ok, || format!("{name}: the run did not finish: {}", run.reason));
         let made = run.presses.iter().filter(|p| p.0 == which).count();
         self.checks.check(made == 1 && run.presses.len() == 1, || format!("{name}: {made} presses seen, 1 made"));
-        let next_start_ms = run.frames.get(1).map(|f| f.start_ms);
-        self.checks.check(next_start_ms.is_some_and(|s| s >= press_ms && s - press_ms <= RESPONSE_MS), || {
-            format!("{name}: pressed at {press_ms:.1} ms, the next frame started at {next_start_ms:?} ms (at most {RESPONSE_MS} ms later)")
-        });
+        let next_start_ms = self.check_response(name, press_ms, &run);
         // Each frame's scene and turn.
         let shots: Vec<(&String, u32)> = if image.turn {
             self.scenes
@@ -108,6 +105,16 @@ impl Session<'_> {
                 .check(ok, || format!("{name}: frame {k} is not {scene}'s frame (turned {step}) as host-sim draws it"));
         }
         Ok(ButtonRow { what: image.what, press_ms, next_start_ms, same, checked: run.frames.len() })
+    }
+
+    /// Checks that `run`'s second frame, the one after a press at `press_ms`, started within
+    /// [`RESPONSE_MS`] of it; when it started.
+    pub(super) fn check_response(&mut self, name: &str, press_ms: f64, run: &BoardRun) -> Option<f64> {
+        let next_start_ms = run.frames.get(1).map(|f| f.start_ms);
+        self.checks.check(next_start_ms.is_some_and(|s| s >= press_ms && s - press_ms <= RESPONSE_MS), || {
+            format!("{name}: pressed at {press_ms:.1} ms, the next frame started at {next_start_ms:?} ms (at most {RESPONSE_MS} ms later)")
+        });
+        next_start_ms
     }
 }
 
