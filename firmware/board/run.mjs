@@ -572,7 +572,7 @@ function main() {
   if (records) records.save(opt.recordsLog);
   if (profile) writeFileSync(opt.profile, JSON.stringify([...profile.entries()]));
   const total = board.snapshot();
-  for (const r of display?.refreshes ?? []) emit({ event: 'epaper', startMs: r.start / 1e6, endMs: r.end / 1e6, dataMs: r.dataAt / 1e6 });
+  for (const r of display?.refreshes ?? []) emit({ event: 'epaper', startMs: r.start / 1e6, endMs: r.end / 1e6, dataMs: r.dataAt / 1e6, window: r.window });
   emit({
     event: 'end',
     ok,

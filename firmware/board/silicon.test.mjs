@@ -422,8 +422,34 @@ test('UC8151: BUSY low through PON and a refresh as long as its LUT, gate-ordere
   assert.equal(px(0, 1), 0);
   for (let y = 8; y < 16; y++) assert.equal(px(2, y) + px(3, y), 2, 'the partial window');
   assert.equal(px(4, 8), 0);
+  // A refresh in partial mode drives its window alone: gate 0's top pixel goes black in the
+  // RAM, outside the window, and stays white on the glass; the window's gate 5 goes white.
+  fcmd(0x13, ...new Array(296 * 16).fill(0));
+  fcmd(0x91);
+  fcmd(0x90, 0, 7, 0, 5, 0, 5, 1);
+  fcmd(0x13, 0x80);
+  fcmd(0x12);
+  assert.equal(f.error, null);
+  assert.deepEqual(f.refreshes[1].window, { hs: 0, he: 7, vs: 5, ve: 5 });
+  advance(now + 930e6);
+  const after = f.shown();
+  const px2 = (x, y) => (after[y * 37 + (x >> 3)] >> (7 - (x & 7))) & 1;
+  assert.equal(px2(0, 0), 1, 'outside the window: the glass as it was');
+  assert.equal(px2(5, 0), 1, 'inside the window: the RAM');
+  assert.equal(px2(5, 1), 0);
+  fcmd(0x92);
   fcmd(0x05);
   assert.match(f.error, /0x5: not one this model knows/);
+  // Partial refreshes alone since power-on: the glass outside their windows is unknown.
+  const [p, pcmd] = make();
+  setUp(pcmd);
+  pcmd(0x04);
+  advance(now + 30e6);
+  pcmd(0x91);
+  pcmd(0x90, 0, 7, 0, 0, 0, 0, 1);
+  pcmd(0x13, 0xff);
+  pcmd(0x12);
+  assert.match(p.notShowable(), /only partial refreshes since power-on/);
   const [g, gcmd] = make();
   gcmd(0x01, 3, 0);
   gcmd(0x04);

@@ -8,8 +8,9 @@
 // (DTM2) in gate order: for each of the 296 gates (the glass's columns, left to right with
 // PSR's SHIFT_RIGHT and SCAN_DOWN) 16 bytes of sources (its rows, top to bottom, each byte's top
 // bit first), a 1 white (CDI's DDX 00, as the Badger's driver sets it). A partial window (PTIN,
-// PTL) limits DTM2 to a rectangle of whole source bytes. A refresh shows the RAM as it was when
-// DRF came; it lasts the register LUT's frames (the VCOM LUT's seven groups: the four phase
+// PTL) limits DTM2 to a rectangle of whole source bytes, and a refresh in partial mode drives
+// that window alone: the glass outside it keeps what it showed (unknown, if nothing was ever
+// refreshed whole). A refresh shows the RAM as it was when DRF came; it lasts the register LUT's frames (the VCOM LUT's seven groups: the four phase
 // times of each, times its repeat count) at the PLL's frame rate, or 4.5 s with the LUT in OTP
 // (what Pimoroni measured of the Badger's panel: the model knows no OTP waveform).
 //
@@ -82,6 +83,7 @@ export class Uc8151 {
   resetState() {
     this.ram = new Uint8Array(GATES * STRIDE);
     this.picture = null;
+    this.outsideUnknown = false;
     this.psr = null;
     this.vcomLut = null;
     this.pll = 0x3c;
@@ -207,8 +209,23 @@ export class Uc8151 {
       nanos = (frames / PLL_HZ[this.pll]) * 1e9;
     }
     const start = this.now();
-    this.refreshes.push({ start, end: start + nanos, dataAt: this.dataAt ?? start });
-    this.picture = this.ram.slice();
+    const window = this.partial ? this.window : null;
+    if (this.partial && !window) return this.fail('DRF in partial mode (PTIN) with no window (PTL)');
+    this.refreshes.push({ start, end: start + nanos, dataAt: this.dataAt ?? start, window });
+    if (window) {
+      // The window's gates and source bytes from the RAM; outside it, the glass as it was.
+      if (this.picture === null) {
+        this.picture = new Uint8Array(this.ram.length);
+        this.outsideUnknown = true;
+      }
+      for (let gate = window.vs; gate <= window.ve; gate++) {
+        const at = gate * STRIDE;
+        this.picture.set(this.ram.subarray(at + window.hs / 8, at + (window.he + 1) / 8), at + window.hs / 8);
+      }
+    } else {
+      this.picture = this.ram.slice();
+      this.outsideUnknown = false;
+    }
     this.work(nanos);
   }
 
@@ -255,6 +272,7 @@ export class Uc8151 {
   notShowable() {
     if (this.error) return this.error;
     if (this.picture === null) return 'no refresh since power-on: the glass shows whatever it last had';
+    if (this.outsideUnknown) return 'only partial refreshes since power-on: outside their windows the glass shows whatever it last had';
     return null;
   }
 

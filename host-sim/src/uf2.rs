@@ -128,8 +128,8 @@ pub fn build_image(
     // side) could each keep the other's image.
     static BUILDING: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _one_at_a_time = BUILDING.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
-    cmd.current_dir(root).args(args).env_remove("RUSTFLAGS").env_remove("FIRMWARE_FLASH_KIB");
+    let mut cmd = firmware_cargo(root);
+    cmd.args(args);
     match scenes {
         Scenes::Inherited => {}
         Scenes::Default => {
@@ -150,6 +150,38 @@ pub fn build_image(
     let from = root.join("firmware/target").join(built);
     std::fs::copy(&from, &kept).with_context(|| format!("cannot copy {} to {}", from.display(), kept.display()))?;
     Ok(kept)
+}
+
+/// `cargo`, run from the repository's root, for a firmware build: the caller's `RUSTFLAGS` and
+/// `FIRMWARE_FLASH_KIB` left out, and the source paths an image carries (the panic locations of
+/// the core, a path dependency outside the firmware's workspace, and of registry crates)
+/// written relative to the repository (`lattice-rt/`) and to cargo's home (`cargo/`). So an
+/// image, its size and its cycles are the same wherever the repository is checked out (they
+/// were not: a clone in /tmp/ci-check built a default image 40 bytes larger than /work/main's,
+/// its code laid out differently behind the XIP cache). Every firmware build the project's
+/// commands run goes through here, so they share one set of compiled dependencies.
+pub fn firmware_cargo(root: &Path) -> Command {
+    let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    let home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".cargo")));
+    let mut flags: Vec<String> = Vec::new();
+    let mut remap = |from: &Path, to: &str| flags.push(format!("--remap-path-prefix={}={to}", from.display()));
+    if let Some(home) = &home {
+        remap(home, "cargo");
+    }
+    // The later of two matching prefixes wins: the repository's, should it live in cargo's home.
+    remap(root, "lattice-rt");
+    if let Ok(canonical) = root.canonicalize() {
+        if canonical != root {
+            remap(&canonical, "lattice-rt");
+        }
+    }
+    cmd.current_dir(root)
+        .env_remove("RUSTFLAGS")
+        .env_remove("FIRMWARE_FLASH_KIB")
+        .env("CARGO_ENCODED_RUSTFLAGS", flags.join("\x1f"));
+    cmd
 }
 
 /// Where `cargo pico-build` (with any extra features) writes the Pico image, inside `firmware/target`.

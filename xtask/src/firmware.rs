@@ -167,7 +167,9 @@ fn pico_variants() -> [Variant; 2] {
     let pico = "Raspberry Pi Pico + SSD1306, fixed, all five scenes baked (run on an emulated board by `cargo xtask board`: docs/board.md)";
     let pico2 = "Raspberry Pi Pico 2 + SSD1306, f32, all five scenes baked (built only: no RP2350 emulator here; its core's code runs as qemu-m33-f32-baked)";
     [
-        Variant { bin: "pico", machine: None, ..Variant::qemu("pico", M0, "pico", "fixed", pico) },
+        // The profiles of `cargo pico-build` and `cargo pico2-build`: the image kept as `pico` is
+        // the one `cargo xtask board` runs, whichever command built it last.
+        Variant { bin: "pico", machine: None, profile: "sram", ..Variant::qemu("pico", M0, "pico", "fixed", pico) },
         Variant { bin: "pico", machine: None, profile: "speed", ..Variant::qemu("pico2", M33, "pico2", "f32", pico2) },
     ]
 }
@@ -224,11 +226,7 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
 /// message (the build is run again to read it, its folder left out of the paths it names), the
 /// linker's when a region overflowed, or the build's failure.
 pub(crate) fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
-    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(root)
-        .args(args)
-        .env("FIRMWARE_SCENES", scenes)
-        .output();
+    let out = host_sim::uf2::firmware_cargo(root).args(args).env("FIRMWARE_SCENES", scenes).output();
     let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
     refusal_in(&text, scenes)
 }
@@ -443,11 +441,8 @@ const TINY: &str = "tiny-m0-fixed-chair";
 /// What the `tiny` build, which leaves out spheres and cones, says when it is built with a scene
 /// of spheres: the reason it refuses it (`None` if it did not, and would draw it without them).
 fn tiny_refuses_spheres(root: &Path, v: &Variant) -> Result<Option<String>> {
-    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .current_dir(root)
+    let out = host_sim::uf2::firmware_cargo(root)
         .args(cargo_args(v))
-        .env_remove("RUSTFLAGS")
-        .env_remove("FIRMWARE_FLASH_KIB")
         .env("FIRMWARE_SCENES", "spheres")
         .stdin(Stdio::null())
         .output()

@@ -6,6 +6,12 @@
 //! go on with the next frame while it runs; the next frame's bytes wait for BUSY to go high.
 //! The waveform is in registers (a short one: 93 frames at 100 Hz, 0.93 s), so the refresh's
 //! length is known and not the OTP's 4.5 s.
+//!
+//! Only what changed is refreshed: the bands note the gates and source bytes whose pixels
+//! changed since the frame on the glass ([`Changed`]), and a frame sends that window alone as
+//! a partial refresh (PTIN, PTL, its bytes, DRF; PTOUT before the next command that is not),
+//! or nothing at all when no pixel changed, so a scene drawn again does not flash the glass.
+//! The first frame after reset, and one whose changes span the glass, are refreshed whole.
 
 use super::{Band, SetUp};
 use crate::wiring::{Interface, Wiring};
@@ -89,14 +95,63 @@ const DTM2: u8 = 0x13;
 const DSP: u8 = 0x11;
 /// Display refresh.
 const DRF: u8 = 0x12;
+/// Partial window: its first and last source (whole bytes), first and last gate (two bytes
+/// each), and the gate scan's extent.
+const PTL: u8 = 0x90;
+/// Partial mode in: refreshes and data go to the window alone.
+const PTIN: u8 = 0x91;
+/// Partial mode out.
+const PTOUT: u8 = 0x92;
+/// PTL's last byte, PT_SCAN: the gates scan inside and outside the window (the window's
+/// pixels get the waveform; those outside keep their picture).
+const PT_SCAN: u8 = 0x01;
+
+/// The gates (columns) and source bytes (8 rows each) holding a pixel that changed since the
+/// frame on the glass: inclusive ranges, empty while the first is past the last.
+#[derive(Clone, Copy)]
+struct Changed {
+    gates: (u16, u16),
+    bytes: (u8, u8),
+}
+
+impl Changed {
+    /// No pixel changed.
+    const NONE: Changed = Changed { gates: (u16::MAX, 0), bytes: (u8::MAX, 0) };
+    /// The whole glass.
+    const ALL: Changed = Changed { gates: (0, WIDTH - 1), bytes: (0, STRIDE as u8 - 1) };
+
+    /// Gate `x`'s source byte `byte` changed.
+    fn include(&mut self, x: usize, byte: usize) {
+        let (x, byte) = (x as u16, byte as u8);
+        self.gates = (self.gates.0.min(x), self.gates.1.max(x));
+        self.bytes = (self.bytes.0.min(byte), self.bytes.1.max(byte));
+    }
+
+    /// Whether no pixel changed.
+    fn is_empty(&self) -> bool {
+        self.gates.0 > self.gates.1
+    }
+
+    /// Whether the window is the whole glass.
+    fn is_all(&self) -> bool {
+        self.gates == Changed::ALL.gates && self.bytes == Changed::ALL.bytes
+    }
+}
 
 /// The e-paper: the frame gathered in RAM, sent at its end.
 pub struct Gates {
     bus: Interface,
-    /// The frame in the controller's order (a static: 4.6 KiB off core 0's stack).
+    /// The frame in the controller's order (a static: 4.6 KiB off core 0's stack). Between
+    /// frames it is the frame on the glass, which the next frame's bands are told from.
     ram: &'static mut [u8; RAM],
     /// Set up and powered on since reset.
     ready: bool,
+    /// A frame has been refreshed whole since reset: the glass shows `ram`.
+    shown: bool,
+    /// The controller is in partial mode (the last refresh was partial).
+    partial: bool,
+    /// Where this frame differs from the glass.
+    changed: Changed,
 }
 
 /// Whether the controller works (BUSY low: powering on or refreshing).
@@ -120,7 +175,7 @@ impl Gates {
         let Some(ram) = cortex_m::singleton!(: [u8; RAM] = [0; RAM]) else {
             defmt::panic!("the e-paper's frame is taken");
         };
-        Gates { bus, ram, ready: false }
+        Gates { bus, ram, ready: false, shown: false, partial: false, changed: Changed::NONE }
     }
 
     /// Command `c` with its parameters `p`.
@@ -155,14 +210,40 @@ impl SetUp for Gates {
         true
     }
 
-    /// The frame to the controller once the last refresh has ended, and its refresh started:
-    /// the cores go on while it runs.
+    /// The frame's changes to the controller once the last refresh has ended, and their
+    /// refresh started (the cores go on while it runs): the whole frame the first time, the
+    /// window of its changes after, nothing when it is the frame on the glass.
     fn flush(&mut self) -> Result<(), DisplayError> {
+        let changed = if self.shown { core::mem::replace(&mut self.changed, Changed::NONE) } else { Changed::ALL };
+        if changed.is_empty() {
+            defmt::info!("e-paper: the glass shows this frame already, no refresh");
+            return Ok(());
+        }
         wait();
-        self.bus.send_commands(DataFormat::U8(&[DTM2]))?;
-        self.bus.send_data(DataFormat::U8(&self.ram[..]))?;
+        let partial = !changed.is_all();
+        if self.partial && !partial {
+            self.command(PTOUT, &[])?;
+        }
+        if partial {
+            let ((g0, g1), (b0, b1)) = (changed.gates, changed.bytes);
+            let [v0h, v0l] = g0.to_be_bytes();
+            let [v1h, v1l] = g1.to_be_bytes();
+            self.command(PTIN, &[])?;
+            self.command(PTL, &[b0 * 8, b1 * 8 + 7, v0h, v0l, v1h, v1l, PT_SCAN])?;
+            self.bus.send_commands(DataFormat::U8(&[DTM2]))?;
+            for x in usize::from(g0)..=usize::from(g1) {
+                let gate = x * STRIDE;
+                self.bus.send_data(DataFormat::U8(&self.ram[gate + usize::from(b0)..=gate + usize::from(b1)]))?;
+            }
+            defmt::info!("e-paper: partial refresh of gates {}..={}, rows {}..={}", g0, g1, b0 * 8, b1 * 8 + 7);
+        } else {
+            self.bus.send_commands(DataFormat::U8(&[DTM2]))?;
+            self.bus.send_data(DataFormat::U8(&self.ram[..]))?;
+        }
         self.command(DSP, &[])?;
-        self.command(DRF, &[])
+        self.command(DRF, &[])?;
+        (self.shown, self.partial, self.changed) = (true, partial, Changed::NONE);
+        Ok(())
     }
 }
 
@@ -177,10 +258,14 @@ impl Band for Gates {
             let (byte, bit) = (y / 8, 0x80u8 >> (y % 8));
             for x in x0..x0 + w {
                 let at = &mut self.ram[x * STRIDE + byte];
+                let was = *at;
                 if colors.next().is_some_and(|c| c.is_on()) {
                     *at |= bit;
                 } else {
                     *at &= !bit;
+                }
+                if *at != was {
+                    self.changed.include(x, byte);
                 }
             }
         }
