@@ -236,9 +236,14 @@ mod writer {
             )
         }
     }
-    impl<R: Literal> Literal for Object<R> {
+    /// An object with its eye and first light in its own space, as the scene's set-up computes
+    /// them ([`Object::local_eye_and_light`]): written whole whether or not this build keeps
+    /// them (`lean-objects`), so the tables are the same for every build that includes them.
+    struct Whole<'a, R>(&'a Object<R>, Vec3<R>, Vec3<R>);
+
+    impl<R: Literal> Literal for Whole<'_, R> {
         fn literal(&self, out: &mut String) {
-            let o = self;
+            let Whole(o, eye_local, light_local) = self;
             out.push_str("Object::from_tables(");
             let parts: [&dyn Literal; 15] = [
                 &o.shape,
@@ -251,8 +256,8 @@ mod writer {
                 &o.bounds,
                 &o.dir_scale,
                 &o.inv_dir_scale,
-                &o.eye_local,
-                &o.light_local,
+                eye_local,
+                light_local,
                 o.region.eye_window(),
                 o.region.eye_hull(),
                 o.region.shadow_window(),
@@ -298,7 +303,15 @@ mod writer {
             "/// The scene `{name}`, baked.\n\
              pub static {name}: Baked<{scalar}> = Baked {{\n    scene: Scene::from_tables(\n        &"
         );
-        list(scene.objects, &mut out);
+        let objects: alloc::vec::Vec<Whole<'_, R>> = scene
+            .objects
+            .iter()
+            .map(|o| {
+                let (eye, light) = o.local_eye_and_light(scene.camera.eye, scene.lights);
+                Whole(o, eye, light)
+            })
+            .collect();
+        list(&objects, &mut out);
         let arg = |out: &mut String, v: &dyn Literal| {
             out.push_str(",\n        ");
             v.literal(out);

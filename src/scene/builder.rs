@@ -308,7 +308,9 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             dir_scale: R::pow2(log2_of_pow2(dir_scale)),
             inv_dir_scale: R::pow2(log2_of_pow2(1.0 / dir_scale)),
             // The camera is known at `finish`, which sets both.
+            #[cfg(not(feature = "lean-objects"))]
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
+            #[cfg(not(feature = "lean-objects"))]
             light_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
             region: Region::everywhere(),
         };
@@ -341,11 +343,10 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let shadow_basis = shadow_basis(&self.parts.lights);
         let regions = Regions::new(&camera, shadow_basis, &world);
         for o in self.storage[..self.len].iter_mut() {
-            o.eye_local = o.point_local(camera.eye);
-            o.light_local = match self.parts.lights.first() {
-                Some(Light::Directional { to_light, .. }) => o.direction_local(*to_light),
-                _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),
-            };
+            #[cfg(not(feature = "lean-objects"))]
+            {
+                (o.eye_local, o.light_local) = o.local_eye_and_light(camera.eye, &self.parts.lights);
+            }
             o.region = regions.of(o);
         }
         let bound = brightness_bound(&self.parts.materials, &self.parts.lights, self.ambient, self.background);

@@ -119,11 +119,15 @@ pub struct Object<R> {
     /// `1 / dir_scale`.
     pub(crate) inv_dir_scale: Pow2<R>,
     /// The camera's eye in object space, `to_object.vector(eye - origin) * unscale`: the same
-    /// for every eye ray, so it is computed once per scene instead of once per eye-ray test.
+    /// for every eye ray, so it is computed once per scene instead of once per eye-ray test
+    /// (not kept with `lean-objects`).
+    #[cfg(not(feature = "lean-objects"))]
     pub(crate) eye_local: Vec3<R>,
     /// The direction towards the scene's first light, when it is directional, in object space
     /// as [`Object::intersect`] maps a ray's direction (zero otherwise): the same for every
-    /// shadow ray towards that light, so it is mapped once per scene instead of once per test.
+    /// shadow ray towards that light, so it is mapped once per scene instead of once per test
+    /// (not kept with `lean-objects`).
+    #[cfg(not(feature = "lean-objects"))]
     pub(crate) light_local: Vec3<R>,
     /// Where it can appear, to each kind of ray that culling tests ([`crate::cull`]).
     pub(crate) region: Region<R>,
@@ -144,7 +148,9 @@ impl<R: Real> Default for Object<R> {
             bounds: Aabb { min: z, max: z },
             dir_scale: R::pow2(0),
             inv_dir_scale: R::pow2(0),
+            #[cfg(not(feature = "lean-objects"))]
             eye_local: z,
+            #[cfg(not(feature = "lean-objects"))]
             light_local: z,
             region: Region::everywhere(),
         }
@@ -153,7 +159,8 @@ impl<R: Real> Default for Object<R> {
 
 impl<R> Object<R> {
     /// An object from its parts, as [`bake::source`](crate::bake) writes them: for baked
-    /// tables only, which hold objects of a validated scene.
+    /// tables only, which hold objects of a validated scene (with `lean-objects`, `eye_local`
+    /// and `light_local` are not kept).
     #[doc(hidden)]
     #[allow(clippy::too_many_arguments)]
     pub const fn from_tables(
@@ -173,6 +180,9 @@ impl<R> Object<R> {
         eye_hull: EyeHull,
         shadow_window: ShadowWindow<R>,
     ) -> Self {
+        // Not kept (a const fn cannot drop a generic value: it forgets them).
+        #[cfg(feature = "lean-objects")]
+        core::mem::forget((eye_local, light_local));
         Object {
             shape,
             to_object,
@@ -184,7 +194,9 @@ impl<R> Object<R> {
             bounds,
             dir_scale,
             inv_dir_scale,
+            #[cfg(not(feature = "lean-objects"))]
             eye_local,
+            #[cfg(not(feature = "lean-objects"))]
             light_local,
             region: Region::from_tables(eye_window, eye_hull, shadow_window),
         }
@@ -192,6 +204,18 @@ impl<R> Object<R> {
 }
 
 impl<R: Real> Object<R> {
+    /// The camera's eye `eye` in the object's space, and the direction towards the first of
+    /// `lights` when it is directional (zero otherwise) as a test maps a ray's direction: what
+    /// the object keeps (without `lean-objects`) for eye rays and first-light shadow rays.
+    #[cfg_attr(all(feature = "lean-objects", not(feature = "bake")), allow(dead_code))]
+    pub(crate) fn local_eye_and_light(&self, eye: Vec3<R>, lights: &[Light<R>]) -> (Vec3<R>, Vec3<R>) {
+        let light = match lights.first() {
+            Some(Light::Directional { to_light, .. }) => self.direction_local(*to_light),
+            _ => Vec3::new(R::ZERO, R::ZERO, R::ZERO),
+        };
+        (self.point_local(eye), light)
+    }
+
     /// Nearest hit of a world ray with `tmin < t <= tmax`: `t` (the world ray's parameter) and
     /// the object-space normal and point.
     #[inline]
@@ -229,7 +253,12 @@ impl<R: Real> Object<R> {
         if !self.eye_window_meets([uv[0]; 2], [uv[1]; 2]) {
             return Err(Culled);
         }
-        Ok(self.intersect_local(self.eye_local, self.direction_local(ray.dir), tmin, tmax))
+        #[cfg(not(feature = "lean-objects"))]
+        let eye = self.eye_local;
+        // The ray's origin is the camera's eye, which the scene's set-up mapped the same way.
+        #[cfg(feature = "lean-objects")]
+        let eye = self.point_local(ray.origin);
+        Ok(self.intersect_local(eye, self.direction_local(ray.dir), tmin, tmax))
     }
 
     /// [`Object::intersect`] for a shadow ray towards the scene's first light when that light
@@ -237,7 +266,12 @@ impl<R: Real> Object<R> {
     /// the direction's object-space image taken from the scene instead of transformed again.
     #[inline]
     pub fn intersect_first_light_ray(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        self.intersect_local(self.point_local(ray.origin), self.light_local, tmin, tmax)
+        #[cfg(not(feature = "lean-objects"))]
+        let towards = self.light_local;
+        // The ray's direction is the light's, which the scene's set-up mapped the same way.
+        #[cfg(feature = "lean-objects")]
+        let towards = self.direction_local(ray.dir);
+        self.intersect_local(self.point_local(ray.origin), towards, tmin, tmax)
     }
 
     /// Whether a shadow ray towards the scene's first light (directional) at position `w` across

@@ -2,7 +2,9 @@
 //! baked into its own Pico image (`FIRMWARE_SCENES` takes the file's path; objects, lattice and
 //! windows in flash, read through the XIP cache), run on the emulated board and checked bit for
 //! bit against host-sim's frame of the same file. A scene whose tables do not fit the image is
-//! refused by `firmware/build.rs` with the figures; the report gives its message.
+//! built again with the firmware's `lean-objects` (24 bytes less per object); one that fits
+//! neither way is refused by `firmware/build.rs` with the figures, and the report gives its
+//! message.
 
 use super::{elf_sizes, m3, reported_frame, run_emulator, save_frame, Session, PICO, PICO_SCALAR};
 use crate::firmware::{host_frame_of, refusal};
@@ -38,6 +40,8 @@ pub(super) struct SpdRow {
     objects: usize,
     /// The image's flash and static RAM (bytes), or why it was not built.
     built: Result<(u64, u64), String>,
+    /// Bytes of one object's record in flash (less with `lean-objects`).
+    record: u64,
     /// The frame, as run (none if the image was refused or the run showed none).
     frame: Option<SpdFrame>,
 }
@@ -78,23 +82,15 @@ impl Session<'_> {
         host_sim::output::write_atomic(&nff, text.as_bytes())?;
         let objects = lattice_rt::object_count(&text);
         let image = format!("pico-spd-{name}");
-        let args = ["pico-build", "--features", "triangles"];
         let scenes = nff.to_str().context("the frames folder's path is not UTF-8")?;
-        eprintln!("building the Pico image with {name} ({objects} objects) baked");
-        let elf = if self.no_build {
-            let kept = kept_image(self.root, &image);
-            if kept.exists() {
-                Ok(kept)
-            } else {
-                Err(format!("no image kept in {} (run without --no-build)", kept.display()))
-            }
-        } else {
-            build_image(self.root, &image, &args, (Scenes::Listed(scenes), &[]), &pico_built())
-                .map_err(|_| refusal(self.root, &args, scenes))
-        };
+        let (mut elf, mut record) = (self.spd_image(&image, scenes, false), WHOLE_RECORD);
+        // Kept images (`--no-build`) are looked for the same way: whole, then lean.
+        if matches!(&elf, Err(why) if too_big(why) || self.no_build) {
+            (elf, record) = (self.spd_image(&image, scenes, true), LEAN_RECORD);
+        }
         let elf = match elf {
             Ok(elf) => elf,
-            Err(why) => return Ok(SpdRow { name, objects, built: Err(why), frame: None }),
+            Err(why) => return Ok(SpdRow { name, objects, built: Err(why), record, frame: None }),
         };
         let built = Ok(elf_sizes(&elf)?);
         let uf2 = dir.join(format!("lattice-rt-{image}.uf2"));
@@ -123,9 +119,34 @@ impl Session<'_> {
         self.checks.check(frame.as_ref().is_some_and(|f| f.same), || {
             format!("SPD {name}: the board's frame is not host-sim's (see {})", work.display())
         });
-        Ok(SpdRow { name, objects, built, frame })
+        Ok(SpdRow { name, objects, built, record, frame })
+    }
+
+    /// The Pico image `image` with the NFF file `scenes` baked (`lean`: with the firmware's
+    /// `lean-objects`), built or (`--no-build`) kept; or why not: the build's refusal.
+    fn spd_image(&self, image: &str, scenes: &str, lean: bool) -> Result<std::path::PathBuf, String> {
+        let (features, image) =
+            if lean { ("triangles,lean-objects", format!("{image}-lean")) } else { ("triangles", image.to_string()) };
+        let args = ["pico-build", "--features", features];
+        if self.no_build {
+            let kept = kept_image(self.root, &image);
+            return if kept.exists() {
+                Ok(kept)
+            } else {
+                Err(format!("no image kept in {} (run without --no-build)", kept.display()))
+            };
+        }
+        eprintln!("building the Pico image {image} (cargo {})", args.join(" "));
+        build_image(self.root, &image, &args, (Scenes::Listed(scenes), &[]), &pico_built())
+            .map_err(|_| refusal(self.root, &args, scenes))
     }
 }
+
+/// Bytes of an object's record in a Pico image's flash.
+const WHOLE_RECORD: u64 = std::mem::size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>() as u64;
+/// The same with the firmware's `lean-objects`: without the eye and first light in the
+/// object's space.
+const LEAN_RECORD: u64 = WHOLE_RECORD - 2 * std::mem::size_of::<lattice_rt::Vec3<lattice_rt::Fx>>() as u64;
 
 /// The plot of the sphereflake's images (`balls` at each size run): flash and static RAM (KiB),
 /// cycles per frame (millions) and XIP misses per ray against its objects, written as [`PLOT`]
@@ -179,7 +200,7 @@ fn record_parts() -> String {
     let named: usize = parts.iter().map(|p| p.1).sum();
     let each: Vec<String> = parts.iter().map(|(n, b)| format!("{n} {b}")).collect();
     format!(
-        "Each object, whatever its shape, is one record of {total} bytes in flash: {}, and {} for its shape, scales, material and composite",
+        "Each object, whatever its shape, is one record of {total} bytes in flash: {}, and {} for its shape, scales, material and composite. A scene whose tables do not fit so is built again with the firmware's `lean-objects` (*lean* in the table): records of {LEAN_RECORD} bytes without the eye and light in object space, which an eye ray's or first-light shadow ray's test then transforms again, with the same answers",
         each.join(", "),
         total - named
     )
@@ -225,7 +246,6 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
     writeln!(md, "| scene | objects | flash (image) | object records | lattice bytes | RAM (static) | frame: cycles | fps at 125 MHz | XIP misses per ray | XIP stall | eye rays | all rays | object tests per ray | bit-identical to host-sim |")?;
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")?;
     let kib = |b: u64| format!("{:.0} KiB", b as f64 / 1024.0);
-    let record = std::mem::size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>() as u64;
     let mut refused = Vec::new();
     for r in rows {
         let (flash, ram) = match &r.built {
@@ -236,7 +256,8 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
                 (cell.into(), "-".into())
             }
         };
-        let records = kib(r.objects as u64 * record);
+        let lean = if r.record == LEAN_RECORD { " (lean)" } else { "" };
+        let records = format!("{}{lean}", kib(r.objects as u64 * r.record));
         let Some(f) = &r.frame else {
             writeln!(
                 md,
