@@ -11,7 +11,7 @@ use lattice_rt::bake::Literal;
 use lattice_rt::lattice::{LatticeConfig, LatticeStorage, SubLattice};
 use lattice_rt::scene::Object;
 use lattice_rt::Lattice;
-use lattice_rt::{Real, Sizes, Vec3};
+use lattice_rt::{Real, Sizes};
 
 use board_records::frame;
 use std::fmt::Write as _;
@@ -72,12 +72,7 @@ fn main() {
     if baked {
         // Baked once it is known whether the tracer asks the lattices: where it never does,
         // they are left out of flash.
-        let mut footprints = Vec::new();
-        for (name, path, text) in &scenes {
-            let bake = Bake { name, with_lattice: !windows_only, out: &mut tables, footprints: &mut footprints };
-            plan_in_scalar(path, text, Some(bake));
-        }
-        check_fits(&footprints, &sizes);
+        tables = bake_scenes(&scenes, !windows_only, &mut sizes);
     }
     if has("effects-all") {
         effects = lattice_rt::Effects::ALL.bits();
@@ -204,8 +199,57 @@ fn replace_line(map: &str, start: &str, line: &str) -> String {
 struct Bake<'a> {
     name: &'a str,
     with_lattice: bool,
+    /// Most bytes its lattice may take (the core's lattice budget), or none.
+    budget: Option<usize>,
     out: &'a mut String,
     footprints: &'a mut Vec<Footprint>,
+}
+
+/// The tables of `scenes` (name, path, text), each with its lattice (`with_lattice`), and the
+/// storage they need merged into `sizes`. Where they do not fit the board's flash but their
+/// objects do, they are baked again with their lattices fitted to the flash the objects leave
+/// (each a share in proportion to its lattice's bytes: the core's budget search, the lattice
+/// of least estimated cost within it), and the build says so; what still does not fit is
+/// refused ([`check_fits`]).
+fn bake_scenes(scenes: &[(String, PathBuf, String)], with_lattice: bool, sizes: &mut Sizes) -> String {
+    let mut budgets = vec![None; scenes.len()];
+    loop {
+        let (mut tables, mut footprints) = (String::new(), Vec::new());
+        for ((name, path, text), &budget) in scenes.iter().zip(&budgets) {
+            let bake = Bake { name, with_lattice, budget, out: &mut tables, footprints: &mut footprints };
+            let (s, ..) = plan_in_scalar(path, text, Some(bake));
+            *sizes = sizes.max(s);
+        }
+        let fitted = lattice_budgets(&footprints).filter(|_| budgets.iter().all(Option::is_none));
+        let Some(fitted) = fitted else {
+            check_fits(&footprints, sizes);
+            return tables;
+        };
+        for (f, b) in footprints.iter().zip(&fitted) {
+            let kib = |b: usize| b as f64 / 1024.0;
+            println!(
+                "cargo:warning={}: its lattice of {:.0} KiB does not fit the flash its objects leave: fitted to {:.0} KiB",
+                f.scene,
+                kib(f.lattice_bytes),
+                kib(*b)
+            );
+        }
+        budgets = fitted.into_iter().map(Some).collect();
+    }
+}
+
+/// Per scene of `footprints`, the bytes its lattice may take when the tables do not fit the
+/// board's flash but the objects alone do: the flash left after the objects, shared in
+/// proportion to the lattices' bytes. None when they fit, or cannot be made to.
+fn lattice_budgets(footprints: &[Footprint]) -> Option<Vec<usize>> {
+    let (flash, code, _) = board_memory()?;
+    let objects: usize = footprints.iter().map(|f| f.objects * f.object_bytes).sum();
+    let lattices: usize = footprints.iter().map(|f| f.lattice_bytes).sum();
+    let left = (flash - code).checked_sub(objects)?;
+    if lattices <= left || left == 0 {
+        return None;
+    }
+    Some(footprints.iter().map(|f| (left as u128 * f.lattice_bytes as u128 / lattices as u128) as usize).collect())
 }
 
 /// The flash a baked scene's tables take: its objects (each a full record: shape, placement and
@@ -229,16 +273,22 @@ const PICO2_CODE_FLASH: usize = 128 * 1024;
 /// core 1's stack (32 KiB), the tile buffers, the panel's frame, and room for core 0's stack.
 const PICO_OTHER_RAM: usize = 160 * 1024;
 
+/// The flash the board's image has besides its code loaded into SRAM, the flash its other code
+/// takes at most, and its RAM (bytes): the Pico's and the Pico 2's; none for other boards.
+fn board_memory() -> Option<(usize, usize, usize)> {
+    match (has("pico"), has("pico2")) {
+        (true, _) => Some((pico_flash_kib() * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024)),
+        (_, true) => Some((4096 * 1024, PICO2_CODE_FLASH, 512 * 1024)),
+        _ => None,
+    }
+}
+
 /// Refuses, with the figure needed and the figure available, baked scenes whose tables do not
 /// fit the Pico's flash or whose mailboxes (a word per object and lattice, for each core) do not
 /// fit its RAM, before the linker would say so less clearly. Other boards are left to their
 /// linker scripts.
 fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
-    let (flash, code, ram) = match (has("pico"), has("pico2")) {
-        (true, _) => (pico_flash_kib() * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024),
-        (_, true) => (4096 * 1024, PICO2_CODE_FLASH, 512 * 1024),
-        _ => return,
-    };
+    let Some((flash, code, ram)) = board_memory() else { return };
     let kib = |b: usize| format!("{:.0} KiB", b as f64 / 1024.0);
     let tables: usize = footprints.iter().map(|f| f.objects * f.object_bytes + f.lattice_bytes).sum();
     if tables + code > flash {
@@ -377,9 +427,9 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<Bake
         }
     }
     let effects = lattice_rt::Effects::of(&scene).bits();
-    let cfg = LatticeConfig::default();
+    let cfg = LatticeConfig { budget: bake.as_ref().and_then(|b| b.budget), ..LatticeConfig::default() };
     let sizes = Sizes::of(&scene, Some(&cfg), &frame);
-    if let Some(Bake { name, with_lattice, out, footprints }) = bake {
+    if let Some(Bake { name, with_lattice, out, footprints, .. }) = bake {
         let s = Lattice::plan(&scene, &cfg);
         let (mut lattices, mut coords, mut words) =
             (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);
@@ -394,8 +444,10 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<Bake
         footprints.push(Footprint {
             scene: name.to_string(),
             objects: scene.objects().len(),
-            // The host's objects are whole; `lean-objects` leaves the eye and light out.
-            object_bytes: size_of::<Object<R>>() - if has("lean-objects") { 2 * size_of::<Vec3<R>>() } else { 0 },
+            // This script's core has the firmware's `lean-objects` too (cargo turns a feature's
+            // `lattice-rt/...` on in every dependency of that name), so its objects are the size
+            // the image's are.
+            object_bytes: size_of::<Object<R>>(),
             lattice_bytes: if with_lattice { lattice.bytes() } else { 0 },
         });
     }

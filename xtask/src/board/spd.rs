@@ -200,7 +200,7 @@ fn record_parts() -> String {
     let named: usize = parts.iter().map(|p| p.1).sum();
     let each: Vec<String> = parts.iter().map(|(n, b)| format!("{n} {b}")).collect();
     format!(
-        "Each object, whatever its shape, is one record of {total} bytes in flash: {}, and {} for its shape, scales, material and composite. A scene whose tables do not fit so is built again with the firmware's `lean-objects` (*lean* in the table): records of {LEAN_RECORD} bytes without the eye and light in object space, which an eye ray's or first-light shadow ray's test then transforms again, with the same answers",
+        "Each object, whatever its shape, is one record of {total} bytes in flash: {}, and {} for its shape, scales, material and composite. A scene whose tables do not fit so is built again with the firmware's `lean-objects` (*lean* in the table): records of {LEAN_RECORD} bytes without the eye and light in object space, which an eye ray's or first-light shadow ray's test then transforms again, with the same answers. Where the objects fit and their lattice does not, `firmware/build.rs` fits the lattice to the flash they leave (the core's lattice budget: the lattice of least estimated cost within it) and *lattice bytes* is the fitted lattice's",
         each.join(", "),
         total - named
     )
