@@ -572,14 +572,19 @@ struct Session<'a> {
     scenes_dir: PathBuf,
     chair: PathBuf,
     chair_text: String,
+    /// Of the SPD's scenes, only those of at most [`spd::SMALL`] objects.
+    spd_small: bool,
     checks: Checks,
 }
 
 /// The command `cargo xtask board`: the default image on every embedded scene, then each
 /// variant (a model left out, a build-time lever, orbit, ladder, progressive, outline) as a
 /// row of the report, every frame checked against host-sim's.
-pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd_only: bool) -> Result<()> {
+/// `(spd_only, spd_small)`: only the SPD's images; of them only the small scenes.
+pub fn board_cmd(root: &Path, out: &Path, frames_dir: &Path, no_build: bool, spd: (bool, bool)) -> Result<()> {
+    let (spd_only, spd_small) = spd;
     let mut s = Session::prepare(root, frames_dir, no_build)?;
+    s.spd_small = spd_small;
     if spd_only {
         let rows = s.spd_runs()?;
         spd::spd_plot(&rows, out)?;
@@ -775,6 +780,7 @@ impl<'a> Session<'a> {
             scenes_dir,
             chair,
             chair_text,
+            spd_small: false,
             checks: Checks::default(),
         })
     }

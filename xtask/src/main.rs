@@ -55,6 +55,11 @@ enum Command {
         /// their plot beside the report (the report itself is not written).
         #[arg(long)]
         spd_only: bool,
+        /// Of the Standard Procedural Databases, run only the scenes of at most a thousand
+        /// objects (the sphereflake at sizes 1 to 3, jacks): what CI runs, as each scene of
+        /// thousands takes minutes to bake and run (docs/board.md has them all).
+        #[arg(long)]
+        spd_small: bool,
     },
     /// Build the firmware, run it in QEMU, check its frames against the host bit for bit,
     /// and write the flash/RAM/instruction budgets to a report.
@@ -252,8 +257,8 @@ fn main() {
 fn real_main() -> Result<()> {
     let root = std::env::current_dir()?;
     match Cli::parse().command {
-        Command::Board { out, frames, no_build, spd_only } => {
-            board::board_cmd(&root, &out, &frames, no_build, spd_only)
+        Command::Board { out, frames, no_build, spd_only, spd_small } => {
+            board::board_cmd(&root, &out, &frames, no_build, (spd_only, spd_small))
         }
         Command::Playground { out, serve, check, screenshot, no_build } => {
             playground::playground_cmd(&root, &playground::PlaygroundArgs { out, serve, check, screenshot, no_build })

@@ -28,6 +28,9 @@ pub(super) const SCENES: [(Generator, Option<u32>); 9] = [
     (Generator::Shells, None),
 ];
 
+/// Most objects of a scene `cargo xtask board --spd-small` runs.
+pub(super) const SMALL: usize = 1000;
+
 /// Cycles a frame of `balls` at size 3 may take: 2 frames per second at 125 MHz.
 const BALLS_3_TARGET: u64 = 62_500_000;
 /// Cycles a frame of an SPD scene at its default size may take: 2 seconds at 125 MHz.
@@ -69,6 +72,10 @@ impl Session<'_> {
         let mut rows = Vec::new();
         for (g, size) in SCENES {
             let size = size.unwrap_or_else(|| g.default_size());
+            if self.spd_small && lattice_rt::object_count(&g.nff(size)?) > SMALL {
+                eprintln!("leaving out {}-{size} (--spd-small)", g.name());
+                continue;
+            }
             rows.push(self.spd_run(g, size, &dir)?);
         }
         Ok(rows)
