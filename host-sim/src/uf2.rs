@@ -156,10 +156,12 @@ pub fn build_image(
 /// `FIRMWARE_FLASH_KIB` left out, and the source paths an image carries (the panic locations of
 /// the core, a path dependency outside the firmware's workspace, and of registry crates)
 /// written relative to the repository (`lattice-rt/`) and to cargo's home (`cargo/`). So an
-/// image, its size and its cycles are the same wherever the repository is checked out (they
-/// were not: a clone in /tmp/ci-check built a default image 40 bytes larger than /work/main's,
-/// its code laid out differently behind the XIP cache). Every firmware build the project's
-/// commands run goes through here, so they share one set of compiled dependencies.
+/// image's size is the same wherever the repository is checked out (a clone in /tmp built a
+/// default image 40 bytes larger than /work/main's before). Its layout still is not quite:
+/// cargo's crate hashes include the path, and functions of one size may swap places, which
+/// moves code that runs from flash behind the XIP cache (the slot image's frame by up to 3 %).
+/// Every firmware build the project's commands run goes through here, so they share one set of
+/// compiled dependencies.
 pub fn firmware_cargo(root: &Path) -> Command {
     let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     let home = std::env::var_os("CARGO_HOME")
