@@ -491,14 +491,14 @@ fn save_frame_sized(bits: &[u8], size: (u32, u32), path: &Path) -> Result<()> {
 }
 
 /// Calls `f` with a panel frame's bits (rows MSB first, lit = 1) of `size` as a [`BitFrame`].
-fn with_panel<T>(bits: &[u8], (w, h): (u32, u32), f: impl FnOnce(&BitFrame<'_>) -> Result<T>) -> Result<T> {
+pub(super) fn with_panel<T>(bits: &[u8], (w, h): (u32, u32), f: impl FnOnce(&BitFrame<'_>) -> Result<T>) -> Result<T> {
     let mut raster = bits.to_vec();
     raster.resize(BitFrame::bytes(w, h), 0);
     f(&BitFrame::wrap(w, h, &mut raster).context("frame size")?)
 }
 
 /// A picture of where two frames differ: lit where they do.
-fn diff_frame(a: &[u8], b: &[u8]) -> Vec<u8> {
+pub(super) fn diff_frame(a: &[u8], b: &[u8]) -> Vec<u8> {
     a.iter().zip(b).map(|(x, y)| x ^ y).collect()
 }
 

@@ -6,7 +6,7 @@
 //! finished before. A third run shows the partial refresh: a scene drawn twice, then with a
 //! ball added in one corner, is refreshed whole, not at all, then in the ball's window alone.
 
-use super::{m3, run_emulator, save_frame_sized, write_uf2, BoardRun, Session, PICO_SCALAR};
+use super::{diff_frame, m3, run_emulator, save_frame_sized, with_panel, write_uf2, BoardRun, Session, PICO_SCALAR};
 use crate::firmware::board_frame::{Build, PICO};
 use crate::firmware::host_frame_of;
 use anyhow::{Context, Result};
@@ -162,7 +162,7 @@ impl Session<'_> {
         let windows: Vec<Option<Window>> = run.epaper.iter().map(|r| r.window).collect();
         // The third frame's window: the gates and whole bytes of rows where it differs from the
         // second (host-sim's frames), no more.
-        let changed = changed_window(&wants[1], &wants[2], (w, h));
+        let changed = changed_window(&wants[1], &wants[2], (w, h))?;
         let ok = matches!(windows[..], [None, Some(win)] if Some(win) == changed);
         self.checks.check(ok, || {
             format!("{what}: refreshes {windows:?}, not the whole glass, then none (the same frame), then {changed:?}")
@@ -205,22 +205,17 @@ pub(super) fn epaper_report(e: &EpaperReport, clk_hz: f64) -> Result<String> {
 /// The window of the pixels where two 1-bit frames of `size` (rows MSB first) differ, as PTL
 /// sets one: rows widened to whole bytes of 8, the glass's columns as gates. None where they
 /// are the same.
-fn changed_window(a: &[u8], b: &[u8], (w, h): (u16, u16)) -> Option<Window> {
-    let stride = usize::from(w).div_ceil(8);
-    let lit = |f: &[u8], x: usize, y: usize| f.get(y * stride + x / 8).map(|v| v >> (7 - x % 8) & 1);
-    let mut window: Option<Window> = None;
-    for y in 0..usize::from(h) {
-        for x in 0..usize::from(w) {
-            if lit(a, x, y) == lit(b, x, y) {
-                continue;
-            }
-            let (x, y) = (x as u16, y as u16);
+fn changed_window(a: &[u8], b: &[u8], (w, h): (u16, u16)) -> Result<Option<Window>> {
+    with_panel(&diff_frame(a, b), (u32::from(w), u32::from(h)), |differs| {
+        let mut window: Option<Window> = None;
+        let pixels = (0..h).flat_map(|y| (0..w).map(move |x| (x, y)));
+        for (x, y) in pixels.filter(|&(x, y)| differs.get(x.into(), y.into())) {
             let win = window.get_or_insert(Window { hs: y, he: y, vs: x, ve: x });
             (win.hs, win.he) = (win.hs.min(y), win.he.max(y));
             (win.vs, win.ve) = (win.vs.min(x), win.ve.max(x));
         }
-    }
-    window.map(|win| Window { hs: win.hs / 8 * 8, he: win.he / 8 * 8 + 7, ..win })
+        Ok(window.map(|win| Window { hs: win.hs / 8 * 8, he: win.he / 8 * 8 + 7, ..win }))
+    })
 }
 
 /// The partial run's paragraph.
@@ -246,7 +241,7 @@ mod tests {
         let mut b = a.clone();
         b[9 * 2] |= 0x80 >> 3;
         b[10 * 2 + 1] |= 0x80 >> 4;
-        assert_eq!(changed_window(&a, &b, (16, 16)), Some(Window { hs: 8, he: 15, vs: 3, ve: 12 }));
-        assert_eq!(changed_window(&a, &a, (16, 16)), None);
+        assert_eq!(changed_window(&a, &b, (16, 16)).unwrap(), Some(Window { hs: 8, he: 15, vs: 3, ve: 12 }));
+        assert_eq!(changed_window(&a, &a, (16, 16)).unwrap(), None);
     }
 }
