@@ -212,19 +212,8 @@ struct Bake<'a> {
 /// of least estimated cost within it), and the build says so; what still does not fit is
 /// refused ([`check_fits`]).
 fn bake_scenes(scenes: &[(String, PathBuf, String)], with_lattice: bool, sizes: &mut Sizes) -> String {
-    let mut budgets = vec![None; scenes.len()];
-    loop {
-        let (mut tables, mut footprints) = (String::new(), Vec::new());
-        for ((name, path, text), &budget) in scenes.iter().zip(&budgets) {
-            let bake = Bake { name, with_lattice, budget, out: &mut tables, footprints: &mut footprints };
-            let (s, ..) = plan_in_scalar(path, text, Some(bake));
-            *sizes = sizes.max(s);
-        }
-        let fitted = lattice_budgets(&footprints).filter(|_| budgets.iter().all(Option::is_none));
-        let Some(fitted) = fitted else {
-            check_fits(&footprints, sizes);
-            return tables;
-        };
+    let (mut tables, mut footprints) = bake_with(scenes, with_lattice, &vec![None; scenes.len()], sizes);
+    if let Some(fitted) = lattice_budgets(&footprints) {
         for (f, b) in footprints.iter().zip(&fitted) {
             let kib = |b: usize| b as f64 / 1024.0;
             println!(
@@ -234,8 +223,28 @@ fn bake_scenes(scenes: &[(String, PathBuf, String)], with_lattice: bool, sizes: 
                 kib(*b)
             );
         }
-        budgets = fitted.into_iter().map(Some).collect();
+        let budgets: Vec<Option<usize>> = fitted.into_iter().map(Some).collect();
+        (tables, footprints) = bake_with(scenes, with_lattice, &budgets, sizes);
     }
+    check_fits(&footprints, sizes);
+    tables
+}
+
+/// The tables of `scenes`, each lattice within its budget of `budgets` (none: as configured),
+/// and their footprints; the storage they need merged into `sizes`.
+fn bake_with(
+    scenes: &[(String, PathBuf, String)],
+    with_lattice: bool,
+    budgets: &[Option<usize>],
+    sizes: &mut Sizes,
+) -> (String, Vec<Footprint>) {
+    let (mut tables, mut footprints) = (String::new(), Vec::new());
+    for ((name, path, text), &budget) in scenes.iter().zip(budgets) {
+        let bake = Bake { name, with_lattice, budget, out: &mut tables, footprints: &mut footprints };
+        let (s, ..) = plan_in_scalar(path, text, Some(bake));
+        *sizes = sizes.max(s);
+    }
+    (tables, footprints)
 }
 
 /// Per scene of `footprints`, the bytes its lattice may take when the tables do not fit the
