@@ -68,9 +68,10 @@ pub(super) fn save_pictures(rows: &[PanelRow], images: &std::path::Path) -> Resu
 
 impl Session<'_> {
     /// Every panel's image on every embedded scene; with the e-paper's run, for its refreshes,
-    /// and the Thumby's image with its A button pressed, and its `thumby,parse` image with B.
+    /// and the boards' buttons pressed: the Thumby's A on its image, its B on `thumby,parse`,
+    /// the Badger's camera-turn button on `uc8151,parse,code-in-flash`.
     pub(super) fn panel_runs(&mut self) -> Result<(Vec<PanelRow>, Option<BoardRun>, Vec<ButtonRow>)> {
-        let (mut rows, mut epaper, mut thumby) = (Vec::new(), None, Vec::new());
+        let (mut rows, mut epaper, mut pressed) = (Vec::new(), None, Vec::new());
         for image in PANELS {
             let (panel, _, what) = image;
             let (features, glass) = (features(image), panel.glass());
@@ -116,37 +117,43 @@ impl Session<'_> {
                         turn: false,
                         what: "the Thumby's A (GP27)",
                     };
-                    thumby.push(self.press_run(&image, first.end_ms, "thumby-button")?);
-                    thumby.extend(self.thumby_turn_run(build)?);
+                    pressed.push(self.press_run(&image, first.end_ms, "thumby-button")?);
+                    pressed.extend(self.turn_run(
+                        panel,
+                        "thumby,parse",
+                        build,
+                        "the Thumby's B (GP24), `thumby,parse`",
+                    )?);
                 }
             }
             if panel == Panel::Uc8151 {
                 epaper = Some(run);
+                let what = "the Badger's up button (GP15), `uc8151,parse,code-in-flash`";
+                pressed.extend(self.turn_run(panel, "uc8151,parse,code-in-flash", build, what)?);
             }
         }
-        Ok((rows, epaper, thumby))
+        Ok((rows, epaper, pressed))
     }
 
-    /// The Thumby's image that sets its scenes up on the board (`thumby,parse`), its B button
-    /// (GP24) pressed after the first frame: that scene again, turned a step.
-    fn thumby_turn_run(&mut self, build: Build) -> Result<Option<ButtonRow>> {
-        const FEATURES: &str = "thumby,parse";
-        let extra = ["--panel", Panel::Thumby.name()];
-        let (run, dir) = self.variant(FEATURES, true, 1, &extra)?;
+    /// A board's image that sets its scenes up on the board (`features`: the Thumby's
+    /// `thumby,parse`, the Badger's `uc8151,parse,code-in-flash`), its camera-turn button
+    /// pressed after the first frame: that scene again, turned a step.
+    fn turn_run(
+        &mut self,
+        panel: Panel,
+        features: &str,
+        build: Build,
+        what: &'static str,
+    ) -> Result<Option<ButtonRow>> {
+        let extra = ["--panel", panel.name()];
+        let (run, dir) = self.variant(features, true, 1, &extra)?;
         let Some(first) = run.frames.first() else {
-            self.checks.fail(format!("{FEATURES}: no frame shown ({})", run.reason));
+            self.checks.fail(format!("{features}: no frame shown ({})", run.reason));
             return Ok(None);
         };
-        let (elf, uf2) = (run_variant_image(self.root, FEATURES), dir.join(variant_uf2(FEATURES)));
-        let image = Pressed {
-            elf: &elf,
-            uf2: &uf2,
-            build,
-            extra: &extra,
-            turn: true,
-            what: "the Thumby's B (GP24), `thumby,parse`",
-        };
-        self.press_run(&image, first.end_ms, "thumby-turn").map(Some)
+        let (elf, uf2) = (run_variant_image(self.root, features), dir.join(variant_uf2(features)));
+        let image = Pressed { elf: &elf, uf2: &uf2, build, extra: &extra, turn: true, what };
+        self.press_run(&image, first.end_ms, &format!("{}-turn", panel.name())).map(Some)
     }
 }
 

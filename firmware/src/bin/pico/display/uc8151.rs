@@ -29,10 +29,11 @@ const _: () = assert!(WIDTH == 296 && HEIGHT == 128, "the UC8151's glass is 296x
 // Orbit mode's image at 296x128 leaves core 0 3.5 KiB of stack on the RP2040: it faults at boot.
 #[cfg(feature = "orbit")]
 compile_error!("orbit mode at the e-paper's 296x128 does not fit the RP2040's RAM");
-// So does a scene parsed and its lattice built on the board (the `parse` and `slot` images):
-// the linker would refuse it with the stack's end above its start.
-#[cfg(feature = "parse")]
-compile_error!("a scene parsed on the board at the e-paper's 296x128 (`parse`, `slot`) does not fit the RP2040's RAM: the Badger's image bakes its scenes");
+// So does a scene parsed and its lattice built on the board (the `parse` and `slot` images)
+// with the tracer's code in RAM: the linker would refuse it with the stack's end above its
+// start. With the code in flash (`code-in-flash`) it fits, and the camera turns.
+#[cfg(all(feature = "parse", not(feature = "code-in-flash")))]
+compile_error!("a scene parsed on the board at the e-paper's 296x128 (`parse`, `slot`) does not fit the RP2040's RAM with the code in RAM: add `code-in-flash` (the code then runs from flash, through the XIP cache)");
 
 /// Panel setting: 128x296, the waveform from registers, black and white, shift right and scan
 /// down (the Badger's upright picture), booster on, no soft reset.
