@@ -17,6 +17,13 @@ use board_records::frame;
 use std::fmt::Write as _;
 use std::{env, fs, path::PathBuf};
 
+/// [`refuse`] with `format!`'s arguments.
+macro_rules! refuse {
+    ($($arg:tt)*) => {
+        refuse(&format!($($arg)*))
+    };
+}
+
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     link(&out);
@@ -45,16 +52,16 @@ fn main() {
         .map(|entry| {
             let (name, path) = scene_file(entry);
             println!("cargo:rerun-if-changed={}", path.display());
-            let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("FIRMWARE_SCENES: {}: {e}", path.display()));
+            let text = fs::read_to_string(&path).unwrap_or_else(|e| refuse!("FIRMWARE_SCENES: {}: {e}", path.display()));
             if !baked && lattice_rt::scene::Format::of(&text) == lattice_rt::scene::Format::Nff {
-                panic!("FIRMWARE_SCENES: {}: an NFF scene is baked into the image only (this build parses its scenes on the board: leave out `parse` and `orbit`)", path.display());
+                refuse!("FIRMWARE_SCENES: {}: an NFF scene is baked into the image only (this build parses its scenes on the board: leave out `parse` and `orbit`)", path.display());
             }
             (name, path, text)
         })
         .collect();
     for (i, (name, path, _)) in scenes.iter().enumerate() {
         if let Some((other, ..)) = scenes[..i].iter().find(|(n, ..)| table_name(n) == table_name(name)) {
-            panic!("FIRMWARE_SCENES: {} is named `{name}`, as `{other}` before it is (scenes are told apart by name: rename the file)", path.display());
+            refuse!("FIRMWARE_SCENES: {} is named `{name}`, as `{other}` before it is (scenes are told apart by name: rename the file)", path.display());
         }
     }
     for (name, path, text) in &scenes {
@@ -134,7 +141,7 @@ fn link(out: &std::path::Path) {
     println!("cargo:rerun-if-env-changed=FIRMWARE_FLASH_KIB");
     if let (true, Ok(kib)) = (tiny, env::var("FIRMWARE_FLASH_KIB")) {
         let kib: u32 =
-            kib.trim().parse().unwrap_or_else(|_| panic!("FIRMWARE_FLASH_KIB is not a number of KiB: {kib:?}"));
+            kib.trim().parse().unwrap_or_else(|_| refuse!("FIRMWARE_FLASH_KIB is not a number of KiB: {kib:?}"));
         map = map.replace("LENGTH = 16K", &format!("LENGTH = {kib}K"));
     }
     // The Pico's flash as this image divides it (`pico_flash_kib`, `pico_code_load_kib`).
@@ -313,7 +320,7 @@ fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
                 )
             })
             .collect();
-        panic!(
+        refuse!(
             "FIRMWARE_SCENES: the baked scenes' tables need {} of flash ({}), and the image has {} for them ({} of flash less {} for its code): bake fewer or smaller scenes",
             kib(tables),
             each.join("; "),
@@ -324,7 +331,7 @@ fn check_fits(footprints: &[Footprint], sizes: &Sizes) {
     }
     let mailboxes = 2 * 4 * (sizes.objects + sizes.lattices);
     if mailboxes + PICO_OTHER_RAM > ram {
-        panic!(
+        refuse!(
             "FIRMWARE_SCENES: the largest baked scene's mailboxes need {} of RAM (a word per object and lattice on each core: {} objects, {} lattices), and the image has {} for them ({} of RAM less {} for the rest)",
             kib(mailboxes),
             sizes.objects,
@@ -346,9 +353,19 @@ fn scene_file(entry: &str) -> (String, PathBuf) {
     let path = PathBuf::from(entry);
     let stem = path.file_stem().and_then(|s| s.to_str()).filter(|s| !s.is_empty());
     let name = stem.unwrap_or_else(|| {
-        panic!("FIRMWARE_SCENES: {entry}: a path names its scene by its file's stem, and this one has none")
+        refuse!("FIRMWARE_SCENES: {entry}: a path names its scene by its file's stem, and this one has none")
     });
     (name.to_string(), path)
+}
+
+/// Stops the build with `why` as cargo's own error (`cargo::error`, one line each), where a
+/// scene or setting is one the image cannot take: the user's input, told without a panic's
+/// location and backtrace. Cargo fails the build on it.
+fn refuse(why: &str) -> ! {
+    for line in why.lines() {
+        println!("cargo::error={line}");
+    }
+    std::process::exit(0)
 }
 
 /// Whether the image bakes its scenes: asked for (`baked`), or the Raspberry Pi boards' default:
@@ -422,13 +439,13 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<Bake
     // fitted to its shape (square pixels on any glass).
     let frame = frame::rendered(frame::Build::of(has));
     let scene = lattice_rt::scene::parse_with::<R>(text, &mut storage, &mut parts, |c| c.frame = frame.size())
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        .unwrap_or_else(|e| refuse!("{}: {e}", path.display()));
     // build.rs's own lattice-rt has every shape: the firmware's may not.
     for (i, o) in scene.objects().iter().enumerate() {
         let Some(feature) = o.shape().feature() else { continue };
         if !has(feature) {
             let default = if feature == "triangles" { "" } else { ", a default one" };
-            panic!(
+            refuse!(
                 "{}: object {i} is a {}, which this build leaves out (the firmware's feature `{feature}`{default})",
                 path.display(),
                 lattice_rt::shape::SHAPE_NAMES[o.shape().kind()]
@@ -443,7 +460,7 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<Bake
         let (mut lattices, mut coords, mut words) =
             (vec![SubLattice::EMPTY; s.lattices], vec![R::ZERO; s.coords], vec![0; s.words()]);
         let storage = LatticeStorage { lattices: &mut lattices, coords: &mut coords, words: &mut words };
-        let lattice = Lattice::build(&scene, &cfg, storage).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let lattice = Lattice::build(&scene, &cfg, storage).unwrap_or_else(|e| refuse!("{}: {e}", path.display()));
         out.push_str(&lattice_rt::bake::source(
             &table_name(name),
             "S",

@@ -721,7 +721,7 @@ impl Session<'_> {
     /// no outline, the slot and the SPD: every run after the clean one but the side thread's.
     fn main_runs(&mut self, clean: &[SceneRow]) -> Result<MainRuns> {
         let fault_rows = self.fault_runs(clean)?;
-        let button_rows: Vec<_> = self.button_run(clean)?.into_iter().collect();
+        let button_rows: Vec<_> = self.button_run(clean)?.into_iter().chain(self.both_buttons_run()?).collect();
         let bare = self.no_display_run()?;
         let (models, (alone, levers)) = (self.model_runs()?, self.lever_runs()?);
         let (orun, orbit_same) = self.orbit_run()?;

@@ -233,12 +233,13 @@ pub(crate) fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
 
 /// [`refusal`] read from the build's error output `text`.
 fn refusal_in(text: &str, scenes: &str) -> String {
-    // The build script's panic message is the line after its `panicked at`; without one, the
-    // linker's complaint about the first region the image overflowed (cargo may set it after
-    // a `= note:`).
-    let mut lines = text.lines().map(str::trim);
-    let message =
-        lines.by_ref().find(|l| l.contains("panicked at")).and(lines.next()).map(str::to_string).or_else(|| {
+    // The build script's refusal is cargo's `error: firmware@VERSION: ...` line (its
+    // `cargo::error`); without one, the linker's complaint about the first region the image
+    // overflowed (cargo may set it after a `= note:`).
+    let message = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("error: firmware@")?.split_once(": ").map(|(_, why)| why.to_string()))
+        .or_else(|| {
             text.lines().find(|l| l.contains("will not fit in region")).map(|l| {
                 let what = l.split_once("error: ").map_or(l.trim(), |(_, what)| what);
                 format!("the linker: {what}")
@@ -1115,7 +1116,7 @@ mod tests {
 
     #[test]
     fn a_refusal_gives_the_build_scripts_message_without_the_scenes_folder() {
-        let text = "  thread 'main' panicked at build.rs:255:9:\n  FIRMWARE_SCENES: /tmp/out/tree.nff:3:1: too big for fixed point\n";
+        let text = "   Compiling firmware v0.1.0 (/src/firmware)\nerror: firmware@0.1.0: FIRMWARE_SCENES: /tmp/out/tree.nff:3:1: too big for fixed point\nerror: build script logged errors\n";
         assert_eq!(refusal_in(text, "/tmp/out/tree.nff"), "tree.nff:3:1: too big for fixed point");
     }
 }

@@ -4,7 +4,7 @@
 //! bit-identical to host-sim's (the next scene's, or the same scene's turned a step), and the
 //! frames after it follow in order.
 
-use super::{host_frame, run_emulator, BoardRun, SceneRow, Session, PICO, PICO_SCALAR};
+use super::{host_frame, run_emulator, run_variant_image, variant_uf2, BoardRun, SceneRow, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
 use board_records::frame::{rendered, Build, TURN_STEPS};
 use lattice_rt::Fx;
@@ -37,8 +37,20 @@ pub(super) struct Pressed<'a> {
     pub uf2: &'a Path,
     pub build: Build,
     pub extra: &'a [&'a str],
-    pub turn: bool,
+    pub press: Buttons,
     pub what: &'static str,
+}
+
+/// The buttons a run presses, at one moment.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Buttons {
+    /// The next-scene button: the scenes in turn.
+    Next,
+    /// The camera-turn button: the first scene, that scene turned a step, the second scene.
+    Turn,
+    /// Both at one probe: the first scene, the second (the next-scene button is taken first),
+    /// that scene turned (the turn taken at the next pause's first probe).
+    Both,
 }
 
 impl Session<'_> {
@@ -54,10 +66,25 @@ impl Session<'_> {
             uf2: &uf2,
             build: PICO,
             extra: &[],
-            turn: false,
+            press: Buttons::Next,
             what: "GP14 (a push button to ground)",
         };
         self.press_run(&image, f0.frame.end_ms, "button").map(Some)
+    }
+
+    /// The `parse` image (whose camera turns) with both buttons pressed at one moment in the
+    /// first pause: neither press may be lost.
+    pub(super) fn both_buttons_run(&mut self) -> Result<Option<ButtonRow>> {
+        const FEATURES: &str = "parse";
+        let (run, dir) = self.variant(FEATURES, true, 1, &[])?;
+        let Some(first) = run.frames.first() else {
+            self.checks.fail(format!("{FEATURES}: no frame shown ({})", run.reason));
+            return Ok(None);
+        };
+        let (elf, uf2) = (run_variant_image(self.root, FEATURES), dir.join(variant_uf2(FEATURES)));
+        let what = "GP14 and GP15 at once, `parse`";
+        let image = Pressed { elf: &elf, uf2: &uf2, build: PICO, extra: &[], press: Buttons::Both, what };
+        self.press_run(&image, first.end_ms, "both-buttons").map(Some)
     }
 
     /// `image` with its button pressed [`PRESS_AFTER_MS`] after its first frame ended at
@@ -68,27 +95,31 @@ impl Session<'_> {
         let press_ms = first_end_ms + PRESS_AFTER_MS;
         let dir = self.frames_dir.join(name);
         std::fs::create_dir_all(&dir)?;
-        let frames = 3.min(self.scenes.len() + usize::from(image.turn));
+        let frames = 3.min(self.scenes.len() + usize::from(image.press != Buttons::Next));
         eprintln!("{name}: the button pressed at {press_ms:.1} ms");
         let press = format!("{press_ms:.3}");
-        let (switch, which) = if image.turn { ("--press-turn", "turn") } else { ("--press", "next") };
-        let mut args = vec![switch, &press];
+        let which: &[(&str, &str)] = match image.press {
+            Buttons::Next => &[("--press", "next")],
+            Buttons::Turn => &[("--press-turn", "turn")],
+            Buttons::Both => &[("--press", "next"), ("--press-turn", "turn")],
+        };
+        let mut args: Vec<&str> = which.iter().flat_map(|&(switch, _)| [switch, press.as_str()]).collect();
         args.extend(image.extra);
         let run = run_emulator(self.root, image.elf, image.uf2, &self.bootrom, frames, true, &dir, &args)?;
         self.checks.check(run.ok, || format!("{name}: the run did not finish: {}", run.reason));
-        let made = run.presses.iter().filter(|p| p.0 == which).count();
-        self.checks.check(made == 1 && run.presses.len() == 1, || format!("{name}: {made} presses seen, 1 made"));
+        let seen = which.iter().all(|&(_, w)| run.presses.iter().filter(|p| p.0 == w).count() == 1);
+        self.checks.check(seen && run.presses.len() == which.len(), || {
+            format!("{name}: {} presses seen, {} made", run.presses.len(), which.len())
+        });
         let next_start_ms = self.check_response(name, press_ms, &run);
         // Each frame's scene and turn.
-        let shots: Vec<(&String, u32)> = if image.turn {
-            self.scenes
-                .iter()
-                .take(1)
-                .flat_map(|s| [(s, 0), (s, 1)])
-                .chain(self.scenes.iter().skip(1).map(|s| (s, 0)))
-                .collect()
-        } else {
-            self.scenes.iter().map(|s| (s, 0)).collect()
+        let (first, rest) = self.scenes.split_at(1.min(self.scenes.len()));
+        let shots: Vec<(&String, u32)> = match image.press {
+            Buttons::Next => self.scenes.iter().map(|s| (s, 0)).collect(),
+            Buttons::Turn => first.iter().flat_map(|s| [(s, 0), (s, 1)]).chain(rest.iter().map(|s| (s, 0))).collect(),
+            Buttons::Both => {
+                first.iter().map(|s| (s, 0)).chain(rest.iter().take(1).flat_map(|s| [(s, 0), (s, 1)])).collect()
+            }
         };
         let mut same = 0;
         for (k, (frame, (scene, step))) in run.frames.iter().zip(shots).enumerate() {
@@ -124,7 +155,7 @@ pub(super) fn button_report(rows: &[ButtonRow]) -> Result<String> {
     writeln!(md, "\n## The buttons: the next scene, the camera turned\n")?;
     writeln!(
         md,
-        "Written by `cargo xtask board`: a push button from GP14 to ground (`Wiring::NEXT`, pulled up inside; the Thumby's A button on GP27 in the `thumby` image) ends the 3 s pause between scenes, so the next scene is drawn at once; the firmware reads it at every probe of the pause (20 ms). The emulated board presses it {PRESS_AFTER_MS:.0} ms into the pause after the first frame (`run.mjs --press`); the next frame must start within {RESPONSE_MS:.0} ms and every frame must be its scene's, bit-identical to host-sim's. A second button, from GP15 (`Wiring::TURN`; the Thumby's B on GP24), draws the scene again from an eighth of a circle further round; it works where the scene is set up on the board (the `slot` and `parse` images, `thumby,parse` on the Thumby, `uc8151,parse,code-in-flash` on the Badger, whose default image bakes its scenes: parsing at 296x128 fits the RP2040's RAM only with the code in flash), and *The scene slot* above and the Thumby's B and the Badger's rows below press it (the first scene, then that scene turned, then the next scene after the pause, each bit-identical to host-sim's). The Badger 2040's buttons close to 3V3: its image reads them with pull-downs, and the emulated board's buttons read what the pad's pull gives a released pin, so an image that pulled them the wrong way would see a button held down (the e-paper's run below presses its button C).\n"
+        "Written by `cargo xtask board`: a push button from GP14 to ground (`Wiring::NEXT`, pulled up inside; the Thumby's A button on GP27 in the `thumby` image) ends the 3 s pause between scenes, so the next scene is drawn at once; the firmware reads it at every probe of the pause (20 ms). The emulated board presses it {PRESS_AFTER_MS:.0} ms into the pause after the first frame (`run.mjs --press`); the next frame must start within {RESPONSE_MS:.0} ms and every frame must be its scene's, bit-identical to host-sim's. A second button, from GP15 (`Wiring::TURN`; the Thumby's B on GP24), draws the scene again from an eighth of a circle further round; it works where the scene is set up on the board (the `slot` and `parse` images, `thumby,parse` on the Thumby, `uc8151,parse,code-in-flash` on the Badger, whose default image bakes its scenes: parsing at 296x128 fits the RP2040's RAM only with the code in flash), and *The scene slot* above and the Thumby's B and the Badger's rows below press it (the first scene, then that scene turned, then the next scene after the pause, each bit-identical to host-sim's). Both pressed at one probe (the `parse` image's row), the next-scene button is taken first and the turn at the next pause's first probe, so neither is lost: the first scene, the second, the second turned. The Badger 2040's buttons close to 3V3: its image reads them with pull-downs, and the emulated board's buttons read what the pad's pull gives a released pin, so an image that pulled them the wrong way would see a button held down (the e-paper's run below presses its button C).\n"
     )?;
     writeln!(md, "| button | pressed at | the next frame started after | frames bit-identical to host-sim |")?;
     writeln!(md, "|---|---:|---:|---:|")?;

@@ -5,7 +5,7 @@
 //! datasheets (firmware/board/sh1106.mjs, ssd1309.mjs, ssd1306.mjs's glasses): a command the
 //! controller does not have fails the run.
 
-use super::button::{ButtonRow, Pressed};
+use super::button::{ButtonRow, Buttons, Pressed};
 use super::{host_frame, m3, run_variant_image, save_frame_sized, variant_uf2, BoardRun, Session, PICO, PICO_SCALAR};
 use anyhow::Result;
 use board_records::frame::{Build, Panel};
@@ -114,7 +114,7 @@ impl Session<'_> {
                         uf2: &uf2,
                         build,
                         extra: &extra,
-                        turn: false,
+                        press: Buttons::Next,
                         what: "the Thumby's A (GP27)",
                     };
                     pressed.push(self.press_run(&image, first.end_ms, "thumby-button")?);
@@ -152,7 +152,7 @@ impl Session<'_> {
             return Ok(None);
         };
         let (elf, uf2) = (run_variant_image(self.root, features), dir.join(variant_uf2(features)));
-        let image = Pressed { elf: &elf, uf2: &uf2, build, extra: &extra, turn: true, what };
+        let image = Pressed { elf: &elf, uf2: &uf2, build, extra: &extra, press: Buttons::Turn, what };
         self.press_run(&image, first.end_ms, &format!("{}-turn", panel.name())).map(Some)
     }
 }

@@ -22,8 +22,13 @@ const BUTTONS: [(u8, Press); 2] = [(Wiring::NEXT, Press::Next), (Wiring::TURN, P
 /// The buttons down at the last read, as GPIO bits (a press is a change from up to down).
 static DOWN: AtomicU32 = AtomicU32::new(0);
 
-/// The button pressed since the last call, if any: down now and up then (the next-scene button
-/// first when both were).
+/// Presses read and not yet reported, as GPIO bits: of two buttons pressed between two reads,
+/// the second is reported by the next call.
+static PENDING: AtomicU32 = AtomicU32::new(0);
+
+/// The button pressed since the last call, if any: down now and up then. Of both pressed, the
+/// next-scene button first and the camera-turn button at the next call (the next scene, then
+/// that scene turned), so no press is lost.
 pub fn pressed() -> Option<Press> {
     // SAFETY: a read of SIO's GPIO_IN, which has no side effects.
     #[allow(unsafe_code)]
@@ -34,5 +39,8 @@ pub fn pressed() -> Option<Press> {
     // A load and a store (the M0 has no atomic swap): only core 0 reads the buttons.
     let was_down = DOWN.load(Ordering::Relaxed);
     DOWN.store(down, Ordering::Relaxed);
-    BUTTONS.iter().find(|&&(pin, _)| down & !was_down & 1 << pin != 0).map(|&(_, press)| press)
+    let pending = PENDING.load(Ordering::Relaxed) | (down & !was_down);
+    let first = BUTTONS.iter().find(|&&(pin, _)| pending & 1 << pin != 0);
+    PENDING.store(first.map_or(pending, |&(pin, _)| pending & !(1 << pin)), Ordering::Relaxed);
+    first.map(|&(_, press)| press)
 }

@@ -6,9 +6,19 @@ use crate::hal;
 use firmware::app::Cores;
 use hal::pac;
 
-/// Core 1's stack (32 KiB; a frame's tracing needs well under half of it). rp2040-hal guards
-/// its lowest 32 bytes with core 1's MPU, so an overflow faults instead of corrupting memory.
-static CORE1_STACK: hal::multicore::Stack<8192> = hal::multicore::Stack::new();
+/// Core 1's stack. rp2040-hal guards its lowest 32 bytes with core 1's MPU, so an overflow
+/// faults instead of corrupting memory.
+static CORE1_STACK: hal::multicore::Stack<CORE1_STACK_WORDS> = hal::multicore::Stack::new();
+
+/// Core 1's stack in words: 32 KiB where the scenes are baked. Its tile jobs need 6 KiB at
+/// most (5,984 bytes at 296x128 over the five scenes, as the emulated board found it).
+#[cfg(baked_scenes)]
+const CORE1_STACK_WORDS: usize = 8192;
+/// Core 1's stack in words: 16 KiB where the scenes are parsed on the board (`parse`, `slot`,
+/// `orbit`), whose storage lives on core 0's stack and needs the rest: with 32 KiB here the
+/// `parse` image of the five scenes overflowed core 0's stack at boot.
+#[cfg(not(baked_scenes))]
+const CORE1_STACK_WORDS: usize = 4096;
 
 /// Core 1: runs each job core 0 sends through the SIO FIFO and answers when it is done.
 fn core1_main() {
