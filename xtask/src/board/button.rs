@@ -75,22 +75,35 @@ impl Session<'_> {
     /// The `parse` image (whose camera turns) with both buttons pressed at one moment in the
     /// first pause: neither press may be lost.
     pub(super) fn both_buttons_run(&mut self) -> Result<Option<ButtonRow>> {
-        const FEATURES: &str = "parse";
-        let (run, dir) = self.variant(FEATURES, true, 1, &[])?;
+        self.variant_press_run("parse", &[], PICO, (Buttons::Both, "GP14 and GP15 at once, `parse`"), "both-buttons")
+    }
+
+    /// The image with `features` (run with the switches `extra`, drawing frames as `build`
+    /// says) run for its first frame, then again with `press` made after it: [`Self::press_run`],
+    /// its frames in the folder `name`.
+    pub(super) fn variant_press_run(
+        &mut self,
+        features: &str,
+        extra: &[&str],
+        build: Build,
+        (press, what): (Buttons, &'static str),
+        name: &str,
+    ) -> Result<Option<ButtonRow>> {
+        let (run, dir) = self.variant(features, true, 1, extra)?;
         let Some(first) = run.frames.first() else {
-            self.checks.fail(format!("{FEATURES}: no frame shown ({})", run.reason));
+            self.checks.fail(format!("{features}: no frame shown ({})", run.reason));
             return Ok(None);
         };
-        let (elf, uf2) = (run_variant_image(self.root, FEATURES), dir.join(variant_uf2(FEATURES)));
-        let what = "GP14 and GP15 at once, `parse`";
-        let image = Pressed { elf: &elf, uf2: &uf2, build: PICO, extra: &[], press: Buttons::Both, what };
-        self.press_run(&image, first.end_ms, "both-buttons").map(Some)
+        let (elf, uf2) = (run_variant_image(self.root, features), dir.join(variant_uf2(features)));
+        let image = Pressed { elf: &elf, uf2: &uf2, build, extra, press, what };
+        self.press_run(&image, first.end_ms, name).map(Some)
     }
 
     /// `image` with its button pressed [`PRESS_AFTER_MS`] after its first frame ended at
     /// `first_end_ms`; its frames in the folder `name`. The next-scene button's frames are the
     /// scenes in turn; the camera-turn button's the first scene, the first scene turned a step
-    /// ([`TURN_STEPS`]), then the second scene from its own camera (after the pause).
+    /// ([`TURN_STEPS`]), then the second scene from its own camera (after the pause); both
+    /// buttons' the first scene, the second, then the second turned a step.
     pub(super) fn press_run(&mut self, image: &Pressed<'_>, first_end_ms: f64, name: &str) -> Result<ButtonRow> {
         let press_ms = first_end_ms + PRESS_AFTER_MS;
         let dir = self.frames_dir.join(name);

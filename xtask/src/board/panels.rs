@@ -145,15 +145,8 @@ impl Session<'_> {
         build: Build,
         what: &'static str,
     ) -> Result<Option<ButtonRow>> {
-        let extra = ["--panel", panel.name()];
-        let (run, dir) = self.variant(features, true, 1, &extra)?;
-        let Some(first) = run.frames.first() else {
-            self.checks.fail(format!("{features}: no frame shown ({})", run.reason));
-            return Ok(None);
-        };
-        let (elf, uf2) = (run_variant_image(self.root, features), dir.join(variant_uf2(features)));
-        let image = Pressed { elf: &elf, uf2: &uf2, build, extra: &extra, press: Buttons::Turn, what };
-        self.press_run(&image, first.end_ms, &format!("{}-turn", panel.name())).map(Some)
+        let name = format!("{}-turn", panel.name());
+        self.variant_press_run(features, &["--panel", panel.name()], build, (Buttons::Turn, what), &name)
     }
 }
 
