@@ -35,7 +35,11 @@ compile_error!("orbit mode at the e-paper's 296x128 does not fit the RP2040's RA
 // with the tracer's code in RAM: the linker would refuse it with the stack's end above its
 // start. With the code in flash (`code-in-flash`) it fits, and the camera turns.
 #[cfg(all(feature = "parse", not(feature = "code-in-flash")))]
-compile_error!("a scene parsed on the board at the e-paper's 296x128 (`parse`, `slot`) does not fit the RP2040's RAM with the code in RAM: add `code-in-flash` (the code then runs from flash, through the XIP cache)");
+compile_error!("a scene parsed on the board at the e-paper's 296x128 (`parse`) does not fit the RP2040's RAM with the code in RAM: add `code-in-flash` (the code then runs from flash, through the XIP cache)");
+// The slot image (which has its code in flash) stays refused: `host-sim uf2 --scene` checks a
+// slot's scene at 128x64, and no run checks the slot at 296x128.
+#[cfg(feature = "slot")]
+compile_error!("the scene slot (`slot`) is not built for the e-paper's 296x128: `host-sim uf2 --scene` checks the slot's scenes at 128x64");
 
 /// Panel setting: 128x296, the waveform from registers, black and white, shift right and scan
 /// down (the Badger's upright picture), booster on, no soft reset.
