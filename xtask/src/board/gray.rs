@@ -10,7 +10,7 @@
 
 use super::{build_image, m3, pico_built, run_emulator, write_uf2, BoardRun, Session, PICO};
 use anyhow::Result;
-use board_records::frame::{rendered, Build, Glass};
+use board_records::frame::{rendered, Build, Glass, Panel};
 use host_sim::uf2::Scenes;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -175,7 +175,7 @@ pub(super) struct GrayReport {
     frames: Vec<(String, u64, u64)>,
     /// The panel 3 % fast: the typical image's scan, the calibrated image's.
     fast: Option<(Scan, Scan)>,
-    /// The Thumby's 72x40 panel: its scan and its chair's cycles.
+    /// The Thumby's image: its scan and its chair's cycles.
     thumby: (Scan, u64),
     clk_hz: f64,
 }
@@ -217,15 +217,16 @@ impl Session<'_> {
         self.scenes.iter().map(|n| Shades::of(&self.scenes_dir, n, glass)).collect()
     }
 
-    /// The gray mode on the Thumby's panel (72x40, SPI): every scene's refreshes checked as
-    /// the 128x64 panel's are; the chair's first cycle and the run's first frame's cycles.
+    /// The gray mode on the Thumby (its 72x40 panel on SPI on its own pins, the `thumby,gray`
+    /// image): every scene's refreshes checked as the 128x64 panel's are; the chair's first
+    /// cycle and the run's first frame's cycles.
     fn thumby_run(&mut self) -> Result<(Scan, u64)> {
         let want = self.shades(Glass::Oled72x40)?;
-        let args = ["--scan", "--panel", "ssd1306-72x40"];
-        let (run, dir) = self.variant("oled-72x40,gray", true, self.scenes.len() + 1, &args)?;
-        self.checks.check(run.ok, || format!("gray on 72x40: the run did not finish: {}", run.reason));
+        let args = ["--scan", "--panel", Panel::Thumby.name()];
+        let (run, dir) = self.variant("thumby,gray", true, self.scenes.len() + 1, &args)?;
+        self.checks.check(run.ok, || format!("gray on the Thumby: the run did not finish: {}", run.reason));
         let checked = scan(&run, &want);
-        self.check_scan("gray on the 72x40 panel", &checked, self.scenes.len());
+        self.check_scan("gray on the Thumby", &checked, self.scenes.len());
         save_shades(&checked.perceived, Glass::Oled72x40, &dir.join("perceived.png"))?;
         Ok((checked, run.frames.first().map_or(0, |f| f.cycles)))
     }
@@ -324,8 +325,8 @@ pub(super) fn gray_report(g: &GrayReport, spi_chair: Option<u64>, picture: &Path
         writeln!(md, "\n**A panel whose oscillator runs {OSC_ERROR} % fast** (`run.mjs --osc-error {OSC_ERROR}`): the image that assumes the typical clock tears {} of {} refreshes; the image built with `FIRMWARE_GRAY_ROW_NS={}` (the row period measured for that panel) tears {} of {}, and holds the chair {} refreshes.", typical.torn, typical.refreshes, (ROW_NS / (1.0 + OSC_ERROR / 100.0)).round(), calibrated.torn, calibrated.refreshes, calibrated.held.first().map_or(0, |h| h.1))?;
     }
     let (t, cycles) = &g.thumby;
-    writeln!(md, "\n**The Thumby's panel** (SSD1306 72x40 on SPI, `--features oled-72x40,gray`, 40 rows a refresh, 4 ms): {} scenes each held at least {} refreshes, their cycles host-sim's frames: {}; {} refreshes, {} torn, {} out of order; the chair's frame {} cycles.", t.held.len().min(g.frames.len()), t.held.iter().take(g.frames.len()).map(|h| h.1).min().unwrap_or(0), if t.held.iter().take(g.frames.len()).all(|h| h.2) { "all" } else { "**not all**" }, t.refreshes, t.torn, t.out_of_order, m3(*cycles))?;
+    writeln!(md, "\n**The Thumby** (its SSD1306 72x40 on SPI on its own pins, `uf2 --panel thumby --features gray`, 40 rows a refresh, 4 ms): {} scenes each held at least {} refreshes, their cycles host-sim's frames: {}; {} refreshes, {} torn, {} out of order; the chair's frame {} cycles.", t.held.len().min(g.frames.len()), t.held.iter().take(g.frames.len()).map(|h| h.1).min().unwrap_or(0), if t.held.iter().take(g.frames.len()).all(|h| h.2) { "all" } else { "**not all**" }, t.refreshes, t.torn, t.out_of_order, m3(*cycles))?;
     let name = |p: &Path| p.file_name().and_then(|n| n.to_str()).unwrap_or("").to_string();
-    writeln!(md, "\nThe chair as the eye sees it on the emulated panels (each pixel's lit share of a cycle, from the panel's own refreshes), 128x64 and 72x40:\n\n![the chair in four shades on the emulated panel](images/{}) ![the chair in four shades on the 72x40 panel](images/{})", name(picture), name(&thumby_picture))?;
+    writeln!(md, "\nThe chair as the eye sees it on the emulated panels (each pixel's lit share of a cycle, from the panel's own refreshes), 128x64 and the Thumby's 72x40:\n\n![the chair in four shades on the emulated panel](images/{}) ![the chair in four shades on the 72x40 panel](images/{})", name(picture), name(&thumby_picture))?;
     Ok(md)
 }
