@@ -245,13 +245,14 @@ mod writer {
         fn literal(&self, out: &mut String) {
             let Whole(o, eye_local, light_local) = self;
             out.push_str("Object::from_tables(");
-            let parts: [&dyn Literal; 15] = [
+            let parts: [&dyn Literal; 16] = [
                 &o.shape,
                 &o.to_object,
                 &o.to_world,
                 &o.unscale,
                 &o.dir_factor,
                 &o.material,
+                &o.distant,
                 &o.composite,
                 &o.bounds,
                 &o.dir_scale,

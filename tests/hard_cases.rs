@@ -176,36 +176,105 @@ fn translate_scene(text: &str, d: f64) -> String {
 // 3. A small sphere far away: its silhouette within half a pixel of f64, or the scene refused.
 fn small_far_sphere<R: Real>() {
     let text = "camera eye 0 0 -200 look 0 0 0 fov 1 1\nsphere radius 0.5\n";
-    let mut st = vec![Object::<R>::default(); 2];
+    // The world size of a pixel at the sphere.
+    let pixel = 2.0 * (0.5f64.to_radians()).tan() * 200.0 / 64.0;
+    silhouette_as_f64::<R>(text, 1, (Vec3::new(0.0, 0.0, 0.0), 0.5), pixel, true);
+}
+
+// 3b. A small sphere in a scene thousands of times its size (in fixed point, the world box
+// reaches 400000 in its own coordinates, so its rays are moved to near it before they are
+// mapped): its silhouette within half a pixel of f64 all the same.
+fn small_sphere_in_a_large_scene<R: Real>() {
+    let text = "camera eye 1 0 -0.2 look 1 0 0 fov 10 10\nbox min -4000 -4000 100 max 4000 4000 200\n\
+                sphere center 1 0 0 radius 0.01\n";
+    let pixel = 2.0 * (5f64.to_radians()).tan() * 0.2 / 64.0;
+    let centre = Vec3::new(1.0, 0.0, 0.0);
+    silhouette_as_f64::<R>(text, 2, (centre, 0.01), pixel, false);
+    // Rays from thousands of units away (as from the big box towards a light), aimed across
+    // the sphere: hit as the same ray (its origin and direction as `R` holds them) in f64, at
+    // the same distance, but within a few units of fixed point's last place of the silhouette.
+    let (mut st, mut st64) = (vec![Object::<R>::default(); 2], vec![Object::<f64>::default(); 2]);
+    let (mut parts, mut parts64) = (lattice_rt::Parts::default(), lattice_rt::Parts::default());
+    let scene = parse::<R>(text, &mut st, &mut parts).unwrap();
+    let s64 = parse::<f64>(text, &mut st64, &mut parts64).unwrap();
+    let (sphere, sphere64) = (&scene.objects()[1], &s64.objects()[1]);
+    let mut hits = 0;
+    for from in [Vec3::new(1.0, 0.0, 150.0), Vec3::new(-3000.0, 2000.0, 150.0), Vec3::new(3900.0, -3900.0, -0.5)] {
+        for k in 0..400 {
+            let off = Vec3::new((k % 20) as f64 - 9.5, (k / 20) as f64 - 9.5, 0.0) * 0.0012;
+            let r = Ray::new(from.cast::<R>(), (centre + off - from).normalize().cast::<R>());
+            let r64 = Ray::new(r.origin.cast::<f64>(), r.dir.cast::<f64>());
+            let (hit, hit64) = (sphere.intersect(&r, R::ZERO, R::MAX), sphere64.intersect(&r64, 0.0, f64::MAX));
+            let (o, d) = (r64.origin - centre, r64.dir.normalize());
+            let closest = (o - d * o.dot(d)).length();
+            match (hit, hit64) {
+                (Some(h), Some(h64)) => {
+                    hits += 1;
+                    let err = (h.t.to_f64() - h64.t).abs();
+                    assert!(
+                        err < 0.02,
+                        "{}: from {from:?} offset {off:?}: t {} against {}",
+                        R::NAME,
+                        h.t.to_f64(),
+                        h64.t
+                    );
+                }
+                (None, None) => {}
+                (h, h64) => assert!(
+                    (closest - 0.01).abs() < 2e-4,
+                    "{}: from {from:?} offset {off:?}: {closest} {h:?} {h64:?}",
+                    R::NAME
+                ),
+            }
+        }
+    }
+    assert!(hits > 3 * 150, "{}: {hits} hits", R::NAME);
+}
+
+/// Casts 64 x 64 eye rays into the scene `text` of `objects` objects in `R` and in `f64`: where
+/// they disagree on hitting anything, the ray passes within half a `pixel` of the silhouette of
+/// the sphere `(centre, radius)`. A refusal is allowed where `may_refuse`, in fixed point only,
+/// as too small.
+fn silhouette_as_f64<R: Real>(
+    text: &str,
+    objects: usize,
+    (centre, radius): (Vec3<f64>, f64),
+    pixel: f64,
+    may_refuse: bool,
+) {
+    let mut st = vec![Object::<R>::default(); objects];
     let mut parts = lattice_rt::Parts::default();
     let scene = match parse::<R>(text, &mut st, &mut parts) {
         Ok(s) => s,
         Err(e) => {
-            assert!(R::NAME == "fixed", "{e}");
+            assert!(may_refuse && R::NAME == "fixed", "{e}");
             return assert!(e.to_string().contains("too small for this scene"), "{e}");
         }
     };
-    let mut st64 = vec![Object::<f64>::default(); 2];
+    let mut st64 = vec![Object::<f64>::default(); objects];
     let mut parts = lattice_rt::Parts::default();
     let s64 = parse::<f64>(text, &mut st64, &mut parts).unwrap();
     let n = 64;
-    let pixel = 2.0 * (0.5f64.to_radians()).tan() * 200.0 / n as f64; // world size of a pixel at the sphere
     let mut mb = vec![0; 4];
     let mut q = Query::new(&mut mb);
+    let mut disagree = 0;
     for y in 0..n {
         for x in 0..n {
             let r = scene.camera().ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
             let r64 = s64.camera().ray(2 * x + 1, 2 * y + 1, 2 * n, 2 * n);
-            let hit = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q).is_some();
-            let hit64 = BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &mut q).is_some();
+            let hit = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q).map(|h| h.object);
+            let hit64 = BruteForce.nearest(&s64, &r64, 0.0, f64::MAX, &mut q).map(|h| h.object);
             if hit != hit64 {
                 // Only rays passing within half a pixel of the f64 silhouette may disagree.
                 let d = r64.dir.normalize();
-                let closest = (r64.origin - d * r64.origin.dot(d)).length();
-                assert!((closest - 0.5).abs() < 0.5 * pixel, "{}: pixel {x},{y} {hit} vs {hit64}", R::NAME);
+                let o = r64.origin - centre;
+                let closest = (o - d * o.dot(d)).length();
+                assert!((closest - radius).abs() < 0.5 * pixel, "{}: pixel {x},{y} {hit:?} vs {hit64:?}", R::NAME);
+                disagree += 1;
             }
         }
     }
+    assert!(disagree < n, "{}: {disagree} rays disagree", R::NAME);
 }
 
 // 4. Rays tangent to a sphere, cylinder and cone, swept a few units in the last place (LSB)
@@ -591,6 +660,7 @@ every_scalar! {
     rays_leaving_a_surface_from_outside_miss_its_object => leaving_rays_miss_their_object;
     a_scene_far_from_the_origin_renders_the_same => far_from_the_origin;
     a_small_far_sphere_keeps_its_silhouette => small_far_sphere;
+    a_small_sphere_in_a_large_scene_keeps_its_silhouette => small_sphere_in_a_large_scene;
     tangent_rays_never_give_nan_and_decide_consistently => tangent_rays;
     glass_handles_the_critical_angle_and_rays_from_inside => glass_and_total_internal_reflection;
     plus_and_minus_zero_directions_give_the_same_answer => signed_zero_parallel_rays;

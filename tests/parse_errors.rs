@@ -210,16 +210,29 @@ fn fixed_point_refuses_coordinates_beyond_its_range() {
 }
 
 #[test]
-fn fixed_point_refuses_an_object_too_small_for_the_scene_and_names_its_line() {
-    let text = "camera eye 0 0 -10\nsphere radius 2\nsphere center 1 0 0 radius 0.0005\n";
+fn fixed_point_refuses_an_object_too_thin_for_its_length_and_names_its_line() {
+    // A needle 10 long and 0.001 across: within twice its length of its box's centre (where a
+    // ray is moved before its test), its own coordinates reach 20 / 0.0005 = 40000 (and some),
+    // past fixed point's range wherever the scene is.
+    let text = "camera eye 0 0 -10\nsphere radius 2\ncylinder base 1 0 0 height 10 radius 0.0005\n";
     assert_eq!(
         err::<lattice_rt::Fx>(text),
-        "line 3, column 1 at `sphere`: object 1 is too small for this scene in fixed: its own coordinates reach 20000 inside the world box, the limit is 8192 (make it larger or the scene smaller)"
+        "line 3, column 1 at `cylinder`: object 1 is too small for this scene in fixed: its own coordinates reach 40086 near it, the limit is 8192 (make it thicker or shorter)"
     );
     // The same scene is fine in floating point.
     let mut storage = vec![Object::<f32>::default(); 4];
     let mut parts = lattice_rt::Parts::default();
     assert!(parse::<f32>(text, &mut storage, &mut parts).is_ok());
+}
+
+#[test]
+fn fixed_point_traces_an_object_small_for_the_scene_from_near_it() {
+    // The world box reaches 20000 in the small sphere's own coordinates, past fixed point's
+    // 8192: its rays are moved to near it before they are mapped (`Object::distant`).
+    let text = "camera eye 0 0 -10\nsphere radius 2\nsphere center 1 0 0 radius 0.0005\n";
+    let mut storage = vec![Object::<lattice_rt::Fx>::default(); 4];
+    let mut parts = lattice_rt::Parts::default();
+    assert!(parse::<lattice_rt::Fx>(text, &mut storage, &mut parts).is_ok());
 }
 
 #[test]

@@ -303,6 +303,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             unscale: R::pow2(log2_of_pow2(unscale)),
             dir_factor: R::pow2(log2_of_pow2(unscale * dir_scale)),
             material,
+            // Known once the world box is, at `finish`.
+            distant: false,
             composite,
             bounds: bounds.cast_padded(),
             dir_scale: R::pow2(log2_of_pow2(dir_scale)),
@@ -350,12 +352,12 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
             o.region = regions.of(o);
         }
         let bound = brightness_bound(&self.parts.materials, &self.parts.lights, self.ambient, self.background);
+        check_range::<R>(world.min.cast())?;
+        check_range::<R>(world.max.cast())?;
+        check_objects(&mut self.storage[..self.len], &world)?;
         let (len, ambient, background, max_depth) = (self.len, self.ambient, self.background, self.max_depth);
         let objects: &'a [Object<R>] = &self.storage[..len];
         let parts: &'a Parts<R> = self.parts;
-        check_range::<R>(world.min.cast())?;
-        check_range::<R>(world.max.cast())?;
-        check_objects(objects, &world)?;
         if !(bound < R::LIMIT) {
             return Err(SceneError::TooBright { bound, limit: R::LIMIT, scalar: R::NAME });
         }
@@ -408,22 +410,31 @@ fn camera<R: Real>(c: &CameraDesc) -> Result<Camera<R>, SceneError> {
     })
 }
 
-/// Checks each object against what the scalar can hold: its own coordinates of the world box's
-/// corners within the scalar's range, and thick enough for the scalar to resolve.
-fn check_objects<R: Real>(objects: &[Object<R>], world: &Aabb<R>) -> Result<(), SceneError> {
+/// Checks each object against what the scalar can hold, and marks those it holds only near
+/// them ([`Object::distant`]): its own coordinates of the world box's corners within the
+/// scalar's range, or else of the points a ray is moved to near it, and thick enough for the
+/// scalar to resolve.
+fn check_objects<R: Real>(objects: &mut [Object<R>], world: &Aabb<R>) -> Result<(), SceneError> {
     // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
-    // coordinates never exceed those of the world box's corners in its space.
-    for (i, o) in objects.iter().enumerate() {
-        let inv = o.to_object.cast::<f64>();
-        let unscale = R::pow2_value(o.unscale);
-        let reach = world
-            .corners()
-            .into_iter()
-            .map(|p| (inv.vector(p.cast() - o.origin().cast()) * unscale).max_abs())
-            .fold(0.0, f64::max);
+    // coordinates never exceed those of the world box's corners in its space; a distant
+    // object's test maps only points within `Object::near_reach` of its box's centre on every
+    // axis.
+    for (i, o) in objects.iter_mut().enumerate() {
+        let reach = own_reach(o, world.corners().map(|p| p.cast()));
+        if reach < R::LIMIT {
+            continue;
+        }
+        // As the test computes them, in `R`.
+        let b = &o.bounds;
+        let r = Object::near_reach(b.extent());
+        let centre = b.min + (b.max - b.min) * R::HALF;
+        let r = Vec3::new(r, r, r);
+        let near = Aabb { min: centre - r, max: centre + r };
+        let reach = own_reach(o, near.corners().map(|p| p.cast()));
         if reach >= R::LIMIT {
             return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
         }
+        o.distant = true;
     }
     // A triangle has no inside for a secondary ray to start in (every ray off it leaves it):
     // the rule is for solids.
@@ -434,6 +445,13 @@ fn check_objects<R: Real>(objects: &[Object<R>], world: &Aabb<R>) -> Result<(), 
         }
     }
     Ok(())
+}
+
+/// The largest of the object's own coordinates of the world points `corners`, in `f64`.
+fn own_reach<R: Real>(o: &Object<R>, corners: [Vec3<f64>; 8]) -> f64 {
+    let inv = o.to_object.cast::<f64>();
+    let unscale = R::pow2_value(o.unscale);
+    corners.into_iter().map(|p| (inv.vector(p - o.origin().cast()) * unscale).max_abs()).fold(0.0, f64::max)
 }
 
 /// A shape, its placement and the placement's inverse.

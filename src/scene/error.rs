@@ -99,8 +99,9 @@ pub enum SceneError {
     SmoothLeftOut,
     /// The scene has no objects.
     NoObjects,
-    /// Inside the world box, an object's own coordinates grow beyond what the scalar holds
-    /// (the object is too small for the size of the scene).
+    /// Near the object (within its length of its box, where a ray is moved before its test when
+    /// the world box is beyond the scalar's range in the object's own space), its own
+    /// coordinates grow beyond what the scalar holds: the object is too thin for its length.
     ObjectOutOfRange {
         /// Index of the object (in the order it was added).
         object: usize,
@@ -175,7 +176,7 @@ impl fmt::Display for SceneError {
             SceneError::ObjectOutOfRange { object, reach, limit, scalar } => write!(
                 f,
                 "object {object} is too small for this scene in {scalar}: its own coordinates reach \
-                 {} inside the world box, the limit is {} (make it larger or the scene smaller)",
+                 {} near it, the limit is {} (make it thicker or shorter)",
                 Round(*reach),
                 Round(*limit)
             ),

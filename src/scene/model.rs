@@ -109,6 +109,11 @@ pub struct Object<R> {
     pub(crate) dir_factor: Pow2<R>,
     /// Index into the scene's materials.
     pub(crate) material: u8,
+    /// Whether the world box, in the object's own space, reaches past the scalar's range (a
+    /// small object in a large scene, in fixed point): a ray is then first moved along itself to
+    /// near the object ([`Object::intersect`]), so that only points near it are mapped into its
+    /// space.
+    pub(crate) distant: bool,
     /// Composite object it belongs to, or [`NO_COMPOSITE`].
     pub(crate) composite: u16,
     /// World-space bounding box, padded for the scalar's rounding.
@@ -144,6 +149,7 @@ impl<R: Real> Default for Object<R> {
             unscale: R::pow2(0),
             dir_factor: R::pow2(0),
             material: 0,
+            distant: false,
             composite: NO_COMPOSITE,
             bounds: Aabb { min: z, max: z },
             dir_scale: R::pow2(0),
@@ -170,6 +176,7 @@ impl<R> Object<R> {
         unscale: Pow2<R>,
         dir_factor: Pow2<R>,
         material: u8,
+        distant: bool,
         composite: u16,
         bounds: Aabb<R>,
         dir_scale: Pow2<R>,
@@ -190,6 +197,7 @@ impl<R> Object<R> {
             unscale,
             dir_factor,
             material,
+            distant,
             composite,
             bounds,
             dir_scale,
@@ -220,7 +228,52 @@ impl<R: Real> Object<R> {
     /// the object-space normal and point.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
+        if self.distant {
+            return self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax);
+        }
         self.intersect_local(self.point_local(ray.origin), self.direction_local(ray.dir), tmin, tmax)
+    }
+
+    /// The test of a [distant](Object::distant) object, its direction `dir` already in object
+    /// space: the ray's origin moved along the ray to where it crosses the plane through the
+    /// centre of the object's box across the axis the ray runs most along, `t0` along it, and
+    /// the test made from there with the range shifted by `t0` (exact in fixed point, whose
+    /// sums do not round). `t0` is one quotient of a difference of coordinates, so fixed point
+    /// finds that point to a unit or two of its last place however far the ray came (a closest
+    /// approach, through `dir . dir`, would carry its relative rounding times the distance).
+    /// A ray that meets the box passes within its half diagonal of the centre, and crosses the
+    /// plane within three halves of the box's extent of it: one whose crossing lies farther on
+    /// some axis than twice the extent (and the scalar's offset) misses at once, and any other's
+    /// moved origin lies within that distance, which the scene's validation checks the object's
+    /// own coordinates hold there ([`crate::scene::SceneBuilder::finish`]).
+    #[inline(never)]
+    fn intersect_near(&self, ray: &Ray<R>, dir: Vec3<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
+        let b = &self.bounds;
+        let extent = b.extent();
+        let centre = b.min + (b.max - b.min) * R::HALF;
+        let (o, d) = (ray.origin, ray.dir);
+        let (ax, ay, az) = (d.x.abs(), d.y.abs(), d.z.abs());
+        let t0 = if ax >= ay && ax >= az {
+            (centre.x - o.x) / d.x
+        } else if ay >= az {
+            (centre.y - o.y) / d.y
+        } else {
+            (centre.z - o.z) / d.z
+        };
+        let near = ray.at(t0);
+        if (near - centre).max_abs() > Self::near_reach(extent) {
+            return None;
+        }
+        let tmax = if tmax == R::MAX { R::MAX } else { tmax - t0 };
+        let hit = self.intersect_local(self.point_local(near), dir, tmin - t0, tmax)?;
+        Some(ShapeHit { t: hit.t + t0, ..hit })
+    }
+
+    /// How far on any axis from the centre of its box a distant object's test may map a point
+    /// into its space, for a box of largest extent `extent` ([`Object::intersect_near`]).
+    #[inline]
+    pub(crate) fn near_reach(extent: R) -> R {
+        extent + extent + R::offset_eps()
     }
 
     /// Whether the object's eye window meets the window rectangle `u` x `v` (2^-16 units,
@@ -253,6 +306,9 @@ impl<R: Real> Object<R> {
         if !self.eye_window_meets([uv[0]; 2], [uv[1]; 2]) {
             return Err(Culled);
         }
+        if self.distant {
+            return Ok(self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax));
+        }
         #[cfg(not(feature = "lean-objects"))]
         let eye = self.eye_local;
         // The ray's origin is the camera's eye, which the scene's set-up mapped the same way.
@@ -271,6 +327,9 @@ impl<R: Real> Object<R> {
         // The ray's direction is the light's, which the scene's set-up mapped the same way.
         #[cfg(feature = "lean-objects")]
         let towards = self.direction_local(ray.dir);
+        if self.distant {
+            return self.intersect_near(ray, towards, tmin, tmax);
+        }
         self.intersect_local(self.point_local(ray.origin), towards, tmin, tmax)
     }
 
