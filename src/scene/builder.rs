@@ -414,14 +414,16 @@ fn camera<R: Real>(c: &CameraDesc) -> Result<Camera<R>, SceneError> {
 /// them ([`Object::distant`]): its own coordinates of the world box's corners within the
 /// scalar's range, or else of the points a ray is moved to near it, and thick enough for the
 /// scalar to resolve.
+// Out of line, and its boxes' corners mapped one at a time: built into a board's image that
+// parses its scenes, its frame would otherwise add to the set-up's deepest stack.
+#[inline(never)]
 fn check_objects<R: Real>(objects: &mut [Object<R>], world: &Aabb<R>) -> Result<(), SceneError> {
     // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
     // coordinates never exceed those of the world box's corners in its space; a distant
     // object's test maps only points within `Object::near_reach` of its box's centre on every
     // axis.
     for (i, o) in objects.iter_mut().enumerate() {
-        let reach = own_reach(o, world.corners().map(|p| p.cast()));
-        if reach < R::LIMIT {
+        if own_reach(o, world) < R::LIMIT {
             continue;
         }
         // As the test computes them, in `R`.
@@ -429,8 +431,7 @@ fn check_objects<R: Real>(objects: &mut [Object<R>], world: &Aabb<R>) -> Result<
         let r = Object::near_reach(b.extent());
         let centre = b.min + (b.max - b.min) * R::HALF;
         let r = Vec3::new(r, r, r);
-        let near = Aabb { min: centre - r, max: centre + r };
-        let reach = own_reach(o, near.corners().map(|p| p.cast()));
+        let reach = own_reach(o, &Aabb { min: centre - r, max: centre + r });
         if reach >= R::LIMIT {
             return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
         }
@@ -447,11 +448,11 @@ fn check_objects<R: Real>(objects: &mut [Object<R>], world: &Aabb<R>) -> Result<
     Ok(())
 }
 
-/// The largest of the object's own coordinates of the world points `corners`, in `f64`.
-fn own_reach<R: Real>(o: &Object<R>, corners: [Vec3<f64>; 8]) -> f64 {
+/// The largest of the object's own coordinates of the corners of the box `b`, in `f64`.
+fn own_reach<R: Real>(o: &Object<R>, b: &Aabb<R>) -> f64 {
     let inv = o.to_object.cast::<f64>();
     let unscale = R::pow2_value(o.unscale);
-    corners.into_iter().map(|p| (inv.vector(p - o.origin().cast()) * unscale).max_abs()).fold(0.0, f64::max)
+    b.corners().into_iter().map(|p| (inv.vector(p.cast() - o.origin().cast()) * unscale).max_abs()).fold(0.0, f64::max)
 }
 
 /// A shape, its placement and the placement's inverse.
