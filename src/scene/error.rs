@@ -99,9 +99,10 @@ pub enum SceneError {
     SmoothLeftOut,
     /// The scene has no objects.
     NoObjects,
-    /// Near the object (within its length of its box, where a ray is moved before its test when
-    /// the world box is beyond the scalar's range in the object's own space), its own
-    /// coordinates grow beyond what the scalar holds: the object is too thin for its length.
+    /// Near the object (within twice its box's extent of the box's centre, where a ray is moved
+    /// before its test when the world box is beyond the scalar's range in the object's own
+    /// space), its own coordinates grow beyond what the scalar holds: the object is too thin for
+    /// its length.
     ObjectOutOfRange {
         /// Index of the object (in the order it was added).
         object: usize,
