@@ -217,7 +217,7 @@ fn fixed_point_refuses_an_object_too_thin_for_its_length_and_names_its_line() {
     let text = "camera eye 0 0 -10\nsphere radius 2\ncylinder base 1 0 0 height 10 radius 0.0005\n";
     assert_eq!(
         err::<lattice_rt::Fx>(text),
-        "line 3, column 1 at `cylinder`: object 1 is too small for this scene in fixed: its own coordinates reach 40086 near it, the limit is 8192 (make it thicker or shorter)"
+        "line 3, column 1 at `cylinder`: object 1 is too small for this scene in fixed: its own coordinates reach 40086 where rays meet it, the limit is 8192 (make it thicker)"
     );
     // The same scene is fine in floating point.
     let mut storage = vec![Object::<f32>::default(); 4];

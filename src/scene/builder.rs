@@ -423,8 +423,12 @@ fn check_objects<R: Real>(objects: &mut [Object<R>], world: &Aabb<R>) -> Result<
     // object's test maps only points within `Object::near_reach` of its box's centre on every
     // axis.
     for (i, o) in objects.iter_mut().enumerate() {
-        if own_reach(o, world) < R::LIMIT {
+        let reach = own_reach(o, world);
+        if reach < R::LIMIT {
             continue;
+        }
+        if !cfg!(feature = "distant-objects") {
+            return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
         }
         // As the test computes them, in `R`.
         let b = &o.bounds;

@@ -99,10 +99,11 @@ pub enum SceneError {
     SmoothLeftOut,
     /// The scene has no objects.
     NoObjects,
-    /// Near the object (within twice its box's extent of the box's centre, where a ray is moved
-    /// before its test when the world box is beyond the scalar's range in the object's own
-    /// space), its own coordinates grow beyond what the scalar holds: the object is too thin for
-    /// its length.
+    /// Where rays meet the object (within twice its box's extent of the box's centre, where a
+    /// ray is moved before its test when the world box is beyond the scalar's range in the
+    /// object's own space; the world box in a build without `distant-objects`), its own
+    /// coordinates grow beyond what the scalar holds: the object is too thin for its length, or
+    /// without `distant-objects` too small for the scene.
     ObjectOutOfRange {
         /// Index of the object (in the order it was added).
         object: usize,
@@ -177,7 +178,7 @@ impl fmt::Display for SceneError {
             SceneError::ObjectOutOfRange { object, reach, limit, scalar } => write!(
                 f,
                 "object {object} is too small for this scene in {scalar}: its own coordinates reach \
-                 {} near it, the limit is {} (make it thicker or shorter)",
+                 {} where rays meet it, the limit is {} (make it thicker)",
                 Round(*reach),
                 Round(*limit)
             ),

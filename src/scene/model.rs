@@ -228,7 +228,7 @@ impl<R: Real> Object<R> {
     /// the object-space normal and point.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        if self.distant {
+        if cfg!(feature = "distant-objects") && self.distant {
             return self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax);
         }
         self.intersect_local(self.point_local(ray.origin), self.direction_local(ray.dir), tmin, tmax)
@@ -306,7 +306,7 @@ impl<R: Real> Object<R> {
         if !self.eye_window_meets([uv[0]; 2], [uv[1]; 2]) {
             return Err(Culled);
         }
-        if self.distant {
+        if cfg!(feature = "distant-objects") && self.distant {
             return Ok(self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax));
         }
         #[cfg(not(feature = "lean-objects"))]
@@ -327,7 +327,7 @@ impl<R: Real> Object<R> {
         // The ray's direction is the light's, which the scene's set-up mapped the same way.
         #[cfg(feature = "lean-objects")]
         let towards = self.direction_local(ray.dir);
-        if self.distant {
+        if cfg!(feature = "distant-objects") && self.distant {
             return self.intersect_near(ray, towards, tmin, tmax);
         }
         self.intersect_local(self.point_local(ray.origin), towards, tmin, tmax)
