@@ -226,7 +226,7 @@ pub fn render_scene<'t, R: Real, D: DrawTarget<Color = Shown, Error: Send> + Sen
     hooks: &mut impl Hooks,
 ) -> Result<Report, AppError<'t, D::Error>> {
     let mut second = ShareMemory::new();
-    let board = Board { cores: &mut OneCore, second: &mut second, now: &|| 0, shown: &mut |_| {} };
+    let board = Board { cores: &mut OneCore, second: &mut second, now: &|| 0, shown: &mut |_| {}, alive: &|| {} };
     render_scene_at(text, st, target, hooks, &Shot::default(), board)
 }
 
@@ -283,6 +283,19 @@ pub struct Board<'a, C: Cores> {
     pub now: &'a (dyn Fn() -> u64 + Sync),
     /// Called with each pass once it is on the display.
     pub shown: &'a mut dyn FnMut(u8),
+    /// Called by core 1 after each eye sample it traces, as core 0's hooks are
+    /// ([`Hooks::sampled`]): a sign that it makes progress, for a watchdog.
+    pub alive: &'a (dyn Fn() + Sync),
+}
+
+/// Core 1's hooks: each eye sample it traces reported to the board's `alive`.
+struct Alive<'a>(&'a (dyn Fn() + Sync));
+
+impl Hooks for Alive<'_> {
+    #[inline(always)]
+    fn sampled(&mut self) {
+        (self.0)();
+    }
 }
 
 /// Whether the board has a second core to trace share 1 (the `rp` boards): it then needs its own
@@ -507,7 +520,7 @@ fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<C
     let pick = |tuned| if cfg!(feature = "ladder") { tuned } else { &RENDERED };
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
-    let Board { cores, second, now, shown } = board;
+    let Board { cores, second, now, shown, alive } = board;
     let ShareMemory { mailbox, rows, traced, kept, rays, above, band, carries } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
@@ -516,7 +529,7 @@ fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<C
     if TRACE_THEN_DITHER {
         let memory = DitherMemory { mailbox, rows, kept, rays, above, band, carries };
         let (s, [there, mine]) =
-            trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown), target)?;
+            trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown, alive), target)?;
         return Ok(Report {
             stats: s,
             objects: scene.objects().len(),
@@ -573,7 +586,8 @@ struct DitherMemory<'m> {
 /// pass is free to trace as soon as its band of the last has been dithered (`trace_pass`, each
 /// tile's rays kept in `memory` from pass to pass), so neither core waits at a pass's end; each
 /// pass is bit for bit what `render_pass` draws. `here` is core 0's side: its query scratch,
-/// the render's hooks, the board's clock and what to do once each pass is on the display.
+/// the render's hooks, the board's clock, what to do once each pass is on the display, and
+/// what core 1 calls after each eye sample it traces.
 /// Returns both cores' statistics and their times, core 1's first.
 #[allow(clippy::type_complexity)]
 fn trace_then_dither<
@@ -586,11 +600,12 @@ fn trace_then_dither<
     frame: &Frame,
     cores: &mut impl Cores,
     memory: DitherMemory<'_>,
-    (scratch, hooks, now, shown): (
+    (scratch, hooks, now, shown, alive): (
         &mut lattice_rt::Scratch<'_>,
         &mut impl Hooks,
         &(dyn Fn() -> u64 + Sync),
         &mut dyn FnMut(u8),
+        &(dyn Fn() + Sync),
     ),
     target: &mut D,
 ) -> Result<(Stats, [u64; 2]), AppError<'t, D::Error>> {
@@ -605,8 +620,8 @@ fn trace_then_dither<
         &mut || {
             let t0 = now();
             let mut scratch = lattice_rt::Scratch::new(&mut mailbox[..], &mut rows[..]);
-            let mut no_hooks = lattice_rt::NoHooks;
-            let mut trace = tile_tracer(tracer, &mut no_hooks);
+            let mut alive = Alive(alive);
+            let mut trace = tile_tracer(tracer, &mut alive);
             loop {
                 match schedule.take(&mut scratch, &mut trace) {
                     Take::Tile(Ok(s)) => there.0.add(&s),

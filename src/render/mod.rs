@@ -34,10 +34,14 @@ use crate::trace::Tracer;
 use embedded_graphics_core::draw_target::DrawTarget;
 use tiles::{render_tiles, Out};
 
-/// Callbacks between tiles.
+/// Callbacks between tiles, and one inside them.
 pub trait Hooks {
     /// A finished tile of gray levels (0..=64) at `(x, y)`, `w x h`, row-major.
     fn gray_tile(&mut self, _x: u16, _y: u16, _w: u16, _h: u16, _levels: &[u8]) {}
+    /// Called after each eye sample a tile traces (with the rays it spawned): progress finer
+    /// than a tile, for a board's watchdog, as one tile of a heavy scene can take seconds.
+    #[inline(always)]
+    fn sampled(&mut self) {}
     /// Called after each tile; return false to cancel the render.
     fn progress(&mut self, _done: u32, _total: u32) -> bool {
         true

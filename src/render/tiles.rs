@@ -99,7 +99,7 @@ pub(super) fn render_tiles<R: Real, A: Accelerator<R> + ?Sized, D: DrawTarget<Co
                 (*n, &mut traced[k * per_tile..(k + 1) * per_tile])
             });
             let mut ray = Eye { tracer, work: &mut work, cache: &mut eyes };
-            sample(&mut ray, &mut sampler, at, candidates, looks, traced, &mut tile);
+            sample(&mut ray, &mut sampler, at, (candidates, looks), traced, &mut tile, hooks);
             hooks.gray_tile(at.x0 as u16, at.y0 as u16, at.tw as u16, at.th as u16, &tile.levels[..at.tw * at.th]);
             // What a kept tile keeps of its sides (a drawn one keeps none: the compiler leaves it out).
             let mut sides = KeptTile::EMPTY;
@@ -218,10 +218,10 @@ fn sample<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     eye: &mut Eye<'_, '_, '_, '_, '_, R, A, E>,
     sampler: &mut Sampler<'_>,
     at: TileAt,
-    candidates: u64,
-    looks: Looks,
+    (candidates, looks): (u64, Looks),
     traced: Option<(u8, &mut [super::Traced])>,
     tile: &mut TileWork<impl Shade>,
+    hooks: &mut impl Hooks,
 ) {
     let tracer = eye.tracer;
     let size = eye.cache.size();
@@ -231,6 +231,7 @@ fn sample<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
         let (ray, uv) = eye.ray(sx, sy);
         let (v, id, depth) = tracer.eye_sample(ray, uv, eye.work);
+        hooks.sampled();
         (v, id as u16, if looks.keys { depth.depth_key() } else { u16::MAX })
     };
     let TileWork { levels, hits, .. } = tile;

@@ -420,20 +420,18 @@ fn camera<R: Real>(c: &CameraDesc) -> Result<Camera<R>, SceneError> {
 fn check_objects<R: Real>(objects: &mut [Object<R>], world: &Aabb<R>) -> Result<(), SceneError> {
     // Every ray the tracer casts stays in the world box (or leaves it), so an object's own
     // coordinates never exceed those of the world box's corners in its space; a distant
-    // object's test maps only points within `Object::near_reach` of its box's centre on every
+    // object's test maps only points within `Object::near` of its box's centre on every
     // axis.
     for (i, o) in objects.iter_mut().enumerate() {
         let reach = own_reach(o, world);
         if reach < R::LIMIT {
             continue;
         }
-        if !cfg!(feature = "distant-objects") {
+        if !Object::<R>::TRACES_DISTANT {
             return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
         }
         // As the test computes them, in `R`.
-        let b = &o.bounds;
-        let r = Object::near_reach(b.extent());
-        let centre = b.min + (b.max - b.min) * R::HALF;
+        let (centre, r) = o.near();
         let r = Vec3::new(r, r, r);
         let reach = own_reach(o, &Aabb { min: centre - r, max: centre + r });
         if reach >= R::LIMIT {

@@ -228,7 +228,7 @@ impl<R: Real> Object<R> {
     /// the object-space normal and point.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        if cfg!(feature = "distant-objects") && self.distant {
+        if Self::TRACES_DISTANT && self.distant {
             return self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax);
         }
         self.intersect_local(self.point_local(ray.origin), self.direction_local(ray.dir), tmin, tmax)
@@ -248,9 +248,7 @@ impl<R: Real> Object<R> {
     /// own coordinates hold there ([`crate::scene::SceneBuilder::finish`]).
     #[inline(never)]
     fn intersect_near(&self, ray: &Ray<R>, dir: Vec3<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        let b = &self.bounds;
-        let extent = b.extent();
-        let centre = b.min + (b.max - b.min) * R::HALF;
+        let (centre, reach) = self.near();
         let (o, d) = (ray.origin, ray.dir);
         let (ax, ay, az) = (d.x.abs(), d.y.abs(), d.z.abs());
         let t0 = if ax >= ay && ax >= az {
@@ -261,7 +259,7 @@ impl<R: Real> Object<R> {
             (centre.z - o.z) / d.z
         };
         let near = ray.at(t0);
-        if (near - centre).max_abs() > Self::near_reach(extent) {
+        if (near - centre).max_abs() > reach {
             return None;
         }
         let tmax = if tmax == R::MAX { R::MAX } else { tmax - t0 };
@@ -269,12 +267,21 @@ impl<R: Real> Object<R> {
         Some(ShapeHit { t: hit.t + t0, ..hit })
     }
 
-    /// How far on any axis from the centre of its box a distant object's test may map a point
-    /// into its space, for a box of largest extent `extent` ([`Object::intersect_near`]).
+    /// The centre of the object's box, and how far from it on any axis a distant object's test
+    /// may map a point into its space ([`Object::intersect_near`]): twice the box's largest
+    /// extent and the scalar's offset.
     #[inline]
-    pub(crate) fn near_reach(extent: R) -> R {
-        extent + extent + R::offset_eps()
+    pub(crate) fn near(&self) -> (Vec3<R>, R) {
+        let b = &self.bounds;
+        let extent = b.extent();
+        (b.min + (b.max - b.min) * R::HALF, extent + extent + R::offset_eps())
     }
+
+    /// Whether this build traces [distant](Object::distant) objects in `R`: with the
+    /// `distant-objects` feature, in a scalar of narrow range (fixed point, whose own
+    /// coordinates stop at 8,192). A float's range holds any scene's coordinates, so its images
+    /// carry no distant branch.
+    pub(crate) const TRACES_DISTANT: bool = cfg!(feature = "distant-objects") && R::LIMIT < 1e6;
 
     /// Whether the object's eye window meets the window rectangle `u` x `v` (2^-16 units,
     /// inclusive bounds, see [`EyeWindow`]).
@@ -306,7 +313,7 @@ impl<R: Real> Object<R> {
         if !self.eye_window_meets([uv[0]; 2], [uv[1]; 2]) {
             return Err(Culled);
         }
-        if cfg!(feature = "distant-objects") && self.distant {
+        if Self::TRACES_DISTANT && self.distant {
             return Ok(self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax));
         }
         #[cfg(not(feature = "lean-objects"))]
@@ -327,7 +334,7 @@ impl<R: Real> Object<R> {
         // The ray's direction is the light's, which the scene's set-up mapped the same way.
         #[cfg(feature = "lean-objects")]
         let towards = self.direction_local(ray.dir);
-        if cfg!(feature = "distant-objects") && self.distant {
+        if Self::TRACES_DISTANT && self.distant {
             return self.intersect_near(ray, towards, tmin, tmax);
         }
         self.intersect_local(self.point_local(ray.origin), towards, tmin, tmax)

@@ -171,7 +171,7 @@ fn main() -> ! {
         let mut frame = BitFrame::new(FRAME.width as u32, FRAME.height as u32, &mut bits).unwrap();
         let t0 = ticks();
         let shot = Shot::default();
-        let board = Board { cores: &mut OneCore, second: &mut second, now: &ticks, shown: &mut |_| {} };
+        let board = Board { cores: &mut OneCore, second: &mut second, now: &ticks, shown: &mut |_| {}, alive: &|| {} };
         match render_embedded_at(scene, &mut st, &mut frame, &mut NoHooks, &shot, board) {
             Ok(r) => {
                 let t = ticks() - t0;

@@ -1,14 +1,17 @@
 //! What brings a board back by itself. The watchdog: started in every board image once the
-//! display is set up, and fed by core 0 only where it makes progress (after each tile it
-//! traces, between frames, while it waits for a panel that does not answer). Core 0 waits for
-//! core 1's share of a frame without feeding it, so a core that stops making progress resets
-//! the board within [`TIMEOUT_MS`]; the next boot logs why ([`reset_reason`]). The panic
+//! display is set up, and fed only where the firmware makes progress: by core 0 after each tile
+//! it traces, between frames and while it waits for a panel that does not answer, and by either
+//! core every [`SAMPLES_PER_FEED`] eye samples traced ([`alive`]: one tile of a heavy scene can
+//! take seconds). A core that stops making progress stops feeding it, and the other runs out
+//! of tiles and waits for it without feeding, so the board resets within [`TIMEOUT_MS`] of
+//! that; the next boot logs why ([`reset_reason`]). The panic
 //! handler of the images without a probe: the reason kept in RAM across a reset, reported by
 //! the next boot ([`last_panic`]); `cargo pico` (feature `probe`) keeps panic-probe's
 //! breakpoint for the debugger.
 
 use crate::hal;
 use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
 use critical_section::Mutex;
 
 /// How long core 0 may go without feeding the watchdog.
@@ -21,6 +24,28 @@ static WATCHDOG: Mutex<RefCell<Option<hal::Watchdog>>> = Mutex::new(RefCell::new
 pub fn start(mut watchdog: hal::Watchdog) {
     watchdog.start(hal::fugit::MicrosDurationU32::millis(TIMEOUT_MS));
     critical_section::with(|cs| WATCHDOG.borrow(cs).replace(Some(watchdog)));
+}
+
+/// Eye samples traced (by both cores, so some counts may be lost to a race: it only paces
+/// [`alive`]'s feeding).
+static SAMPLES: AtomicU32 = AtomicU32::new(0);
+
+/// How many eye samples [`alive`] counts between feeds: at most a few million cycles even in a
+/// scene of thousands of objects, far below [`TIMEOUT_MS`], and the watchdog's critical
+/// section taken once in 32 samples, not at each.
+pub const SAMPLES_PER_FEED: u32 = 32;
+
+/// An eye sample traced, on either core: the watchdog fed every [`SAMPLES_PER_FEED`]. Out of
+/// line and in flash: the tracer's code in SRAM (`ram_code`) carries one call for it, not its
+/// body at every place the sampler traces.
+#[inline(never)]
+pub fn alive() {
+    // Load and store: a Cortex-M0+ has no atomic read-modify-write.
+    let n = SAMPLES.load(Ordering::Relaxed).wrapping_add(1);
+    SAMPLES.store(n, Ordering::Relaxed);
+    if n.is_multiple_of(SAMPLES_PER_FEED) {
+        feed();
+    }
 }
 
 /// Feeds the watchdog (nothing before [`start`]).

@@ -109,7 +109,13 @@ impl<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: Outpu
         let refresh0 = crate::display::gray::refresh_us();
         let _ = self.led.set_high();
         let now = || timer.get_counter().ticks();
-        let board = Board { cores: &mut self.cores, second: self.second, now: &now, shown: &mut |_| {} };
+        let board = Board {
+            cores: &mut self.cores,
+            second: self.second,
+            now: &now,
+            shown: &mut |_| {},
+            alive: &crate::guard::alive,
+        };
         let result = render_embedded_at(scene, self.st, &mut self.target, &mut crate::display::Pump, shot, board);
         // The frame is on the panel once the bus has sent its last queued byte.
         let sent = self.target.flush();

@@ -211,7 +211,8 @@ pub fn flush() -> Result<(), BusError> {
 }
 
 /// The render's hooks on the Pico: after each tile core 0 traces, the display's queue moves on
-/// to the bus ([`pump`]) and the watchdog is fed (`guard`).
+/// to the bus ([`pump`]) and the watchdog is fed (`guard`); its eye samples count as progress
+/// ([`crate::guard::alive`]).
 pub struct Pump;
 
 impl lattice_rt::render::Hooks for Pump {
@@ -219,6 +220,10 @@ impl lattice_rt::render::Hooks for Pump {
         pump();
         crate::guard::feed();
         true
+    }
+    #[inline(always)]
+    fn sampled(&mut self) {
+        crate::guard::alive();
     }
 }
 
