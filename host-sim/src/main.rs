@@ -117,7 +117,9 @@ enum Command {
         image: PathBuf,
         /// Scene or NFF files (comma-separated) to bake into the image in place of the default
         /// scenes: objects, lattice and windows as tables in flash, thousands of objects
-        /// (`host-sim spd balls --size 3`); NFF's polygons need `--features triangles`.
+        /// (`host-sim spd balls --size 3`). The firmware's `triangles` is added for a scene with
+        /// triangles (NFF's polygons), and on the Pico `lean-objects` when the tables do not
+        /// fit its flash whole.
         #[arg(long, value_name = "FILES", value_delimiter = ',', conflicts_with = "scene")]
         bake: Vec<PathBuf>,
     },

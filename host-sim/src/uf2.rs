@@ -219,8 +219,11 @@ pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, bake: &[PathBu
         .map(|f| f.canonicalize().with_context(|| format!("cannot read the scene to bake {}", f.display())))
         .collect::<Result<Vec<_>>>()?;
     let list = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(",");
-    let scenes = if files.is_empty() { Scenes::Inherited } else { Scenes::Listed(&list) };
-    let elf = build_board_with(root, board, features, scenes)?;
+    let elf = if files.is_empty() {
+        build_board_with(root, board, features, Scenes::Inherited)?
+    } else {
+        build_baked(root, board, features, &files, &list)?
+    };
     let stems: Vec<String> =
         files.iter().filter_map(|f| f.file_stem()).map(|s| s.to_string_lossy().to_string()).collect();
     let parts: Vec<String> = features.map(|f| f.replace(',', "-")).into_iter().chain(stems).collect();
@@ -237,6 +240,61 @@ pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, bake: &[PathBu
         board.drive()
     );
     Ok(())
+}
+
+/// What [`refusal`] says of a build that failed with neither the build script's message nor
+/// the linker's.
+const NOT_BUILT: &str = "the image did not build";
+
+/// `board`'s image with the scene files `files` (`list`, comma-separated) baked, built with
+/// what they need beyond `features`: the firmware's `triangles` when a scene has triangles (the
+/// SPD's polygons), and, on the Pico, built again with `lean-objects` (records without the eye
+/// and light in object space) when the scenes' tables do not fit its flash whole, as `cargo
+/// xtask board` builds the SPD's largest scenes. A refusal is the build script's own message.
+fn build_baked(root: &Path, board: Board, features: Option<&str>, files: &[PathBuf], list: &str) -> Result<PathBuf> {
+    let mut wanted: Vec<String> =
+        features.into_iter().flat_map(|f| f.split(',')).map(|f| f.trim().to_string()).collect();
+    if !wanted.iter().any(|f| f == "triangles") && files.iter().any(|f| has_triangles(f)) {
+        eprintln!("the scenes have triangles: building with the firmware's `triangles`");
+        wanted.push("triangles".into());
+    }
+    let mut lean = wanted.iter().any(|f| f == "lean-objects");
+    loop {
+        let mut all = wanted.clone();
+        if lean && !all.iter().any(|f| f == "lean-objects") {
+            all.push("lean-objects".into());
+        }
+        let joined = all.join(",");
+        let chosen = (!joined.is_empty()).then_some(joined.as_str());
+        let failed = match build_board_with(root, board, chosen, Scenes::Listed(list)) {
+            Ok(elf) => return Ok(elf),
+            Err(e) => e,
+        };
+        let alias = format!("{}-build", board.name());
+        let mut args = vec![alias.as_str()];
+        if let Some(f) = chosen {
+            args.extend(["--features", f]);
+        }
+        let why = refusal(root, &args, list);
+        if why == NOT_BUILT {
+            return Err(failed);
+        }
+        if why.contains("of flash") && board == Board::Pico && !lean {
+            eprintln!("the scenes' tables do not fit whole: building again with the firmware's `lean-objects` (24 bytes less per object)");
+            lean = true;
+            continue;
+        }
+        bail!("the {} image with {} baked was not built: {why}", board.name(), list.replace(',', ", "));
+    }
+}
+
+/// Whether the scene file `path` has a triangle (parsed in `f64`; a file that does not parse
+/// has none here, and its build says where it fails).
+fn has_triangles(path: &Path) -> bool {
+    let Ok(text) = crate::load::read(path) else { return false };
+    let Ok(mut store) = crate::load::object_storage::<f64>(&text) else { return false };
+    let parsed = lattice_rt::scene::parse_with::<f64>(&text, &mut store.objects, &mut store.parts, |_| {});
+    parsed.is_ok_and(|scene| scene.objects().iter().any(|o| o.shape().feature() == Some("triangles")))
 }
 
 /// The command `host-sim uf2 --scene FILE`: `image` (the slot image's UF2 file) with the scene
@@ -258,4 +316,50 @@ pub fn scene_cmd(board: Board, scene: &Path, image: &Path, out: Option<&Path>) -
     crate::output::write_atomic(&out, &bytes)?;
     println!("wrote {}: the slot image with {} in its scene slot ({} bytes); hold BOOTSEL while plugging the Pico in, then copy this file onto the RPI-RP2 drive", out.display(), scene.display(), text.len());
     Ok(())
+}
+
+/// Why the image built by `cargo ARGS` with `scenes` baked was not built: `firmware/build.rs`'s
+/// message (the build is run again to read it, its folder left out of the paths it names), the
+/// linker's when a region overflowed, or the build's failure.
+pub fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
+    let out = firmware_cargo(root).args(args).env("FIRMWARE_SCENES", scenes).output();
+    let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
+    refusal_in(&text, scenes)
+}
+
+/// [`refusal`] read from the build's error output `text`.
+fn refusal_in(text: &str, scenes: &str) -> String {
+    // The build script's refusal is cargo's `error: firmware@VERSION: ...` line (its
+    // `cargo::error`); without one, the linker's complaint about the first region the image
+    // overflowed (cargo may set it after a `= note:`).
+    let message = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("error: firmware@")?.split_once(": ").map(|(_, why)| why.to_string()))
+        .or_else(|| {
+            text.lines().find(|l| l.contains("will not fit in region")).map(|l| {
+                let what = l.split_once("error: ").map_or(l.trim(), |(_, what)| what);
+                format!("the linker: {what}")
+            })
+        });
+    let folder = Path::new(scenes).parent().map(|p| format!("{}/", p.display())).unwrap_or_default();
+    message.map_or_else(|| NOT_BUILT.into(), |m| m.trim_start_matches("FIRMWARE_SCENES: ").replace(&folder, ""))
+}
+#[cfg(test)]
+mod tests {
+    use super::refusal_in;
+
+    #[test]
+    fn a_refusal_gives_the_linker_line_without_its_prefixes() {
+        let text = "error: linking with `flip-link` failed: exit status: 1\n  = note: rust-lld: error: section '.rodata' will not fit in region 'FLASH': overflowed by 2469876 bytes\n          rust-lld: error: section '.gnu.sgstubs' will not fit in region 'FLASH': overflowed by 2469888 bytes\n";
+        assert_eq!(
+            refusal_in(text, "/tmp/out/shells.nff"),
+            "the linker: section '.rodata' will not fit in region 'FLASH': overflowed by 2469876 bytes"
+        );
+    }
+
+    #[test]
+    fn a_refusal_gives_the_build_scripts_message_without_the_scenes_folder() {
+        let text = "   Compiling firmware v0.1.0 (/src/firmware)\nerror: firmware@0.1.0: FIRMWARE_SCENES: /tmp/out/tree.nff:3:1: too big for fixed point\nerror: build script logged errors\n";
+        assert_eq!(refusal_in(text, "/tmp/out/tree.nff"), "tree.nff:3:1: too big for fixed point");
+    }
 }

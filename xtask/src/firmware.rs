@@ -222,36 +222,6 @@ pub(crate) fn build(root: &Path, v: &Variant) -> Result<()> {
     Ok(())
 }
 
-/// Why the image built by `cargo ARGS` with `scenes` baked was not built: `firmware/build.rs`'s
-/// message (the build is run again to read it, its folder left out of the paths it names), the
-/// linker's when a region overflowed, or the build's failure.
-pub(crate) fn refusal(root: &Path, args: &[&str], scenes: &str) -> String {
-    let out = host_sim::uf2::firmware_cargo(root).args(args).env("FIRMWARE_SCENES", scenes).output();
-    let text = out.map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).unwrap_or_default();
-    refusal_in(&text, scenes)
-}
-
-/// [`refusal`] read from the build's error output `text`.
-fn refusal_in(text: &str, scenes: &str) -> String {
-    // The build script's refusal is cargo's `error: firmware@VERSION: ...` line (its
-    // `cargo::error`); without one, the linker's complaint about the first region the image
-    // overflowed (cargo may set it after a `= note:`).
-    let message = text
-        .lines()
-        .find_map(|l| l.trim().strip_prefix("error: firmware@")?.split_once(": ").map(|(_, why)| why.to_string()))
-        .or_else(|| {
-            text.lines().find(|l| l.contains("will not fit in region")).map(|l| {
-                let what = l.split_once("error: ").map_or(l.trim(), |(_, what)| what);
-                format!("the linker: {what}")
-            })
-        });
-    let folder = Path::new(scenes).parent().map(|p| format!("{}/", p.display())).unwrap_or_default();
-    message.map_or_else(
-        || "the image did not build".into(),
-        |m| m.trim_start_matches("FIRMWARE_SCENES: ").replace(&folder, ""),
-    )
-}
-
 /// Flash bytes (every allocated section with contents, `.data` counted at its load address)
 /// and static RAM bytes (`.data`, `.bss`, `.uninit`).
 pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
@@ -1099,24 +1069,4 @@ pub fn float_audit(elf: &Path) -> Result<(Vec<String>, Vec<String>)> {
     setup.sort();
     setup.dedup();
     Ok((reached, setup))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::refusal_in;
-
-    #[test]
-    fn a_refusal_gives_the_linker_line_without_its_prefixes() {
-        let text = "error: linking with `flip-link` failed: exit status: 1\n  = note: rust-lld: error: section '.rodata' will not fit in region 'FLASH': overflowed by 2469876 bytes\n          rust-lld: error: section '.gnu.sgstubs' will not fit in region 'FLASH': overflowed by 2469888 bytes\n";
-        assert_eq!(
-            refusal_in(text, "/tmp/out/shells.nff"),
-            "the linker: section '.rodata' will not fit in region 'FLASH': overflowed by 2469876 bytes"
-        );
-    }
-
-    #[test]
-    fn a_refusal_gives_the_build_scripts_message_without_the_scenes_folder() {
-        let text = "   Compiling firmware v0.1.0 (/src/firmware)\nerror: firmware@0.1.0: FIRMWARE_SCENES: /tmp/out/tree.nff:3:1: too big for fixed point\nerror: build script logged errors\n";
-        assert_eq!(refusal_in(text, "/tmp/out/tree.nff"), "tree.nff:3:1: too big for fixed point");
-    }
 }

@@ -7,10 +7,10 @@
 //! message.
 
 use super::{elf_sizes, m3, reported_frame, run_emulator, save_frame, Session, PICO, PICO_SCALAR};
-use crate::firmware::{host_frame_of, refusal};
+use crate::firmware::host_frame_of;
 use anyhow::{Context, Result};
 use host_sim::spd::Generator;
-use host_sim::uf2::{build_image, kept_image, pico_built, write_uf2, Scenes};
+use host_sim::uf2::{build_image, kept_image, pico_built, refusal, write_uf2, Scenes};
 use std::fmt::Write as _;
 use std::path::Path;
 

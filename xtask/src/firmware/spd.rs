@@ -4,9 +4,10 @@
 //! `-icount shift=0`, its frame checked bit for bit against host-sim's render of the same file.
 //! There is no RP2350 emulator here, so the figures are instructions, not cycles.
 
-use super::{board_frame, build, elf_path, elf_sizes, host_frame_of, refusal, run_qemu, Tally, Variant, M33};
+use super::{board_frame, build, elf_path, elf_sizes, host_frame_of, run_qemu, Tally, Variant, M33};
 use anyhow::{Context, Result};
 use host_sim::spd::Generator;
+use host_sim::uf2::refusal;
 use std::fmt::Write as _;
 use std::path::Path;
 
