@@ -283,8 +283,9 @@ pub struct Board<'a, C: Cores> {
     pub now: &'a (dyn Fn() -> u64 + Sync),
     /// Called with each pass once it is on the display.
     pub shown: &'a mut dyn FnMut(u8),
-    /// Called by core 1 after each eye sample it traces, as core 0's hooks are
-    /// ([`Hooks::sampled`]): a sign that it makes progress, for a watchdog.
+    /// Called after each eye sample of the second share (core 1's, or on one core the share
+    /// it traces second), as core 0's hooks are ([`Hooks::sampled`]): a sign that it makes
+    /// progress, for a watchdog.
     pub alive: &'a (dyn Fn() + Sync),
 }
 
@@ -301,7 +302,7 @@ impl Hooks for Alive<'_> {
 
 /// The render's hooks behind one type, whichever share they serve (core 0's own, or
 /// [`Alive`]), so the tracer's code is built once for both shares, not once per type of hooks
-/// (core 1's own type took 30 KB more of the Pico 2 image's flash). A call through it costs an
+/// (core 1's own type took 27 KB more of the Pico 2 image's flash). A call through it costs an
 /// indirect branch: once a tile, and once an eye sample for [`Hooks::sampled`].
 struct AnyHooks<'h>(&'h mut dyn Hooks);
 
