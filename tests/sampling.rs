@@ -56,3 +56,49 @@ fn contrast_also_refines_shadow_edges() {
     let (_, contrast) = gray(Sampling::Edges { contrast: 16 });
     assert!(contrast > plain, "contrast {contrast} vs object edges {plain}");
 }
+
+/// Counts the render's calls: eye samples and tiles.
+#[derive(Default)]
+struct Calls {
+    sampled: u64,
+    tiles: u32,
+    /// Eye samples before the first tile was done: a tile reports its samples as it traces.
+    before_first_tile: u64,
+}
+impl Hooks for Calls {
+    fn sampled(&mut self) {
+        self.sampled += 1;
+    }
+    fn progress(&mut self, done: u32, _total: u32) -> bool {
+        if self.tiles == 0 {
+            self.before_first_tile = self.sampled;
+        }
+        self.tiles = done;
+        true
+    }
+}
+
+#[test]
+fn every_eye_sample_is_reported_as_it_is_traced() {
+    // `Hooks::sampled` paces a board's watchdog inside tiles that take seconds: it comes once
+    // per eye ray the statistics count, in every sampling mode, and within the tile.
+    let text = scene_text("spheres");
+    let mut storage = vec![Object::<f64>::default(); 16];
+    let mut parts = lattice_rt::Parts::default();
+    let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
+    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
+    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
+    let adaptive = Sampling::Adaptive { contrast: 16, coarse: true };
+    for sampling in [Sampling::Center, Sampling::Grid2x2, Sampling::Edges { contrast: 16 }, adaptive] {
+        let frame = Frame { sampling, ..Frame::new(128, 64) };
+        let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
+        let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
+        let mut scratch = HeapScratch::new(&scene, &frame);
+        let mut calls = Calls::default();
+        let stats =
+            render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut scratch.scratch(), &mut calls).unwrap();
+        assert_eq!(calls.sampled, stats.rays[0], "{sampling:?}: eye samples reported against eye rays traced");
+        assert!(calls.tiles > 1 && calls.before_first_tile > 0, "{sampling:?}: {} tiles", calls.tiles);
+        assert!(calls.before_first_tile < calls.sampled, "{sampling:?}: every sample came in the first tile");
+    }
+}
