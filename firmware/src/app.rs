@@ -283,14 +283,14 @@ pub struct Board<'a, C: Cores> {
     pub now: &'a (dyn Fn() -> u64 + Sync),
     /// Called with each pass once it is on the display.
     pub shown: &'a mut dyn FnMut(u8),
-    /// Called after each eye sample of the second share (core 1's, or on one core the share
-    /// it traces second), as core 0's hooks are ([`Hooks::sampled`]): a sign that it makes
-    /// progress, for a watchdog.
+    /// Called after each eye sample core 1 traces (or, on one core rendering trace then
+    /// dither, the second share's), as core 0's hooks are ([`Hooks::sampled`]): a sign that it
+    /// makes progress, for a watchdog.
     pub alive: &'a (dyn Fn() + Sync),
 }
 
-/// The other share's hooks (core 1's, or the second share's on one core): each eye sample it
-/// traces reported to the board's `alive`.
+/// Core 1's hooks in [`trace_then_dither`]: each eye sample it traces reported to the board's
+/// `alive`.
 struct Alive<'a>(&'a (dyn Fn() + Sync));
 
 impl Hooks for Alive<'_> {
@@ -300,8 +300,8 @@ impl Hooks for Alive<'_> {
     }
 }
 
-/// The render's hooks behind one type, whichever share they serve (core 0's own, or
-/// [`Alive`]), so the tracer's code is built once for both shares, not once per type of hooks
+/// The render's hooks behind one type in [`trace_then_dither`], whichever core they serve
+/// (core 0's own, or [`Alive`]), so the tracer's code is built once for both, not once per type of hooks
 /// (core 1's own type took 27 KB more of the Pico 2 image's flash). A call through it costs an
 /// indirect branch: once a tile, and once an eye sample for [`Hooks::sampled`].
 struct AnyHooks<'h>(&'h mut dyn Hooks);
@@ -542,7 +542,6 @@ fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<C
     let (first, other) = (Share { index: 0, of: SHARES }, Share { index: 1, of: SHARES });
     let tracer = &tracer;
     let Board { cores, second, now, shown, alive } = board;
-    let hooks = &mut AnyHooks(hooks);
     let ShareMemory { mailbox, rows, traced, kept, rays, above, band, carries } = second;
     let [traced_here, traced_there] = traced;
     let mut stats = Stats::default();
@@ -550,8 +549,14 @@ fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<C
     let tiles_at = now();
     if TRACE_THEN_DITHER {
         let memory = DitherMemory { mailbox, rows, kept, rays, above, band, carries };
-        let (s, [there, mine]) =
-            trace_then_dither(tracer, pick(&tuned), cores, memory, (&mut scratch, hooks, now, shown, alive), target)?;
+        let (s, [there, mine]) = trace_then_dither(
+            tracer,
+            pick(&tuned),
+            cores,
+            memory,
+            (&mut scratch, &mut AnyHooks(hooks), now, shown, alive),
+            target,
+        )?;
         return Ok(Report {
             stats: s,
             objects: scene.objects().len(),
@@ -577,7 +582,7 @@ fn render_loaded<'t, R: Real, A: Accelerator<R> + Sync + ?Sized, D: DrawTarget<C
             &mut traced_there[..],
             target,
             &mut scratch,
-            &mut AnyHooks(&mut Alive(alive)),
+            &mut lattice_rt::NoHooks,
         );
         stats.add(&more.map_err(AppError::Render)?);
         (*here_us, *there_us) = (*here_us + t1 - t0, *there_us + now() - t1);
