@@ -290,9 +290,12 @@ const PICO2_CODE_FLASH: usize = 128 * 1024;
 const PICO_OTHER_RAM: usize = 160 * 1024;
 
 /// The flash the board's image has besides its code loaded into SRAM, the flash its other code
-/// takes at most, and its RAM (bytes): the Pico's and the Pico 2's; none for other boards.
+/// takes at most, and its RAM (bytes): the Pico's and the Pico 2's (whose core's image on
+/// QEMU's Cortex-M33 board has the same memory, `qemu-an505/memory.x`, and so the same
+/// budgets); none for other boards.
 fn board_memory() -> Option<(usize, usize, usize)> {
-    match (has("pico"), has("pico2")) {
+    let m33 = env::var("TARGET").is_ok_and(|t| t.starts_with("thumbv8m"));
+    match (has("pico"), has("pico2") || m33) {
         (true, _) => Some((pico_flash_kib() * 1024 - 0x100, PICO_CODE_FLASH, 256 * 1024)),
         (_, true) => Some((4096 * 1024, PICO2_CODE_FLASH, 512 * 1024)),
         _ => None,
