@@ -344,9 +344,10 @@ fn refusal_in(text: &str, scenes: &str) -> String {
     let folder = Path::new(scenes).parent().map(|p| format!("{}/", p.display())).unwrap_or_default();
     message.map_or_else(|| NOT_BUILT.into(), |m| m.trim_start_matches("FIRMWARE_SCENES: ").replace(&folder, ""))
 }
+
 #[cfg(test)]
 mod tests {
-    use super::refusal_in;
+    use super::{has_triangles, refusal_in};
 
     #[test]
     fn a_refusal_gives_the_linker_line_without_its_prefixes() {
@@ -361,5 +362,26 @@ mod tests {
     fn a_refusal_gives_the_build_scripts_message_without_the_scenes_folder() {
         let text = "   Compiling firmware v0.1.0 (/src/firmware)\nerror: firmware@0.1.0: FIRMWARE_SCENES: /tmp/out/tree.nff:3:1: too big for fixed point\nerror: build script logged errors\n";
         assert_eq!(refusal_in(text, "/tmp/out/tree.nff"), "tree.nff:3:1: too big for fixed point");
+    }
+
+    #[test]
+    fn a_scene_needs_the_triangle_test_only_when_it_has_triangles() {
+        // `uf2 --bake` adds the firmware's `triangles` for NFF's polygons, not for spheres, and
+        // leaves a file that does not parse to the build, which says where it fails.
+        let dir = std::env::temp_dir().join(format!("uf2-triangles-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let head = "v\nfrom 0 -5 2\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.1\nresolution 64 64\nl 5 -5 5\nf 1 1 1 0.8 0 0 0 1\n";
+        let files = [
+            ("spheres.nff", format!("{head}s 0 0 0 1\n"), false),
+            ("floor.nff", format!("{head}s 0 0 0 1\np 3\n-4 -4 -1\n4 -4 -1\n0 4 -1\n"), true),
+            ("broken.nff", format!("{head}p 3\n-4 -4\n"), false),
+        ];
+        for (name, text, want) in files {
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            assert_eq!(has_triangles(&path), want, "{name}");
+        }
+        assert!(!has_triangles(&dir.join("missing.nff")));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
