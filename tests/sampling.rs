@@ -18,7 +18,8 @@ impl Hooks for Gray {
     }
 }
 
-fn gray(sampling: Sampling) -> (Vec<u8>, u64) {
+/// The spheres scene rendered at 128x64 with `sampling`, `hooks` called: the render's statistics.
+fn render_spheres(sampling: Sampling, hooks: &mut impl Hooks) -> lattice_rt::Stats {
     let text = scene_text("spheres");
     let mut storage = vec![Object::<f64>::default(); 16];
     let mut parts = lattice_rt::Parts::default();
@@ -29,8 +30,12 @@ fn gray(sampling: Sampling) -> (Vec<u8>, u64) {
     let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
     let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
     let mut scratch = HeapScratch::new(&scene, &frame);
+    render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut scratch.scratch(), hooks).unwrap()
+}
+
+fn gray(sampling: Sampling) -> (Vec<u8>, u64) {
     let mut hooks = Gray(vec![0; 128 * 64], 128);
-    let stats = render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut scratch.scratch(), &mut hooks).unwrap();
+    let stats = render_spheres(sampling, &mut hooks);
     (hooks.0, stats.rays[0])
 }
 
@@ -82,21 +87,10 @@ impl Hooks for Calls {
 fn every_eye_sample_is_reported_as_it_is_traced() {
     // `Hooks::sampled` paces a board's watchdog inside tiles that take seconds: it comes once
     // per eye ray the statistics count, in every sampling mode, and within the tile.
-    let text = scene_text("spheres");
-    let mut storage = vec![Object::<f64>::default(); 16];
-    let mut parts = lattice_rt::Parts::default();
-    let scene = parse::<f64>(&text, &mut storage, &mut parts).unwrap();
-    let mut bufs = lattice_storage(&scene, &LatticeConfig::default());
-    let lat = build_lattice(&scene, &LatticeConfig::default(), &mut bufs);
     let adaptive = Sampling::Adaptive { contrast: 16, coarse: true };
     for sampling in [Sampling::Center, Sampling::Grid2x2, Sampling::Edges { contrast: 16 }, adaptive] {
-        let frame = Frame { sampling, ..Frame::new(128, 64) };
-        let mut bits = vec![0u8; BitFrame::bytes(128, 64)];
-        let mut target = BitFrame::new(128, 64, &mut bits).unwrap();
-        let mut scratch = HeapScratch::new(&scene, &frame);
         let mut calls = Calls::default();
-        let stats =
-            render(&Tracer::new(&scene, &lat), &frame, &mut target, &mut scratch.scratch(), &mut calls).unwrap();
+        let stats = render_spheres(sampling, &mut calls);
         assert_eq!(calls.sampled, stats.rays[0], "{sampling:?}: eye samples reported against eye rays traced");
         assert!(calls.tiles > 1 && calls.before_first_tile > 0, "{sampling:?}: {} tiles", calls.tiles);
         assert!(calls.before_first_tile < calls.sampled, "{sampling:?}: every sample came in the first tile");
