@@ -84,18 +84,23 @@ pub fn build_board(root: &Path, board: Board, features: Option<&str>) -> Result<
 
 /// [`build_board`] with `scenes` embedded.
 pub fn build_board_with(root: &Path, board: Board, features: Option<&str>, scenes: Scenes) -> Result<PathBuf> {
-    let alias = format!("{}-build", board.name());
-    let mut args = vec![alias.as_str()];
-    let name = match features {
-        Some(f) => {
-            args.extend(["--features", f]);
-            format!("{}-{}", board.name(), f.replace(',', "-"))
-        }
-        None => board.name().to_string(),
-    };
+    let owned = board_args(board, features);
+    let args: Vec<&str> = owned.iter().map(String::as_str).collect();
+    let name =
+        features.map_or_else(|| board.name().to_string(), |f| format!("{}-{}", board.name(), f.replace(',', "-")));
     eprintln!("building the {} image (cargo {})", board.name(), args.join(" "));
     build_image(root, &name, &args, (scenes, &[]), &board.built())
-        .with_context(|| format!("`cargo {alias}` failed (its own message is above; it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", board.target()))
+        .with_context(|| format!("`cargo {}` failed (its own message is above; it links with flip-link: `cargo install flip-link`; the target: `rustup target add {}`)", args[0], board.target()))
+}
+
+/// The cargo arguments that build `board`'s image with `features`: its alias
+/// (`pico-build`, `pico2-build`), then `--features` if any.
+fn board_args(board: Board, features: Option<&str>) -> Vec<String> {
+    let mut args = vec![format!("{}-build", board.name())];
+    if let Some(f) = features {
+        args.extend(["--features".to_string(), f.to_string()]);
+    }
+    args
 }
 
 /// The scenes an image embeds (the firmware's build script reads `FIRMWARE_SCENES`).
@@ -270,12 +275,8 @@ fn build_baked(root: &Path, board: Board, features: Option<&str>, files: &[PathB
             Ok(elf) => return Ok(elf),
             Err(e) => e,
         };
-        let alias = format!("{}-build", board.name());
-        let mut args = vec![alias.as_str()];
-        if let Some(f) = chosen {
-            args.extend(["--features", f]);
-        }
-        let why = refusal(root, &args, list);
+        let args = board_args(board, chosen);
+        let why = refusal(root, &args.iter().map(String::as_str).collect::<Vec<_>>(), list);
         if why == NOT_BUILT {
             return Err(failed);
         }
