@@ -188,8 +188,9 @@ impl<R: Real> Aabb<R> {
     /// onto the ray's origin, given as `(o + pad, o - pad)`: the crossings of the sides are
     /// taken as `(min - (o + pad)) / d` and `(max - (o - pad)) / d`, from origins a caller makes
     /// once per ray, not as `((min - pad) - o) / d` from a box grown at every test. The same
-    /// value in fixed point (its sums are exact); in floats within a rounding of it.
-    #[inline]
+    /// value in fixed point (its sums are exact); in floats within a rounding of it. Always
+    /// inlined: a walk's box test is this, in its loop.
+    #[inline(always)]
     pub fn clip_grown_by_inverse(&self, (near, far): (Vec3<R>, Vec3<R>), inv: Vec3<R>, t0: R, t1: R) -> Option<(R, R)> {
         let i = inv;
         let (t0, t1) = slab_by((near.x, far.x), i.x, self.min.x, self.max.x, t0, t1)?;

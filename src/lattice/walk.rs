@@ -4,7 +4,7 @@
 use super::{index, locate, Lattice, MAX_NESTING};
 use crate::accel::{offer, reach, slack, Hit, Query};
 use crate::bounds::at;
-use crate::math::{Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3};
 use crate::scalar::Real;
 use crate::scene::Scene;
 
@@ -13,7 +13,7 @@ impl<R: Real> Lattice<'_, R> {
     /// ray enters, in order, without testing objects (for tests and statistics).
     pub fn walk_cells(&self, ray: &Ray<R>, tmin: R, tmax: R, mut visit: impl FnMut([usize; 3], R, R)) {
         let inv = Inverse::new(ray, false, R::ZERO);
-        let Some((t0, t1)) = self.lattices[0].bounds.padded(slack(ray)).clip(ray, tmin, tmax) else { return };
+        let Some((t0, t1)) = inv.clip(&self.lattices[0].bounds.padded(slack(ray)), tmin, tmax) else { return };
         let mut slot = None;
         let w = Walker::start_in(&mut slot, self, 0, ray, &inv, t0, t1);
         let mut enter = t0;
@@ -37,10 +37,10 @@ impl<R: Real> Lattice<'_, R> {
         q: &mut Query<'_>,
     ) -> Option<Hit<R>> {
         let slack = slack(ray);
-        let (t0, t1) = self.lattices[0].bounds.padded(slack).clip(ray, tmin, tmax)?;
-        q.next_ray();
         // A window culls an object before its test for less than the box test costs.
         let inv = Inverse::new(ray, q.filter.tests_boxes() && !q.filter.by_windows(), slack);
+        let (t0, t1) = inv.clip(&self.lattices[0].bounds.padded(slack), tmin, tmax)?;
+        q.next_ray();
         let mut best: Option<Hit<R>> = None;
         let mut stack: [Option<Walker<R>>; MAX_NESTING] = [None; MAX_NESTING];
         let mut depth = 1;
@@ -65,7 +65,7 @@ impl<R: Real> Lattice<'_, R> {
                         let g = composite + 1;
                         let limit = reach(&best, tmax);
                         if depth < MAX_NESTING && q.first_visit(self.objects + composite) {
-                            if let Some((a, b)) = self.lattices[g].bounds.padded(slack).clip(ray, tmin, limit) {
+                            if let Some((a, b)) = inv.clip(&self.lattices[g].bounds.padded(slack), tmin, limit) {
                                 Walker::start_in(&mut stack[depth], self, g, ray, &inv, a, b);
                                 depth += 1;
                                 q.stats.cells_visited += 1;
@@ -98,7 +98,7 @@ struct Inverse<R> {
     origin: [R; 3],
     factor: [R; 3],
     /// `1 / d` per axis (zero where the ray does not move along it): what [`Inverse::may_meet`]
-    /// multiplies by, in every scalar.
+    /// and [`Inverse::clip`] multiply by, in every scalar.
     inv: Vec3<R>,
     /// Whether [`Inverse::may_meet`] tests boxes for this ray ([`Filter::box_tests`], and not
     /// through windows; in fixed point only while no direction component reaches 64, so the
@@ -115,7 +115,7 @@ impl<R: Real> Inverse<R> {
     fn new(ray: &Ray<R>, boxes: bool, slack: R) -> Self {
         let d = [ray.dir.x, ray.dir.y, ray.dir.z];
         let boxes = boxes && (R::WALK_BY_RECIPROCAL || ray.dir.max_abs() < R::from_i32(64));
-        let inv = d.map(|v| if (boxes || R::WALK_BY_RECIPROCAL) && v != R::ZERO { v.recip() } else { R::ZERO });
+        let inv = d.map(|v| if v != R::ZERO { v.recip() } else { R::ZERO });
         Inverse {
             moves: d.map(|v| v != R::ZERO),
             origin: [ray.origin.x, ray.origin.y, ray.origin.z],
@@ -144,6 +144,16 @@ impl<R: Real> Inverse<R> {
         }
         q.stats.inside_tests += 1;
         at(scene.objects, i).bounds.clip_grown_by_inverse(self.grown, self.inv, tmin, limit).is_some()
+    }
+
+    /// [`Aabb::clip`] of the ray by `b` on `[t0, t1]`, the same range, from the reciprocals
+    /// taken once per ray: a lattice's box (the world's at the start, a sub-lattice's at each
+    /// entry) costs no division. Out of line, as [`Aabb::clip`] is: the box test stays the one
+    /// slab test inlined into the walk.
+    #[inline(never)]
+    fn clip(&self, b: &Aabb<R>, t0: R, t1: R) -> Option<(R, R)> {
+        let o = Vec3::new(self.origin[0], self.origin[1], self.origin[2]);
+        b.clip_by_inverse(o, self.inv, t0, t1)
     }
 
     /// The ray parameter where the ray crosses `plane` on axis `a` (which it moves along).
