@@ -124,8 +124,9 @@ impl Div for Fx {
     type Output = Fx;
     /// `(a << 16) / b` rounded half away from zero; saturates, and `x / 0` is the largest value
     /// of the sign of `x`. A Cortex-M0+ has no divide instruction, and a 64-bit division is
-    /// several times dearer than a 32-bit one, so a divisor below 128 (nearly every one the
-    /// tracer uses) is done as long division in base 256 with three 32-bit steps.
+    /// several times dearer than a 32-bit one, so a divisor of at most 1 (a unit direction's
+    /// component) is done as long division in base 2^16 with two 32-bit steps, and one below 128
+    /// (nearly every other one the tracer uses) in base 256 with three.
     #[inline]
     fn div(self, o: Fx) -> Fx {
         if o.0 == 0 {
@@ -145,6 +146,22 @@ impl Div for Fx {
                 q + 1
             } else {
                 q
+            }
+        } else if !cfg!(feature = "compact") && b <= 1 << FRAC {
+            // A divisor of at most 1 (a unit direction's component, the walk's every crossing):
+            // the remainder stays below 2^16, so the long division is in base 2^16, two steps
+            // (not built for size: the next path gives the same quotient).
+            let (q0, r) = (a / b, a % b);
+            if q0 >= 1 << 15 {
+                i32::MAX as u32
+            } else {
+                let (q1, r) = ((r << FRAC) / b, (r << FRAC) % b);
+                let q = (q0 << FRAC) | q1;
+                if r >= b - r {
+                    q + 1
+                } else {
+                    q
+                }
             }
         } else if b < 1 << 23 {
             let (q0, r) = (a / b, a % b);
@@ -622,13 +639,27 @@ mod tests {
             if b == 0 {
                 continue;
             }
-            let (n, d) = ((a as i64).abs() << 16, (b as i64).abs());
-            // Half away from zero (magnitudes here, the sign comes after).
-            let q = if (n % d) * 2 >= d { n / d + 1 } else { n / d };
-            let q = q.min(i32::MAX as i64);
-            let want = if (a < 0) != (b < 0) { -q } else { q } as i32;
-            assert_eq!((Fx(a) / Fx(b)).0, want, "{a} / {b}");
+            assert_eq!((Fx(a) / Fx(b)).0, wide_quotient(a, b), "{a} / {b}");
         }
+        // Each path's edges: divisors at and around 1 (the base 2^16 steps' last) and 2^23,
+        // quotients at and just below saturation.
+        for b in [1, 2, 65_535, 65_536, 65_537, (1 << 23) - 1, 1 << 23, i32::MAX] {
+            for a in [1, 65_535, 65_536, 65_537, b / 2, b, (b >> 1) << 15, ((b >> 1) << 15) + 1, i32::MAX] {
+                for (a, b) in [(a, b), (-a, b), (a, -b)] {
+                    assert_eq!((Fx(a) / Fx(b)).0, wide_quotient(a, b), "{a} / {b}");
+                }
+            }
+        }
+    }
+
+    /// `(a << 16) / b` in 64 bits, rounded half away from zero and saturated: what `Fx`'s
+    /// division must give.
+    fn wide_quotient(a: i32, b: i32) -> i32 {
+        let (n, d) = ((a as i64).abs() << 16, (b as i64).abs());
+        // Half away from zero (magnitudes here, the sign comes after).
+        let q = if (n % d) * 2 >= d { n / d + 1 } else { n / d };
+        let q = q.min(i32::MAX as i64);
+        (if (a < 0) != (b < 0) { -q } else { q }) as i32
     }
 
     #[test]
