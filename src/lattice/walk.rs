@@ -46,9 +46,11 @@ impl<R: Real> Lattice<'_, R> {
         let mut depth = 1;
         Walker::start_in(&mut stack[0], self, 0, ray, &inv, t0, t1);
         q.stats.cells_visited += 1;
-        while depth > 0 {
+        'walk: while depth > 0 {
             let Some(w) = stack[depth - 1].as_mut() else { break };
-            if w.ref_i < w.ref_end {
+            // The cell's references, with the walker fixed for the loop (its place in the stack
+            // is not looked up again per reference).
+            while w.ref_i < w.ref_end {
                 let item = index::decode(index::get(self.refs, self.narrow, w.ref_i as usize), self.narrow);
                 w.ref_i += 1;
                 match item {
@@ -69,11 +71,11 @@ impl<R: Real> Lattice<'_, R> {
                                 Walker::start_in(&mut stack[depth], self, g, ray, &inv, a, b);
                                 depth += 1;
                                 q.stats.cells_visited += 1;
+                                continue 'walk;
                             }
                         }
                     }
                 }
-                continue;
             }
             // The cell is done: stop if the best hit's tie window ends before its exit, else step.
             let done = best.is_some() && reach(&best, tmax) < w.exit();
