@@ -152,10 +152,27 @@ impl<R: Real> Inverse<R> {
     /// taken once per ray: a lattice's box (the world's at the start, a sub-lattice's at each
     /// entry) costs no division. Out of line, as [`Aabb::clip`] is: the box test stays the one
     /// slab test inlined into the walk.
+    ///
+    /// From strictly inside the box (every ray a scene's tracer casts starts inside the world's,
+    /// and a secondary ray inside the sub-lattice of its point) on a range from zero on, every
+    /// side behind the origin is crossed at or before zero, so only the three ahead cut the
+    /// range: three products instead of six, and the same range.
     #[inline(never)]
     fn clip(&self, b: &Aabb<R>, t0: R, t1: R) -> Option<(R, R)> {
         let o = Vec3::new(self.origin[0], self.origin[1], self.origin[2]);
-        b.clip_by_inverse(o, self.inv, t0, t1)
+        let inside = (0..3).all(|a| b.min.axis(a) < o.axis(a) && o.axis(a) < b.max.axis(a));
+        if !(inside && t0 >= R::ZERO) {
+            return b.clip_by_inverse(o, self.inv, t0, t1);
+        }
+        let mut t1 = t1;
+        for a in 0..3 {
+            let inv = self.inv.axis(a);
+            let ahead = if inv > R::ZERO { b.max.axis(a) } else { b.min.axis(a) };
+            if inv != R::ZERO {
+                t1 = t1.min((ahead - o.axis(a)) * inv);
+            }
+        }
+        (t0 <= t1).then_some((t0, t1))
     }
 
     /// The ray parameter where the ray crosses `plane` on axis `a` (which it moves along).
@@ -272,5 +289,63 @@ impl<R: Real> Walker<R> {
         self.t_next[a] = inv.crossing(a, l.coords[(self.plane_at[a] + i) as usize]);
         self.load_cell(l);
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Inverse;
+    use crate::fixed::Fx;
+    use crate::generate::Rng;
+    use crate::math::{Aabb, Ray, Vec3};
+    use crate::scalar::Real;
+
+    /// A random point near a box of corners -2 and 3 on every axis: inside, outside, or on a
+    /// side or a corner.
+    fn point<R: Real>(rng: &mut Rng) -> Vec3<R> {
+        let c = |rng: &mut Rng| match rng.below(5) {
+            0 => R::from_i32(-2),
+            1 => R::from_i32(3),
+            2 => R::from_f64(rng.range(-4.0, 5.0)),
+            _ => R::from_f64(rng.range(-1.9, 2.9)),
+        };
+        Vec3::new(c(rng), c(rng), c(rng))
+    }
+
+    /// A random direction, some components zero or tiny.
+    fn direction<R: Real>(rng: &mut Rng) -> Vec3<R> {
+        let c = |rng: &mut Rng| match rng.below(6) {
+            0 => R::ZERO,
+            1 => R::from_f64(rng.range(-1e-4, 1e-4)),
+            _ => R::from_f64(rng.range(-1.0, 1.0)),
+        };
+        Vec3::new(c(rng), c(rng), c(rng))
+    }
+
+    fn clips_as_the_box_does<R: Real>() {
+        let b = Aabb {
+            min: Vec3::new(R::from_i32(-2), R::from_i32(-2), R::from_i32(-2)),
+            max: Vec3::new(R::from_i32(3), R::from_i32(3), R::from_i32(3)),
+        };
+        let mut rng = Rng::new(7);
+        let mut inside = 0;
+        for _ in 0..100_000 {
+            let ray = Ray::new(point(&mut rng), direction(&mut rng));
+            let t0 = if rng.below(2) == 0 { R::ZERO } else { R::from_f64(rng.range(-1.0, 2.0)) };
+            let t1 = if rng.below(2) == 0 { R::MAX } else { R::from_f64(rng.range(0.0, 9.0)) };
+            let want = b.clip(&ray, t0, t1);
+            assert_eq!(Inverse::new(&ray, false, R::ZERO).clip(&b, t0, t1), want, "{ray:?} on [{t0:?}, {t1:?}]");
+            inside +=
+                usize::from((0..3).all(|a| b.min.axis(a) < ray.origin.axis(a) && ray.origin.axis(a) < b.max.axis(a)));
+        }
+        // Both of the clip's ways were taken.
+        assert!(inside > 5_000 && inside < 95_000, "{inside} rays from inside");
+    }
+
+    #[test]
+    fn a_walk_clips_a_lattice_box_as_the_box_clips_the_ray() {
+        clips_as_the_box_does::<f64>();
+        clips_as_the_box_does::<f32>();
+        clips_as_the_box_does::<Fx>();
     }
 }
