@@ -677,3 +677,27 @@ impl<'a, R: Real> Scene<'a, R> {
         self.smooth.get(k)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Object;
+    use crate::fixed::Fx;
+    use core::mem::{align_of, offset_of, size_of};
+
+    /// What a baked table of objects in flash relies on (8-byte XIP cache lines): every record
+    /// starts on a line and its bounds, what a walk's box test reads, do too. In fixed point and
+    /// f32, the boards' scalars, the record is 240 bytes (216 without the eye and light in object
+    /// space), the bounds at 104.
+    #[test]
+    fn an_objects_bounds_start_on_a_flash_line() {
+        fn check<R>() {
+            let lean = cfg!(feature = "lean-objects");
+            assert_eq!(align_of::<Object<R>>(), 8);
+            assert_eq!(size_of::<Object<R>>(), if lean { 216 } else { 240 });
+            assert_eq!(offset_of!(Object<R>, bounds), 104);
+        }
+        check::<Fx>();
+        check::<f32>();
+        assert_eq!(offset_of!(Object<f64>, bounds) % 8, 0);
+    }
+}
