@@ -419,6 +419,18 @@ fn table_name(scene: &str) -> String {
     }
 }
 
+/// The lattice a scene is planned with, within `budget` bytes (none: as configured): on the
+/// Pico and the Pico 2, whose baked lattices are read from flash, at
+/// [`board_records::BAKED_DENSITY`] cells per object; elsewhere the core's default.
+fn lattice_config(budget: Option<usize>) -> LatticeConfig {
+    let mut cfg = LatticeConfig { budget, ..LatticeConfig::default() };
+    if bakes() && board_memory().is_some() {
+        let fine = lattice_rt::lattice::Resolution::Auto { density: board_records::BAKED_DENSITY };
+        (cfg.top, cfg.sub) = (fine, fine);
+    }
+    cfg
+}
+
 /// [`plan`] in the scalar the firmware's features choose.
 fn plan_in_scalar(path: &std::path::Path, text: &str, bake: Option<Bake<'_>>) -> (Sizes, u8, bool) {
     if has("scalar-fixed") {
@@ -456,7 +468,7 @@ fn plan<R: Real + Literal>(path: &std::path::Path, text: &str, bake: Option<Bake
         }
     }
     let effects = lattice_rt::Effects::of(&scene).bits();
-    let cfg = LatticeConfig { budget: bake.as_ref().and_then(|b| b.budget), ..LatticeConfig::default() };
+    let cfg = lattice_config(bake.as_ref().and_then(|b| b.budget));
     let sizes = Sizes::of(&scene, Some(&cfg), &frame);
     if let Some(Bake { name, with_lattice, out, footprints, .. }) = bake {
         let s = Lattice::plan(&scene, &cfg);

@@ -238,13 +238,16 @@ mod writer {
     }
     /// An object with its eye and first light in its own space, as the scene's set-up computes
     /// them ([`Object::local_eye_and_light`]): written whole whether or not this build keeps
-    /// them (`lean-objects`), so the tables are the same for every build that includes them.
+    /// them (`lean-objects`), so the tables are the same for every build that includes them
+    /// (but for the shadow window, which a core with `lean-objects` never made: it writes the
+    /// whole plane, which such an image does not keep either).
     struct Whole<'a, R>(&'a Object<R>, Vec3<R>, Vec3<R>);
 
-    impl<R: Literal> Literal for Whole<'_, R> {
+    impl<R: Real + Literal> Literal for Whole<'_, R> {
         fn literal(&self, out: &mut String) {
             let Whole(o, eye_local, light_local) = self;
             out.push_str("Object::from_tables(");
+            let shadow_window = o.region.shadow_window();
             let parts: [&dyn Literal; 16] = [
                 &o.shape,
                 &o.to_object,
@@ -261,7 +264,7 @@ mod writer {
                 light_local,
                 o.region.eye_window(),
                 o.region.eye_hull(),
-                o.region.shadow_window(),
+                &shadow_window,
             ];
             for (i, p) in parts.iter().enumerate() {
                 if i > 0 {

@@ -254,7 +254,7 @@ const NOT_BUILT: &str = "the image did not build";
 /// `board`'s image with the scene files `files` (`list`, comma-separated) baked, built with
 /// what they need beyond `features`: the firmware's `triangles` when a scene has triangles (the
 /// SPD's polygons), and, on the Pico, built again with `lean-objects` (records without the eye
-/// and light in object space) when the scenes' tables do not fit its flash whole, as `cargo
+/// and light in object space and the shadow window) when the scenes' tables do not fit its flash whole, as `cargo
 /// xtask board` builds the SPD's largest scenes. A refusal is the build script's own message.
 fn build_baked(root: &Path, board: Board, features: Option<&str>, files: &[PathBuf], list: &str) -> Result<PathBuf> {
     let mut wanted: Vec<String> =
@@ -281,7 +281,7 @@ fn build_baked(root: &Path, board: Board, features: Option<&str>, files: &[PathB
             return Err(failed);
         }
         if why.contains("of flash") && board == Board::Pico && !lean {
-            eprintln!("the scenes' tables do not fit whole: building again with the firmware's `lean-objects` (24 bytes less per object)");
+            eprintln!("the scenes' tables do not fit whole: building again with the firmware's `lean-objects` (40 bytes less per object)");
             lean = true;
             continue;
         }

@@ -89,15 +89,19 @@ impl Regions {
     /// The region of object `o`, placed and bounded.
     pub(crate) fn of<R: Real>(&self, o: &Object<R>) -> Region<R> {
         let p = self.projection.as_ref();
-        Region {
-            eye_window: p.map_or(WHOLE_PLANE, |p| eye_window(&o.bounds, p)),
-            // The padding the object's world box got (`Aabb::pad_for`), on its own box.
+        Region::from_tables(
+            p.map_or(WHOLE_PLANE, |p| eye_window(&o.bounds, p)),
+            // The padding the object's world box got (`Aabb::pad_for`), on its own box (not
+            // kept without the `eye-hulls` feature).
             #[cfg(feature = "eye-hulls")]
-            eye_hull: p.map_or(super::NO_HULL, |p| super::hull::eye_hull(o, p, o.bounds.pad_for::<R>())),
-            shadow_window: match self.shadow_basis {
+            p.map_or(super::NO_HULL, |p| super::hull::eye_hull(o, p, o.bounds.pad_for::<R>())),
+            #[cfg(not(feature = "eye-hulls"))]
+            super::NO_HULL,
+            // Not kept with `lean-objects`.
+            match self.shadow_basis {
                 Some((a, b)) => shadow_window(&o.bounds, a, b, self.margin),
                 None => shadow_whole_plane(),
             },
-        }
+        )
     }
 }

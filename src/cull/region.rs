@@ -104,7 +104,9 @@ pub fn hull_meets(hull: &EyeHull, u: [i32; 2], v: [i32; 2]) -> bool {
 
 /// An object's regions, one per kind of ray that culling tests: it can be hit only by an eye
 /// ray through its eye window (and, with the `eye-hulls` feature, its eye hull), and only by a
-/// shadow ray towards a directional first light through its shadow window.
+/// shadow ray towards a directional first light through its shadow window (not kept with
+/// `lean-objects`, whose records leave out what serves only the eye's and a directional first
+/// light's rays: such a shadow ray then takes the exact test, with the same answer).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Region<R> {
     /// The part of the image the object can appear in, as an [`EyeWindow`].
@@ -113,20 +115,30 @@ pub struct Region<R> {
     #[cfg(feature = "eye-hulls")]
     pub(crate) eye_hull: EyeHull,
     /// Where a shadow ray towards the scene's first light can meet it, as a [`ShadowWindow`].
+    #[cfg(not(feature = "lean-objects"))]
     pub(crate) shadow_window: ShadowWindow<R>,
+    /// Without the shadow window, the scalar the region is in.
+    #[cfg(feature = "lean-objects")]
+    pub(crate) scalar: core::marker::PhantomData<R>,
 }
 
 impl<R> Region<R> {
     /// A region from its parts, as [`bake::source`](crate::bake) writes them (a build without
-    /// the `eye-hulls` feature drops the hull).
+    /// the `eye-hulls` feature drops the hull, one with `lean-objects` the shadow window).
     pub const fn from_tables(eye_window: EyeWindow, eye_hull: EyeHull, shadow_window: ShadowWindow<R>) -> Self {
         #[cfg(not(feature = "eye-hulls"))]
         let _ = eye_hull;
+        // Not kept (a const fn cannot drop a generic value: it forgets it).
+        #[cfg(feature = "lean-objects")]
+        core::mem::forget(shadow_window);
         Region {
             eye_window,
             #[cfg(feature = "eye-hulls")]
             eye_hull,
+            #[cfg(not(feature = "lean-objects"))]
             shadow_window,
+            #[cfg(feature = "lean-objects")]
+            scalar: core::marker::PhantomData,
         }
     }
     /// The eye window.
@@ -139,10 +151,6 @@ impl<R> Region<R> {
         return &self.eye_hull;
         #[cfg(not(feature = "eye-hulls"))]
         return &NO_HULL;
-    }
-    /// The shadow window.
-    pub fn shadow_window(&self) -> &ShadowWindow<R> {
-        &self.shadow_window
     }
     /// Whether the eye window meets the window rectangle `u` x `v` (2^-16 units, inclusive
     /// bounds, see [`EyeWindow`]).
@@ -167,11 +175,26 @@ impl<R: Real> Region<R> {
     pub fn everywhere() -> Self {
         Region::from_tables(WHOLE_PLANE, NO_HULL, shadow_whole_plane())
     }
+    /// The shadow window ([`shadow_whole_plane`] with `lean-objects`, which keeps none).
+    pub fn shadow_window(&self) -> ShadowWindow<R> {
+        #[cfg(not(feature = "lean-objects"))]
+        return self.shadow_window;
+        #[cfg(feature = "lean-objects")]
+        return shadow_whole_plane();
+    }
     /// Whether a shadow ray towards the first light at position `w` across the light can meet
-    /// the object: `w` lies in its shadow window.
+    /// the object: `w` lies in its shadow window (always, with `lean-objects`).
     #[inline]
     pub fn shadow_holds(&self, w: [R; 2]) -> bool {
-        let sw = &self.shadow_window;
-        w[0] >= sw[0] && w[0] <= sw[1] && w[1] >= sw[2] && w[1] <= sw[3]
+        #[cfg(not(feature = "lean-objects"))]
+        {
+            let sw = &self.shadow_window;
+            w[0] >= sw[0] && w[0] <= sw[1] && w[1] >= sw[2] && w[1] <= sw[3]
+        }
+        #[cfg(feature = "lean-objects")]
+        {
+            let _ = w;
+            true
+        }
     }
 }

@@ -2,7 +2,7 @@
 //! baked into its own Pico image (`FIRMWARE_SCENES` takes the file's path; objects, lattice and
 //! windows in flash, read through the XIP cache), run on the emulated board and checked bit for
 //! bit against host-sim's frame of the same file. A scene whose tables do not fit the image is
-//! built again with the firmware's `lean-objects` (24 bytes less per object); one that fits
+//! built again with the firmware's `lean-objects` (40 bytes less per object); one that fits
 //! neither way is refused by `firmware/build.rs` with the figures, and the report gives its
 //! message.
 
@@ -153,8 +153,10 @@ impl Session<'_> {
 /// Bytes of an object's record in a Pico image's flash.
 const WHOLE_RECORD: u64 = std::mem::size_of::<lattice_rt::scene::Object<lattice_rt::Fx>>() as u64;
 /// The same with the firmware's `lean-objects`: without the eye and first light in the
-/// object's space.
-const LEAN_RECORD: u64 = WHOLE_RECORD - 2 * std::mem::size_of::<lattice_rt::Vec3<lattice_rt::Fx>>() as u64;
+/// object's space and the shadow window.
+const LEAN_RECORD: u64 = WHOLE_RECORD
+    - 2 * std::mem::size_of::<lattice_rt::Vec3<lattice_rt::Fx>>() as u64
+    - std::mem::size_of::<lattice_rt::scene::ShadowWindow<lattice_rt::Fx>>() as u64;
 
 /// The plot of the sphereflake's images (`balls` at each size run): flash and static RAM (KiB),
 /// cycles per frame (millions) and XIP misses per ray against its objects, written as [`PLOT`]
@@ -208,9 +210,10 @@ fn record_parts() -> String {
     let named: usize = parts.iter().map(|p| p.1).sum();
     let each: Vec<String> = parts.iter().map(|(n, b)| format!("{n} {b}")).collect();
     format!(
-        "Each object, whatever its shape, is one record of {total} bytes in flash: {}, and {} for its shape, scales, material and composite. A scene whose tables do not fit so is built again with the firmware's `lean-objects` (*lean* in the table): records of {LEAN_RECORD} bytes without the eye and light in object space, which an eye ray's or first-light shadow ray's test then transforms again, with the same answers. Where the objects fit and their lattice does not, `firmware/build.rs` fits the lattice to the flash they leave (the core's lattice budget: the lattice of least estimated cost within it) and *lattice bytes* is the fitted lattice's",
+        "Each object, whatever its shape, is one record of {total} bytes in flash: {}, and {} for its shape, scales, material and composite. A scene whose tables do not fit so is built again with the firmware's `lean-objects` (*lean* in the table): records of {LEAN_RECORD} bytes without the eye and light in object space, which an eye ray's or first-light shadow ray's test then transforms again, and without the shadow window, which culls only shadow rays towards a directional first light (the SPD's lights are points): the same answers. A baked lattice is planned finer than host-sim's default, at {} cells per object (`firmware/build.rs`); where the objects fit and that lattice does not, `firmware/build.rs` fits the lattice to the flash they leave (the core's lattice budget: the lattice of least estimated cost within it) and *lattice bytes* is the fitted lattice's",
         each.join(", "),
-        total - named
+        total - named,
+        board_records::BAKED_DENSITY,
     )
 }
 
