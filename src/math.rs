@@ -145,6 +145,11 @@ impl<R: Real> Aabb<R> {
             )
         })
     }
+    /// Whether `p` lies strictly inside the box: off its sides on every axis.
+    #[inline]
+    pub fn strictly_holds(&self, p: Vec3<R>) -> bool {
+        (0..3).all(|a| self.min.axis(a) < p.axis(a) && p.axis(a) < self.max.axis(a))
+    }
     /// The empty box (min above max), the identity of [`Aabb::union`].
     pub fn empty() -> Self {
         Aabb { min: Vec3::new(R::MAX, R::MAX, R::MAX), max: Vec3::new(-R::MAX, -R::MAX, -R::MAX) }

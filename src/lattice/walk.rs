@@ -160,7 +160,7 @@ impl<R: Real> Inverse<R> {
     #[inline(never)]
     fn clip(&self, b: &Aabb<R>, t0: R, t1: R) -> Option<(R, R)> {
         let o = Vec3::new(self.origin[0], self.origin[1], self.origin[2]);
-        let inside = (0..3).all(|a| b.min.axis(a) < o.axis(a) && o.axis(a) < b.max.axis(a));
+        let inside = b.strictly_holds(o);
         if !(inside && t0 >= R::ZERO) {
             return b.clip_by_inverse(o, self.inv, t0, t1);
         }
@@ -335,8 +335,7 @@ mod tests {
             let t1 = if rng.below(2) == 0 { R::MAX } else { R::from_f64(rng.range(0.0, 9.0)) };
             let want = b.clip(&ray, t0, t1);
             assert_eq!(Inverse::new(&ray, false, R::ZERO).clip(&b, t0, t1), want, "{ray:?} on [{t0:?}, {t1:?}]");
-            inside +=
-                usize::from((0..3).all(|a| b.min.axis(a) < ray.origin.axis(a) && ray.origin.axis(a) < b.max.axis(a)));
+            inside += usize::from(b.strictly_holds(ray.origin));
         }
         // Both of the clip's ways were taken.
         assert!(inside > 5_000 && inside < 95_000, "{inside} rays from inside");
