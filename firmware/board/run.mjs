@@ -59,11 +59,13 @@
 // (1024: a progressive frame's passes, each a whole panel), instead of when the LED goes out.
 // With --profile FILE it also samples core 0's program counter every 97th instruction of the
 // first frame (--profile-frames N: of the first N frames; while the LED is lit) and writes the
-// counts as JSON pairs [pc, samples].
+// counts as JSON pairs [pc, samples]. With --miss-lines FILE it counts the XIP cache's misses
+// of the first frame (--profile-frames N: of the first N) by the flash address of the line
+// missed and writes them as JSON pairs [address, misses].
 //
 // Usage: node run.mjs --uf2 FILE --bootrom FILE --rtt ADDR --log FILE
 //                     [--records ADDR --records-log FILE] [--frames N] [--max-cycles N]
-//                     [--no-display] [--until-ms T] [--profile FILE]
+//                     [--no-display] [--until-ms T] [--profile FILE] [--miss-lines FILE]
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
 //                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
@@ -173,6 +175,7 @@ function parseArgs(argv) {
     else if (a === '--no-display') o.display = false;
     else if (a === '--profile') o.profile = next();
     else if (a === '--profile-frames') o.profileFrames = Number(next());
+    else if (a === '--miss-lines') o.missLines = next();
     else if (a === '--no-core1') o.core1 = false;
     else if (a === '--no-cache') o.cache = false;
     else if (a === '--pass-bytes') o.passBytes = Number(next());
@@ -342,6 +345,7 @@ function main() {
   let i2cTransfers = 0; // address bytes sent (each START or repeated START)
   let naks = 0;
   let ledOn = false;
+  const missLines = opt.missLines ? new Map() : null;
   let firstByteOfFrame = null;
   const snapshot = () => {
     const s = board.snapshot();
@@ -414,6 +418,7 @@ function main() {
     ledOn = on;
     ledToggles++;
     if (!display) return;
+    if (missLines && board.xip) board.xip.missLines = on && frames.length < opt.profileFrames ? missLines : null;
     if (on) {
       frameStart = snapshot();
       firstByteOfFrame = null;
@@ -571,6 +576,7 @@ function main() {
   records?.poll();
   if (records) records.save(opt.recordsLog);
   if (profile) writeFileSync(opt.profile, JSON.stringify([...profile.entries()]));
+  if (missLines) writeFileSync(opt.missLines, JSON.stringify([...missLines.entries()]));
   const total = board.snapshot();
   for (const r of display?.refreshes ?? []) emit({ event: 'epaper', startMs: r.start / 1e6, endMs: r.end / 1e6, dataMs: r.dataAt / 1e6, window: r.window });
   emit({

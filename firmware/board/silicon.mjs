@@ -148,7 +148,8 @@ export class Divider {
 
 /**
  * The XIP cache (datasheet 2.6.3): `access` is called for every flash read, instruction fetch
- * or data, and returns the cycles the reading core stalls.
+ * or data, and returns the cycles the reading core stalls. While `missLines` is a Map, each
+ * miss also counts against its line's flash address there (where a frame's misses come from).
  */
 export class XipCache {
   constructor(ssi, { bytes = 16384, ways = 2, line = 8 } = {}) {
@@ -163,6 +164,7 @@ export class XipCache {
     this.uncached = 0;
     this.stallCycles = 0;
     this.busyUntil = 0; // the flash interface is busy until this cycle
+    this.missLines = null;
   }
 
   /**
@@ -205,6 +207,10 @@ export class XipCache {
       }
     }
     this.misses++;
+    if (this.missLines) {
+      const at = FLASH + (line << this.lineShift);
+      this.missLines.set(at, (this.missLines.get(at) || 0) + 1);
+    }
     if (alias === 0) {
       const w = this.lru[set];
       this.tags[base + w] = tag;

@@ -61,6 +61,18 @@ test('16 KiB, 2-way, 8-byte lines: a third line on a set evicts the least recent
   assert.deepEqual([c.hits, c.misses], [3, 4]);
 });
 
+test('misses count against their line in flash while missLines is a Map, in any cached alias', () => {
+  const c = new XipCache(W25Q080_XIP);
+  c.access(0x10000100, 0); // before counting: not counted
+  c.missLines = new Map();
+  c.access(0x10000104, 100); // a hit
+  c.access(0x1100020c, 200); // XIP_NOALLOC: missed, and not kept
+  c.access(0x10000208, 300); // the same line: missed again
+  c.access(0x10004000, 400);
+  assert.deepEqual([...c.missLines.entries()], [[0x10000208, 2], [0x10004000, 1]]);
+  assert.equal(c.misses, 4);
+});
+
 test('no-allocate and no-cache aliases, and misses queue on the one flash interface', () => {
   const c = new XipCache(W25Q080_XIP);
   c.access(0x11000100, 0);

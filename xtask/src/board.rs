@@ -371,8 +371,13 @@ impl BoardRun {
     }
 }
 
+/// The file in a run's folder where `run.mjs --miss-lines` counts the first frame's XIP misses
+/// by the flash line missed (a run with the display and no fault models).
+const MISS_LINES: &str = "miss-lines.json";
+
 /// Runs `uf2` in the emulator (with `models` switches such as `--no-cache`) and decodes its log
-/// with the ELF's defmt table.
+/// with the ELF's defmt table. With the display and no `models`, the first frame's PC samples
+/// and XIP misses by line are kept in `work` (`profile.json`, [`MISS_LINES`]).
 #[allow(clippy::too_many_arguments)]
 fn run_emulator(
     root: &Path,
@@ -415,6 +420,7 @@ fn run_emulator(
         cmd.args(["--no-display", "--until-ms", "2500"]);
     } else if models.is_empty() {
         cmd.arg("--profile").arg(work.join("profile.json"));
+        cmd.arg("--miss-lines").arg(work.join(MISS_LINES));
     }
     let mut child = cmd.spawn().context("cannot run node (Node.js 18 or newer is needed)")?;
     let mut run = BoardRun::default();

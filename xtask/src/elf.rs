@@ -69,6 +69,39 @@ impl Elf {
         Ok((flash, ram))
     }
 
+    /// The slices (address and length, as a `&[T]` lies in memory: a pointer into flash, then
+    /// a length) in the data symbols whose demangled names start with `prefix`: where the
+    /// tables a baked scene points to lie.
+    pub(crate) fn slices_in(&self, prefix: &str) -> Result<Vec<(u64, u64)>> {
+        let file = self.file()?;
+        let mut slices = Vec::new();
+        for s in file
+            .symbols()
+            .filter(|s| s.kind() == SymbolKind::Data && demangled(s.name().unwrap_or("")).starts_with(prefix))
+        {
+            let Some(section) = s.section_index().and_then(|i| file.section_by_index(i).ok()) else { continue };
+            let Ok(data) = section.data() else { continue };
+            let start = (s.address() - section.address()) as usize;
+            let Some(bytes) = data.get(start..start + s.size() as usize) else { continue };
+            let words: Vec<u64> =
+                bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]).into()).collect();
+            slices.extend(words.windows(2).filter(|w| FLASH.contains(&w[0])).map(|w| (w[0], w[1])));
+        }
+        Ok(slices)
+    }
+
+    /// The address ranges of the executable sections that lie in flash (code run from there,
+    /// through the XIP cache).
+    pub(crate) fn flash_code(&self) -> Result<Vec<std::ops::Range<u64>>> {
+        Ok(self
+            .file()?
+            .sections()
+            .filter(|s| matches!(s.flags(), SectionFlags::Elf { sh_flags } if sh_flags & object::elf::SHF_EXECINSTR as u64 != 0))
+            .filter(|s| FLASH.contains(&s.address()))
+            .map(|s| s.address()..s.address() + s.size())
+            .collect())
+    }
+
     /// Bytes of the symbols whose demangled names start with `prefix`.
     pub(crate) fn symbol_bytes(&self, prefix: &str) -> Result<u64> {
         Ok(self
@@ -79,6 +112,9 @@ impl Elf {
             .sum())
     }
 }
+
+/// The RP2040's flash as its XIP window maps it.
+const FLASH: std::ops::Range<u64> = 0x1000_0000..0x1100_0000;
 
 /// A symbol's name demangled, without its hash.
 pub(crate) fn demangled(name: &str) -> String {

@@ -6,7 +6,8 @@
 //! neither way is refused by `firmware/build.rs` with the figures, and the report gives its
 //! message.
 
-use super::{elf_sizes, m3, reported_frame, run_emulator, save_frame, Session, PICO, PICO_SCALAR};
+use super::{elf_sizes, m3, reported_frame, run_emulator, save_frame, Session, MISS_LINES, PICO, PICO_SCALAR};
+use crate::elf::Elf;
 use crate::firmware::host_frame_of;
 use anyhow::{Context, Result};
 use host_sim::spd::Generator;
@@ -61,6 +62,55 @@ struct SpdFrame {
     rays: [u64; 4],
     object_tests: u64,
     lattice_bytes: u32,
+    /// Where the frame's XIP misses came from.
+    misses: MissParts,
+}
+
+/// A frame's XIP misses by the part of the image whose line missed (`run.mjs --miss-lines`).
+#[derive(Default)]
+struct MissParts {
+    /// On the object records.
+    records: u64,
+    /// On code run from flash.
+    code: u64,
+    /// On the rest: the lattice and the scene's other tables.
+    rest: u64,
+}
+
+impl MissParts {
+    /// The misses counted in `lines` (JSON pairs [address, misses]) of image `elf`, whose
+    /// baked scene holds `objects` records of `record` bytes: the records are the table the
+    /// baked scene points to with `objects` entries.
+    fn of(elf: &Path, lines: &Path, objects: usize, record: u64) -> Result<MissParts> {
+        let text = std::fs::read_to_string(lines).with_context(|| format!("cannot read {}", lines.display()))?;
+        let counted: Vec<(u64, u64)> = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not JSON pairs [address, misses]", lines.display()))?;
+        let image = Elf::read(elf)?;
+        let start = image
+            .slices_in("firmware::app::baked::")?
+            .into_iter()
+            .find(|&(_, len)| len == objects as u64)
+            .map(|(at, _)| at)
+            .with_context(|| format!("{}: no baked table of {objects} objects", elf.display()))?;
+        let records = start..start + objects as u64 * record;
+        let code = image.flash_code()?;
+        let mut parts = MissParts::default();
+        for (at, n) in counted {
+            if records.contains(&at) {
+                parts.records += n;
+            } else if code.iter().any(|c| c.contains(&at)) {
+                parts.code += n;
+            } else {
+                parts.rest += n;
+            }
+        }
+        Ok(parts)
+    }
+
+    /// All of them.
+    fn total(&self) -> u64 {
+        self.records + self.code + self.rest
+    }
 }
 
 impl Session<'_> {
@@ -108,6 +158,7 @@ impl Session<'_> {
         let run = run_emulator(self.root, &elf, &uf2, &self.bootrom, 1, true, &work, &[])?;
         self.checks.check(run.ok, || format!("SPD {name}: the run did not finish: {}", run.reason));
         let want = host_frame_of(&nff, PICO_SCALAR, PICO)?;
+        let misses = MissParts::of(&elf, &work.join(MISS_LINES), objects, record)?;
         let frame = run.frames.first().map(|f| {
             let reported = reported_frame(&run.records, 0);
             SpdFrame {
@@ -119,6 +170,7 @@ impl Session<'_> {
                 rays: reported.map_or([0; 4], |r| r.rays),
                 object_tests: reported.map_or(0, |r| r.object_tests),
                 lattice_bytes: reported.map_or(0, |r| r.lattice_bytes),
+                misses,
             }
         });
         if let Some(f) = run.frames.first() {
@@ -243,6 +295,19 @@ fn default_verdict(r: &SpdRow) -> String {
     }
 }
 
+/// The table of where each frame's XIP misses came from.
+fn miss_table(rows: &[SpdRow], md: &mut String) -> Result<()> {
+    writeln!(md, "\nWhere a frame's XIP misses come from: the flash line of each miss, counted by the emulated cache (`run.mjs --miss-lines`), by the part of the image it lies in (the object records: the baked table of that many objects the scene points to, found in the ELF; code run from flash; the rest, the lattice and the scene's other tables):\n")?;
+    writeln!(md, "| scene | XIP misses | object records | lattice and other tables | code |")?;
+    writeln!(md, "|---|---:|---:|---:|---:|")?;
+    for (r, f) in rows.iter().filter_map(|r| Some((r, r.frame.as_ref()?))) {
+        let m = &f.misses;
+        let share = |n: u64| format!("{:.1} %", 100.0 * n as f64 / m.total().max(1) as f64);
+        writeln!(md, "| {} | {} | {} | {} | {} |", r.name, m.total(), share(m.records), share(m.rest), share(m.code))?;
+    }
+    Ok(())
+}
+
 /// The picture [`spd_plot`] draws, in docs/images.
 pub(super) const PLOT: &str = "board-spd-balls.svg";
 
@@ -295,6 +360,7 @@ pub(super) fn spd_report(rows: &[SpdRow]) -> Result<String> {
         )?;
     }
     writeln!(md, "\n{}.", record_parts())?;
+    miss_table(rows, &mut md)?;
     if !refused.is_empty() {
         writeln!(md, "\nRefused by `firmware/build.rs`:\n")?;
         for r in &refused {
