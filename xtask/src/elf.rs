@@ -69,9 +69,10 @@ impl Elf {
         Ok((flash, ram))
     }
 
-    /// The slices (address and length, as a `&[T]` lies in memory: a pointer into flash, then
-    /// a length) in the data symbols whose demangled names start with `prefix`: where the
-    /// tables a baked scene points to lie.
+    /// Every word of the data symbols whose demangled names start with `prefix` that points
+    /// into flash, with the word after it: as a `&[T]` lies in memory (pointer, then length),
+    /// the slices of those symbols are among these pairs, with whatever else happens to match;
+    /// the caller picks the table it knows by its length.
     pub(crate) fn slices_in(&self, prefix: &str) -> Result<Vec<(u64, u64)>> {
         let file = self.file()?;
         let mut slices = Vec::new();
