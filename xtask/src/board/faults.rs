@@ -40,6 +40,22 @@ enum Fault {
 }
 
 impl Fault {
+    /// The fault as run.mjs gets it: its moments to the microsecond ([`Fault::args`] writes
+    /// three decimals). The checks compare the bus's events with these moments, so they must be
+    /// the moments the emulator was given: a byte not acknowledged 0.3 µs after the rounded
+    /// moment may come before the unrounded one.
+    fn as_sent(self) -> Self {
+        let us = |ms: f64| (ms * 1e3).round() / 1e3;
+        match self {
+            Fault::PanelOff(start, len) => Fault::PanelOff(us(start), us(len)),
+            Fault::Reset(at) => Fault::Reset(us(at)),
+            Fault::HangCore1(at) => Fault::HangCore1(us(at)),
+            Fault::Panic(at, request) => Fault::Panic(us(at), request),
+            Fault::SdaStuck(at, pulses) => Fault::SdaStuck(us(at), pulses),
+            Fault::Nack(at) => Fault::Nack(us(at)),
+        }
+    }
+
     /// run.mjs's switches for it.
     fn args(self) -> Vec<String> {
         match self {
@@ -171,7 +187,7 @@ impl Session<'_> {
         std::fs::create_dir_all(&dir)?;
         let mut rows = Vec::new();
         for sc in &SCENARIOS {
-            let fault = (sc.fault)(&f0.frame, &f1.frame, request);
+            let fault = (sc.fault)(&f0.frame, &f1.frame, request).as_sent();
             let args = fault.args();
             eprintln!("fault {}: {}", sc.name, args.join(" "));
             let run = run_emulator(
@@ -341,4 +357,28 @@ pub(super) fn fault_report(rows: &[FaultRow]) -> Result<String> {
     }
     writeln!(md, "\nNot survived yet: a power cut shorter than the gaps between one frame's transfers (the bus idles while the cores trace) that ends before the frame's last byte. No transfer fails, the board reports the frame shown, and the panel stays dark until the next frame sets it up: an SSD1306 on I2C cannot be read back. The SPI image sees no cut at all (SPI has no acknowledge); its frames still set the panel up, so the next frame after the power's return is good. A panel that holds SDA low through nine clock pulses needs its power cycled: the firmware logs it and keeps trying.")?;
     Ok(md)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Fault;
+
+    /// The moment the checks use is the one run.mjs reads back from the switches, to the bit:
+    /// the clean run placed this NACK 0.3 µs after the rounded moment the emulator was given.
+    #[test]
+    fn a_fault_as_sent_is_the_moment_run_mjs_reads() {
+        let faults = [
+            Fault::Nack(3_135.583_4),
+            Fault::Reset(0.000_6),
+            Fault::SdaStuck(2_073.148_5, 9),
+            Fault::PanelOff(773.147_4, 600.000_2),
+        ];
+        for fault in faults {
+            let sent = fault.as_sent();
+            let args = sent.args();
+            let at: f64 = args[1].split(':').next().unwrap().parse().unwrap();
+            assert_eq!(at.to_bits(), sent.start().to_bits(), "{args:?}");
+            assert!((sent.start() - fault.start()).abs() <= 0.000_5, "{args:?}");
+        }
+    }
 }
