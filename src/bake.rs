@@ -248,18 +248,19 @@ mod writer {
             let Whole(o, eye_local, light_local) = self;
             out.push_str("Object::from_tables(");
             let shadow_window = o.region.shadow_window();
-            let parts: [&dyn Literal; 16] = [
+            let parts: [&dyn Literal; 17] = [
                 &o.shape,
-                &o.to_object,
-                &o.to_world,
+                &o.origin,
                 &o.unscale,
                 &o.dir_factor,
-                &o.material,
-                &o.distant,
-                &o.composite,
-                &o.bounds,
                 &o.dir_scale,
                 &o.inv_dir_scale,
+                &o.material,
+                &o.flags,
+                &o.composite,
+                &o.to_object,
+                &o.to_world,
+                &o.bounds,
                 eye_local,
                 light_local,
                 o.region.eye_window(),

@@ -59,7 +59,7 @@ const MARGIN: f64 = 1.0;
 pub(crate) fn eye_hull<R: Real>(o: &Object<R>, projection: &Projection, pad: f64) -> EyeHull {
     // The box's corners' images, by linearity: the image of its lowest corner plus, per axis
     // where a corner lies high, the image of that edge (no point mapped eight times over).
-    let place = o.to_world.cast::<f64>();
+    let place = o.to_world().cast::<f64>();
     let (lo, hi) = o.shape.bounds();
     let (lo, hi) = (lo.cast::<f64>(), hi.cast::<f64>());
     let base = projection.image(place.point(lo));

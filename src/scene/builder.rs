@@ -5,7 +5,7 @@ use super::model::{Composite, Light, Material, Object, Parts, Scene, Smooth, NO_
 use crate::camera::{lowest_terms, resolvable_pixels, Camera, CameraDesc};
 use crate::cull::build::{shadow_basis, Regions};
 use crate::cull::Region;
-use crate::math::{Aabb, Affine, Vec3};
+use crate::math::{Aabb, Affine, Linear, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
 use crate::trace::Effects;
@@ -296,19 +296,23 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         let mut scaled = inv;
         scaled.m.iter_mut().flatten().for_each(|v| *v /= unscale);
         scaled.m.iter_mut().for_each(|row| row[3] = 0.0);
+        let to_object: Linear<R> = scaled.linear().cast();
+        let m = &to_object.m;
+        let uniform = (0..3).all(|i| (0..3).all(|j| if i == j { m[i][j] == m[0][0] } else { m[i][j] == R::ZERO }));
         self.storage[self.len] = Object {
             shape,
-            to_object: scaled.linear().cast(),
-            to_world: place.cast(),
+            origin: Vec3::new(place.m[0][3], place.m[1][3], place.m[2][3]).cast(),
             unscale: R::pow2(log2_of_pow2(unscale)),
             dir_factor: R::pow2(log2_of_pow2(unscale * dir_scale)),
-            material,
-            // Known once the world box is, at `finish`.
-            distant: false,
-            composite,
-            bounds: bounds.cast_padded(),
             dir_scale: R::pow2(log2_of_pow2(dir_scale)),
             inv_dir_scale: R::pow2(log2_of_pow2(1.0 / dir_scale)),
+            material,
+            // Distant is known once the world box is, at `finish`.
+            flags: if uniform { Object::<R>::UNIFORM } else { 0 },
+            composite,
+            to_object,
+            to_world: place.linear().cast(),
+            bounds: bounds.cast_padded(),
             // The camera is known at `finish`, which sets both.
             #[cfg(not(feature = "lean-objects"))]
             eye_local: Vec3::new(R::ZERO, R::ZERO, R::ZERO),
@@ -437,7 +441,7 @@ fn check_objects<R: Real>(objects: &mut [Object<R>], world: &Aabb<R>) -> Result<
         if reach >= R::LIMIT {
             return Err(SceneError::ObjectOutOfRange { object: i, reach, limit: R::LIMIT, scalar: R::NAME });
         }
-        o.distant = true;
+        o.flags |= Object::<R>::DISTANT;
     }
     // A triangle has no inside for a secondary ray to start in (every ray off it leaves it):
     // the rule is for solids.

@@ -91,43 +91,46 @@ pub enum Light<R> {
 /// One primitive placed in the world.
 ///
 /// Laid out as declared and aligned to 8 bytes (`repr(C, align(8))`), as the flash's cache lines
-/// are: in a baked table of them, read through the XIP cache, the bounds a walk's box test reads
-/// then start on a line (offset 104) and take three lines, never four.
+/// are, in the order a ray test reads it: in a baked table of them, read through the XIP cache,
+/// an exact test reads the first 76 bytes (10 lines), a sphere or other object placed by a
+/// uniform scale and a translation alone only the first 44 (6 lines: [`Object::UNIFORM`]); the
+/// bounds a walk's box test reads start on a line (offset 112) and take three lines, never
+/// four; the placement's linear part, read at a hit, lies between them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(8))]
 pub struct Object<R> {
     /// The canonical primitive.
     pub(crate) shape: Shape<R>,
-    /// World-to-object transform (the inverse of the placement) multiplied by the power of two
-    /// `2^-unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
-    /// full precision however large or small the object is (exact in floating point).
-    pub(crate) to_object: Linear<R>,
-    /// The placement, from canonical object space to the world: hit points are mapped back
-    /// through it ([`Object::surface_point`]). Its translation is the object's origin: rays are
-    /// taken relative to it before `to_object` (whose translation is then zero), so a scene far
-    /// from the world's origin loses no precision to cancellation.
-    pub(crate) to_world: Affine<R>,
+    /// The placement's translation: the object's origin in the world. Rays are taken relative
+    /// to it before `to_object` (whose translation is then zero), so a scene far from the
+    /// world's origin loses no precision to cancellation.
+    pub(crate) origin: Vec3<R>,
     /// The power of two `to_object`'s results are multiplied by to get object space
     /// ([`Real::mul_pow2`]: a shift in fixed point, not a multiply).
     pub(crate) unscale: Pow2<R>,
     /// `unscale * dir_scale`: what `to_object`'s direction results are multiplied by.
     pub(crate) dir_factor: Pow2<R>,
-    /// Index into the scene's materials.
-    pub(crate) material: u8,
-    /// Whether the world box, in the object's own space, reaches past the scalar's range (a
-    /// small object in a large scene, in fixed point): a ray is then first moved along itself to
-    /// near the object ([`Object::intersect`]), so that only points near it are mapped into its
-    /// space.
-    pub(crate) distant: bool,
-    /// Composite object it belongs to, or [`NO_COMPOSITE`].
-    pub(crate) composite: u16,
-    /// World-space bounding box, padded for the scalar's rounding.
-    pub(crate) bounds: Aabb<R>,
     /// A power of two that object-space directions are multiplied by, so that they stay near
     /// unit length however small or large the object is (exact in floating point).
     pub(crate) dir_scale: Pow2<R>,
     /// `1 / dir_scale`.
     pub(crate) inv_dir_scale: Pow2<R>,
+    /// Index into the scene's materials.
+    pub(crate) material: u8,
+    /// [`Object::DISTANT`] and [`Object::UNIFORM`], or neither.
+    pub(crate) flags: u8,
+    /// Composite object it belongs to, or [`NO_COMPOSITE`].
+    pub(crate) composite: u16,
+    /// World-to-object transform (the inverse of the placement) multiplied by the power of two
+    /// `2^-unscale` that brings its largest linear entry into `(0.5, 1]`, so fixed point keeps
+    /// full precision however large or small the object is (exact in floating point).
+    pub(crate) to_object: Linear<R>,
+    /// The placement's linear part, from canonical object space to the world (with
+    /// [`Object::origin`], [`Object::to_world`]): hit points are mapped back through it
+    /// ([`Object::surface_point`]).
+    pub(crate) to_world: Linear<R>,
+    /// World-space bounding box, padded for the scalar's rounding.
+    pub(crate) bounds: Aabb<R>,
     /// The camera's eye in object space, `to_object.vector(eye - origin) * unscale`: the same
     /// for every eye ray, so it is computed once per scene instead of once per eye-ray test
     /// (not kept with `lean-objects`).
@@ -149,16 +152,17 @@ impl<R: Real> Default for Object<R> {
         let z = Vec3::new(R::ZERO, R::ZERO, R::ZERO);
         Object {
             shape: Shape::Sphere,
-            to_object: Affine::identity().linear(),
-            to_world: Affine::identity(),
+            origin: z,
             unscale: R::pow2(0),
             dir_factor: R::pow2(0),
-            material: 0,
-            distant: false,
-            composite: NO_COMPOSITE,
-            bounds: Aabb { min: z, max: z },
             dir_scale: R::pow2(0),
             inv_dir_scale: R::pow2(0),
+            material: 0,
+            flags: Object::<R>::UNIFORM,
+            composite: NO_COMPOSITE,
+            to_object: Affine::identity().linear(),
+            to_world: Affine::identity().linear(),
+            bounds: Aabb { min: z, max: z },
             #[cfg(not(feature = "lean-objects"))]
             eye_local: z,
             #[cfg(not(feature = "lean-objects"))]
@@ -169,6 +173,17 @@ impl<R: Real> Default for Object<R> {
 }
 
 impl<R> Object<R> {
+    /// [`Object::flags`]: the object is small in a large scene, in fixed point: its world box,
+    /// in the object's own space, reaches past the scalar's range, so a ray is first moved along
+    /// itself to near the object ([`Object::intersect`]), and only points near it are mapped
+    /// into its space.
+    pub const DISTANT: u8 = 1;
+    /// [`Object::flags`]: `to_object` is a multiple of the identity (a sphere or box placed by
+    /// a uniform scale and a translation, as most of the SPD's are): a point or direction is
+    /// mapped into object space by its first entry alone, the same products the whole matrix
+    /// gives (its other entries are zero) without reading the rest of it.
+    pub const UNIFORM: u8 = 2;
+
     /// An object from its parts, as [`bake::source`](crate::bake) writes them: for baked
     /// tables only, which hold objects of a validated scene (with `lean-objects`, `eye_local`
     /// and `light_local` are not kept).
@@ -176,16 +191,17 @@ impl<R> Object<R> {
     #[allow(clippy::too_many_arguments)]
     pub const fn from_tables(
         shape: Shape<R>,
-        to_object: Linear<R>,
-        to_world: Affine<R>,
+        origin: Vec3<R>,
         unscale: Pow2<R>,
         dir_factor: Pow2<R>,
-        material: u8,
-        distant: bool,
-        composite: u16,
-        bounds: Aabb<R>,
         dir_scale: Pow2<R>,
         inv_dir_scale: Pow2<R>,
+        material: u8,
+        flags: u8,
+        composite: u16,
+        to_object: Linear<R>,
+        to_world: Linear<R>,
+        bounds: Aabb<R>,
         eye_local: Vec3<R>,
         light_local: Vec3<R>,
         eye_window: EyeWindow,
@@ -197,16 +213,17 @@ impl<R> Object<R> {
         core::mem::forget((eye_local, light_local));
         Object {
             shape,
-            to_object,
-            to_world,
+            origin,
             unscale,
             dir_factor,
-            material,
-            distant,
-            composite,
-            bounds,
             dir_scale,
             inv_dir_scale,
+            material,
+            flags,
+            composite,
+            to_object,
+            to_world,
+            bounds,
             #[cfg(not(feature = "lean-objects"))]
             eye_local,
             #[cfg(not(feature = "lean-objects"))]
@@ -233,13 +250,13 @@ impl<R: Real> Object<R> {
     /// the object-space normal and point.
     #[inline]
     pub fn intersect(&self, ray: &Ray<R>, tmin: R, tmax: R) -> Option<ShapeHit<R>> {
-        if Self::TRACES_DISTANT && self.distant {
+        if Self::TRACES_DISTANT && self.is_distant() {
             return self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax);
         }
         self.intersect_local(self.point_local(ray.origin), self.direction_local(ray.dir), tmin, tmax)
     }
 
-    /// The test of a [distant](Object::distant) object, its direction `dir` already in object
+    /// The test of a [distant](Object::DISTANT) object, its direction `dir` already in object
     /// space: the ray's origin moved along the ray to where it crosses the plane through the
     /// centre of the object's box across the axis the ray runs most along, `t0` along it, and
     /// the test made from there with the range shifted by `t0` (exact in fixed point, whose
@@ -282,7 +299,7 @@ impl<R: Real> Object<R> {
         (b.min + (b.max - b.min) * R::HALF, extent + extent + R::offset_eps())
     }
 
-    /// Whether this build traces [distant](Object::distant) objects in `R`: with the
+    /// Whether this build traces [distant](Object::DISTANT) objects in `R`: with the
     /// `distant-objects` feature, in a scalar of narrow range (fixed point, whose own
     /// coordinates stop at 8,192). A float's range holds any scene's coordinates, so its images
     /// carry no distant branch.
@@ -318,7 +335,7 @@ impl<R: Real> Object<R> {
         if !self.eye_window_meets([uv[0]; 2], [uv[1]; 2]) {
             return Err(Culled);
         }
-        if Self::TRACES_DISTANT && self.distant {
+        if Self::TRACES_DISTANT && self.is_distant() {
             return Ok(self.intersect_near(ray, self.direction_local(ray.dir), tmin, tmax));
         }
         #[cfg(not(feature = "lean-objects"))]
@@ -339,7 +356,7 @@ impl<R: Real> Object<R> {
         // The ray's direction is the light's, which the scene's set-up mapped the same way.
         #[cfg(feature = "lean-objects")]
         let towards = self.direction_local(ray.dir);
-        if Self::TRACES_DISTANT && self.distant {
+        if Self::TRACES_DISTANT && self.is_distant() {
             return self.intersect_near(ray, towards, tmin, tmax);
         }
         self.intersect_local(self.point_local(ray.origin), towards, tmin, tmax)
@@ -361,13 +378,26 @@ impl<R: Real> Object<R> {
     /// origin, then through `to_object` and its scale.
     #[inline]
     pub(crate) fn point_local(&self, p: Vec3<R>) -> Vec3<R> {
-        self.to_object.vector(p - self.origin()).mul_pow2(self.unscale)
+        self.linear_local(p - self.origin).mul_pow2(self.unscale)
     }
 
     /// A world direction in object space, scaled to about unit length ([`Object::dir_scale`]).
     #[inline]
     pub(crate) fn direction_local(&self, d: Vec3<R>) -> Vec3<R> {
-        self.to_object.vector(d).mul_pow2(self.dir_factor)
+        self.linear_local(d).mul_pow2(self.dir_factor)
+    }
+
+    /// `to_object.vector(v)`; for a [uniform](Object::UNIFORM) object by its first entry alone.
+    /// In fixed point the same bits (a product by zero is zero, a sum with zero exact); in
+    /// floating point the same value (but for the sign of a zero sum).
+    #[inline(always)]
+    fn linear_local(&self, v: Vec3<R>) -> Vec3<R> {
+        if self.flags & Self::UNIFORM != 0 {
+            let s = self.to_object.m[0][0];
+            Vec3::new(s * v.x, s * v.y, s * v.z)
+        } else {
+            self.to_object.vector(v)
+        }
     }
 
     /// The intersection, given the ray's origin and direction already in object space.
@@ -409,8 +439,20 @@ impl<R: Real> Object<R> {
     /// The world point at the object's origin.
     #[inline]
     pub fn origin(&self) -> Vec3<R> {
-        let m = &self.to_world.m;
-        Vec3::new(m[0][3], m[1][3], m[2][3])
+        self.origin
+    }
+    /// The placement, from canonical object space to the world.
+    pub fn to_world(&self) -> Affine<R> {
+        let mut a = self.to_world.affine();
+        for (row, t) in a.m.iter_mut().zip([self.origin.x, self.origin.y, self.origin.z]) {
+            row[3] = t;
+        }
+        a
+    }
+    /// Whether the object is [distant](Object::DISTANT).
+    #[inline]
+    pub fn is_distant(&self) -> bool {
+        self.flags & Self::DISTANT != 0
     }
     /// The world point of a hit found with [`Object::intersect`]: the object-space point put
     /// on the surface ([`Shape::on_surface`]) and mapped through the placement. Its error is a
@@ -419,7 +461,8 @@ impl<R: Real> Object<R> {
     /// 10^14 units away is more than a thin object is thick.
     #[inline]
     pub fn surface_point(&self, point: Vec3<R>, normal: Vec3<R>) -> Vec3<R> {
-        self.to_world.point(self.shape.on_surface(point, normal))
+        // As `to_world().point(..)` sums it, term by term.
+        self.to_world.vector(self.shape.on_surface(point, normal)) + self.origin
     }
     /// The largest side of the object's (padded) box: the size term of the offset of the
     /// secondary rays that leave it ([`Real::offset`]).
@@ -694,7 +737,7 @@ mod tests {
             let lean = cfg!(feature = "lean-objects");
             assert_eq!(align_of::<Object<R>>(), 8);
             assert_eq!(size_of::<Object<R>>(), if lean { 200 } else { 240 });
-            assert_eq!(offset_of!(Object<R>, bounds), 104);
+            assert_eq!(offset_of!(Object<R>, bounds), 112);
         }
         check::<Fx>();
         check::<f32>();
