@@ -158,8 +158,13 @@ impl Session<'_> {
         let run = run_emulator(self.root, &elf, &uf2, &self.bootrom, 1, true, &work, &[])?;
         self.checks.check(run.ok, || format!("SPD {name}: the run did not finish: {}", run.reason));
         let want = host_frame_of(&nff, PICO_SCALAR, PICO)?;
-        let misses = MissParts::of(&elf, &work.join(MISS_LINES), objects, record)?;
-        let frame = run.frames.first().map(|f| {
+        // Counted for the first frame: a run that showed none (it failed, or node itself died)
+        // may have written no counts, and is reported as failed above.
+        let misses = match run.frames.first() {
+            Some(_) => Some(MissParts::of(&elf, &work.join(MISS_LINES), objects, record)?),
+            None => None,
+        };
+        let frame = run.frames.first().zip(misses).map(|(f, misses)| {
             let reported = reported_frame(&run.records, 0);
             SpdFrame {
                 same: f.error.is_none() && f.pixels == want,
