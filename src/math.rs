@@ -276,6 +276,17 @@ pub struct Linear<R> {
 }
 
 impl<R: Real> Linear<R> {
+    /// Applies the affine map `[A | t]` to a point: `A p + t`, each row's products summed
+    /// before `t` is added.
+    #[inline]
+    pub fn point_plus(&self, p: Vec3<R>, t: Vec3<R>) -> Vec3<R> {
+        let (m, e) = (&self.m, entry_times);
+        Vec3::new(
+            e(m[0][0], p.x) + e(m[0][1], p.y) + e(m[0][2], p.z) + t.x,
+            e(m[1][0], p.x) + e(m[1][1], p.y) + e(m[1][2], p.z) + t.y,
+            e(m[2][0], p.x) + e(m[2][1], p.y) + e(m[2][2], p.z) + t.z,
+        )
+    }
     /// Applies the map to a direction.
     #[inline]
     pub fn vector(&self, v: Vec3<R>) -> Vec3<R> {
@@ -324,12 +335,8 @@ impl<R: Real> Affine<R> {
     /// Applies to a point.
     #[inline]
     pub fn point(&self, p: Vec3<R>) -> Vec3<R> {
-        let (m, t) = (&self.m, entry_times);
-        Vec3::new(
-            t(m[0][0], p.x) + t(m[0][1], p.y) + t(m[0][2], p.z) + m[0][3],
-            t(m[1][0], p.x) + t(m[1][1], p.y) + t(m[1][2], p.z) + m[1][3],
-            t(m[2][0], p.x) + t(m[2][1], p.y) + t(m[2][2], p.z) + m[2][3],
-        )
+        let m = &self.m;
+        self.linear().point_plus(p, Vec3::new(m[0][3], m[1][3], m[2][3]))
     }
     /// Applies the linear part to a direction.
     #[inline]

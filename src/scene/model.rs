@@ -461,8 +461,7 @@ impl<R: Real> Object<R> {
     /// 10^14 units away is more than a thin object is thick.
     #[inline]
     pub fn surface_point(&self, point: Vec3<R>, normal: Vec3<R>) -> Vec3<R> {
-        // As `to_world().point(..)` sums it, term by term.
-        self.to_world.vector(self.shape.on_surface(point, normal)) + self.origin
+        self.to_world.point_plus(self.shape.on_surface(point, normal), self.origin)
     }
     /// The largest side of the object's (padded) box: the size term of the offset of the
     /// secondary rays that leave it ([`Real::offset`]).
