@@ -729,7 +729,7 @@ mod tests {
     /// What a baked table of objects in flash relies on (8-byte XIP cache lines): every record
     /// starts on a line and its bounds, what a walk's box test reads, do too. In fixed point and
     /// f32, the boards' scalars, the record is 240 bytes (200 with `lean-objects`: without the
-    /// eye and light in object space and the shadow window), the bounds at 104.
+    /// eye and light in object space and the shadow window), the bounds at 112.
     #[test]
     fn an_objects_bounds_start_on_a_flash_line() {
         fn check<R>() {
@@ -737,9 +737,34 @@ mod tests {
             assert_eq!(align_of::<Object<R>>(), 8);
             assert_eq!(size_of::<Object<R>>(), if lean { 200 } else { 240 });
             assert_eq!(offset_of!(Object<R>, bounds), 112);
+            // What an exact test reads: 76 bytes, a uniform object's 44 (to_object's first
+            // entry at 40).
+            assert_eq!(offset_of!(Object<R>, to_object), 40);
+            assert_eq!(offset_of!(Object<R>, to_world), 76);
         }
         check::<Fx>();
         check::<f32>();
         assert_eq!(offset_of!(Object<f64>, bounds) % 8, 0);
+    }
+
+    /// A uniform object maps points and directions into its space by `to_object`'s first
+    /// entry alone: in fixed point the bits the whole matrix gives, over scales and vectors of
+    /// every size.
+    #[test]
+    fn a_uniform_objects_map_is_the_whole_matrixs() {
+        use crate::math::{Linear, Vec3};
+        use crate::scalar::Real;
+        let mut rng = crate::generate::Rng::new(7);
+        for _ in 0..2000 {
+            let s = Fx::from_f64(rng.range(-1.0, 1.0));
+            let z = Fx::ZERO;
+            let mut o = Object::<Fx>::default();
+            o.to_object = Linear { m: [[s, z, z], [z, s, z], [z, z, s]] };
+            assert!(o.flags & Object::<Fx>::UNIFORM != 0);
+            let size = rng.range(-6.0, 12.0).exp2();
+            let v = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let v = Vec3::new(Fx::from_f64(v.x * size), Fx::from_f64(v.y * size), Fx::from_f64(v.z * size));
+            assert_eq!(o.linear_local(v), o.to_object.vector(v), "{s:?} {v:?}");
+        }
     }
 }
