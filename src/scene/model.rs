@@ -758,8 +758,7 @@ mod tests {
         for _ in 0..2000 {
             let s = Fx::from_f64(rng.range(-1.0, 1.0));
             let z = Fx::ZERO;
-            let mut o = Object::<Fx>::default();
-            o.to_object = Linear { m: [[s, z, z], [z, s, z], [z, z, s]] };
+            let o = Object::<Fx> { to_object: Linear { m: [[s, z, z], [z, s, z], [z, z, s]] }, ..Default::default() };
             assert!(o.flags & Object::<Fx>::UNIFORM != 0);
             let size = rng.range(-6.0, 12.0).exp2();
             let v = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
