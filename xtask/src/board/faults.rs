@@ -363,8 +363,9 @@ pub(super) fn fault_report(rows: &[FaultRow]) -> Result<String> {
 mod tests {
     use super::Fault;
 
-    /// The moment the checks use is the one run.mjs reads back from the switches, to the bit:
-    /// the clean run placed this NACK 0.3 µs after the rounded moment the emulator was given.
+    /// The moment the checks use is the one run.mjs reads back from the switches, to the bit (in
+    /// a run that failed so, a byte went unacknowledged 0.3 µs after the rounded moment the
+    /// emulator was given, and before the unrounded one the check used).
     #[test]
     fn a_fault_as_sent_is_the_moment_run_mjs_reads() {
         let faults = [
