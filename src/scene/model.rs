@@ -173,12 +173,12 @@ impl<R: Real> Default for Object<R> {
 }
 
 impl<R> Object<R> {
-    /// [`Object::flags`]: the object is small in a large scene, in fixed point: its world box,
+    /// An object flag: it is small in a large scene, in fixed point: its world box,
     /// in the object's own space, reaches past the scalar's range, so a ray is first moved along
     /// itself to near the object ([`Object::intersect`]), and only points near it are mapped
     /// into its space.
     pub const DISTANT: u8 = 1;
-    /// [`Object::flags`]: `to_object` is a multiple of the identity (a sphere or box placed by
+    /// An object flag: its `to_object` is a multiple of the identity (a sphere or box placed by
     /// a uniform scale and a translation, as most of the SPD's are): a point or direction is
     /// mapped into object space by its first entry alone, the same products the whole matrix
     /// gives (its other entries are zero) without reading the rest of it.
