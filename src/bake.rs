@@ -137,11 +137,6 @@ mod writer {
             record(out, "Linear", &[("m", &self.m)]);
         }
     }
-    impl<R: Literal> Literal for crate::math::Affine<R> {
-        fn literal(&self, out: &mut String) {
-            record(out, "Affine", &[("m", &self.m)]);
-        }
-    }
     impl<R: Literal> Literal for Shape<R> {
         fn literal(&self, out: &mut String) {
             match self {
