@@ -411,6 +411,38 @@ fn corners_faces_and_sub_lattices<R: Real>() {
     });
 }
 
+// An object reaching far out (a sphere far off, as large as it is far) beside a crowd of small
+// ones: the world cell they crowd into gets a lattice of its own over the part of the cell they
+// occupy, found in steps of the cell, and a coordinate far nearer the middle than the cell is
+// wide is lost beside its side when the step is reckoned. The crowd's lattice still holds every
+// one of them, so the lattice answers as brute force.
+fn far_reaching_object_beside_a_crowd<R: Real>() {
+    let far = (R::LIMIT / 10.0).min(1e30);
+    let mut text = format!(
+        "camera eye -1 -2.6 0.5 look -1 -1.6 0.5 up 0 0 1 fov 60 60\nsphere center {far} 0 0 radius {}\n",
+        far / 4.0
+    );
+    // More than the split (16) in one world cell.
+    for k in 0..24 {
+        let a = k as f64 * std::f64::consts::TAU / 24.0;
+        text += &format!("sphere center {} {} {} radius 0.3\n", -1.0 + 2.0 * a.cos(), 2.0, 1.2 * a.sin());
+    }
+    let mut st = Default::default();
+    let scene = scene_in::<R>(&text, &mut st);
+    let mut mb = vec![0; 32];
+    let mut q = Query::new(&mut mb);
+    let mut hits = 0;
+    with_accels(&scene, &LatticeConfig::default(), |name, a| {
+        for k in 0..32 * 32 {
+            let r = scene.camera().ray(k % 32, k / 32, 32, 32);
+            let want = BruteForce.nearest(&scene, &r, R::ZERO, R::MAX, &mut q);
+            hits += usize::from(want.is_some());
+            assert_eq!(a.nearest(&scene, &r, R::ZERO, R::MAX, &mut q), want, "{} {name} {r:?}", R::NAME);
+        }
+    });
+    assert!(hits > 3 * 100, "{}: {hits} hits", R::NAME);
+}
+
 // 9. A long ray across thousands of cells: the same cell sequence as an exact walk.
 fn long_walk_does_not_drift<R: Real>() {
     let text = "camera eye 0 0 -5 look 1 1 0\nbox min 0 0 0 max 1000 1000 1\n";
@@ -665,6 +697,7 @@ every_scalar! {
     glass_handles_the_critical_angle_and_rays_from_inside => glass_and_total_internal_reflection;
     plus_and_minus_zero_directions_give_the_same_answer => signed_zero_parallel_rays;
     corners_faces_and_sub_lattices_answer_as_brute_force => corners_faces_and_sub_lattices;
+    an_object_reaching_far_out_hides_no_other_from_the_lattice => far_reaching_object_beside_a_crowd;
     a_long_walk_follows_the_exact_cell_sequence => long_walk_does_not_drift;
     a_large_object_does_not_hide_a_nearer_one_and_each_is_tested_once => large_object_and_mailbox;
     cylinder_and_cone_special_rays_behave => cylinder_and_cone_special_rays;

@@ -145,10 +145,20 @@ impl Occupied {
         let mut w = 0;
         for a in 0..3 {
             let (lo, hi) = (cell.min.axis(a).to_f64(), cell.max.axis(a).to_f64());
-            let step = |x: R| if hi > lo { (x.to_f64() - lo) / (hi - lo) * STEPS as f64 } else { 0.0 };
+            let (min, max) = (b.min.axis(a).to_f64(), b.max.axis(a).to_f64());
+            let step = |x: f64| if hi > lo { (x - lo) / (hi - lo) * STEPS as f64 } else { 0.0 };
             // max/min, not clamp: clamp's assertion would link float formatting in.
-            let first = libm::floor(step(b.min.axis(a))).max(0.0).min((STEPS - 1) as f64) as u32;
-            let last = (libm::ceil(step(b.max.axis(a))).max(0.0) as u32).max(first + 1).min(STEPS) - 1;
+            let mut first = libm::floor(step(min)).max(0.0).min((STEPS - 1) as f64) as u32;
+            let mut last = (libm::ceil(step(max)).max(0.0) as u32).max(first + 1).min(STEPS) - 1;
+            // A side far nearer the middle than the cell is wide is lost in `x - lo` (a cell
+            // of a scene with one object reaching far out): the step found then lies beyond it.
+            // The planes as the region places them decide.
+            while first > 0 && step_plane(lo, hi, first) > min {
+                first -= 1;
+            }
+            while last + 1 < STEPS && step_plane(lo, hi, last + 1) < max {
+                last += 1;
+            }
             w |= (first | last << 5) << (10 * a);
         }
         w
@@ -174,7 +184,7 @@ impl Occupied {
                 0 => lo,
                 STEPS => hi,
                 _ => {
-                    let v = R::from_f64(lo.to_f64() + (hi.to_f64() - lo.to_f64()) * k as f64 / STEPS as f64);
+                    let v = R::from_f64(step_plane(lo.to_f64(), hi.to_f64(), k));
                     (v + out * (v.abs() + R::ONE) * R::pad_eps()).max(lo).min(hi)
                 }
             }
@@ -187,6 +197,12 @@ impl Occupied {
             max: Vec3::new(at(0, last[0], up), at(1, last[1], up), at(2, last[2], up)),
         }
     }
+}
+
+/// Plane `k` of the [`STEPS`] across `lo..hi`, where [`Occupied::region`] places it (before its
+/// padding).
+fn step_plane(lo: f64, hi: f64, k: u32) -> f64 {
+    lo + (hi - lo) * k as f64 / STEPS as f64
 }
 
 /// What [`scan`] calls per object and cell: the cell's number in its chunk, its box, the object's
@@ -284,15 +300,25 @@ mod tests {
     /// scalar, and stays inside the cell.
     fn occupied_holds_its_boxes<R: Real>() {
         let mut rng = Rng::new(5);
-        for _ in 0..300 {
+        for case in 0..600 {
             let lo = Vec3::new(rng.range(-50.0, 50.0), rng.range(-50.0, 50.0), rng.range(-50.0, 50.0));
-            let cell =
-                Aabb { min: lo, max: lo + Vec3::new(rng.range(0.0, 9.0), rng.range(0.0, 9.0), rng.range(0.0, 9.0)) };
+            let size = Vec3::new(rng.range(0.0, 9.0), rng.range(0.0, 9.0), rng.range(0.0, 9.0));
+            // Half the cells are vast around boxes near the origin (a scene with one object
+            // reaching far out), so that a box's coordinate is lost beside the cell's side in a
+            // float sum: the lattice's dense cells of such scenes.
+            let far = (R::LIMIT / 16.0).min(1e80);
+            let cell = if case % 2 == 0 {
+                Aabb { min: lo, max: lo + size }
+            } else {
+                let half = far * rng.range(0.5, 1.0);
+                Aabb { min: Vec3::new(-half, -half, -half), max: Vec3::new(half, half, half * rng.range(1.0, 7.0)) }
+            };
             let cell = Aabb { min: cell.min.cast::<R>(), max: cell.max.cast::<R>() };
             let boxes: std::vec::Vec<Aabb<R>> = (0..1 + rng.below(4))
                 .map(|_| {
                     let mut p = |a: usize| {
                         let (l, h) = (cell.min.axis(a).to_f64(), cell.max.axis(a).to_f64());
+                        let (l, h) = if h - l > 1e3 { (-3.0, 3.0) } else { (l, h) };
                         let (x, y) = (rng.range(l - 1.0, h + 1.0), rng.range(l - 1.0, h + 1.0));
                         (R::from_f64(x.min(y)), R::from_f64(x.max(y)))
                     };
