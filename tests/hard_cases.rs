@@ -411,7 +411,7 @@ fn corners_faces_and_sub_lattices<R: Real>() {
     });
 }
 
-// An object reaching far out (a sphere far off, as large as it is far) beside a crowd of small
+// 19. An object reaching far out (a sphere far off, as large as it is far) beside a crowd of small
 // ones: the world cell they crowd into gets a lattice of its own over the part of the cell they
 // occupy, found in steps of the cell, and a coordinate far nearer the middle than the cell is
 // wide is lost beside its side when the step is reckoned. The crowd's lattice still holds every
