@@ -110,7 +110,7 @@ mod writer {
         out.push_str(" }");
     }
 
-    impl Literal for crate::cull::HullEdge {
+    impl Literal for crate::scene::HullEdge {
         fn literal(&self, out: &mut String) {
             let _ = write!(out, "HullEdge::new({}, {}, {})", self.a, self.b, self.c);
         }
@@ -368,10 +368,10 @@ pub mod prelude {
     pub use crate::lattice::{Lattice, SubLattice};
     pub use crate::math::{Aabb, Affine, Linear, Vec3};
     pub use crate::scalar::Pow2;
+    pub use crate::scene::Effects;
     pub use crate::scene::Scene;
     pub use crate::scene::{Camera, Composite, HullEdge, Light, Material, Object, Smooth};
     pub use crate::shape::Shape;
-    pub use crate::trace::Effects;
     pub use crate::{F32Micro, F32MicroNewton, Fx};
 }
 

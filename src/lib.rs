@@ -34,8 +34,7 @@
 //! # Where things are
 //!
 //! In the order data flows: [`scene`] (the scene format, [`parse`], validation into the
-//! tracer's scalar), [`camera`], [`cull`] (where each object can appear on the image), [`lattice`]
-//! and the other [`accel`]erators, [`trace`] (the intersection tree, without recursion),
+//! tracer's scalar, where each object can appear), [`camera`], [`lattice`] and the other [`accel`]erators, [`trace`] (the intersection tree, without recursion),
 //! [`sample`], [`outline`] and [`dither`], and [`render`](mod@render) (the tile loop, progressive passes,
 //! two-core bands). [`storage`] and [`load`] hold and fill the memory; [`bake`] writes a scene
 //! as static tables. The repository's `ARCHITECTURE.md` draws the whole.
@@ -77,11 +76,10 @@ pub use math::{Aabb, Affine, Linear, Ray, Vec3};
 pub mod camera;
 pub mod shape;
 pub use shape::{Shape, ShapeHit};
-pub mod cull;
 pub mod scene;
 pub use scene::text::ParseError;
 pub use scene::{object_count, parse};
-pub use scene::{Parts, Scene, SceneBuilder, SceneError};
+pub use scene::{Effects, Parts, Scene, SceneBuilder, SceneError};
 pub mod accel;
 #[cfg(any(test, feature = "generate"))]
 pub mod generate;
@@ -93,11 +91,13 @@ pub mod storage;
 pub use load::{LoadError, Loaded};
 pub mod bake;
 pub use bake::Baked;
-pub use storage::{Buffers, Sizes, Storage, StorageView};
 #[cfg(feature = "alloc")]
-pub use storage::{HeapScratch, HeapStorage};
+pub use render::HeapScratch;
+#[cfg(feature = "alloc")]
+pub use storage::HeapStorage;
+pub use storage::{Buffers, Sizes, Storage, StorageView};
 pub mod trace;
-pub use trace::{Effects, EyeRays, Tracer};
+pub use trace::{EyeRays, Tracer};
 pub mod dither;
 pub mod sample;
 pub use dither::{Dither, Tone};

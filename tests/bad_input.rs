@@ -218,7 +218,7 @@ fn numbers_and_transforms_beyond_f64_say_out_of_range() {
     );
     assert_eq!(
         err::<f64>("sphere scale 1e200 scale 1e200"),
-        "line 1, column 20 at `scale`: transform out of range: composed, its entries overflow (more than 1e308)"
+        "line 1, column 20 at `scale`: transform out of range: its entries, composed or multiplied, overflow (more than 1e308)"
     );
     assert_eq!(err::<f64>("sphere center nan 0 0"), "line 1, column 15 at `nan`: number is not finite");
 }

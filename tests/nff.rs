@@ -119,14 +119,15 @@ fn what_cannot_be_drawn_is_refused_by_name_at_its_place() {
     assert_eq!(err(&format!("{view}s 0 0 zero 1\n")), "line 2, column 7 at `zero`: expected a number");
     assert!(err(&format!("{view}s 0 0 nan 1\n")).starts_with("line 2, column 7 at `nan`: "));
     assert!(err(&format!("{view}s 0 0 1e999 1\n")).starts_with("line 2, column 7 at `1e999`: number out of range"));
-    assert_eq!(err(&format!("{view}s 0 0 0\n")), "line 3, column 1: a value is missing at the end of the line");
+    // A value missing is reported just past the entity's last word, on its own line.
+    assert_eq!(err(&format!("{view}s 0 0 0\n")), "line 2, column 8: a value is missing at the end of the line");
     assert_eq!(
         err("v from 0 -5 0 at 0 0 0 angle 40\ns 0 0 0 1\n"),
         "line 1, column 1 at `v`: the view needs its `up` line"
     );
     assert_eq!(
         err(&format!("{view}f 1 1 1 1 0 0 0.5 0.5\ns 0 0 0 1\n")),
-        "line 2, column 15 at `0.5`: coefficients must be >= 0 and the index of refraction >= 1"
+        "line 2, column 19 at `0.5`: coefficients must be >= 0 and the index of refraction >= 1"
     );
 }
 

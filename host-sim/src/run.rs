@@ -9,7 +9,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use embedded_graphics::pixelcolor::{BinaryColor, Gray2};
 use lattice_rt::dither::Shade;
 use lattice_rt::render::{Hooks, RenderError};
-use lattice_rt::trace::{Effects, EyeRays};
+use lattice_rt::trace::EyeRays;
+use lattice_rt::Effects;
 use lattice_rt::{
     render, Accelerator, BitFrame, BoundingBox, BruteForce, Frame, HeapScratch, Lattice, LatticeConfig, Real, Scene,
     ShadeFrame, Stats, Tracer,

@@ -12,7 +12,7 @@ use lattice_rt::dither::Shade;
 use lattice_rt::render::{RenderError, Sampling};
 use lattice_rt::scene::Object;
 use lattice_rt::scene::{object_count, parse_with};
-use lattice_rt::trace::Effects;
+use lattice_rt::Effects;
 use lattice_rt::{
     render, BitFrame, Dither, Frame, Fx, HeapScratch, HeapStorage, LatticeConfig, NoHooks, Real, ShadeFrame, Sizes,
     Tone, Tracer,

@@ -4,7 +4,7 @@
 use super::config::uniform_coord;
 use super::oriented::{self, Oriented};
 use super::plan::{axis_planes, lattice_bounds, lattice_resolution};
-use super::{cluster, for_each_item, index, Lattice, LatticeConfig, SubLattice};
+use super::{cluster, for_each_item, index, planes, Lattice, LatticeConfig, SubLattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::{Object, Scene};
@@ -229,7 +229,7 @@ fn for_each_ref<R: Real>(
     let object = |item: u32| (item & index::SUB_FLAG == 0).then(|| &scene.objects[item as usize]);
     for_each_item(scene, cfg, 0, |item, ib| {
         visit_cells(coords, world, ib, object(item), |c| match find(c) {
-            Some(k) if item & index::SUB_FLAG == 0 && cluster::moves(&cluster::cell_box(&wp, c), ib) => {
+            Some(k) if item & index::SUB_FLAG == 0 && cluster::moves(&planes::cell_box(&wp, c), ib) => {
                 visit_cells(coords, &dense[k], ib, object(item), |c| f(item, c))
             }
             _ => f(item, c),

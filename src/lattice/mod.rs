@@ -30,6 +30,7 @@ mod config;
 mod index;
 mod oriented;
 mod plan;
+mod planes;
 mod walk;
 
 #[cfg(feature = "budget")]

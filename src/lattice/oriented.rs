@@ -4,7 +4,7 @@
 //! in many cells it misses, and tested by every ray through them. Planning and building
 //! count the same cells ([`for_each_cell`], [`count_cells`]).
 
-use super::cluster::{span, Planes};
+use super::planes::{span, Planes};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Object;

@@ -2,7 +2,7 @@
 
 use super::config::{resolution, uniform_coord, LatticeConfig, Resolution, Spacing, MAX_PER_AXIS};
 use super::oriented::{count_cells, Oriented};
-use super::{cluster, for_each_item, Lattice};
+use super::{cluster, for_each_item, planes, Lattice};
 use crate::math::Aabb;
 use crate::scalar::Real;
 use crate::scene::Scene;
@@ -242,10 +242,10 @@ fn with_planes<R: Real, T>(
     g: usize,
     b: &Aabb<R>,
     n: [u16; 3],
-    work: impl FnOnce(&dyn cluster::Planes<R>) -> T,
+    work: impl FnOnce(&dyn planes::Planes<R>) -> T,
 ) -> T {
     match cfg.spacing {
-        Spacing::Uniform => work(&cluster::Uniform { bounds: b, n }),
+        Spacing::Uniform => work(&planes::Uniform { bounds: b, n }),
         Spacing::Adaptive => listed_planes(scene, cfg, g, b, n, work),
     }
 }
@@ -258,7 +258,7 @@ fn listed_planes<R: Real, T>(
     g: usize,
     b: &Aabb<R>,
     n: [u16; 3],
-    work: impl FnOnce(&dyn cluster::Planes<R>) -> T,
+    work: impl FnOnce(&dyn planes::Planes<R>) -> T,
 ) -> T {
     let mut planes = [[R::ZERO; MAX_PER_AXIS as usize + 1]; 3];
     for (a, p) in planes.iter_mut().enumerate() {

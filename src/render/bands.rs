@@ -4,13 +4,13 @@
 //! from tile to tile and still draw it bit for bit as [`super::render`] does.
 
 use super::frame::{Frame, RenderError, Share, TileAt};
+use super::scratch::Scratch;
 use super::tiles::{render_tiles, KeptTile, Nowhere, Out};
 use super::Hooks;
 use crate::accel::{Accelerator, Stats};
 use crate::dither::{Ditherer, Shade, MAX_TILE};
 use crate::outline::Apron;
 use crate::scalar::Real;
-use crate::storage::Scratch;
 use crate::trace::Tracer;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};

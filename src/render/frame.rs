@@ -129,7 +129,7 @@ impl Frame {
 
     /// Entries of [`Scratch::with_cover`](super::Scratch::with_cover) a render of this frame uses (a few per tile).
     pub fn cover_len(&self) -> usize {
-        crate::cull::tiles::Tiling {
+        super::cull::tiles::Tiling {
             t: self.tile.max(1) as usize,
             size: (self.width as usize, self.height as usize),
             margin: 0,

@@ -14,17 +14,21 @@
 //! dither: how two cores share a frame).
 
 mod bands;
+pub(crate) mod cull;
 pub(crate) mod frame;
 mod pass;
 mod progressive;
+mod scratch;
 mod tiles;
 
 pub use crate::sample::{level, Hits, Sampling, Shot};
-pub use crate::storage::Scratch;
 pub use bands::{dither_band, dither_tiles, trace_share, BandRows};
 pub use frame::{Frame, RenderError, Share, TileGrid};
 pub use pass::Traced;
 pub use progressive::{render_pass, trace_pass};
+#[cfg(feature = "alloc")]
+pub use scratch::HeapScratch;
+pub use scratch::Scratch;
 pub use tiles::KeptTile;
 
 use crate::accel::{Accelerator, Stats};

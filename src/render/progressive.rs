@@ -4,12 +4,12 @@
 
 use super::frame::{Frame, RenderError, Share};
 use super::pass::{Pass, Traced};
+use super::scratch::Scratch;
 use super::tiles::{render_tiles, KeptTile, Nowhere, Out};
 use super::Hooks;
 use crate::accel::{Accelerator, Stats};
 use crate::dither::Shade;
 use crate::scalar::Real;
-use crate::storage::Scratch;
 use crate::trace::Tracer;
 use embedded_graphics_core::draw_target::DrawTarget;
 

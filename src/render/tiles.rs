@@ -4,13 +4,13 @@
 
 use super::frame::{check, resolves, Frame, RenderError, Share, TileAt};
 use super::pass::{pass_tile, Pass};
+use super::scratch::Scratch;
 use super::Hooks;
 use crate::accel::{Accelerator, Query, Stats};
 use crate::dither::{Dither, Ditherer, Shade, MAX_TILE};
 use crate::outline::Apron;
 use crate::sample::{Hits, Sampler, Sampling, Shot};
 use crate::scalar::Real;
-use crate::storage::Scratch;
 use crate::trace::Tracer;
 use crate::trace::Work;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -166,10 +166,10 @@ impl<R: Real, A: Accelerator<R> + ?Sized, const E: u8> Eye<'_, '_, '_, '_, '_, R
     }
 }
 
-/// Which objects a tile's eye rays can hit: a mask of the first 64 ([`crate::cull::tiles`]), or
+/// Which objects a tile's eye rays can hit: a mask of the first 64 ([`super::cull::tiles`]), or
 /// past 64 objects a list per tile when the scratch has room for the lists.
 struct Culling<'c> {
-    tiling: crate::cull::tiles::Tiling,
+    tiling: super::cull::tiles::Tiling,
     /// Whether the scene lists its objects per tile (more than 64 of them).
     many: bool,
     /// Whether the lists were counted (room for them in the scratch).
@@ -184,8 +184,8 @@ impl<'c> Culling<'c> {
     fn new<R: Real>(scene: &crate::scene::Scene<'_, R>, frame: &Frame, cover: &'c mut [u32]) -> Self {
         let (t, block) = (frame.tile as usize, frame.dither.block() as usize);
         let (w, h) = (frame.width as usize, frame.height as usize);
-        let tiling = crate::cull::tiles::Tiling { t, size: (w, h), margin: block };
-        let many = cfg!(feature = "tile-lists") && crate::cull::tiles::lists(scene.objects().len());
+        let tiling = super::cull::tiles::Tiling { t, size: (w, h), margin: block };
+        let many = cfg!(feature = "tile-lists") && super::cull::tiles::lists(scene.objects().len());
         let counted = many && tiling.count(scene, (frame.rows.0 as usize, frame.rows.1 as usize), cover);
         Culling { tiling, many, counted, cover, block, size: (4 * w as i32, 4 * h as i32) }
     }
@@ -204,7 +204,7 @@ impl<'c> Culling<'c> {
             work.set_eye_list(if self.counted { self.tiling.list(self.cover, (tx, ty)) } else { None });
             u64::MAX
         } else {
-            let c = crate::cull::tiles::tile_candidates(scene, (at.x0, at.tw), (at.y0, at.th), self.block, self.size);
+            let c = super::cull::tiles::tile_candidates(scene, (at.x0, at.tw), (at.y0, at.th), self.block, self.size);
             work.set_eye_candidates(c);
             c
         }
@@ -226,7 +226,7 @@ fn sample<R: Real, A: Accelerator<R> + ?Sized, const E: u8>(
     let tracer = eye.tracer;
     let size = eye.cache.size();
     let mut alone = |xs: [usize; 2], ys: [usize; 2], id: u16, far: u16| {
-        crate::cull::block::alone(tracer, candidates, (at.x0, at.y0), (xs, ys), id, far, size)
+        super::cull::block::alone(tracer, candidates, (at.x0, at.y0), (xs, ys), id, far, size)
     };
     let mut shoot = |sx: usize, sy: usize| -> Shot<R> {
         let (ray, uv) = eye.ray(sx, sy);

@@ -1,14 +1,14 @@
 //! The builder: raw descriptions in `f64` in, validated objects in the tracer's scalar out.
 
+use super::effects::{Effects, MAX_DEPTH};
 use super::error::SceneError;
 use super::model::{Composite, Light, Material, Object, Parts, Scene, Smooth, NO_COMPOSITE};
+use super::region::Region;
+use super::windows::{shadow_basis, Regions};
 use crate::camera::{lowest_terms, resolvable_pixels, Camera, CameraDesc};
-use crate::cull::build::{shadow_basis, Regions};
-use crate::cull::Region;
 use crate::math::{Aabb, Affine, Linear, Vec3};
 use crate::scalar::{log2_of_pow2, Real};
 use crate::shape::Shape;
-use crate::trace::Effects;
 
 /// Builds and validates a [`Scene`] into caller-provided object storage.
 #[derive(Debug)]
@@ -174,7 +174,8 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
 
     /// Adds a smooth triangle: [`SceneBuilder::add_triangle`] with a normal at each corner
     /// (NFF's `pp`), interpolated across it for shading ([`Smooth`]). A corner's normal of no
-    /// length (or not finite) takes the flat one; normals need not face the triangle's side.
+    /// length (or not finite) takes the flat one; any other, however long or short, is taken
+    /// as its direction; normals need not face the triangle's side.
     pub fn add_smooth_triangle(
         &mut self,
         corners: [Vec3<f64>; 3],
@@ -187,10 +188,13 @@ impl<'a, R: Real> SceneBuilder<'a, R> {
         self.add_triangle(corners, material)?;
         let [a, b, c] = corners;
         let flat = (b - a).cross(c - a).normalize();
+        // Divided by its largest component first, so a normal of any finite length (1e300,
+        // 1e-300) keeps its direction: its square would overflow or vanish.
         let unit = |n: Vec3<f64>| {
-            let l = n.length();
-            if l > 0.0 && l.is_finite() {
-                n * (1.0 / l)
+            let m = n.max_abs();
+            if m > 0.0 && m.is_finite() {
+                let v = Vec3::new(n.x / m, n.y / m, n.z / m);
+                v * (1.0 / v.length())
             } else {
                 flat
             }
@@ -519,7 +523,7 @@ fn is_unit(v: Vec3<f64>) -> bool {
 /// The inverse of a transform, refusing one whose entries overflowed (composition of huge
 /// factors) or that is singular.
 fn checked_inverse(t: &Affine<f64>) -> Result<Affine<f64>, SceneError> {
-    if t.m.iter().flatten().any(|v| !v.is_finite()) {
+    if t.m.iter().flatten().any(|v| !v.is_finite()) || !t.det().is_finite() {
         return Err(SceneError::TransformOverflow);
     }
     t.inverse().ok_or(SceneError::SingularTransform)
@@ -560,7 +564,7 @@ fn brightness_bound<R: Real>(materials: &[Material<R>], lights: &[Light<R>], amb
         ambient.abs() * m.ka.to_f64() + (m.kd.to_f64() + highlight) * ip
     };
     let mut below = materials.iter().map(local).fold(bg, f64::max);
-    for _ in 0..crate::trace::MAX_DEPTH {
+    for _ in 0..MAX_DEPTH {
         below = materials.iter().map(|m| local(m) + (m.ks.to_f64() + m.kt.to_f64()) * below).fold(bg, f64::max);
     }
     below

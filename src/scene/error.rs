@@ -138,7 +138,7 @@ impl fmt::Display for SceneError {
                 write!(f, "{what} out of range for {scalar}: magnitude must stay below {}", Round(*limit))
             }
             SceneError::TransformOverflow => {
-                write!(f, "transform out of range: composed, its entries overflow (more than 1e308)")
+                write!(f, "transform out of range: its entries, composed or multiplied, overflow (more than 1e308)")
             }
             SceneError::TooBright { bound, limit, scalar } => write!(
                 f,

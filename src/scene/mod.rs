@@ -7,28 +7,37 @@
 //! slice, so the capacity is the caller's choice and running out is an ordinary error.
 //!
 //! Rooms: [`model`] (what a validated scene is), [`builder`] (how one is validated),
-//! [`error`] (why one is refused) and [`text`] (the plain-text format, one function per
-//! statement). Where on the image an object can appear is [`crate::cull`]'s; the camera is
-//! [`crate::camera`]'s.
+//! [`error`] (why one is refused), [`effects`] (what the scene calls for), [`region`] (where
+//! on the image and across the light each object can appear, built by `windows` through the
+//! eye's `projection` and, with the `eye-hulls` feature, `hull`), and the formats: [`text`]
+//! (the plain-text format, one function per statement) and `nff` (with `polygon`). The camera
+//! is [`crate::camera`]'s.
 
 pub mod builder;
+pub mod effects;
 pub mod error;
+#[cfg(feature = "eye-hulls")]
+pub(crate) mod hull;
 pub mod model;
 #[cfg(feature = "nff")]
 pub mod nff;
 #[cfg(feature = "nff")]
 pub mod polygon;
+mod projection;
+pub mod region;
 pub mod text;
+mod windows;
 
 pub use crate::camera::{lowest_terms, Camera, CameraDesc, FieldOfView, DEFAULT_FRAME, VIEW_MARGIN};
-pub use crate::cull::{
-    Culled, EyeHull, EyeWindow, HullEdge, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE,
-};
 pub use builder::{check_value, SceneBuilder, IOR};
+pub use effects::{Effects, MAX_DEPTH};
 pub use error::SceneError;
 pub use model::{
     axis_normal, Composite, Light, Material, Object, Parts, Scene, Smooth, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS,
     MAX_SMOOTH, NO_COMPOSITE,
+};
+pub use region::{
+    Culled, EyeHull, EyeWindow, HullEdge, Region, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE,
 };
 
 use crate::scalar::Real;
@@ -51,7 +60,8 @@ impl Format {
     /// The format of `text`: NFF when its first word is one of [`NFF_ENTITIES`] (a build
     /// without the `nff` feature tells them apart too, to refuse NFF by name).
     pub fn of(text: &str) -> Self {
-        let first = text.lines().map(|l| l.split('#').next().unwrap_or("")).flat_map(str::split_whitespace).next();
+        let first =
+            without_bom(text).lines().map(|l| l.split('#').next().unwrap_or("")).flat_map(str::split_whitespace).next();
         if first.is_some_and(|w| NFF_ENTITIES.contains(&w)) {
             Format::Nff
         } else {
@@ -60,8 +70,14 @@ impl Format {
     }
 }
 
+/// `text` without the UTF-8 byte-order mark some editors put first: no word of either format.
+fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
+
 /// The object storage `text` (either [`Format`]) needs.
 pub fn object_count(text: &str) -> usize {
+    let text = without_bom(text);
     match Format::of(text) {
         #[cfg(feature = "nff")]
         Format::Nff => nff::object_count(text),
@@ -88,6 +104,7 @@ pub fn parse_with<'a, 't, R: Real>(
     parts: &'a mut Parts<R>,
     camera: impl FnOnce(&mut CameraDesc),
 ) -> Result<Scene<'a, R>, ParseError<'t>> {
+    let text = without_bom(text);
     match Format::of(text) {
         #[cfg(feature = "nff")]
         Format::Nff => nff::parse_with(text, storage, parts, camera),

@@ -1,11 +1,12 @@
 //! The validated scene: objects, composites, materials, lights and the camera.
 
+use super::effects::Effects;
+use super::region::{any_object, Culled, EyeHull, EyeWindow, Region, ShadowWindow};
+use crate::bounds::at;
 use crate::camera::Camera;
-use crate::cull::{any_object, Culled, EyeHull, EyeWindow, Region, ShadowWindow};
 use crate::math::{Aabb, Affine, Linear, Ray, Vec3};
 use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
-use crate::trace::Effects;
 use heapless::Vec;
 
 /// Most materials a scene may define: 16 in a build without `alloc` (a microcontroller's),
@@ -314,7 +315,7 @@ impl<R: Real> Object<R> {
 
     /// Whether the object can appear in the window rectangle `u` x `v` (as
     /// [`Object::eye_window_meets`] takes it): its eye window meets it, and so does its
-    /// [`crate::cull::EyeHull`] where the build keeps one (the `eye-hulls` feature).
+    /// [`EyeHull`] where the build keeps one (the `eye-hulls` feature).
     #[inline]
     pub fn eye_region_meets(&self, u: [i32; 2], v: [i32; 2]) -> bool {
         self.region.eye_meets(u, v)
@@ -717,6 +718,47 @@ impl<'a, R: Real> Scene<'a, R> {
     pub fn smooth_of(&self, i: u32) -> Option<&'a Smooth<R>> {
         let k = self.smooth.binary_search_by_key(&i, |s| s.object).ok()?;
         self.smooth.get(k)
+    }
+}
+
+/// What a scene calls for is read from its model: the set is worked out once, when the scene is
+/// validated, and kept in it.
+impl Effects {
+    /// The effects a scene calls for. Shadows need a light and at least two objects (a lone
+    /// convex solid never shadows itself; a lone open side can); reflection needs a
+    /// material with `Ks > 0` on some object, refraction one with `Kt > 0`, highlights one with
+    /// `Ks > 0` and a `shine` power.
+    pub fn of<R: Real>(scene: &Scene<'_, R>) -> Self {
+        scene.effects
+    }
+
+    /// [`Effects::of`] worked out from the scene's objects, materials and lights (when the scene
+    /// is validated, so a baked scene carries it as a literal).
+    pub(crate) fn called_for<R: Real>(scene: &Scene<'_, R>) -> Self {
+        let used = |f: fn(&Material<R>) -> R| {
+            scene.objects.iter().any(|o| f(at(scene.materials, o.material as usize)) > R::ZERO)
+        };
+        let mut e = Self::NONE;
+        let self_shadowing = || scene.objects.iter().any(|o| !o.shape.is_solid());
+        if !scene.lights.is_empty() && (scene.objects.len() > 1 || self_shadowing()) {
+            e = e | Self::SHADOWS;
+        }
+        if used(|m| if m.shine > 0 { m.ks } else { R::ZERO }) {
+            e = e | Self::HIGHLIGHTS;
+        }
+        if used(|m| m.ks) {
+            e = e | Self::REFLECTION;
+        }
+        if used(|m| m.kt) {
+            e = e | Self::REFRACTION;
+        }
+        if scene.lights.iter().any(|l| matches!(l, Light::Point { .. })) {
+            e = e | Self::POINT_LIGHTS;
+        }
+        if !scene.composites.is_empty() {
+            e = e | Self::COMPOSITES;
+        }
+        e
     }
 }
 

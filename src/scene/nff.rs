@@ -46,8 +46,10 @@ pub fn object_count(text: &str) -> usize {
         match w {
             "s" | "c" => n += 1,
             "p" | "pp" => {
+                // A polygon larger than the reader takes is refused at its line; it counts no more
+                // than the largest it takes (so no storage is sized for a count it refuses).
                 if let Some(k) = t.next().and_then(|(_, _, c)| c.parse::<usize>().ok()) {
-                    n = n.saturating_add(k.saturating_sub(2));
+                    n = n.saturating_add(k.min(MAX_VERTICES).saturating_sub(2));
                 }
             }
             _ => {}
@@ -81,6 +83,8 @@ pub fn parse_with<'a, 't, R: Real>(
         material: None,
         lights: Vec::new(),
         last: (1, 1, ""),
+        view: None,
+        background: None,
     };
     p.b.background = 0.0;
     while let Some(at) = p.t.next() {
@@ -93,31 +97,46 @@ pub fn parse_with<'a, 't, R: Real>(
 /// A word of the text with its line and column (1-based).
 type At<'t> = (u32, u32, &'t str);
 
-/// The words of NFF text, with their lines and columns; `#` comments skipped.
+/// The words of NFF text, with their lines and columns; `#` comments skipped. A line ends at
+/// LF, CR LF or a lone CR, as in the scene format. Columns are counted in characters as the
+/// words go by, so a file of one long line reads in time linear in its length.
+#[derive(Clone, Copy)]
 struct Tokens<'t> {
     text: &'t str,
     pos: usize,
     line: u32,
-    line_start: usize,
+    /// The byte up to which the line's characters are counted, and the column there.
+    counted: (usize, u32),
+    /// Just past the last word read: its line and the column after it (where a value missing
+    /// after it is reported).
+    end: (u32, u32),
 }
 
 impl<'t> Tokens<'t> {
     fn new(text: &'t str) -> Self {
-        Tokens { text, pos: 0, line: 1, line_start: 0 }
+        Tokens { text, pos: 0, line: 1, counted: (0, 1), end: (1, 1) }
+    }
+
+    /// The column of byte `at` of the current line (at or after the bytes counted so far).
+    fn column(&mut self, at: usize) -> u32 {
+        let col = self.counted.1 + self.text[self.counted.0..at].chars().count() as u32;
+        self.counted = (at, col);
+        col
     }
 
     fn next(&mut self) -> Option<At<'t>> {
         let b = self.text.as_bytes();
+        let ends_line = |i: usize| b[i] == b'\n' || (b[i] == b'\r' && b.get(i + 1) != Some(&b'\n'));
         loop {
             let c = *b.get(self.pos)?;
-            if c == b'\n' {
+            if ends_line(self.pos) {
                 self.pos += 1;
                 self.line += 1;
-                self.line_start = self.pos;
+                self.counted = (self.pos, 1);
             } else if c.is_ascii_whitespace() {
                 self.pos += 1;
             } else if c == b'#' {
-                while b.get(self.pos).is_some_and(|&c| c != b'\n') {
+                while self.pos < b.len() && !ends_line(self.pos) {
                     self.pos += 1;
                 }
             } else {
@@ -128,13 +147,19 @@ impl<'t> Tokens<'t> {
         while b.get(self.pos).is_some_and(|&c| !c.is_ascii_whitespace() && c != b'#') {
             self.pos += 1;
         }
-        let col = self.text[self.line_start..start].chars().count() as u32 + 1;
+        let col = self.column(start);
+        self.end = (self.line, self.column(self.pos));
         Some((self.line, col, &self.text[start..self.pos]))
     }
 
     /// The next word without taking it.
     fn peek(&self) -> Option<At<'t>> {
-        Tokens { ..*self }.next()
+        { *self }.next()
+    }
+
+    /// A value missing after the last word read: reported just past that word.
+    fn missing(&self) -> ParseError<'t> {
+        ParseError { line: self.end.0, col: self.end.1, token: "", kind: ParseErrorKind::MissingValue }
     }
 }
 
@@ -148,6 +173,10 @@ struct Reader<'a, 't, R> {
     lights: Vec<(Vec3<f64>, f64, At<'t>), MAX_LIGHTS>,
     /// The entity being read (what a scene-wide error is blamed on).
     last: At<'t>,
+    /// The last view (`v`) and background (`b`): what a camera's or the background's error,
+    /// found when the scene is validated, is blamed on.
+    view: Option<At<'t>>,
+    background: Option<At<'t>>,
 }
 
 fn error(at: At<'_>, kind: ParseErrorKind) -> ParseError<'_> {
@@ -159,8 +188,8 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
         match at.2 {
             "v" => self.view(at),
             "b" => {
-                let [r, g, b] = self.numbers()?;
-                self.b.background = luminance(r, g, b);
+                self.b.background = self.colour()?;
+                self.background = Some(at);
                 Ok(())
             }
             "l" => self.light(at),
@@ -173,17 +202,20 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
         }
     }
 
-    /// The next word, or an error at the end of the text.
+    /// The next word, or an error just past the last word at the end of the text.
     fn word(&mut self) -> Result<At<'t>, ParseError<'t>> {
-        match self.t.next() {
-            Some(at) => Ok(at),
-            None => Err(ParseError { line: self.t.line, col: 1, token: "", kind: ParseErrorKind::MissingValue }),
-        }
+        self.t.next().ok_or_else(|| self.t.missing())
     }
 
-    /// A finite number.
+    /// A finite number. An entity's word on a later line than the word before it (the next
+    /// entity, where this one's last value is missing) is reported as a value missing just past
+    /// the word before it.
     fn number(&mut self) -> Result<f64, ParseError<'t>> {
+        let before = self.t;
         let at = self.word()?;
+        if at.0 > before.end.0 && super::NFF_ENTITIES.contains(&at.2) {
+            return Err(before.missing());
+        }
         match parse_number(at.2) {
             Some(v) if v.is_finite() => Ok(v),
             // Digits beyond f64 (`1e999`) are out of range; `nan` and `inf` are not finite.
@@ -201,6 +233,31 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
             *x = self.number()?;
         }
         Ok(v)
+    }
+
+    /// A number that `ok` accepts, or `kind` at its word.
+    fn checked(&mut self, ok: impl Fn(f64) -> bool, kind: ParseErrorKind) -> Result<f64, ParseError<'t>> {
+        let at = self.t.peek();
+        let v = self.number()?;
+        match at {
+            Some(at) if !ok(v) => Err(error(at, kind)),
+            _ => Ok(v),
+        }
+    }
+
+    /// `R G B`, each at least 0, as a gray ([`luminance`]); a gray beyond f64 is out of range at
+    /// the colour's first word.
+    fn colour(&mut self) -> Result<f64, ParseError<'t>> {
+        let at = self.t.peek();
+        let mut rgb = [0.0; 3];
+        for c in rgb.iter_mut() {
+            *c = self.checked(|v| v >= 0.0, ParseErrorKind::NegativeColour)?;
+        }
+        let gray = luminance(rgb[0], rgb[1], rgb[2]);
+        match at {
+            Some(at) if !gray.is_finite() => Err(error(at, ParseErrorKind::NumberOutOfRange)),
+            _ => Ok(gray),
+        }
     }
 
     fn point(&mut self) -> Result<Vec3<f64>, ParseError<'t>> {
@@ -246,7 +303,7 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
                 _ => {
                     let [w, h] = self.numbers()?;
                     if !(w >= 1.0 && h >= 1.0) {
-                        return Err(error(next, ParseErrorKind::Scene(SceneError::BadFieldOfView)));
+                        return Err(error(next, ParseErrorKind::BadResolution));
                     }
                     res = Some(w.min(h));
                 }
@@ -268,6 +325,7 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
             return Err(error(at, ParseErrorKind::Scene(SceneError::BadFieldOfView)));
         }
         c.fov = FieldOfView::Within(edges, edges);
+        self.view = Some(at);
         Ok(())
     }
 
@@ -275,21 +333,23 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
     fn light(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
         let pos = self.point()?;
         // A colour follows when the next word is a number.
-        let gray = if self.t.peek().is_some_and(|(_, _, w)| parse_number(w).is_some()) {
-            let [r, g, b] = self.numbers()?;
-            luminance(r, g, b)
-        } else {
-            1.0
-        };
+        let gray = if self.t.peek().is_some_and(|(_, _, w)| parse_number(w).is_some()) { self.colour()? } else { 1.0 };
         self.lights.push((pos, gray, at)).map_err(|_| error(at, ParseErrorKind::Scene(SceneError::TooManyLights)))
     }
 
     /// `f R G B Kd Ks Shine T ior`: the material of the objects that follow.
     fn fill(&mut self, at: At<'t>) -> Result<(), ParseError<'t>> {
-        let [r, g, b, kd, ks, shine] = self.numbers()?;
-        let t_at = self.t.peek();
-        let [t, ior] = self.numbers()?;
-        let gray = luminance(r, g, b);
+        let gray = self.colour()?;
+        let coefficient = || ParseErrorKind::Scene(SceneError::BadCoefficient);
+        let kd_at = self.t.peek();
+        let kd = self.checked(|v| v >= 0.0, coefficient())?;
+        let ks = self.checked(|v| v >= 0.0, coefficient())?;
+        let shine = self.checked(|v| v >= 0.0, coefficient())?;
+        let t = self.checked(|v| v >= 0.0, coefficient())?;
+        let ior = self.checked(|v| t == 0.0 || v >= 1.0, coefficient())?;
+        if let Some(kd_at) = kd_at.filter(|_| !(kd * gray).is_finite()) {
+            return Err(error(kd_at, ParseErrorKind::NumberOutOfRange));
+        }
         let m = Material {
             ka: kd * gray,
             kd: kd * gray,
@@ -298,9 +358,6 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
             ior: if t > 0.0 { ior } else { 1.0 },
             shine: if shine >= 0.0 { Material::power(shine) } else { 0 },
         };
-        if m.ka < 0.0 || ks < 0.0 || t < 0.0 || shine < 0.0 || m.ior < 1.0 {
-            return Err(error(t_at.unwrap_or(at), ParseErrorKind::Scene(SceneError::BadCoefficient)));
-        }
         if let Some(&(_, id)) = self.materials.iter().find(|(known, _)| *known == m) {
             self.material = Some(id);
             return Ok(());
@@ -413,7 +470,14 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
                 .map_err(|e| error(at, ParseErrorKind::Scene(e)))?;
         }
         camera(&mut self.b.camera);
+        // The camera's and the background's errors are the view's and the background's; the
+        // rest are the scene's, blamed on its last entity.
+        let blame = |e: &SceneError| match e {
+            SceneError::DegenerateCamera | SceneError::BadFieldOfView | SceneError::OutOfRange { .. } => self.view,
+            SceneError::ValueOutOfRange { what: "background", .. } => self.background,
+            _ => None,
+        };
         let last = self.last;
-        self.b.finish().map_err(|e| error(last, ParseErrorKind::Scene(e)))
+        self.b.finish().map_err(|e| error(blame(&e).unwrap_or(last), ParseErrorKind::Scene(e)))
     }
 }

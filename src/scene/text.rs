@@ -5,6 +5,7 @@
 //! columns count bytes), the offending token and the reason. Parsing feeds a [`SceneBuilder`],
 //! which validates each object as it arrives, so range errors also point at their line.
 
+use super::effects::MAX_DEPTH;
 use super::{
     check_value, CameraDesc, FieldOfView, Light, Material, Object, Parts, Scene, SceneBuilder, SceneError, IOR,
     MAX_MATERIALS,
@@ -12,7 +13,6 @@ use super::{
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
 use crate::shape::Shape;
-use crate::trace::MAX_DEPTH;
 use core::fmt;
 use heapless::Vec;
 
@@ -68,6 +68,12 @@ pub enum ParseErrorKind {
     CoincidentEnds,
     /// NFF text given to a build without the `nff` feature (the firmware's).
     NffLeftOut,
+    /// NFF: a `resolution` that is not at least one pixel each way.
+    BadResolution,
+    /// NFF: a colour with a negative component (of a surface, a light or the background).
+    NegativeColour,
+    /// NFF: a polygon whose edges cross (a bow tie): it has no inside to draw.
+    SelfIntersecting,
     /// NFF: a polygon of more vertices than this build reads.
     PolygonTooLarge {
         /// The most it reads (`scene::polygon::MAX_VERTICES`).
@@ -149,6 +155,11 @@ impl fmt::Display for ParseErrorKind {
             ParseErrorKind::CoincidentEnds => write!(f, "the cone's base and apex are the same point"),
             ParseErrorKind::NffLeftOut => {
                 write!(f, "NFF, which this build does not read (its lattice-rt lacks the feature `nff`)")
+            }
+            ParseErrorKind::BadResolution => write!(f, "a resolution must be at least 1 pixel each way"),
+            ParseErrorKind::NegativeColour => write!(f, "a colour's components must be >= 0"),
+            ParseErrorKind::SelfIntersecting => {
+                write!(f, "the polygon's edges cross each other (NFF's polygons are simple: no inside to draw)")
             }
             ParseErrorKind::PolygonTooLarge { most } => {
                 write!(f, "a polygon of more vertices than this build reads (at most {most})")

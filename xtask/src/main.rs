@@ -11,6 +11,7 @@ mod display;
 mod effects;
 mod elf;
 mod firmware;
+mod layers;
 mod memory;
 mod motion;
 mod playground;
@@ -245,6 +246,10 @@ enum Command {
         #[arg(long, default_value = "docs/motion.md")]
         out: PathBuf,
     },
+    /// Check the house's layers: the modules of every folder of every crate depend on each
+    /// other without a circle (printed lowest layer first), and ARCHITECTURE.md names every
+    /// module. `cargo test -p xtask` runs the same check.
+    Layers,
 }
 
 fn main() {
@@ -283,5 +288,6 @@ fn real_main() -> Result<()> {
             profile::profile_cmd(&root, &profile::ProfileArgs { variant, scene, top, under })
         }
         Command::Motion { scenes, frames, out } => motion::motion_cmd(&default_scenes(scenes), frames, &out),
+        Command::Layers => layers::layers_cmd(&root),
     }
 }

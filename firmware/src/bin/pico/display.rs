@@ -7,14 +7,9 @@
 //! render loop the same two things: [`Pump`], its hooks, and [`flush`], the wait until the
 //! frame is on the panel.
 
-#[cfg(not(feature = "spi"))]
-mod bus_clear;
 #[cfg(not(any(feature = "sharp", feature = "uc8151")))]
 pub mod controller;
-#[cfg(not(feature = "spi"))]
-mod i2c;
-#[cfg(not(feature = "spi"))]
-pub use i2c::{flush, reset, Pump, QueuedI2c};
+pub use crate::bus::{flush, reset, Pump};
 #[cfg(not(any(feature = "sharp", feature = "gray", feature = "uc8151")))]
 mod pages;
 #[cfg(not(any(feature = "sharp", feature = "gray", feature = "uc8151")))]
@@ -23,14 +18,10 @@ pub use pages::PageTiles;
 pub mod gray;
 #[cfg(feature = "sharp")]
 pub mod sharp;
-#[cfg(feature = "spi")]
-mod spi;
 #[cfg(feature = "gray")]
 mod spi_dma;
 #[cfg(feature = "uc8151")]
 pub mod uc8151;
-#[cfg(feature = "spi")]
-pub use spi::{flush, reset, Pump};
 
 use display_interface::DisplayError;
 #[cfg(not(feature = "gray"))]
@@ -43,9 +34,8 @@ use {
     firmware::app::{HEIGHT, WIDTH},
 };
 
-/// The most rows drawn at once: a band of tiles.
 #[cfg(not(feature = "gray"))]
-const BAND_ROWS: usize = firmware::app::RENDERED.tile as usize;
+use crate::bus::BAND_ROWS;
 
 /// The panel's name in the log.
 #[cfg(not(any(feature = "sharp", feature = "uc8151")))]

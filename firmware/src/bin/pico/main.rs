@@ -19,6 +19,7 @@
 #![no_std]
 #![no_main]
 
+mod bus;
 mod button;
 mod cores;
 mod display;
@@ -109,8 +110,8 @@ fn main() -> ! {
     };
     let sio = hal::Sio::new(pac.SIO);
     let pins = hal::gpio::Pins::new(pac.IO_BANK0, pac.PADS_BANK0, sio.gpio_bank0, &mut pac.RESETS);
-    let wiring::Connected { display: interface, mut led, mut reset } =
-        wiring::connect(pins, pac.I2C0, pac.SPI0, &mut pac.RESETS, &clocks);
+    let bus::Connected { display: interface, mut led, mut reset } =
+        bus::connect(pins, pac.I2C0, pac.SPI0, &mut pac.RESETS, &clocks);
     #[cfg(feature = "pico")]
     let timer_block = pac.TIMER;
     #[cfg(feature = "pico2")]

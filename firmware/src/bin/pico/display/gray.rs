@@ -25,8 +25,9 @@
 
 use super::controller::{self, CLOCK, PANEL, PRECHARGE};
 use super::SetUp;
+use crate::bus::Interface;
 use crate::hal::pac;
-use crate::wiring::{Interface, Wiring};
+use crate::wiring::Wiring;
 use core::cell::{RefCell, UnsafeCell};
 use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
 use cortex_m::interrupt::Mutex;

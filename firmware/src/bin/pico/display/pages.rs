@@ -3,7 +3,8 @@
 //! ([`super::controller::PANEL`]), addressed as it takes them.
 
 use super::controller::{self, Addressing, PANEL};
-use super::{flush, Band, SetUp, BAND_ROWS};
+use super::{flush, Band, SetUp};
+use crate::bus::BAND_ROWS;
 use display_interface::{DataFormat, DisplayError, WriteOnlyDataCommand};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use firmware::app::WIDTH;

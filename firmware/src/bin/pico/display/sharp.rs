@@ -14,9 +14,10 @@
 //! cycles, which core 0 no longer waits out. The bus is the interrupt's and the render loop's
 //! in turn: each touches it with core 0's interrupts masked.
 
-use super::{Band, SetUp, BAND_ROWS};
+use super::{Band, SetUp};
+use crate::bus::Interface;
+use crate::bus::BAND_ROWS;
 use crate::hal;
-use crate::wiring::Interface;
 use core::cell::RefCell;
 use cortex_m::interrupt::Mutex;
 use display_interface::DisplayError;

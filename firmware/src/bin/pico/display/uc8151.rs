@@ -14,7 +14,8 @@
 //! The first frame after reset, and one whose changes span the glass, are refreshed whole.
 
 use super::{Band, SetUp};
-use crate::wiring::{Interface, Wiring};
+use crate::bus::Interface;
+use crate::wiring::Wiring;
 use display_interface::{DataFormat, DisplayError, WriteOnlyDataCommand};
 use embedded_graphics_core::pixelcolor::BinaryColor;
 use firmware::app::{HEIGHT, WIDTH};

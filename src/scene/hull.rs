@@ -12,11 +12,11 @@
 //! cone's hull is drawn in further, to its outline (the images of its caps, or of the circle
 //! where the eye's rays graze the sphere).
 
+use super::model::Object;
 use super::projection::Projection;
 use super::region::{EyeHull, HullEdge, NO_HULL};
 use crate::math::{Affine, Vec3};
 use crate::scalar::Real;
-use crate::scene::Object;
 use crate::shape::Shape;
 
 impl Projection {
@@ -189,7 +189,7 @@ fn disc_support(d: &Disc, a: f64, b: f64) -> Option<f64> {
 }
 
 /// The convex hull of eight points: its corners counter-clockwise, and how many there are.
-pub(super) fn convex_hull(mut points: [[f64; 2]; 8]) -> ([[f64; 2]; 16], usize) {
+pub(crate) fn convex_hull(mut points: [[f64; 2]; 8]) -> ([[f64; 2]; 16], usize) {
     points.sort_unstable_by(|p, q| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])));
     let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
     // Andrew's monotone chain: the lower hull left to right, then the upper right to left.

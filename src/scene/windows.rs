@@ -2,12 +2,12 @@
 //! eye window), along the first light (the shadow window) and, with the `eye-hulls` feature,
 //! the convex hull of its box's image ([`super::hull`]).
 
+use super::model::{Light, Object};
 use super::projection::Projection;
 use super::region::{shadow_whole_plane, EyeWindow, Region, ShadowWindow, EYE_MARGIN, WHOLE_PLANE};
 use crate::camera::Camera;
 use crate::math::{Aabb, Vec3};
 use crate::scalar::Real;
-use crate::scene::{Light, Object};
 
 /// The [`EyeWindow`] of a box: its eight corners projected through the camera's eye onto the
 /// window plane (`projection`: in `f64`, from the camera's vectors as the scalar holds them),

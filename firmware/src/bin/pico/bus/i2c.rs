@@ -2,7 +2,7 @@
 //! controller's TX_EMPTY interrupt on core 0 (and after each tile core 0 traces), so the bus
 //! sends a band while the cores trace the next, and never waits for a tile to end. A transfer
 //! that fails (no acknowledge, arbitration lost, a bus that stops moving) leaves the controller
-//! reset and the bus cleared ([`super::bus_clear`]) before the next one.
+//! reset and the bus cleared ([`super::clear`]) before the next one.
 
 use crate::hal;
 use crate::wiring::Wiring;
@@ -302,8 +302,8 @@ impl<P> QueuedI2c<P> {
             #[allow(unsafe_code)]
             let resets = unsafe { &*pac::RESETS::ptr() };
             resets.reset().modify(|_, w| w.i2c0().set_bit());
-            if super::bus_clear::sda_held(Wiring::SDA) {
-                match super::bus_clear::clear(Wiring::SDA, Wiring::SCL) {
+            if super::clear::sda_held(Wiring::SDA) {
+                match super::clear::clear(Wiring::SDA, Wiring::SCL) {
                     Some(pulses) => {
                         defmt::warn!("the display held SDA low: the bus cleared with {} clock pulses", pulses)
                     }

@@ -1,12 +1,12 @@
 //! The regions' tests: hulls that hold every hit, blocks whose hidden objects never show.
 
 use super::block::{behind, block_directions};
-#[cfg(feature = "eye-hulls")]
-use super::hull::convex_hull;
-use super::region::{hull_meets, HullEdge, NO_HULL};
 use crate::camera::Camera;
 use crate::math::Vec3;
 use crate::scalar::Real;
+#[cfg(feature = "eye-hulls")]
+use crate::scene::hull::convex_hull;
+use crate::scene::region::{hull_meets, HullEdge, NO_HULL};
 use crate::scene::Scene;
 use crate::scene::{Object, Parts, SceneBuilder};
 

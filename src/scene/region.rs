@@ -198,3 +198,24 @@ impl<R: Real> Region<R> {
         }
     }
 }
+
+/// Calls `f` with each object of a mask (bit `i`: object `i`, of the first 64) that a scene of
+/// `n` objects has, lowest first, until `f` answers true; returns whether it did. The mask is
+/// taken by halves of 32 bits (a Cortex-M0+ counts and shifts 64-bit values in library calls),
+/// each cut to the objects there are; two plain loops, which the tracer's eye rays run faster
+/// than an iterator's state.
+#[inline(always)]
+pub(crate) fn any_object(mask: u64, n: usize, mut f: impl FnMut(usize) -> bool) -> bool {
+    let below = |n: usize| if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
+    for (half, base) in [(mask as u32, 0), ((mask >> 32) as u32, 32)] {
+        let mut left = half & below(n.saturating_sub(base));
+        while left != 0 {
+            let i = base + left.trailing_zeros() as usize;
+            left &= left - 1;
+            if f(i) {
+                return true;
+            }
+        }
+    }
+    false
+}

@@ -2,11 +2,11 @@
 //! object be filled from them? Yes when no other object can appear there ([`alone`]), or every
 //! one that can lies behind that object all over the block ([`behind`]).
 
-use super::any_object;
 use crate::accel::Accelerator;
 use crate::camera::Camera;
 use crate::math::{Aabb, Vec3};
 use crate::scalar::Real;
+use crate::scene::region::any_object;
 use crate::scene::Scene;
 use crate::trace::Tracer;
 
