@@ -212,3 +212,93 @@ fn smooth_normals_interpolate_and_face_the_ray() {
     // Met from the other side: turned round.
     assert!(close(s.normal(Vec3::new(third, 0.0, third), -up), -mid));
 }
+
+/// Hostile NFF, each case with the line, column and reason its error must give (issue 88): the
+/// camera's and the background's errors at `v` and `b`, not at the last entity; each word of
+/// `f` at its own column; a value missing just past the entity's last word, on its line; a
+/// byte-order mark and lone CRs read as an editor shows them.
+#[test]
+fn hostile_nff_is_refused_at_its_place_for_its_reason() {
+    let view = "v from 0 -5 0 at 0 0 0 up 0 0 1 angle 40\n";
+    let sphere = "s 0 0 0 1\n";
+    let cases: Vec<(String, &str, &str)> = vec![
+        (
+            format!("v from 0 -5 0 at 0 -5 0 up 0 0 1 angle 40\n{sphere}s 1 1 1 1\n"),
+            "line 1, column 1 at `v`",
+            "camera",
+        ),
+        (format!("v from 0 -5 0 at 0 0 0 up 0 0 0 angle 40\n{sphere}"), "line 1, column 1 at `v`", "camera"),
+        (format!("v from 0 -5 0 at 0 0 0 up 0 1 0 angle 40\n{sphere}"), "line 1, column 1 at `v`", "camera"),
+        (format!("v from 0 1e200 -10 at 0 0 0 up 0 0 1 angle 40\n{sphere}"), "line 1, column 1 at `v`", ""),
+        (format!("{view}b 1e300 1e300 1e300\n{sphere}s 2 0 0 1\n"), "line 2, column 1 at `b`", "background"),
+        (format!("{view}b 1e308 1e308 1e308\n{sphere}"), "line 2, column 1 at `b`", "background"),
+        (
+            format!("{view}v from 0 -5 0 at 0 0 0 up 0 0 1 angle 40 resolution 0 0\n{sphere}"),
+            "line 2, column 42 at `resolution`",
+            "resolution",
+        ),
+        (format!("{view}f 1 -1 1 1 0 0 0 1\n{sphere}"), "line 2, column 5 at `-1`", "colour"),
+        (format!("{view}f 1 1 1 -1 0 0 0 1\n{sphere}"), "line 2, column 9 at `-1`", "coefficients"),
+        (format!("{view}f 1 1 1 1 0 0 0.5 0.5\n{sphere}"), "line 2, column 19 at `0.5`", "index of refraction"),
+        (format!("{view}f 1e200 1e200 1e200 1e200 0 0 0 1\n{sphere}"), "line 2, column 21 at `1e200`", "out of range"),
+        (format!("{view}l 0 0 5 1 -0.5 1\n{sphere}"), "line 2, column 11 at `-0.5`", "colour"),
+        (format!("{view}s 0 0 0 6e102\n"), "line 2, column 1 at `s`", "out of range"),
+        (format!("{view}s 0 0 0\ns 1 1 1 1\n"), "line 2, column 8", "missing"),
+        (format!("{view}pp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0\n"), "line 5, column 6", "missing"),
+        (format!("{view}pp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0\ns 0 0 0 1\n"), "line 5, column 6", "missing"),
+        (format!("{view}p 3\n0 0 0\n1 0 0\n"), "line 4, column 6", "missing"),
+        (format!("{view}p 3000000\n"), "line 2, column 3 at `3000000`", "more vertices"),
+        (format!("{view}p 18446744073709551615\n"), "line 2, column 3 at `18446744073709551615`", "more vertices"),
+        (format!("{view}p 4\n-2 -1 0\n2 1 0\n2 -1 0\n-2 1 0\n"), "line 2, column 1 at `p`", "cross"),
+        (format!("{view}p 4\n0 -2 -1\n0 2 1\n0 2 -1\n0 -2 1\n"), "line 2, column 1 at `p`", "cross"),
+        (format!("\u{feff}{view}s 0 0 0 -1\n"), "line 2, column 9 at `-1`", "negative radius"),
+        (format!("{}\rs 0 0 0 -1\r", view.trim_end()), "line 2, column 9 at `-1`", "negative radius"),
+        (format!("{}\rs 0 0 0\rs 1 1 1 1\r", view.trim_end()), "line 2, column 8", "missing"),
+    ];
+    for (text, place, reason) in &cases {
+        let mut storage = vec![Object::<f64>::default(); lattice_rt::scene::object_count(text).clamp(1, 1 << 16)];
+        let mut parts = Parts::default();
+        let e = match lattice_rt::scene::parse::<f64>(text, &mut storage, &mut parts) {
+            Ok(_) => panic!("accepted:\n{text}"),
+            Err(e) => e.to_string(),
+        };
+        assert!(e.starts_with(&format!("{place}:")), "{text:?}\n  gave {e}\n  want {place}");
+        assert!(e.contains(reason), "{text:?}\n  gave {e}\n  want the reason `{reason}`");
+    }
+}
+
+/// `pp` normals of any finite length shade as the same normals of length 1 (a normal of
+/// 1e200 squared overflows, one of 1e-200 vanishes: neither may fall back to the flat shading).
+#[test]
+fn patch_normals_of_any_length_keep_their_direction() {
+    let tilt = [[0.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 1.0, -1.0]];
+    let unit = gray(&facing_triangle(Some(tilt)));
+    assert_ne!(unit, gray(&facing_triangle(None)), "the tilted normals shade unlike the flat face");
+    for scale in [1e300, 1e200, 1e-200, 1e-300] {
+        let scaled = tilt.map(|n| n.map(|c| c * scale));
+        assert_eq!(gray(&facing_triangle(Some(scaled))), unit, "normals scaled by {scale}");
+    }
+}
+
+/// One line of 20,000 spheres reads in time linear in its length: as fast, to a small factor,
+/// as the same spheres one per line (it was quadratic: columns counted from the line's start).
+#[test]
+fn one_long_line_reads_as_fast_as_many() {
+    let spheres = |sep: &str| {
+        let mut t = String::from("v from 0 -50 0 at 0 0 0 up 0 0 1 angle 40\nl 0 -50 50\n");
+        for i in 0..20_000 {
+            t.push_str(&format!("s {} {} 0 0.4{sep}", i % 200, i / 200));
+        }
+        t
+    };
+    let time = |text: &str| {
+        let start = std::time::Instant::now();
+        let (objects, _) = read(text).expect("read");
+        assert_eq!(objects.len(), 20_000);
+        start.elapsed()
+    };
+    let (lines, line) = (spheres("\n"), spheres(" "));
+    let (a, b) = (time(&lines), time(&line));
+    // Quadratic, one line took 40 times as long as 20,000 lines; linear, about the same.
+    assert!(b < a * 5 + std::time::Duration::from_millis(50), "one line {b:?}, one per line {a:?}");
+}

@@ -12,4 +12,5 @@ pub mod report;
 pub mod run;
 pub mod shared;
 pub mod spd;
+pub mod stdout;
 pub mod uf2;

@@ -126,7 +126,12 @@ enum Command {
 }
 
 fn main() {
-    if let Err(e) = real_main() {
+    // What is left of the last lines is flushed here, so a failure to write it is reported too.
+    if let Err(e) = real_main().and_then(|()| host_sim::stdout::flush()) {
+        if host_sim::stdout::is_closed_pipe(&e) {
+            // The reader went away (`| head`): the output was not wanted further.
+            std::process::exit(0);
+        }
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
@@ -162,19 +167,19 @@ fn real_main() -> Result<()> {
                 }
             })?;
             output::write_atomic(&output, out.as_bytes())?;
-            println!("wrote {}", output.display());
+            host_sim::say!("wrote {}", output.display())?;
             Ok(())
         }
         Some(Command::Spd { generator, size, output }) => {
             let size = size.unwrap_or(generator.default_size());
             let text = generator.nff(size)?;
             match output {
-                Some(p) if p.as_os_str() == "-" => print!("{text}"),
+                Some(p) if p.as_os_str() == "-" => host_sim::stdout::bytes(text.as_bytes())?,
                 _ => {
                     let path = output.unwrap_or_else(|| format!("out/spd/{}-{size}.nff", generator.name()).into());
                     output::write_atomic(&path, text.as_bytes())?;
                     let objects = lattice_rt::scene::object_count(&text);
-                    println!("wrote {} ({objects} objects)", path.display());
+                    host_sim::say!("wrote {} ({objects} objects)", path.display())?;
                 }
             }
             Ok(())

@@ -103,12 +103,12 @@ pub fn orbit_cmd(scene: &Path, out: &Path, frames: u32) -> Result<()> {
     let frame = board_frame::rendered(board_frame::Build { orbit: true, ..board_frame::PICO });
     let bits = orbit_frames::<lattice_rt::Fx>(scene, &text, frames, &frame)?;
     write_atomic(out, &gif_bytes(&bits, frame.width, frame.height)?)?;
-    println!(
+    crate::say!(
         "wrote {} ({frames} frames at {FPS} fps, {}x{}, as the Pico renders them)",
         out.display(),
         frame.width,
         frame.height
-    );
+    )?;
     Ok(())
 }
 

@@ -166,7 +166,7 @@ pub struct StatsReport {
 
 /// Prints `v` as pretty JSON on standard output.
 pub fn print_json(v: &impl Serialize) -> anyhow::Result<()> {
-    println!("{}", serde_json::to_string_pretty(v)?);
+    crate::say!("{}", serde_json::to_string_pretty(v)?)?;
     Ok(())
 }
 

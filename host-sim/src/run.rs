@@ -354,14 +354,20 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
     }
     staged.commit()?;
     if let Some(png) = stdout {
-        use std::io::Write;
-        std::io::stdout().write_all(&png).context("cannot write the PNG to standard output")?;
+        crate::stdout::bytes(&png).context("cannot write the PNG to standard output")?;
     }
     // With the picture or JSON on standard output, the messages go to standard error.
     let quiet = a.output == Path::new("-") || a.json;
-    let say = |line: String| if quiet { eprintln!("{line}") } else { println!("{line}") };
+    let say = |line: String| {
+        if quiet {
+            eprintln!("{line}");
+            Ok(())
+        } else {
+            crate::say!("{line}")
+        }
+    };
     for (p, _) in files.iter().filter(|(p, _)| *p != Path::new("-")) {
-        say(format!("wrote {}", p.display()));
+        say(format!("wrote {}", p.display()))?;
     }
     if a.json {
         let report = RenderReport {
@@ -375,7 +381,7 @@ pub fn render_cmd<R: Real>(a: &RenderArgs) -> Result<()> {
         };
         return print_json(&report);
     }
-    say(stats_line(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel.name()), &out.stats, out.elapsed));
+    say(stats_line(&format!("{} {} {}", a.scene.display(), R::NAME, a.accel.name()), &out.stats, out.elapsed))?;
     Ok(())
 }
 
@@ -472,34 +478,42 @@ pub fn stats_cmd<R: Real>(a: &StatsArgs) -> Result<()> {
     if a.json {
         return print_json(&report);
     }
-    print_stats(&report, &scene, &cfg, a);
+    print_stats(&report, &scene, &cfg, a)?;
     Ok(())
 }
 
 /// `stats`'s report as text: the scene, its lattice, the work per eye ray and the full render.
-fn print_stats<R: Real>(r: &StatsReport, scene: &Scene<'_, R>, cfg: &LatticeConfig, a: &StatsArgs) {
+fn print_stats<R: Real>(r: &StatsReport, scene: &Scene<'_, R>, cfg: &LatticeConfig, a: &StatsArgs) -> Result<()> {
     let fx = Effects::of(scene);
-    println!("scene {} ({})", r.scene, r.scalar);
-    println!(
+    crate::say!("scene {} ({})", r.scene, r.scalar)?;
+    crate::say!(
         "  objects {}, composites {}, materials {}, lights {}, depth {}",
-        r.objects, r.composites, r.materials, r.lights, r.depth
-    );
-    println!("  effects: {fx}");
+        r.objects,
+        r.composites,
+        r.materials,
+        r.lights,
+        r.depth
+    )?;
+    crate::say!("  effects: {fx}")?;
     for (i, n) in r.lattice.lattices.iter().enumerate() {
         let name = if i == 0 { "world lattice".to_string() } else { format!("sub-lattice {}", i - 1) };
-        println!("  {name}: {} x {} x {} cells", n[0], n[1], n[2]);
+        crate::say!("  {name}: {} x {} x {} cells", n[0], n[1], n[2])?;
     }
     if cfg.budget.is_some() {
-        println!("  within {} bytes: {}", a.budget.unwrap_or(0), Lattice::choose(scene, cfg));
+        crate::say!("  within {} bytes: {}", a.budget.unwrap_or(0), Lattice::choose(scene, cfg))?;
     }
-    println!(
+    crate::say!(
         "  lattice: {} cells, {} references, {} bytes, built in {:.3} ms",
-        r.lattice.cells, r.lattice.references, r.lattice.bytes, r.build_ms
-    );
-    println!(
+        r.lattice.cells,
+        r.lattice.references,
+        r.lattice.bytes,
+        r.build_ms
+    )?;
+    crate::say!(
         "  per eye ray at {}x{}, each method answering every eye ray as in the paper's Table 1:",
-        r.width, r.height
-    );
+        r.width,
+        r.height
+    )?;
     for m in &r.per_eye_ray {
         if m.method == "default" {
             let how = match Tracer::new(scene, &BruteForce).eye_rays() {
@@ -507,41 +521,46 @@ fn print_stats<R: Real>(r: &StatsReport, scene: &Scene<'_, R>, cfg: &LatticeConf
                 EyeRays::Accelerator => "the lattice is walked, skipping objects whose window on the image misses the ray",
                 EyeRays::Plain => "the method chosen answers them",
             };
-            println!(
+            crate::say!(
                 "    tracer's default: object tests {:6.3}, cells visited {:6.2}: {how}",
-                m.object_tests_per_eye_ray, m.cells_per_eye_ray
-            );
+                m.object_tests_per_eye_ray,
+                m.cells_per_eye_ray
+            )?;
         } else {
-            println!(
+            crate::say!(
                 "    {:8} object tests {:6.3}, bounding-box (inside) tests {:6.2}, cells visited {:6.2}",
-                m.method, m.object_tests_per_eye_ray, m.inside_tests_per_eye_ray, m.cells_per_eye_ray
-            );
+                m.method,
+                m.object_tests_per_eye_ray,
+                m.inside_tests_per_eye_ray,
+                m.cells_per_eye_ray
+            )?;
         }
     }
-    println!(
+    crate::say!(
         "  full render at {}x{} with the tracer's defaults (eye rays, and shadow rays towards a directional first light, answered by windows where the scene allows: the methods differ only in the rays left to them), median of {} interleaved runs:",
         r.width,
         r.height,
         a.runs.max(1)
-    );
+    )?;
     for m in &r.full_render {
         let w = &m.work;
-        println!(
+        crate::say!(
             "    {:8} {:9.2} ms  rays {:7}  object tests {:9}  ({:.2}/ray)",
             m.method,
             m.median_ms,
             w.rays.total,
             w.object_tests,
             w.object_tests as f64 / w.rays.total.max(1) as f64
-        );
+        )?;
     }
     let (bbox, lat) = (r.full_render[1].median_ms, r.full_render[2].median_ms);
-    println!(
+    crate::say!(
         "  lattice/bbox time ratio {:.3} (lattice {:.2}x faster); images identical across accelerators: {}",
         lat / bbox,
         bbox / lat,
         r.identical
-    );
+    )?;
+    Ok(())
 }
 
 /// Work per eye ray of each accelerator (answering every eye ray, then the tracer's default),
@@ -641,12 +660,12 @@ pub fn gallery(out: &Path, scenes: &Path) -> Result<()> {
                 "--gray".into(),
                 at("-gray.png"),
             ];
-            println!("host-sim {}", line[..].join(" "));
+            crate::say!("host-sim {}", line[..].join(" "))?;
             let RenderLine { args } = <RenderLine as clap::Parser>::try_parse_from(&line)?;
             render_cmd::<f64>(&args)?;
         }
     }
-    println!("wrote {} scenes to {}/ (each as `render` draws it by default)", files.len(), out.display());
+    crate::say!("wrote {} scenes to {}/ (each as `render` draws it by default)", files.len(), out.display())?;
     Ok(())
 }
 
@@ -672,24 +691,29 @@ fn spd_stats<R: Real>(a: &StatsArgs) -> Result<()> {
     if a.json {
         return print_json(&report);
     }
-    println!(
+    crate::say!(
         "scene {} ({}): {} objects, SPD protocol (513x513 eye rays at the pixel corners, depth 5)",
         report.scene,
         R::NAME,
         report.objects
-    );
-    println!(
+    )?;
+    crate::say!(
         "  lattice: {} cells, {} references, {} bytes",
-        report.lattice.cells, report.lattice.references, report.lattice.bytes
-    );
+        report.lattice.cells,
+        report.lattice.references,
+        report.lattice.bytes
+    )?;
     for (name, v) in counts[0].invariants.named() {
-        println!("  {name:<24}{v:>10}");
+        crate::say!("  {name:<24}{v:>10}")?;
     }
     for c in &counts {
-        println!(
+        crate::say!(
             "  {:?}: {:.2} object tests per ray, {:.2} cell steps per ray, {:.0} ms",
-            c.setup, c.tests_per_ray, c.steps_per_ray, c.ms
-        );
+            c.setup,
+            c.tests_per_ray,
+            c.steps_per_ray,
+            c.ms
+        )?;
     }
     Ok(())
 }

@@ -239,11 +239,11 @@ pub fn uf2_cmd(root: &Path, board: Board, features: Option<&str>, bake: &[PathBu
     };
     let out = out.map_or_else(|| PathBuf::from(named), Path::to_path_buf);
     board.write_uf2(&elf, &out)?;
-    println!(
+    crate::say!(
         "wrote {}: hold BOOTSEL while plugging the board in, then copy this file onto the {} drive",
         out.display(),
         board.drive()
-    );
+    )?;
     Ok(())
 }
 
@@ -315,7 +315,7 @@ pub fn scene_cmd(board: Board, scene: &Path, image: &Path, out: Option<&Path>) -
     let stem = scene.file_stem().map_or_else(|| "scene".to_string(), |s| s.to_string_lossy().to_string());
     let out = out.map_or_else(|| PathBuf::from(format!("out/lattice-rt-pico-{stem}.uf2")), Path::to_path_buf);
     crate::output::write_atomic(&out, &bytes)?;
-    println!("wrote {}: the slot image with {} in its scene slot ({} bytes); hold BOOTSEL while plugging the Pico in, then copy this file onto the RPI-RP2 drive", out.display(), scene.display(), text.len());
+    crate::say!("wrote {}: the slot image with {} in its scene slot ({} bytes); hold BOOTSEL while plugging the Pico in, then copy this file onto the RPI-RP2 drive", out.display(), scene.display(), text.len())?;
     Ok(())
 }
 

@@ -28,7 +28,7 @@
 use super::builder::SceneBuilder;
 use super::error::SceneError;
 use super::model::{Light, Material, Object, Parts, Scene, MAX_LIGHTS, MAX_MATERIALS};
-use super::polygon::{triangulate, MAX_VERTICES};
+use super::polygon::{crosses_itself, triangulate, MAX_VERTICES};
 use super::text::{parse_number, ParseError, ParseErrorKind};
 use crate::camera::{CameraDesc, FieldOfView};
 use crate::math::{Affine, Vec3};
@@ -438,6 +438,9 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
             if patch {
                 let _ = normals.push(self.point()?);
             }
+        }
+        if crosses_itself(&v) {
+            return Err(error(at, ParseErrorKind::SelfIntersecting));
         }
         let (mut added, mut failed) = (0usize, None);
         triangulate(&v, |[a, b, c]| {

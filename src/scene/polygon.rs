@@ -65,9 +65,72 @@ pub fn triangulate(v: &[Vec3<f64>], mut f: impl FnMut([usize; 3])) {
     f([left[0] as usize, left[1] as usize, left[2] as usize]);
 }
 
+/// Whether two edges of the planar polygon `v` that share no corner cross each other (a bow
+/// tie): such a polygon has no inside to cut into triangles. Seen along the axis its plane
+/// faces most (the largest cross product of two edges from the first corner, which a bow tie's
+/// cancelling areas do not hide); edges that only touch or overlap in a line do not cross.
+pub fn crosses_itself(v: &[Vec3<f64>]) -> bool {
+    let n = v.len();
+    if n < 4 {
+        return false;
+    }
+    let normal = (2..n)
+        .map(|k| (v[1] - v[0]).cross(v[k] - v[0]))
+        .max_by(|a, b| a.max_abs().total_cmp(&b.max_abs()))
+        .unwrap_or_else(Vec3::zero);
+    let axis = (0..3).max_by(|&i, &j| normal.axis(i).abs().total_cmp(&normal.axis(j).abs())).unwrap_or(2);
+    let (s, t) = ((axis + 1) % 3, (axis + 2) % 3);
+    let p = |i: usize| [v[i % n].axis(s), v[i % n].axis(t)];
+    let side = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        let x = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if x > 0.0 {
+            1
+        } else if x < 0.0 {
+            -1
+        } else {
+            0
+        }
+    };
+    (0..n).any(|i| {
+        // Edge i runs from corner i to i + 1; the edges after i + 1 that do not close on i.
+        (i + 2..n).filter(|&j| (j + 1) % n != i).any(|j| {
+            let (a, b, c, d) = (p(i), p(i + 1), p(j), p(j + 1));
+            side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_bow_tie_crosses_itself_and_simple_polygons_do_not() {
+        let poly = |pts: &[[f64; 2]], plane: usize| -> std::vec::Vec<Vec3<f64>> {
+            pts.iter()
+                .map(|&[a, b]| match plane {
+                    0 => Vec3::new(a, b, 3.0),
+                    1 => Vec3::new(a, 3.0, b),
+                    _ => Vec3::new(3.0, a, b),
+                })
+                .collect()
+        };
+        for plane in 0..3 {
+            assert!(crosses_itself(&poly(&[[-2.0, -1.0], [2.0, 1.0], [2.0, -1.0], [-2.0, 1.0]], plane)));
+            assert!(!crosses_itself(&poly(&[[-2.0, -1.0], [2.0, -1.0], [2.0, 1.0], [-2.0, 1.0]], plane)));
+            // Concave (an arrow head) and a repeated corner: simple.
+            assert!(!crosses_itself(&poly(&[[0.0, 0.0], [2.0, 1.0], [0.0, 2.0], [1.0, 1.0]], plane)));
+            assert!(!crosses_itself(&poly(&[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], plane)));
+            // A pentagram crosses itself.
+            let star: std::vec::Vec<[f64; 2]> = (0..5)
+                .map(|k| {
+                    let a = (k * 2 % 5) as f64 * core::f64::consts::TAU / 5.0;
+                    [libm::cos(a), libm::sin(a)]
+                })
+                .collect();
+            assert!(crosses_itself(&poly(&star, plane)));
+        }
+    }
 
     fn area(v: &[Vec3<f64>], t: [usize; 3]) -> f64 {
         (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]).length() / 2.0
