@@ -9,10 +9,17 @@ pub mod polygons;
 pub mod protocol;
 pub mod teapot;
 
-/// An SPD generator.
+/// The primitives of NFF text as the SPD counts them (its Readme's figures, and the counts in
+/// [`Generator`]'s help): each sphere, cone or cylinder and polygon once. The tracer stores a
+/// polygon of `n` corners as `n - 2` triangles ([`lattice_rt::scene::object_count`]).
+pub fn primitives(nff: &str) -> usize {
+    nff.lines().filter(|l| matches!(l.split_whitespace().next(), Some("s" | "c" | "p" | "pp"))).count()
+}
+
+/// An SPD generator (the counts are primitives, as the SPD counts them: [`primitives`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Generator {
-    /// The sphereflake: 1 + 9 + ... + 9^size spheres and a floor (default 4: 7,382 objects).
+    /// The sphereflake: 1 + 9 + ... + 9^size spheres and a floor (default 4: 7,382 primitives).
     Balls,
     /// Pyramids of rings of pentagons (cylinders and spheres) before a wall (default 7: 8,401).
     Rings,
@@ -31,7 +38,7 @@ pub enum Generator {
     /// A fractal mountain of triangles under four glass spheres (default 6: 8,196).
     Mount,
     /// Newell's teapot of Bezier patches as triangles with normals, on a checkerboard (default
-    /// 12: 9,264 objects; upstream's program defaults to 6, its published figures are for 12).
+    /// 12: 9,264 primitives; upstream's program defaults to 6, its published figures are for 12).
     Teapot,
 }
 
