@@ -15,7 +15,7 @@ pub mod app;
 /// them back into calls to themselves. (A division loop of the same kind saved 300 B more, at
 /// 1.4x the frame's instructions: compiler-builtins' division stays.)
 ///
-/// Its code has no inner attributes, so the host's tests (`tests/compact_builtins.rs`) include it
+/// Its code has no inner attributes, so the host's tests (`tests/integration/compact_builtins.rs`) include it
 /// and check it against Rust's own slice copies.
 #[cfg(feature = "compact")]
 pub mod builtins;

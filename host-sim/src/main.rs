@@ -178,7 +178,8 @@ fn real_main() -> Result<()> {
                 _ => {
                     let path = output.unwrap_or_else(|| format!("out/spd/{}-{size}.nff", generator.name()).into());
                     output::write_atomic(&path, text.as_bytes())?;
-                    let (primitives, objects) = (host_sim::spd::primitives(&text), lattice_rt::scene::object_count(&text));
+                    let (primitives, objects) =
+                        (host_sim::spd::primitives(&text), lattice_rt::scene::object_count(&text));
                     host_sim::say!(
                         "wrote {} ({primitives} primitives as the SPD counts them; {objects} objects as the tracer \
                          stores them, each polygon cut into triangles)",

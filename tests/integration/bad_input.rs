@@ -2,7 +2,7 @@
 //! that concerns the core, in every scalar it concerns. A scene is either refused with the
 //! line and column of what is at fault, or it renders right.
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::scene::text::text_from_bytes;
 use lattice_rt::scene::Object;

@@ -1,7 +1,7 @@
 //! The effect set a scene calls for, one test per effect (a scene with it and without it), and
 //! what the tracer does with it.
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::scene::Object;
 use lattice_rt::trace::MissingEffects;

@@ -1,7 +1,7 @@
 //! Golden 1-bit images of the paper's scenes and the Whitted showcase in f64 and f32, and the
 //! three accelerators drawing identical frames.
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::{Dither, Frame, Real};
 

@@ -1,7 +1,7 @@
 //! Sampling modes: edge-only anti-aliasing spends rays only near edges and leaves every other
 //! pixel exactly as one ray per pixel draws it.
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::render::Hooks;
 use lattice_rt::scene::Object;

@@ -2,7 +2,7 @@
 //! point) and, where rays are answered, in every accelerator (lattice, bounding box, brute
 //! force), and asserts the right behaviour. docs/robustness.md lists the remedies.
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::lattice::Resolution;
 use lattice_rt::scene::Object;

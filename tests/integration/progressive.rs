@@ -4,7 +4,7 @@
 //! every sampling and dither that allows passes, in shares too), and each preview pass shows
 //! its blocks flat.
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;

@@ -4,7 +4,7 @@
 
 #[allow(dead_code, clippy::missing_safety_doc)]
 mod builtins {
-    include!("../firmware/src/builtins.rs");
+    include!("../../firmware/src/builtins.rs");
 }
 use builtins::*;
 

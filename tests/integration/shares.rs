@@ -2,7 +2,7 @@
 //! frame; frames whose tiles depend on each other refuse to be split. Switching shadow-ray
 //! coherence off (the paper's method as it was) changes work, never a pixel.
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::render::RenderError;
 use lattice_rt::scene::Object;

@@ -4,7 +4,7 @@
 //! it gives without, in every scalar and accelerator, on the paper's scenes, the Whitted scene,
 //! generated scenes and cameras that sit inside or right beside an object.
 
-mod common;
+use crate::common;
 
 use common::{build_lattice, lattice_storage, scene_text, ACCELS};
 use lattice_rt::generate::{random_scene, RandomScene};

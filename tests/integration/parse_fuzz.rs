@@ -2,7 +2,7 @@
 //! column inside the text, and every scene that is accepted traces the same with the lattice as
 //! with brute force. (The coverage-guided fuzzer is `fuzz/`, run with `cargo +nightly fuzz`.)
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::scene::Object;
 use lattice_rt::{parse, Accelerator, BruteForce, Fx, LatticeConfig, Query, Real};
@@ -103,9 +103,9 @@ const NFF_WORDS: [&str; 24] = [
 /// and every entity in a few lines.
 fn nff_scene(pick: usize) -> String {
     match pick {
-        0 => include_str!("../host-sim/tests/spd/rings-1.nff").to_string(),
+        0 => include_str!("../../host-sim/tests/spd/rings-1.nff").to_string(),
         1 => "v\nfrom 0 -10 2\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0.01\nresolution 64 64\nb 0.2 0.4 0.6\nl 5 -5 5\nl -5 -5 5 1 0.5 0.5\nf 1 0 0 0.8 0.2 30 0 1\ns 0 0 1 1\nc 2 0 0 0.5 2 0 2 0.5\nc -2 0 0 0.8 -2 0 1.5 0.2\np 4\n-5 -5 0\n5 -5 0\n5 5 0\n-5 5 0\nf 0.5 0.5 0.5 0.5 0.5 0 0.5 1.5\npp 3\n0 3 0 0 0 1\n1 3 0 0 0 1\n0 4 0 0 0 1\n".to_string(),
-        _ => include_str!("../host-sim/tests/spd/tree-2.nff").to_string(),
+        _ => include_str!("../../host-sim/tests/spd/tree-2.nff").to_string(),
     }
 }
 

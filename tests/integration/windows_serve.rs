@@ -3,7 +3,7 @@
 //! each object), so brute force in place of the lattice gives the
 //! same frame; a build whose scenes all qualify links no walk (the firmware's `windows_only`).
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::accel::{Hit, Query};
 use lattice_rt::render::Sampling;

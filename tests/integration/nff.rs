@@ -1,7 +1,7 @@
 //! NFF in: every entity of `NFF.TXT` read, what the tracer cannot draw refused by name, and
 //! every error placed at its line and column.
 
-mod common;
+use crate::common;
 use common::{build_lattice, gray_of, lattice_storage};
 use lattice_rt::scene::nff;
 use lattice_rt::scene::{Format, Light, Object, Parts};

@@ -8,7 +8,7 @@
 //! scene can reach (it lies below the floor's plane, beyond the floor); and the same scene seen
 //! from a camera far away with a field of view that frames it (a telephoto view).
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::generate::Rng;
 use lattice_rt::scene::Object;
@@ -307,7 +307,7 @@ fn a_large_index_of_refraction_renders_as_in_f64_or_is_refused() {
 /// The drift study behind [`bound_with_glass`]: `FAR_AWAY_SEEDS` (default 200) random near
 /// scenes with every material, each scalar against f64; prints the worst share of pixels more
 /// than a level off and checks the bounds. Run with
-/// `cargo test --release --test far_away -- --ignored --nocapture drift`.
+/// `cargo test --release --test integration -- --ignored --nocapture drift`.
 #[test]
 #[ignore]
 fn drift_over_many_seeds() {

@@ -2,7 +2,7 @@
 //! whichever form of field of view the scene gives (first-look.md measured 1.25 at 128x64 and
 //! 0.605 at 200x200 before views were fitted to frames).
 
-mod common;
+use crate::common;
 use common::*;
 use lattice_rt::scene::Object;
 use lattice_rt::{Frame, LatticeConfig, Tracer};
