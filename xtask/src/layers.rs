@@ -192,6 +192,9 @@ fn expand(tail: &str) -> Vec<Vec<String>> {
 /// A dependency between two modules of one folder, and where the code takes it.
 type Edges = BTreeMap<(String, String), Vec<String>>;
 
+/// The dependencies of one circle, with where the code takes each.
+type Circle<'e> = Vec<(&'e (String, String), &'e Vec<String>)>;
+
 /// The dependencies of a crate root, per folder (the module path of the folder, `""` for the
 /// root): between the folder's children, each named by the child a path goes through.
 fn dependencies(top: &Path, mods: &[Module]) -> Result<BTreeMap<Vec<String>, Edges>> {
@@ -225,7 +228,7 @@ fn dependencies(top: &Path, mods: &[Module]) -> Result<BTreeMap<Vec<String>, Edg
 
 /// The circles of one folder's graph: each strongly connected set of two or more modules,
 /// with the edges inside it.
-fn circles(edges: &Edges) -> Vec<Vec<(&(String, String), &Vec<String>)>> {
+fn circles(edges: &Edges) -> Vec<Circle<'_>> {
     let nodes: BTreeSet<&String> = edges.keys().flat_map(|(a, b)| [a, b]).collect();
     let reach = |from: &String| {
         let mut seen = BTreeSet::from([from.clone()]);
