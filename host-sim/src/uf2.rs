@@ -130,9 +130,15 @@ pub fn build_image(
 ) -> Result<PathBuf> {
     // One build at a time, to its copy: cargo writes every variant of a board's image to the
     // same `built` path, so two threads building (`cargo xtask board` runs sections side by
-    // side) could each keep the other's image.
+    // side), or two processes (CI runs the emulated board beside the QEMU firmware), could each
+    // keep the other's image. The thread lock orders this process's threads; the file's lock
+    // (`flock`) orders processes.
     static BUILDING: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _one_at_a_time = BUILDING.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let lock_path = root.join("firmware/target/image-build.lock");
+    std::fs::create_dir_all(root.join("firmware/target")).context("cannot create firmware/target")?;
+    let lock = std::fs::File::create(&lock_path).with_context(|| format!("cannot create {}", lock_path.display()))?;
+    lock.lock().with_context(|| format!("cannot lock {}", lock_path.display()))?;
     let mut cmd = firmware_cargo(root);
     cmd.args(args);
     match scenes {
@@ -153,7 +159,11 @@ pub fn build_image(
     let dir = kept.parent().expect("kept images live in a folder");
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let from = root.join("firmware/target").join(built);
-    std::fs::copy(&from, &kept).with_context(|| format!("cannot copy {} to {}", from.display(), kept.display()))?;
+    // Copied beside, then renamed: a run reading the kept image (another process's) sees the
+    // old file or the new one whole, never one half written.
+    let part = kept.with_extension("part");
+    std::fs::copy(&from, &part).with_context(|| format!("cannot copy {} to {}", from.display(), part.display()))?;
+    std::fs::rename(&part, &kept).with_context(|| format!("cannot rename {} to {}", part.display(), kept.display()))?;
     Ok(kept)
 }
 
