@@ -184,25 +184,63 @@ pub mod uf2 {
     }
 }
 
-/// Checks scene text as the `slot` image will read it: at most [`MAX_TEXT`] bytes, a valid
-/// scene in the Pico's fixed point fitted to its 128x64 panel, within [`ROOM`]. The error
-/// says where and why, as the board would show it.
+/// Checks scene text as the `slot` image will read it: at most [`MAX_TEXT`] bytes, in the
+/// scene format (the image reads no NFF), a valid scene in the Pico's fixed point fitted to its
+/// 128x64 panel, with at most a board's materials and lights
+/// ([`lattice_rt::scene::BOARD_MATERIALS`], [`lattice_rt::scene::BOARD_LIGHTS`]), within
+/// [`ROOM`]. The error says where and why, as the board would show it.
 #[cfg(feature = "alloc")]
 pub fn check_scene(text: &str) -> Result<(), alloc::string::String> {
     use alloc::format;
     use lattice_rt::scene::text::{object_count, parse_with};
+    use lattice_rt::scene::{Format, BOARD_LIGHTS, BOARD_MATERIALS};
     use lattice_rt::{Fx, LatticeConfig, Sizes};
     if text.len() > MAX_TEXT {
         return Err(format!("the scene is {} bytes, more than the {MAX_TEXT} a slot holds", text.len()));
+    }
+    if Format::of(text) == Format::Nff {
+        return Err(alloc::string::String::from(
+            "line 1: NFF, which the slot image does not read (it is built without the NFF reader, to fit \
+             the Pico's flash): write the scene in the scene format (docs/scene-format.md), or bake the \
+             NFF file into an image of its own with `host-sim uf2 --bake FILE`",
+        ));
     }
     let frame = crate::frame::rendered(crate::frame::PICO);
     let mut objects = alloc::vec![lattice_rt::scene::Object::<Fx>::default(); object_count(text).max(1)];
     let mut parts = lattice_rt::Parts::default();
     let scene =
         parse_with::<Fx>(text, &mut objects, &mut parts, |c| c.frame = frame.size()).map_err(|e| format!("{e}"))?;
+    // The host's build holds more materials and lights than a board's: the statement that
+    // goes past the board's is refused where the board refuses it.
+    for (word, blamed, have, most) in
+        [("material", 1, scene.materials().len(), BOARD_MATERIALS), ("light", 0, scene.lights().len(), BOARD_LIGHTS)]
+    {
+        if have > most {
+            let (line, col, w) = statement_at(text, word, most + 1, blamed).unwrap_or((1, 1, word));
+            return Err(format!("line {line}, column {col} at `{w}`: too many {word}s (at most {most})"));
+        }
+    }
     let needs = Sizes::of(&scene, Some(&LatticeConfig::default()), &frame);
     fits(&needs)
         .map_err(|(what, need, have)| format!("the scene needs {need} {what}; the slot image has room for {have}"))
+}
+
+/// Where the board's parser blames the `n`-th statement of `text` whose first word is `word`:
+/// its line, and the column and word of its `blamed`-th word (0: the statement's own word; a
+/// material is blamed on its name, the 1st). Lines end at LF, CR LF or a lone CR, as the scene
+/// format's do.
+#[cfg(feature = "alloc")]
+fn statement_at<'t>(text: &'t str, word: &str, n: usize, blamed: usize) -> Option<(usize, usize, &'t str)> {
+    let (i, line) = text
+        .split('\n')
+        .flat_map(|l| l.strip_suffix('\r').unwrap_or(l).split('\r'))
+        .enumerate()
+        .filter(|(_, l)| l.split('#').next().unwrap_or("").split_whitespace().next() == Some(word))
+        .nth(n - 1)?;
+    let w = line.split_whitespace().nth(blamed)?;
+    // `w` is a slice of `line`: its byte offset gives its column in characters.
+    let at = w.as_ptr() as usize - line.as_ptr() as usize;
+    Some((i + 1, line[..at].chars().count() + 1, w))
 }
 
 /// UF2 files with a scene: the blocks of a slot image's file, and the slot's.
@@ -252,6 +290,50 @@ pub mod with {
             out.extend_from_slice(&uf2::slot_block(text.as_bytes(), k, (blocks.len() + k) as u32, count));
         }
         Ok(out)
+    }
+}
+
+#[cfg(all(test, feature = "alloc"))]
+mod board_checks {
+    use super::check_scene;
+    use alloc::format;
+    use alloc::string::String;
+
+    /// A scene with `materials` materials and `lights` lights, lines ending with `eol`.
+    fn scene(materials: usize, lights: usize, eol: &str) -> String {
+        let mut t = format!("camera eye 0 0 -4{eol}");
+        for i in 0..lights {
+            t += &format!("light point pos {i} 2 -3 intensity 0.2{eol}");
+        }
+        for i in 0..materials {
+            t += &format!("material m{i} kd 0.5{eol}");
+        }
+        t + &format!("box{eol}")
+    }
+
+    /// The same message whether the host's build (with `alloc`: more materials and lights) or a
+    /// board's (`cargo test -p board-records --features alloc` alone builds the core without
+    /// `alloc`) checks the scene.
+    #[test]
+    fn a_board_s_materials_and_lights_are_the_slot_s() {
+        for eol in ["\n", "\r\n", "\r"] {
+            assert_eq!(check_scene(&scene(16, 4, eol)), Ok(()));
+            assert_eq!(
+                check_scene(&scene(20, 1, eol)),
+                Err(String::from("line 19, column 10 at `m16`: too many materials (at most 16)"))
+            );
+            assert_eq!(
+                check_scene(&scene(1, 7, eol)),
+                Err(String::from("line 6, column 1 at `light`: too many lights (at most 4)"))
+            );
+        }
+    }
+
+    #[test]
+    fn nff_is_refused_with_what_to_do() {
+        let e = check_scene("v from 0 -5 0 at 0 0 0 up 0 0 1 angle 40\ns 0 0 0 1\n").unwrap_err();
+        assert!(e.starts_with("line 1: NFF, which the slot image does not read"), "{e}");
+        assert!(e.contains("host-sim uf2 --bake"), "{e}");
     }
 }
 

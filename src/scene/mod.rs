@@ -33,8 +33,8 @@ pub use builder::{check_value, SceneBuilder, IOR};
 pub use effects::{Effects, MAX_DEPTH};
 pub use error::SceneError;
 pub use model::{
-    axis_normal, Composite, Light, Material, Object, Parts, Scene, Smooth, MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS,
-    MAX_SMOOTH, NO_COMPOSITE,
+    axis_normal, Composite, Light, Material, Object, Parts, Scene, Smooth, BOARD_LIGHTS, BOARD_MATERIALS,
+    MAX_COMPOSITES, MAX_LIGHTS, MAX_MATERIALS, MAX_SMOOTH, NO_COMPOSITE,
 };
 pub use region::{
     Culled, EyeHull, EyeWindow, HullEdge, Region, ShadowWindow, EYE_MARGIN, HULL_EDGES, NO_HULL, WHOLE_PLANE,

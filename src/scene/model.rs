@@ -9,11 +9,17 @@ use crate::scalar::{Pow2, Real};
 use crate::shape::{Shape, ShapeHit};
 use heapless::Vec;
 
+/// Most materials a scene may define in a build without `alloc`: a board's ([`MAX_MATERIALS`]
+/// there; a host that checks a scene for a board, as `host-sim uf2 --scene` does, holds it to
+/// this).
+pub const BOARD_MATERIALS: usize = 16;
+/// Most lights a scene may define in a build without `alloc`: a board's ([`MAX_LIGHTS`] there).
+pub const BOARD_LIGHTS: usize = 4;
 /// Most materials a scene may define: 16 in a build without `alloc` (a microcontroller's),
 /// 256 with it (the host's, where NFF scenes give objects dozens of colours; a material index
 /// is a byte).
 #[cfg(not(feature = "alloc"))]
-pub const MAX_MATERIALS: usize = 16;
+pub const MAX_MATERIALS: usize = BOARD_MATERIALS;
 /// Most materials a scene may define: 16 in a build without `alloc` (a microcontroller's),
 /// 256 with it (the host's, where NFF scenes give objects dozens of colours; a material index
 /// is a byte).
@@ -22,7 +28,7 @@ pub const MAX_MATERIALS: usize = 256;
 /// Most lights a scene may define: 4 in a build without `alloc`, 16 with it (the SPD's `tree`
 /// has 7). Each core's work remembers an occluder per light, for at most this many lights.
 #[cfg(not(feature = "alloc"))]
-pub const MAX_LIGHTS: usize = 4;
+pub const MAX_LIGHTS: usize = BOARD_LIGHTS;
 /// Most lights a scene may define: 4 in a build without `alloc`, 16 with it (the SPD's `tree`
 /// has 7). Each core's work remembers an occluder per light, for at most this many lights.
 #[cfg(feature = "alloc")]
