@@ -86,6 +86,8 @@ pub fn parse_scene<'a, R: Real>(
     storage: &'a mut SceneStore<R>,
     frame: &Frame,
 ) -> Result<Scene<'a, R>> {
+    let objects = storage.objects.len();
+    let _shown = crate::progress::step(objects, format!("reading {} ({objects} objects)", path.display()));
     parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| c.frame = frame.size())
         .map_err(|e| anyhow!("{}: {e}", path.display()))
 }
@@ -98,6 +100,7 @@ pub const MAX_LATTICE_BYTES: usize = 512 << 20;
 /// parsed apart, into [`object_storage`]), or an error when it would take more than
 /// [`MAX_LATTICE_BYTES`] (checked before anything is allocated).
 pub fn lattice_storage<R: Real>(scene: &Scene<'_, R>, cfg: &LatticeConfig) -> Result<HeapStorage<R>> {
+    let _shown = crate::progress::step(scene.objects().len(), "planning the lattice");
     let sizes = Sizes { objects: 0, rows: 0, ..Sizes::of(scene, Some(cfg), &Frame::new(1, 1)) };
     let bytes = sizes.bytes::<R>();
     if bytes > MAX_LATTICE_BYTES {
@@ -137,6 +140,7 @@ pub fn build_lattice<'a, R: Real>(
     scene: &Scene<'_, R>,
     cfg: &LatticeConfig,
 ) -> Result<Lattice<'a, R>> {
+    let _shown = crate::progress::step(scene.objects().len(), "building the lattice");
     let (lattice, _) = storage.view().split().1.lattice(scene, cfg).map_err(|e| {
         if e.capacity == "budget" {
             anyhow::Error::new(BudgetTooSmall { available: e.available, needed: e.needed })

@@ -16,6 +16,23 @@ pub fn bar(len: usize, what: &str) -> ProgressBar {
     b
 }
 
+/// Scenes of at least this many objects show what loading them is doing ([`step`]).
+pub const LARGE_SCENE: usize = 20_000;
+
+/// A spinner that says what a long step is doing and for how long (ticking on its own while
+/// the step runs on this thread); hidden, as [`bar`], when stderr is no terminal, and cleared
+/// when dropped. `None` for a scene of fewer than [`LARGE_SCENE`] objects, which loads at once.
+pub fn step(objects: usize, what: impl Display) -> Option<ProgressBar> {
+    if objects < LARGE_SCENE {
+        return None;
+    }
+    let b = ProgressBar::new_spinner().with_finish(ProgressFinish::AndClear);
+    b.set_style(ProgressStyle::with_template("  {spinner} {msg} ({elapsed})").expect("a valid template"));
+    b.set_message(what.to_string());
+    b.enable_steady_tick(std::time::Duration::from_millis(100));
+    Some(b)
+}
+
 /// Prints a log line above the bar (plainly when the bar is hidden).
 pub fn log(b: &ProgressBar, line: impl Display) {
     b.suspend(|| eprintln!("{line}"));
