@@ -88,8 +88,15 @@ pub fn parse_scene<'a, R: Real>(
 ) -> Result<Scene<'a, R>> {
     let objects = storage.objects.len();
     let _shown = crate::progress::step(objects, format!("reading {} ({objects} objects)", path.display()));
-    parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| c.frame = frame.size())
-        .map_err(|e| anyhow!("{}: {e}", path.display()))
+    let scene = parse_with::<R>(text, &mut storage.objects, &mut storage.parts, |c| c.frame = frame.size())
+        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    // A view the render would refuse for this frame (too narrow for the scalar), refused here
+    // at the scene's camera.
+    if let Err(e) = frame.check_view(scene.camera()) {
+        let (line, col, word) = lattice_rt::scene::camera_statement(text).unwrap_or((1, 1, ""));
+        bail!("{}: line {line}, column {col} at `{word}`: {e}", path.display());
+    }
+    Ok(scene)
 }
 
 /// The most memory a lattice may take on the host (so that no flag makes host-sim allocate

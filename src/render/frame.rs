@@ -93,6 +93,14 @@ impl Share {
 }
 
 impl Frame {
+    /// Whether a render of this frame takes `camera`'s view, as [`render`](super::render)
+    /// checks first: the frame has the shape the view was fitted to, and the scalar resolves the
+    /// angle between its pixels. A loader that knows the frame it will render can so refuse a
+    /// view where its scene says why (host-sim names the camera's line).
+    pub fn check_view<R: Real>(&self, camera: &Camera<R>) -> Result<(), RenderError<core::convert::Infallible>> {
+        resolves(camera, self)
+    }
+
     /// Width and height as `[u32; 2]` (what a camera is fitted to: [`crate::scene::CameraDesc::frame`]).
     pub fn size(&self) -> [u32; 2] {
         [u32::from(self.width), u32::from(self.height)]

@@ -85,6 +85,17 @@ pub fn object_count(text: &str) -> usize {
     }
 }
 
+/// Where `text` (either [`Format`]) describes its view: the `camera` statement or NFF's last
+/// `v`, as line, column and word; what a view refused outside the parser is blamed on.
+pub fn camera_statement(text: &str) -> Option<(u32, u32, &str)> {
+    let text = without_bom(text);
+    match Format::of(text) {
+        #[cfg(feature = "nff")]
+        Format::Nff => nff::view_entity(text),
+        _ => text::camera_statement(text),
+    }
+}
+
 /// Parses `text` (either [`Format`]) into a [`Scene`], storing objects in `storage` (at least
 /// [`object_count`] long) and the composites, materials and lights in `parts`: [`text::parse`]
 /// or NFF's reader.

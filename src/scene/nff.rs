@@ -58,6 +58,19 @@ pub fn object_count(text: &str) -> usize {
     n
 }
 
+/// The line, column and word of the last view (`v`) of NFF text, if any: what a view refused
+/// outside the reader (a render's frame) is blamed on.
+pub fn view_entity(text: &str) -> Option<(u32, u32, &str)> {
+    let mut t = Tokens::new(text);
+    let mut found = None;
+    while let Some(at) = t.next() {
+        if at.2 == "v" {
+            found = Some(at);
+        }
+    }
+    found
+}
+
 /// The gray of an RGB colour: its luminance by the Rec. 709 weights.
 pub fn luminance(r: f64, g: f64, b: f64) -> f64 {
     0.2126 * r + 0.7152 * g + 0.0722 * b
