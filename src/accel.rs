@@ -149,7 +149,7 @@ impl<'m> Query<'m> {
 /// What one ray may skip, given with the ray to [`Accelerator::nearest`] and
 /// [`Accelerator::occluded`] in its query ([`Query::filter`]): the objects it is known to miss, the
 /// objects whose regions it
-/// passes outside ([`crate::cull`]: an eye ray's window position, a shadow ray's position across
+/// passes outside ([`crate::scene::region`]: an eye ray's window position, a shadow ray's position across
 /// a directional first light), and whether a lattice walk tests an object's box before it. The
 /// answer is the same whatever the filter says; only the work differs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,7 +6,7 @@
 //!
 //! Words: the camera's *window* is the plane `forward + u right + v up` with `u` and `v` each
 //! running -1..1 across the image; a *window position* is a point of it in integer units of
-//! 2^-16 (what culling compares, [`crate::cull`]); a *ray factor* is the same point in the
+//! 2^-16 (what culling compares, [`crate::scene::region`]); a *ray factor* is the same point in the
 //! scalar (what an eye ray's direction is made from).
 
 use crate::dither::MAX_TILE;

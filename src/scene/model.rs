@@ -149,7 +149,7 @@ pub struct Object<R> {
     /// (not kept with `lean-objects`).
     #[cfg(not(feature = "lean-objects"))]
     pub(crate) light_local: Vec3<R>,
-    /// Where it can appear, to each kind of ray that culling tests ([`crate::cull`]).
+    /// Where it can appear, to each kind of ray that culling tests ([`crate::scene::region`]).
     pub(crate) region: Region<R>,
 }
 
@@ -376,7 +376,7 @@ impl<R: Real> Object<R> {
         self.region.shadow_holds(w)
     }
 
-    /// Where the object can appear ([`crate::cull`]).
+    /// Where the object can appear ([`crate::scene::region`]).
     pub fn region(&self) -> &Region<R> {
         &self.region
     }
