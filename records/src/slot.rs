@@ -186,7 +186,7 @@ pub mod uf2 {
 
 /// Checks scene text as the `slot` image will read it: at most [`MAX_TEXT`] bytes, in the
 /// scene format (the image reads no NFF), a valid scene in the Pico's fixed point fitted to its
-/// 128x64 panel, with at most a board's materials and lights
+/// 128x64 panel, with a view its render takes, with at most a board's materials and lights
 /// ([`lattice_rt::scene::BOARD_MATERIALS`], [`lattice_rt::scene::BOARD_LIGHTS`]), within
 /// [`ROOM`]. The error says where and why, as the board would show it.
 #[cfg(feature = "alloc")]
@@ -210,6 +210,12 @@ pub fn check_scene(text: &str) -> Result<(), alloc::string::String> {
     let mut parts = lattice_rt::Parts::default();
     let scene =
         parse_with::<Fx>(text, &mut objects, &mut parts, |c| c.frame = frame.size()).map_err(|e| format!("{e}"))?;
+    // A view the board's render refuses (too narrow for fixed point on its panel), at the
+    // camera statement.
+    if let Err(e) = frame.check_view(scene.camera()) {
+        let (line, col, word) = lattice_rt::scene::camera_statement(text).unwrap_or((1, 1, ""));
+        return Err(format!("line {line}, column {col} at `{word}`: {e}"));
+    }
     // The host's build holds more materials and lights than a board's: the statement that
     // goes past the board's is refused where the board refuses it.
     for (word, blamed, have, most) in
@@ -327,6 +333,13 @@ mod board_checks {
                 Err(String::from("line 6, column 1 at `light`: too many lights (at most 4)"))
             );
         }
+    }
+
+    #[test]
+    fn a_view_too_narrow_for_the_board_is_refused_at_the_camera() {
+        let e = check_scene("material m kd 0.5\ncamera eye 0 0 -4 fov 1e-9 1e-9\nbox\n").unwrap_err();
+        assert!(e.starts_with("line 2, column 1 at `camera`: the view is too narrow for fixed"), "{e}");
+        assert_eq!(check_scene("material m kd 0.5\ncamera eye 0 0 -4 fov 40\nbox\n"), Ok(()));
     }
 
     #[test]
