@@ -13,6 +13,7 @@
 //! a `budget` [`LatticeError`] and the caller falls back to a method that keeps no lattice
 //! (bounding boxes or brute force).
 
+use super::plan::ray_cost;
 use super::{Lattice, LatticeConfig, LatticeError, LatticeSizes, Resolution};
 use crate::math::Aabb;
 use crate::scalar::Real;
@@ -23,8 +24,6 @@ use core::fmt;
 const STEP: f64 = 0.75;
 /// Most steps per lattice kind: 0.75^60 is 3e-8 of the configured cells.
 const STEPS: i32 = 60;
-/// Cost of an object test in cell steps, for the estimate.
-const TEST: f64 = 2.0;
 
 /// What building within a budget chose.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,9 +109,7 @@ impl<R: Real> Lattice<'_, R> {
         let assess = |c: LatticeConfig, scale: (f64, f64)| {
             let (mut cost, mut world_area, mut world) = (0.0, 1.0, [1; 3]);
             let sizes = Lattice::plan_exact(scene, &c, |g, b, n, refs| {
-                let cells = n.iter().map(|&v| v as f64).product::<f64>();
-                let crossed = 1.0 + n.iter().map(|&v| v as f64).sum::<f64>() / 2.0;
-                let here = crossed * (1.0 + TEST * refs as f64 / cells);
+                let here = ray_cost(n, refs);
                 if g == 0 {
                     (world_area, world) = (area(b), n);
                     cost += here;

@@ -16,9 +16,33 @@ use crate::math::{Aabb, Vec3};
 use crate::scalar::Real;
 use crate::scene::Scene;
 
-/// World cells counted at a time while looking for dense cells (their four counters live on the
-/// stack).
+/// World cells counted at a time while looking for dense cells, without a heap (their tallies
+/// live on the stack, 32 KB).
+#[cfg(not(feature = "alloc"))]
 const CHUNK: usize = 2048;
+/// Most world cells counted at a time with a heap (feature `alloc`): 64 MB of tallies, more
+/// than the largest world lattice the automatic resolution makes (`max_per_axis` 64: 262,144
+/// cells), so that a host's scan passes over the objects once, however many there are.
+#[cfg(feature = "alloc")]
+const HEAP_CHUNK: usize = 1 << 22;
+
+/// What the scan counts per world cell of a chunk.
+#[derive(Clone, Copy)]
+struct Tally {
+    /// Free objects that would move to the cell's lattice.
+    count: u32,
+    /// Of those, the ones centred in the cell.
+    centred: u32,
+    /// The part of the cell they occupy ([`Occupied`]).
+    occupied: u32,
+    /// References to the cell's lattice's cells.
+    refs: u32,
+}
+
+impl Tally {
+    /// Nothing counted.
+    const ZERO: Tally = Tally { count: 0, centred: 0, occupied: NOTHING, refs: 0 };
+}
 
 /// A dense world cell and its lattice.
 #[derive(Clone, Copy, Debug)]
@@ -67,10 +91,14 @@ pub(super) fn for_each_dense<R: Real>(
 /// under a cluster) stays in the world cell's list; in the cell's lattice it would be listed in
 /// most of its cells, and it would stretch the lattice's box over the whole cell.
 pub(super) fn moves<R: Real>(cell: &Aabb<R>, b: &Aabb<R>) -> bool {
-    (0..3).all(|a| {
-        let len = b.max.axis(a) - b.min.axis(a);
-        len + len <= cell.max.axis(a) - cell.min.axis(a)
-    })
+    (0..3).all(|a| small_beside(b, a, cell.min.axis(a), cell.max.axis(a)))
+}
+
+/// Whether box `b` is at most half as long on axis `a` as the span `lo..hi`: [`moves`] on one
+/// axis.
+fn small_beside<R: Real>(b: &Aabb<R>, a: usize, lo: R, hi: R) -> bool {
+    let len = b.max.axis(a) - b.min.axis(a);
+    len + len <= hi - lo
 }
 
 /// Steps per axis in which a dense cell's lattice box is kept, inside the world cell.
@@ -153,13 +181,33 @@ fn step_plane(lo: f64, hi: f64, k: u32) -> f64 {
 /// box, the object's index.
 type Visit<'v, R> = dyn FnMut(usize, &Aabb<R>, &Aabb<R>, usize) + 'v;
 
-/// [`for_each_dense`]'s work, out of line so that its counters are on the stack only when a
-/// scene can have a dense cell.
+/// [`for_each_dense`]'s work, out of line so that its tallies are on the stack only when a
+/// scene can have a dense cell; with a heap, on the heap, one chunk for the whole lattice.
 #[inline(never)]
 fn scan<R: Real>(
     scene: &Scene<'_, R>,
     cfg: &LatticeConfig,
     planes: &(impl Planes<R> + ?Sized),
+    f: impl FnMut(&Dense<R>),
+) {
+    #[cfg(feature = "alloc")]
+    {
+        let total = (0..3).map(|a| planes.cells(a)).product::<usize>();
+        let mut tallies = alloc::vec![Tally::ZERO; total.clamp(1, HEAP_CHUNK)];
+        scan_in(scene, cfg, planes, &mut tallies, f);
+    }
+    #[cfg(not(feature = "alloc"))]
+    scan_in(scene, cfg, planes, &mut [Tally::ZERO; CHUNK], f);
+}
+
+/// [`scan`] over chunks of as many world cells as there are `tallies`: per chunk a pass over
+/// the free objects that counts, and when a cell of the chunk is dense, two more that find
+/// the part each dense cell's objects occupy and count its lattice's references.
+fn scan_in<R: Real>(
+    scene: &Scene<'_, R>,
+    cfg: &LatticeConfig,
+    planes: &(impl Planes<R> + ?Sized),
+    tallies: &mut [Tally],
     mut f: impl FnMut(&Dense<R>),
 ) {
     let split = cfg.split as usize;
@@ -170,10 +218,9 @@ fn scan<R: Real>(
         let bounds = Occupied::region(&cell_box(planes, c), occupied);
         Dense { cell: c, free, centred: 0, bounds, n: resolution(&bounds, free, cfg.sub, cfg.max_per_axis), refs: 0 }
     };
-    let (mut counts, mut centred, mut occupied, mut refs) =
-        ([0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK], [0u32; CHUNK]);
-    for base in (0..total).step_by(CHUNK) {
-        let end = (base + CHUNK).min(total);
+    let size = tallies.len();
+    for base in (0..total).step_by(size) {
+        let end = (base + size).min(total);
         let (z0, z1) = (base / slab, (end - 1) / slab);
         // Calls `visit(cell - base, cell box, object box)` for every cell of the chunk each free
         // object overlaps and would move to, were the cell dense.
@@ -186,49 +233,50 @@ fn scan<R: Real>(
                 // Only the cells the object's own box meets, as the build lists it.
                 let oriented = scene.objects.get(o).and_then(Oriented::of);
                 let r = span(planes, b);
-                for z in lz.max(z0)..=hz.min(z1) {
-                    for y in r[1].0..=r[1].1 {
-                        for x in r[0].0..=r[0].1 {
+                // [`moves`] axis by axis, so that a large object (one that moves nowhere) costs
+                // a test per row, not one per cell of its span.
+                let small = |a: usize, i: usize| small_beside(b, a, planes.plane(a, i), planes.plane(a, i + 1));
+                for z in (lz.max(z0)..=hz.min(z1)).filter(|&z| small(2, z)) {
+                    for y in (r[1].0..=r[1].1).filter(|&y| small(1, y)) {
+                        for x in (r[0].0..=r[0].1).filter(|&x| small(0, x)) {
                             let c = x + n[0] * (y + n[1] * z);
-                            if (base..end).contains(&c) {
-                                let cell = cell_box(planes, c);
-                                if moves(&cell, b) && oriented.as_ref().is_none_or(|k| k.meets(planes, [x, y, z])) {
-                                    visit(c - base, &cell, b, o);
-                                }
+                            if (base..end).contains(&c) && oriented.as_ref().is_none_or(|k| k.meets(planes, [x, y, z]))
+                            {
+                                visit(c - base, &cell_box(planes, c), b, o);
                             }
                         }
                     }
                 }
             }
         };
-        counts.iter_mut().for_each(|k| *k = 0);
-        each(&mut |i, _, _, _| counts[i] += 1);
-        if !counts.iter().any(|&k| k as usize > split) {
+        tallies.iter_mut().for_each(|t| *t = Tally::ZERO);
+        each(&mut |i, _, _, _| tallies[i].count += 1);
+        if !tallies.iter().any(|t| t.count as usize > split) {
             continue;
         }
-        centred.iter_mut().chain(refs.iter_mut()).for_each(|k| *k = 0);
-        occupied.iter_mut().for_each(|k| *k = NOTHING);
         each(&mut |i, cell, b, _| {
-            if counts[i] as usize > split {
-                occupied[i] = Occupied::union(occupied[i], Occupied::of(cell, b));
+            let t = &mut tallies[i];
+            if t.count as usize > split {
+                t.occupied = Occupied::union(t.occupied, Occupied::of(cell, b));
                 let centre = (b.min + b.max) * R::HALF;
-                centred[i] +=
+                t.centred +=
                     u32::from((0..3).all(|a| centre.axis(a) >= cell.min.axis(a) && centre.axis(a) < cell.max.axis(a)));
             }
         });
         each(&mut |i, _, b, o| {
-            if counts[i] as usize > split {
-                let d = dense(base + i, counts[i] as usize, occupied[i]);
+            let t = &mut tallies[i];
+            if t.count as usize > split {
+                let d = dense(base + i, t.count as usize, t.occupied);
                 let oriented = scene.objects.get(o).and_then(Oriented::of);
-                refs[i] += count_cells(&Uniform { bounds: &d.bounds, n: d.n }, b, oriented.as_ref()) as u32;
+                t.refs += count_cells(&Uniform { bounds: &d.bounds, n: d.n }, b, oriented.as_ref()) as u32;
             }
         });
-        for i in 0..end - base {
-            if counts[i] as usize > split {
+        for (i, t) in tallies.iter().enumerate().take(end - base) {
+            if t.count as usize > split {
                 f(&Dense {
-                    centred: centred[i] as usize,
-                    refs: refs[i] as usize,
-                    ..dense(base + i, counts[i] as usize, occupied[i])
+                    centred: t.centred as usize,
+                    refs: t.refs as usize,
+                    ..dense(base + i, t.count as usize, t.occupied)
                 });
             }
         }

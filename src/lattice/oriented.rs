@@ -36,9 +36,16 @@ pub(super) fn count_cells<R: Real>(
     b: &Aabb<R>,
     oriented: Option<&Oriented>,
 ) -> usize {
-    let mut n = 0;
-    for_each_cell(planes, b, oriented, |_| n += 1);
-    n
+    match oriented {
+        // Every cell of the span: its size, not a walk over it (a large object in a fine
+        // lattice spans millions).
+        None => span(planes, b).iter().map(|(lo, hi)| (hi + 1).saturating_sub(*lo)).product(),
+        Some(_) => {
+            let mut n = 0;
+            for_each_cell(planes, b, oriented, |_| n += 1);
+            n
+        }
+    }
 }
 
 /// An object's own box (its canonical shape's, [`crate::shape::Shape::bounds`]) as the

@@ -49,6 +49,10 @@ pub(super) fn lattice_resolution<R: Real>(
     if g == 0 && matches!(res, Resolution::Auto { .. }) && cluster::possible(scene, cfg) {
         n = past_the_clusters(scene, cfg, b, n, count, res);
     }
+    if let Resolution::Auto { density } = res {
+        let coarser = |k: f64| resolution(b, count, Resolution::Auto { density: density * k }, cfg.max_per_axis);
+        n = past_the_overlaps(n, coarser, |m| plan_refs(scene, cfg, g, b, m));
+    }
     if matches!(res, Resolution::Auto { .. }) && cfg.spacing == Spacing::Uniform {
         off_the_faces(scene, cfg, g, b, n, count)
     } else {
@@ -83,6 +87,51 @@ fn past_the_clusters<R: Real>(
         return n;
     }
     resolution(b, items.saturating_sub(centred) + cells, res, cfg.max_per_axis)
+}
+
+/// Cost of an object test in cell steps, for [`ray_cost`].
+const TEST: f64 = 2.0;
+
+/// Estimated cost of a ray through a lattice of `n` cells per axis holding `refs` references,
+/// in cell steps: the cells it crosses (half of them per axis, and the first) times one step
+/// plus the tests of a cell's share of the references.
+pub(super) fn ray_cost(n: [u16; 3], refs: usize) -> f64 {
+    let cells = n.iter().map(|&v| v as f64).product::<f64>();
+    let crossed = 1.0 + n.iter().map(|&v| v as f64).sum::<f64>() / 2.0;
+    crossed * (1.0 + TEST * refs as f64 / cells)
+}
+
+/// A coarser resolution for items that overlap one another. Items at one place (5,000 spheres
+/// written with one centre) or wrapped around each other are listed in every cell they span,
+/// however fine the cells: finer cells then only multiply the references (millions of them,
+/// for a lattice that separates nothing) and the steps of every ray. Lattices with an eighth of
+/// the cells, then an eighth of that, down to one cell, are estimated ([`ray_cost`]); the least
+/// costly is taken when it costs less than half what `n` does. Items that a finer lattice
+/// separates, as in every scene made of parts, make the coarser lattices cost more, and `n`
+/// stands. `coarser(k)` is the resolution for `k` of the cells per item, `refs(m)` the
+/// references of a lattice of `m` cells per axis.
+fn past_the_overlaps(n: [u16; 3], coarser: impl Fn(f64) -> [u16; 3], refs: impl Fn([u16; 3]) -> usize) -> [u16; 3] {
+    let here = ray_cost(n, refs(n));
+    let (mut best, mut least, mut scale) = (n, here, 1.0);
+    let mut m = n;
+    while m != [1; 3] {
+        scale /= 8.0;
+        let next = coarser(scale);
+        // The search ends where the count stops shrinking (a resolution already clamped).
+        if next.iter().map(|&v| v as usize).product::<usize>() >= m.iter().map(|&v| v as usize).product::<usize>() {
+            break;
+        }
+        m = next;
+        let cost = ray_cost(m, refs(m));
+        if cost < least {
+            (best, least) = (m, cost);
+        }
+    }
+    if least < here / 2.0 {
+        best
+    } else {
+        n
+    }
 }
 
 /// A regular scene (a floor of equal tiles) whose pitch is the cell width puts every plane on

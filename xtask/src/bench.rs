@@ -206,6 +206,75 @@ fn generated_as(n: usize, clustered: bool, declared: bool, storage: &mut SceneSt
     Ok(b.finish()?)
 }
 
+/// `n` unit spheres at one place: objects no lattice separates.
+fn coincident(n: usize, storage: &mut SceneStore<f64>) -> Result<Scene<'_, f64>> {
+    storage.objects = vec![Object::default(); n];
+    let mut b = storage.builder();
+    b.add_material(lattice_rt::scene::Material::DEFAULT)?;
+    b.add_light(lattice_rt::scene::Light::Directional { to_light: Vec3::new(0.4, 1.0, -0.5), intensity: 1.0 })?;
+    for _ in 0..n {
+        b.add_object(lattice_rt::Shape::Sphere, lattice_rt::Affine::identity(), 0)?;
+    }
+    b.camera.eye = Vec3::new(0.0, 0.0, -5.0);
+    b.camera.look = Vec3::new(0.0, 0.0, 0.0);
+    b.camera.frame = GENERATED_FRAME;
+    Ok(b.finish()?)
+}
+
+/// How building grows with the objects, whatever their arrangement: the scene's validation and
+/// the lattice's planning and building, timed, and the lattice's bytes per object.
+fn building(md: &mut String, quick: bool, runs: usize) -> Result<()> {
+    let sizes: &[usize] = if quick { &[1_000, 10_000] } else { &[1_000, 10_000, 25_000, 100_000, 1_000_000] };
+    type Make = fn(usize, &mut SceneStore<f64>) -> Result<Scene<'_, f64>>;
+    let kinds: [(&str, Make); 3] =
+        [("random", |n, st| generated(n, false, st)), ("loose cluster", loose), ("coincident spheres", coincident)];
+    writeln!(
+        md,
+        "## Building
+"
+    )?;
+    writeln!(md, "The generated scenes above, the clustered one with its cluster loose (not declared a composite),")?;
+    writeln!(md, "and N unit spheres at one place. Scene: validating the objects (`SceneBuilder::finish`);")?;
+    writeln!(md, "lattice: planning its storage and building it with the defaults. Medians of {runs} runs.\n")?;
+    writeln!(md, "| arrangement | N | scene ms | lattice ms | lattice bytes/object | references/object |")?;
+    writeln!(md, "|---|---|---|---|---|---|")?;
+    let bar = host_sim::progress::bar(kinds.len() * sizes.len(), "building");
+    let mut random = Vec::new();
+    for (name, make) in kinds {
+        for &n in sizes {
+            let (mut scene_t, mut lattice_t, mut bytes, mut refs) = (Vec::new(), Vec::new(), 0, 0);
+            for _ in 0..runs {
+                let mut st = SceneStore::default();
+                let t0 = Instant::now();
+                let scene = make(n, &mut st)?;
+                scene_t.push(t0.elapsed());
+                let cfg = LatticeConfig::default();
+                let t1 = Instant::now();
+                let mut bufs = lattice_storage(&scene, &cfg)?;
+                let lattice = build_lattice(&mut bufs, &scene, &cfg)?;
+                lattice_t.push(t1.elapsed());
+                (bytes, refs) = (lattice.bytes(), lattice.ref_count());
+            }
+            let (s, l) = (median(scene_t).as_secs_f64() * 1e3, median(lattice_t).as_secs_f64() * 1e3);
+            if name == "random" {
+                random.push((n, s + l));
+            }
+            let per = |v: usize| v as f64 / n as f64;
+            writeln!(md, "| {name} | {n} | {s:.1} | {l:.1} | {:.1} | {:.2} |", per(bytes), per(refs))?;
+            bar.inc(1);
+        }
+    }
+    drop(bar);
+    let at = |n: usize| random.iter().find(|(m, _)| *m == n).map(|(_, t)| *t);
+    if let (Some(a), Some(b)) = (at(25_000), at(100_000)) {
+        let r = b / a;
+        let verdict = if r <= 4.5 { "met" } else { "not met" };
+        writeln!(md, "\nRandom, 100,000 objects against 25,000: {r:.2}x the time (4x the objects; target at most 4.5x, {verdict}).")?;
+    }
+    writeln!(md)?;
+    Ok(())
+}
+
 /// The command.
 pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()> {
     let runs = if quick { 1 } else { runs.max(1) };
@@ -213,6 +282,7 @@ pub fn bench_cmd(quick: bool, runs: usize, out: &Path, plot: &Path) -> Result<()
     writeln!(md, "# Performance\n\nWritten by `cargo xtask bench{}` on the host (f64, one core). Times are\nmedians of {runs} runs, the methods interleaved in each run so drift on a shared machine hits all alike.\n", if quick { " --quick" } else { "" })?;
     table1(&mut md, runs)?;
     let series = scaling(&mut md, quick, runs)?;
+    building(&mut md, quick, runs)?;
     resolution_sweep(&mut md, quick, runs)?;
     writeln!(md, "\n![time per ray against N]({})\n", plot_link(out, plot))?;
     md.push_str(&against_povray(quick, runs)?);
