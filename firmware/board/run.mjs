@@ -25,7 +25,7 @@
 // --panel NAME puts another panel on the buses in place of the SSD1306 128x64: sh1106 (the 1.3"
 // modules: 132 columns of RAM, page addressing only), ssd1309 (the 2.42" modules: no charge
 // pump), ssd1306-128x32 or ssd1306-72x40 (smaller glass: the frame's pixels are its size); the
-// image must be built for it (its `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature);
+// image must be built for it (its `sh1106`, `ssd1309`, `ssd1306-128x32` or `ssd1306-72x40` feature);
 // sharp-400x240 or sharp-128x128 puts a Sharp memory LCD on SPI0 alone (its own wiring); uc8151
 // the Badger 2040's e-paper on SPI0 (the SPI modules' CS, DC and RES; its BUSY drives GP26);
 // thumby the Thumby's 72x40 SSD1306 on SPI0 on its own pins (CS GP16, DC GP17, RES GP20), its A

@@ -40,9 +40,9 @@ pub const BUILD: Build = Build {
         None
     },
     exact_sampling: cfg!(feature = "exact-sampling"),
-    glass: if cfg!(feature = "oled-128x32") {
+    glass: if cfg!(feature = "ssd1306-128x32") {
         Glass::Oled128x32
-    } else if cfg!(feature = "oled-72x40") {
+    } else if cfg!(feature = "ssd1306-72x40") {
         Glass::Oled72x40
     } else if cfg!(feature = "sharp-400x240") {
         Glass::Sharp400x240

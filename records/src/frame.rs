@@ -74,9 +74,9 @@ pub enum Glass {
     /// 128x64, the common 0.96" (SSD1306), 1.3" (SH1106) and 2.42" (SSD1309) modules.
     #[default]
     Oled128x64,
-    /// 128x32, the 0.91" SSD1306 modules (the firmware's `oled-128x32` feature).
+    /// 128x32, the 0.91" SSD1306 modules (the firmware's `ssd1306-128x32` feature).
     Oled128x32,
-    /// 72x40, the 0.42" SSD1306 modules and the Thumby's panel (`oled-72x40`).
+    /// 72x40, the 0.42" SSD1306 modules and the Thumby's panel (`ssd1306-72x40`).
     Oled72x40,
     /// 400x240, the Sharp memory LCD LS027B7DH01 (2.7", the Playdate's kind; `sharp-400x240`).
     Sharp400x240,
@@ -101,9 +101,9 @@ impl Glass {
 
     /// The glass a build's features (answered by name) choose.
     pub fn of(has: impl Fn(&str) -> bool) -> Glass {
-        if has("oled-128x32") {
+        if has("ssd1306-128x32") {
             Glass::Oled128x32
-        } else if has("oled-72x40") {
+        } else if has("ssd1306-72x40") {
             Glass::Oled72x40
         } else if has("sharp-400x240") {
             Glass::Sharp400x240
@@ -172,18 +172,12 @@ impl Panel {
         }
     }
 
-    /// The firmware feature that drives it (none for the default).
+    /// The firmware feature that drives it: its name (none for the default), so that
+    /// `--panel` and `--features` speak of a panel in one word.
     pub const fn feature(self) -> Option<&'static str> {
         match self {
             Panel::Ssd1306 => None,
-            Panel::Sh1106 => Some("sh1106"),
-            Panel::Ssd1309 => Some("ssd1309"),
-            Panel::Ssd1306x32 => Some("oled-128x32"),
-            Panel::Ssd1306x40 => Some("oled-72x40"),
-            Panel::Sharp400x240 => Some("sharp-400x240"),
-            Panel::Sharp128x128 => Some("sharp-128x128"),
-            Panel::Uc8151 => Some("uc8151"),
-            Panel::Thumby => Some("thumby"),
+            _ => Some(self.name()),
         }
     }
 
@@ -351,3 +345,25 @@ pub const LADDER: [(&str, Tuning); 7] = [
 /// Tile shares a frame is rendered in (`Share`): one per RP2040 core. Where only one core runs
 /// (the emulator), core 0 renders both, one after the other, and logs each share's time.
 pub const SHARES: u8 = 2;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A panel's `--panel` name is the firmware feature that drives it, and the firmware has
+    /// that feature: one word per panel everywhere.
+    #[test]
+    fn every_panel_is_named_as_its_firmware_feature() {
+        let manifest = include_str!("../../firmware/Cargo.toml");
+        for p in Panel::ALL {
+            match p.feature() {
+                None => assert_eq!(p, Panel::Ssd1306, "only the default panel has no feature"),
+                Some(f) => {
+                    assert_eq!(f, p.name(), "{p:?}");
+                    let declared = manifest.lines().any(|l| l.strip_prefix(f).is_some_and(|r| r.starts_with(" = ")));
+                    assert!(declared, "no firmware feature `{f}`");
+                }
+            }
+        }
+    }
+}

@@ -1,5 +1,5 @@
 //! The panels beside the SSD1306 128x64: each image built for its panel (the firmware's
-//! `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` feature) runs with that panel emulated in
+//! `sh1106`, `ssd1309`, `ssd1306-128x32` or `ssd1306-72x40` feature) runs with that panel emulated in
 //! place of the SSD1306 (run.mjs `--panel`), on I2C at 1 MHz and on SPI, and every scene's
 //! frame must be bit-identical to host-sim's at the glass's size. The models follow their
 //! datasheets (firmware/board/sh1106.mjs, ssd1309.mjs, ssd1306.mjs's glasses): a command the

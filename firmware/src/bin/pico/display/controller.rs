@@ -1,6 +1,6 @@
 //! The OLED controllers with page-organised RAM the firmware drives, one chosen by a feature:
-//! the SSD1306 (default; on 128x32 glass with `oled-128x32`, on 72x40 glass with
-//! `oled-72x40`), the SH1106 (`sh1106`: the common 1.3" 128x64 modules) and the SSD1309
+//! the SSD1306 (default; on 128x32 glass with `ssd1306-128x32`, on 72x40 glass with
+//! `ssd1306-72x40`), the SH1106 (`sh1106`: the common 1.3" 128x64 modules) and the SSD1309
 //! (`ssd1309`: the 2.42" modules). Each is its set-up, sent command by command, and how
 //! an area of pages is addressed. They share the bus (`display-interface`: the control byte on
 //! I2C, D/C# on SPI) and the page layout (a byte is 8 rows of one column, LSB on top), so one
@@ -108,13 +108,13 @@ pub const SSD1309: Controller = Controller {
 };
 
 /// The controller this image drives.
-#[cfg(not(any(feature = "sh1106", feature = "ssd1309", feature = "oled-128x32", feature = "oled-72x40")))]
+#[cfg(not(any(feature = "sh1106", feature = "ssd1309", feature = "ssd1306-128x32", feature = "ssd1306-72x40")))]
 pub const PANEL: Controller = SSD1306;
 /// The controller this image drives.
-#[cfg(feature = "oled-128x32")]
+#[cfg(feature = "ssd1306-128x32")]
 pub const PANEL: Controller = SSD1306_128X32;
 /// The controller this image drives.
-#[cfg(feature = "oled-72x40")]
+#[cfg(feature = "ssd1306-72x40")]
 pub const PANEL: Controller = SSD1306_72X40;
 /// The controller this image drives.
 #[cfg(feature = "sh1106")]
@@ -125,10 +125,10 @@ pub const PANEL: Controller = SSD1309;
 
 #[cfg(any(
     all(feature = "sh1106", feature = "ssd1309"),
-    all(feature = "oled-128x32", feature = "oled-72x40"),
-    all(any(feature = "sh1106", feature = "ssd1309"), any(feature = "oled-128x32", feature = "oled-72x40"))
+    all(feature = "ssd1306-128x32", feature = "ssd1306-72x40"),
+    all(any(feature = "sh1106", feature = "ssd1309"), any(feature = "ssd1306-128x32", feature = "ssd1306-72x40"))
 ))]
-compile_error!("choose one panel: `sh1106`, `ssd1309`, `oled-128x32` or `oled-72x40` (or none: the SSD1306 128x64)");
+compile_error!("choose one panel: `sh1106`, `ssd1309`, `ssd1306-128x32` or `ssd1306-72x40` (or none: the SSD1306 128x64)");
 
 /// A command that changes nothing shown (normal, not inverted, display): the probe of a panel
 /// between frames.
