@@ -92,10 +92,7 @@ pub fn parse_scene<'a, R: Real>(
         .map_err(|e| anyhow!("{}: {e}", path.display()))?;
     // A view the render would refuse for this frame (too narrow for the scalar), refused here
     // at the scene's camera.
-    if let Err(e) = frame.check_view(scene.camera()) {
-        let (line, col, word) = lattice_rt::scene::camera_statement(text).unwrap_or((1, 1, ""));
-        bail!("{}: line {line}, column {col} at `{word}`: {e}", path.display());
-    }
+    frame.check_scene_view(text, scene.camera()).map_err(|e| anyhow!("{}: {e}", path.display()))?;
     Ok(scene)
 }
 

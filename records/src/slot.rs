@@ -212,10 +212,7 @@ pub fn check_scene(text: &str) -> Result<(), alloc::string::String> {
         parse_with::<Fx>(text, &mut objects, &mut parts, |c| c.frame = frame.size()).map_err(|e| format!("{e}"))?;
     // A view the board's render refuses (too narrow for fixed point on its panel), at the
     // camera statement.
-    if let Err(e) = frame.check_view(scene.camera()) {
-        let (line, col, word) = lattice_rt::scene::camera_statement(text).unwrap_or((1, 1, ""));
-        return Err(format!("line {line}, column {col} at `{word}`: {e}"));
-    }
+    frame.check_scene_view(text, scene.camera()).map_err(|e| format!("{e}"))?;
     // The host's build holds more materials and lights than a board's: the statement that
     // goes past the board's is refused where the board refuses it.
     for (word, blamed, have, most) in

@@ -101,6 +101,16 @@ impl Frame {
         resolves(camera, self)
     }
 
+    /// [`Frame::check_view`] for a scene parsed from `text`: a view refused where the text sets
+    /// it (the `camera` statement, NFF's `v`), so that every loader says the same thing at the
+    /// same place (host-sim, and the scene slot's check as the board reads it).
+    pub fn check_scene_view<'t, R: Real>(&self, text: &'t str, camera: &Camera<R>) -> Result<(), ViewRefused<'t>> {
+        self.check_view(camera).map_err(|error| {
+            let (line, col, word) = crate::scene::camera_statement(text).unwrap_or((1, 1, ""));
+            ViewRefused { line, col, word, error }
+        })
+    }
+
     /// Width and height as `[u32; 2]` (what a camera is fitted to: [`crate::scene::CameraDesc::frame`]).
     pub fn size(&self) -> [u32; 2] {
         [u32::from(self.width), u32::from(self.height)]
@@ -248,6 +258,25 @@ impl RenderError<core::convert::Infallible> {
             RenderError::FrameShape { fitted, frame } => RenderError::FrameShape { fitted, frame },
             RenderError::NotProgressive => RenderError::NotProgressive,
         }
+    }
+}
+
+/// A view the frame cannot take ([`Frame::check_scene_view`]), where the scene's text sets it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewRefused<'t> {
+    /// 1-based line of the statement that sets the view.
+    pub line: u32,
+    /// 1-based column of its keyword.
+    pub col: u32,
+    /// Its keyword.
+    pub word: &'t str,
+    /// Why the view is refused.
+    pub error: RenderError<core::convert::Infallible>,
+}
+
+impl fmt::Display for ViewRefused<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "line {}, column {} at `{}`: {}", self.line, self.col, self.word, self.error)
     }
 }
 

@@ -23,7 +23,7 @@ mod tiles;
 
 pub use crate::sample::{level, Hits, Sampling, Shot};
 pub use bands::{dither_band, dither_tiles, trace_share, BandRows};
-pub use frame::{Frame, RenderError, Share, TileGrid};
+pub use frame::{Frame, RenderError, Share, TileGrid, ViewRefused};
 pub use pass::Traced;
 pub use progressive::{render_pass, trace_pass};
 #[cfg(feature = "alloc")]
