@@ -449,6 +449,12 @@ impl<'a, 't, R: Real> Reader<'a, 't, R> {
         for _ in 0..n {
             let _ = v.push(self.point()?);
             if patch {
+                // A vertex's normal follows it on its line: one missing is reported there, not
+                // where the numbers of the lines after it run out.
+                let line = self.t.end.0;
+                if self.t.peek().is_none_or(|w| w.0 > line) {
+                    return Err(self.t.missing());
+                }
                 let _ = normals.push(self.point()?);
             }
         }

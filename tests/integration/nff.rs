@@ -246,6 +246,9 @@ fn hostile_nff_is_refused_at_its_place_for_its_reason() {
         (format!("{view}s 0 0 0\ns 1 1 1 1\n"), "line 2, column 8", "missing"),
         (format!("{view}pp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0\n"), "line 5, column 6", "missing"),
         (format!("{view}pp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0\ns 0 0 0 1\n"), "line 5, column 6", "missing"),
+        // A normal missing mid-polygon, at its vertex's line, not where the numbers run out.
+        (format!("{view}pp 3\n0 0 0 0 0 1\n1 0 0\n0 1 0 0 0 1\ns 0 0 3 1\n"), "line 4, column 6", "missing"),
+        (format!("{view}pp 3\n0 0 0\n1 0 0 0 0 1\n0 1 0 0 0 1\n"), "line 3, column 6", "missing"),
         (format!("{view}p 3\n0 0 0\n1 0 0\n"), "line 4, column 6", "missing"),
         (format!("{view}p 3000000\n"), "line 2, column 3 at `3000000`", "more vertices"),
         (format!("{view}p 18446744073709551615\n"), "line 2, column 3 at `18446744073709551615`", "more vertices"),
