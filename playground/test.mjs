@@ -173,6 +173,18 @@ async function main() {
       const wantGlass = hostFrame(o.hostSim, 'chair', ['--board', 'pico', '--panel', name], work, [w, h]);
       const gotGlass = await readCanvas(page, 'panel', w, h);
       check(size === `${w}x${h}` && differing(gotGlass, wantGlass) === 0, `${name}: a ${size} panel equal to host-sim render --board pico --panel ${name} (${differing(gotGlass, wantGlass)} pixels differ)`);
+      // In a window 1280 pixels wide, the panel stays inside its section and the window.
+      await page.setViewport({ width: 1280, height: 900 });
+      // The page fits its panels again when the window's size changes (its resize event).
+      const inside = () => document.getElementById('panel').getBoundingClientRect().right <= document.getElementById('view').getBoundingClientRect().right;
+      await page.waitForFunction(inside, { timeout: 5000 }).catch(() => {});
+      const fit = await page.evaluate(() => {
+        const c = document.getElementById('panel').getBoundingClientRect();
+        const s = document.getElementById('view').getBoundingClientRect();
+        return { right: Math.round(c.right), section: Math.round(s.right), window: window.innerWidth };
+      });
+      check(fit.right <= fit.section && fit.right <= fit.window, `${name}: in a 1280-pixel window the panel ends at ${fit.right}, inside its section (${fit.section}) and the window (${fit.window})`);
+      await page.setViewport({ width: 1500, height: 1180 });
     }
     await page.select('#glass', 'ssd1306');
     await page.waitForFunction(() => window.playground.settings?.panel === 'ssd1306');

@@ -34,6 +34,19 @@ const lookOf = (panel) => (panel.startsWith('sharp') ? LOOKS.sharp : panel === '
 const shade = (share, look = LOOKS.oled) => look.dark.map((d, i) => Math.round(d + (look.lit[i] - d) * share));
 
 /**
+ * Shows a canvas at the largest whole scale, at most 4x, at which its glass and border (6
+ * pixels a side) fit the width its section has: a 400-pixel glass beside the editor in a
+ * 1280-pixel window at 1x, never running off the page.
+ */
+function fit(canvas) {
+  const room = (canvas.parentElement?.clientWidth ?? 4 * canvas.width) - 12;
+  const scale = Math.max(1, Math.min(4, Math.floor(room / canvas.width)));
+  canvas.style.width = `${canvas.width * scale}px`;
+  canvas.style.height = `${canvas.height * scale}px`;
+}
+addEventListener('resize', () => document.querySelectorAll('canvas').forEach(fit));
+
+/**
  * Draws a frame of `w` x `h` pixels on a canvas (sized to it): a packed 1-bit frame (rows of
  * w / 8 bytes, MSB first, 1 lit), or with `steps` (a step per pixel, 0..=top) its shades, a
  * pixel of step k lit k / top of the time (the gray mode's subframes, as the eye sums them),
@@ -44,10 +57,7 @@ function draw(canvas, bits, steps = null, top = 1, w = W, h = H, look = LOOKS.ol
     canvas.width = w;
     canvas.height = h;
   }
-  // Shown at 4x, or 2x when the glass is wider than the OLEDs'.
-  const scale = w > 128 ? 2 : 4;
-  canvas.style.width = `${w * scale}px`;
-  canvas.style.height = `${h * scale}px`;
+  fit(canvas);
   canvas.style.borderColor = look.frame;
   const ctx = canvas.getContext('2d');
   const img = ctx.createImageData(w, h);
