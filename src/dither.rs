@@ -271,6 +271,8 @@ pub struct Carry<'c> {
     rows: &'c mut [i16],
     width: usize,
     right: [[i16; 2]; MAX_TILE],
+    /// The right border of the rows above the image ([`rows_above`]) to the next tile.
+    above_right: [[i16; 2]; TOP_PAD],
     incoming: usize,
 }
 
@@ -283,7 +285,7 @@ impl<'c> Carry<'c> {
     pub fn new(rows: &'c mut [i16], width: usize) -> Option<Self> {
         let rows = rows.get_mut(..Self::len(width))?;
         rows.iter_mut().for_each(|v| *v = 0);
-        Some(Carry { rows, width, right: [[0; 2]; MAX_TILE], incoming: 0 })
+        Some(Carry { rows, width, right: [[0; 2]; MAX_TILE], above_right: [[0; 2]; TOP_PAD], incoming: 0 })
     }
     /// Row `k` of the half `which`: entry `EDGE_PAD + x` for image column `x`.
     fn row(&mut self, which: usize, k: usize) -> &mut [i16] {
@@ -376,6 +378,10 @@ impl<'c> Carry<'c> {
             }
         }
         self.right = [[0; 2]; MAX_TILE];
+        if y0 == 0 && h > 0 {
+            let edges = (first, lead, w, x0 + w >= self.width);
+            rows_above(&kernel, &mut acc, &padded(&levels[..w], lead, span), edges, &mut self.above_right);
+        }
         for y in 0..h {
             // The left border's error (what went down-left) to the pixel straight below.
             let left = core::mem::take(&mut acc[y][0]);
@@ -384,12 +390,8 @@ impl<'c> Carry<'c> {
             if span == w {
                 kernel(&mut acc, y, row, px);
             } else {
-                // The pads carry the row's first and last grays; their pixels are not drawn.
-                let mut padded = [row[0]; MAX_TILE + 2 * EDGE_PAD];
-                padded[lead..lead + w].copy_from_slice(row);
-                padded[lead + w..span].fill(row[w - 1]);
                 let mut drawn = [C::DARK; MAX_TILE + 2 * EDGE_PAD];
-                kernel(&mut acc, y, &padded[..span], &mut drawn[..span]);
+                kernel(&mut acc, y, &padded(row, lead, span)[..span], &mut drawn[..span]);
                 px.copy_from_slice(&drawn[lead..lead + w]);
             }
         }
@@ -416,6 +418,77 @@ impl<'c> Carry<'c> {
                     row[first + c] += e;
                 }
             }
+        }
+    }
+}
+
+/// Rows dithered above the image and not drawn, each the first row's grays: the first rows
+/// then get error from above as every other row does (without them, a flat gray's first rows
+/// were lit all or nothing, or in a regular pattern, up to 14 standard deviations off the
+/// field's mean).
+const TOP_PAD: usize = 16;
+
+/// A tile row of `span` grays: `row` after `lead` pad grays, the pads carrying its first and
+/// last grays.
+fn padded(row: &[u8], lead: usize, span: usize) -> [u8; MAX_TILE + 2 * EDGE_PAD] {
+    let w = row.len();
+    let mut padded = [row[0]; MAX_TILE + 2 * EDGE_PAD];
+    padded[lead..lead + w].copy_from_slice(row);
+    padded[lead + w..span].fill(row[w - 1]);
+    padded
+}
+
+/// Dithers the [`TOP_PAD`] rows above a first-band tile (`row`: its first row, padded; `lead`
+/// pad columns before its `w`, and whether it is the band's last) in an accumulator of their
+/// own, as its own rows are dithered: each row's error handed right to the next tile through
+/// `right`, and at the image's left edge each row started from its own seed. The error they
+/// send to the two rows below them is added to `acc`'s first two rows. Out of line, so its
+/// accumulator takes stack only meanwhile.
+#[inline(never)]
+fn rows_above<C: Shade>(
+    kernel: &impl Fn(&mut Acc, usize, &[u8], &mut [C]),
+    acc: &mut Acc,
+    row: &[u8; MAX_TILE + 2 * EDGE_PAD],
+    (first, lead, w, last): (usize, usize, usize, bool),
+    right: &mut [[i16; 2]; TOP_PAD],
+) {
+    let span = lead + w + if last { EDGE_PAD } else { 0 };
+    let mut above: Acc = [[0; MAX_TILE + 2 * EDGE_PAD + 3]; MAX_TILE + 2];
+    let mut drawn = [C::DARK; MAX_TILE + 2 * EDGE_PAD];
+    // The first row from a seed per column, as each row starts from one: no start-up pattern.
+    for (c, a) in above[0][1..=span].iter_mut().enumerate() {
+        *a = row_seed(usize::MAX / 2 + first + c);
+    }
+    // `y`: the accumulator's row, rolled back to the top when it fills (the rows above may be
+    // more than a tile's).
+    let mut y = 0;
+    for (k, r) in right.iter_mut().enumerate() {
+        let [r0, r1] = core::mem::take(r);
+        above[y][1 + lead] += r0;
+        if w > 1 {
+            above[y][2 + lead] += r1;
+        }
+        if lead > 0 {
+            // Seeds of their own: not the image rows' (`usize::MAX - k` is no row of a frame).
+            above[y][1] += row_seed(usize::MAX - k);
+        }
+        let left = core::mem::take(&mut above[y][0]);
+        above[y][1] += left;
+        kernel(&mut above, y, &row[..span], &mut drawn[..span]);
+        if !last {
+            *r = [above[y][lead + w + 1], above[y][lead + w + 2]];
+        }
+        y += 1;
+        if y == MAX_TILE {
+            above[0] = above[MAX_TILE];
+            above[1] = above[MAX_TILE + 1];
+            above[2..].iter_mut().for_each(|row| *row = [0; MAX_TILE + 2 * EDGE_PAD + 3]);
+            y = 0;
+        }
+    }
+    for k in 0..2 {
+        for (a, e) in acc[k].iter_mut().zip(above[y + k]) {
+            *a += e;
         }
     }
 }
@@ -636,6 +709,68 @@ mod tests {
         lit
     }
 
+    /// How often each row of a `w x h` flat field of `level` is lit, dithered by `mode` in
+    /// `t x t` tiles in the render's order.
+    fn row_counts(mode: Dither, w: usize, h: usize, t: usize, level: u8) -> std::vec::Vec<u32> {
+        let mut store = std::vec![0i16; Carry::len(w)];
+        let mut carry = Carry::new(&mut store, w).unwrap();
+        let mut lit = std::vec![0u32; h];
+        for y0 in (0..h).step_by(t) {
+            carry.next_band();
+            for x0 in (0..w).step_by(t) {
+                let (tw, th) = (t.min(w - x0), t.min(h - y0));
+                let mut out = [BinaryColor::Off; MAX_TILE * MAX_TILE];
+                carry.tile(mode, (x0, y0), tw, th, &[level; MAX_TILE * MAX_TILE][..tw * th], &mut out[..tw * th]);
+                for (i, px) in out[..tw * th].iter().enumerate() {
+                    lit[y0 + i / tw] += u32::from(px.is_on());
+                }
+            }
+        }
+        lit
+    }
+
+    #[test]
+    fn error_diffusion_draws_no_seam_at_the_top() {
+        // The three first rows look like the interior's rows (first-look: Atkinson's row 0 lit
+        // on all 400 pixels of a flat 41 of 64, 13.9 standard deviations off the mean; Floyd-
+        // Steinberg's row 2 on 267 of 400 at 56 of 64, 12.7 off; 362 of the 378 rows below
+        // outside the interior's spread). A row is outside when it is further from the field's
+        // mean than binomial noise allows (3 standard deviations) and than every interior row;
+        // rows drawn like the interior's are so by chance for one of every `interior + 1`, so
+        // no more top rows than that may be outside, and none by more than a standard deviation.
+        let (mut outside, mut by_chance) = (0, 0.0);
+        for mode in [Dither::FloydSteinberg, Dither::Atkinson] {
+            for (w, h) in [(128, 64), (400, 240), (72, 40)] {
+                for t in [4, 8, MAX_TILE] {
+                    for level in (2..63).step_by(3) {
+                        let lit = row_counts(mode, w, h, t, level);
+                        let total: u32 = lit.iter().sum();
+                        let p = f64::from(total) / (w * h) as f64;
+                        let (mean, sd) = (p * w as f64, (w as f64 * p * (1.0 - p)).sqrt().max(1.0));
+                        let dev = |y: usize| (f64::from(lit[y]) - mean) / sd;
+                        let texture = (6..h - 6).map(|y| dev(y).abs()).fold(3.0, f64::max);
+                        by_chance += 3.0 / (h - 12 + 1) as f64;
+                        for y in [0, 1, 2] {
+                            outside += usize::from(dev(y).abs() > texture);
+                            assert!(
+                                dev(y).abs() <= texture + 1.0,
+                                "{mode:?} {w}x{h} tiles {t} level {level}: row {y} lit {} times against a \
+                                 mean of {mean:.1} ({:.2} sd, the interior within {texture:.2}): first {:?}",
+                                lit[y],
+                                dev(y),
+                                &lit[..4],
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            outside as f64 <= by_chance,
+            "{outside} top rows outside the interior's spread, {by_chance:.1} by chance"
+        );
+    }
+
     #[test]
     fn error_diffusion_draws_no_seam_at_the_edges() {
         // A seam is a border column lit more or less often than the field's mean (first-look:
@@ -678,9 +813,11 @@ mod tests {
         carry.next_band();
         let mut out = [BinaryColor::Off; 16];
         carry.tile(Dither::Atkinson, (0, 0), 4, 4, &[40u8; 16], &mut out);
-        // Row 0 is all on (the pads beside it, at the same gray, hand on errors too small to
-        // turn a pixel off); the negative error it leaves turns pixels of the next rows off.
-        assert_eq!(art(4, &out), "####\n.#..\n.###\n#.##\n");
+        // The rows above the image (dithered, not drawn) hand their error on: the tile is lit
+        // in proportion to its gray, 10 of 16 at 40 of 64, and no row is all on (row 0 was, with
+        // nothing above it).
+        assert_eq!(art(4, &out), "##.#\n##.#\n.##.\n.##.\n");
+        assert_eq!(out.iter().filter(|p| p.is_on()).count(), 10);
     }
 
     /// A `w x h` flat field of `level` dithered to four shades by `mode` in `t x t` tiles, as
