@@ -128,7 +128,9 @@ pub const PANEL: Controller = SSD1309;
     all(feature = "ssd1306-128x32", feature = "ssd1306-72x40"),
     all(any(feature = "sh1106", feature = "ssd1309"), any(feature = "ssd1306-128x32", feature = "ssd1306-72x40"))
 ))]
-compile_error!("choose one panel: `sh1106`, `ssd1309`, `ssd1306-128x32` or `ssd1306-72x40` (or none: the SSD1306 128x64)");
+compile_error!(
+    "choose one panel: `sh1106`, `ssd1309`, `ssd1306-128x32` or `ssd1306-72x40` (or none: the SSD1306 128x64)"
+);
 
 /// A command that changes nothing shown (normal, not inverted, display): the probe of a panel
 /// between frames.
