@@ -457,7 +457,9 @@ fn rows_above<C: Shade>(
     let mut drawn = [C::DARK; MAX_TILE + 2 * EDGE_PAD];
     // The first row from a seed per column, as each row starts from one: no start-up pattern.
     for (c, a) in above[0][1..=span].iter_mut().enumerate() {
-        *a = row_seed(usize::MAX / 2 + first + c);
+        // The hash of the carry column before it: the same number on 32- and 64-bit targets
+        // (`row_seed` hashes the low 32 bits; the QEMU and board frames are held to host-sim's).
+        *a = row_seed((first + c).wrapping_sub(1));
     }
     // `y`: the accumulator's row, rolled back to the top when it fills (the rows above may be
     // more than a tile's).
