@@ -51,7 +51,7 @@ pub(super) fn lattice_resolution<R: Real>(
     }
     if let Resolution::Auto { density } = res {
         let coarser = |k: f64| resolution(b, count, Resolution::Auto { density: density * k }, cfg.max_per_axis);
-        n = past_the_overlaps(n, coarser, |m| plan_refs(scene, cfg, g, b, m));
+        n = past_the_overlaps(n, count, coarser, |m| plan_refs(scene, cfg, g, b, m));
     }
     if matches!(res, Resolution::Auto { .. }) && cfg.spacing == Spacing::Uniform {
         off_the_faces(scene, cfg, g, b, n, count)
@@ -89,6 +89,9 @@ fn past_the_clusters<R: Real>(
     resolution(b, items.saturating_sub(centred) + cells, res, cfg.max_per_axis)
 }
 
+/// References per item above which [`past_the_overlaps`] looks for a coarser lattice.
+const SPREAD: usize = 8;
+
 /// Cost of an object test in cell steps, for [`ray_cost`].
 const TEST: f64 = 2.0;
 
@@ -108,10 +111,21 @@ pub(super) fn ray_cost(n: [u16; 3], refs: usize) -> f64 {
 /// the cells, then an eighth of that, down to one cell, are estimated ([`ray_cost`]); the least
 /// costly is taken when it costs less than half what `n` does. Items that a finer lattice
 /// separates, as in every scene made of parts, make the coarser lattices cost more, and `n`
-/// stands. `coarser(k)` is the resolution for `k` of the cells per item, `refs(m)` the
+/// stands. The search is made only when the `items` are listed in more than [`SPREAD`] cells
+/// each on average (it costs a pass over them per candidate). `coarser(k)` is the resolution for `k` of the cells per item, `refs(m)` the
 /// references of a lattice of `m` cells per axis.
-fn past_the_overlaps(n: [u16; 3], coarser: impl Fn(f64) -> [u16; 3], refs: impl Fn([u16; 3]) -> usize) -> [u16; 3] {
-    let here = ray_cost(n, refs(n));
+fn past_the_overlaps(
+    n: [u16; 3],
+    items: usize,
+    coarser: impl Fn(f64) -> [u16; 3],
+    refs: impl Fn([u16; 3]) -> usize,
+) -> [u16; 3] {
+    let listed = refs(n);
+    // Items listed in a few cells each are separated by the cells: no search.
+    if listed <= SPREAD * items {
+        return n;
+    }
+    let here = ray_cost(n, listed);
     let (mut best, mut least, mut scale) = (n, here, 1.0);
     let mut m = n;
     while m != [1; 3] {
