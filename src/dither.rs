@@ -694,29 +694,20 @@ mod tests {
     /// Per column, how many of an `w x h` flat field of `level` are lit, dithered by `mode` in
     /// tiles of `t x t` as the render orders them.
     fn column_counts(mode: Dither, w: usize, h: usize, t: usize, level: u8) -> std::vec::Vec<u32> {
-        let mut store = std::vec![0i16; Carry::len(w)];
-        let mut carry = Carry::new(&mut store, w).unwrap();
-        let mut lit = std::vec![0u32; w];
-        for y0 in (0..h).step_by(t) {
-            carry.next_band();
-            for x0 in (0..w).step_by(t) {
-                let (tw, th) = (t.min(w - x0), t.min(h - y0));
-                let mut out = [BinaryColor::Off; MAX_TILE * MAX_TILE];
-                carry.tile(mode, (x0, y0), tw, th, &[level; MAX_TILE * MAX_TILE][..tw * th], &mut out[..tw * th]);
-                for (i, px) in out[..tw * th].iter().enumerate() {
-                    lit[x0 + i % tw] += u32::from(px.is_on());
-                }
-            }
-        }
-        lit
+        lit_counts(mode, w, h, t, level).0
     }
 
-    /// How often each row of a `w x h` flat field of `level` is lit, dithered by `mode` in
-    /// `t x t` tiles in the render's order.
+    /// How often each row of the field [`column_counts`] dithers is lit.
     fn row_counts(mode: Dither, w: usize, h: usize, t: usize, level: u8) -> std::vec::Vec<u32> {
+        lit_counts(mode, w, h, t, level).1
+    }
+
+    /// The lit pixels of each column and of each row of a `w x h` flat field of `level`,
+    /// dithered by `mode` in `t x t` tiles in the render's order.
+    fn lit_counts(mode: Dither, w: usize, h: usize, t: usize, level: u8) -> (std::vec::Vec<u32>, std::vec::Vec<u32>) {
         let mut store = std::vec![0i16; Carry::len(w)];
         let mut carry = Carry::new(&mut store, w).unwrap();
-        let mut lit = std::vec![0u32; h];
+        let (mut cols, mut rows) = (std::vec![0u32; w], std::vec![0u32; h]);
         for y0 in (0..h).step_by(t) {
             carry.next_band();
             for x0 in (0..w).step_by(t) {
@@ -724,11 +715,12 @@ mod tests {
                 let mut out = [BinaryColor::Off; MAX_TILE * MAX_TILE];
                 carry.tile(mode, (x0, y0), tw, th, &[level; MAX_TILE * MAX_TILE][..tw * th], &mut out[..tw * th]);
                 for (i, px) in out[..tw * th].iter().enumerate() {
-                    lit[y0 + i / tw] += u32::from(px.is_on());
+                    cols[x0 + i % tw] += u32::from(px.is_on());
+                    rows[y0 + i / tw] += u32::from(px.is_on());
                 }
             }
         }
-        lit
+        (cols, rows)
     }
 
     #[test]
