@@ -48,6 +48,8 @@
 // it through the pins (I2C0's SDA on GP4, SCL on GP5). --nack-at MS (repeatable): the display
 // does not acknowledge the first byte written to it after MS. Each gives an {"event":"bus"}
 // line when it happens (what: "sda held", "sda released", "nack").
+// --look-at MS (repeatable): an {"event":"look","ms":MS,"pixels":...} line with what the
+// panel shows at MS, whatever the firmware is doing (a power cut no transfer saw shows here).
 // --press MS[:LEN_MS] (repeatable) presses the board's next-scene button (GP14 to ground, the
 // firmware's `Wiring::NEXT`) at MS for LEN_MS (100 by default), with an {"event":"button",
 // "which":"next"} line; --press-turn MS[:LEN_MS] the camera-turn button (GP15, `Wiring::TURN`),
@@ -69,7 +71,7 @@
 //                     [--profile-frames N] [--no-core1] [--no-cache] [--untimed-bus]
 //                     [--pass-bytes N] [--panel-off START_MS:LEN_MS] [--reset-at MS]
 //                     [--hang-core1-at MS] [--panic-at MS --panic-request ADDR]
-//                     [--sda-stuck START_MS:PULSES] [--nack-at MS] [--panel NAME]
+//                     [--sda-stuck START_MS:PULSES] [--nack-at MS] [--look-at MS] [--panel NAME]
 //                     [--press MS[:LEN_MS]] [--press-turn MS[:LEN_MS]] [--scan] [--osc-error PERCENT]
 import { readFileSync, writeFileSync } from 'node:fs';
 import { SiliconBoard, GPIOPinState, loadUf2, FLASH } from './silicon.mjs';
@@ -156,7 +158,7 @@ class PushButton {
 const PROFILE_EVERY = 97;
 
 function parseArgs(argv) {
-  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [], sdaStuck: [], nackAt: [], presses: [], panel: 'ssd1306' };
+  const o = { frames: 1, maxCycles: 20e9, display: true, untilMs: null, profileFrames: 1, core1: true, cache: true, timedBus: true, panelOff: [], resetAt: [], hangAt: [], panicAt: [], sdaStuck: [], nackAt: [], looks: [], presses: [], panel: 'ssd1306' };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
     const next = () => {
@@ -197,6 +199,7 @@ function parseArgs(argv) {
       if (!m) throw new Error(`--sda-stuck ${v}: START_MS:PULSES expected (PULSES 1 to 9)`);
       o.sdaStuck.push({ startMs: Number(m[1]), pulses: Number(m[2]) });
     } else if (a === '--nack-at') o.nackAt.push(Number(next()));
+    else if (a === '--look-at') o.looks.push(Number(next()));
     else if (a === '--press' || a === '--press-turn') {
       const v = next();
       const m = /^(\d+(?:\.\d+)?)(?::(\d+(?:\.\d+)?))?$/.exec(v);
@@ -447,6 +450,13 @@ function main() {
     moments.push({ nanos: startMs * 1e6, fn: () => (board.holdSda(0, pulses), busEvent('sda held')) });
   }
   for (const ms of display ? opt.nackAt : []) moments.push({ nanos: ms * 1e6, fn: () => board.nackNext(0) });
+  // --look-at: what the panel shows at that moment, whether or not a frame is being sent.
+  for (const ms of display ? opt.looks : []) {
+    moments.push({ nanos: ms * 1e6, fn: () => {
+      const why = display.notShowable();
+      emit({ event: 'look', ms, error: why, pixels: why ? null : toHex(display.shown()) });
+    } });
+  }
   for (const { which, startMs, lenMs } of opt.presses) {
     moments.push({ nanos: startMs * 1e6, fn: () => (buttons[which].press(true), emit({ event: 'button', which, ms: startMs })) });
     moments.push({ nanos: (startMs + lenMs) * 1e6, fn: () => buttons[which].press(false) });

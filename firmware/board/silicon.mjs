@@ -276,6 +276,10 @@ class CoreBus {
   }
 
   flash(address) {
+    // Past the XIP SSI's window (0x18000000) nothing answers: silicon raises a bus fault. The
+    // first word below the SRAM is where an overflowing stack goes (flip-link puts the stack
+    // at the SRAM's bottom), so this stops the run instead of letting it read garbage.
+    if (address >>> 24 > 0x18) return this.board.unmapped(this.index, address);
     const stall = this.board.xip?.access(address, this.core.cycles);
     if (stall) this.core.cycles += stall;
   }
@@ -315,6 +319,7 @@ class CoreBus {
   writeUint32(address, value) {
     address >>>= 0;
     const region = address >>> 28;
+    if (region === FLASH_REGION && address >>> 24 > 0x18) return this.board.unmapped(this.index, address);
     if (region === 0xd) return this.sioWrite(address - SIO_BASE, value >>> 0);
     if (address >>> 12 === PPB_PAGE) return this.ppbWrite(address & 0xfff, value >>> 0);
     if (region === 2) this.checkGuard(address);
@@ -324,6 +329,7 @@ class CoreBus {
   writeUint16(address, value) {
     address >>>= 0;
     const region = address >>> 28;
+    if (region === FLASH_REGION && address >>> 24 > 0x18) return this.board.unmapped(this.index, address);
     if (region === 0xd || address >>> 12 === PPB_PAGE) return this.writeUint32(address & ~3, (value & 0xffff) * 0x10001);
     if (region === 2) this.checkGuard(address);
     this.mcu.writeUint16(address, value);
@@ -331,6 +337,7 @@ class CoreBus {
   writeUint8(address, value) {
     address >>>= 0;
     const region = address >>> 28;
+    if (region === FLASH_REGION && address >>> 24 > 0x18) return this.board.unmapped(this.index, address);
     if (region === 0xd || address >>> 12 === PPB_PAGE) return this.writeUint32(address & ~3, (value & 0xff) * 0x1010101);
     if (region === 2) this.checkGuard(address);
     this.mcu.writeUint8(address, value);
@@ -548,6 +555,12 @@ export class SiliconBoard {
 
   onBreak(core, code) {
     this.stop = `core ${core} stopped at a breakpoint or undefined instruction (code ${code}) at pc 0x${(this.cores[core].PC >>> 0).toString(16)}: a panic`;
+  }
+
+  /** An access to an address nothing answers at: a bus fault on silicon. */
+  unmapped(core, address) {
+    const hint = address >= 0x1fff0000 ? ': just below the SRAM, where an overflowing stack goes (flip-link)' : '';
+    this.stop ??= `core ${core} accessed 0x${address.toString(16)}, where nothing answers (pc 0x${(this.cores[core].PC >>> 0).toString(16)}): a bus fault${hint}`;
   }
 
   guardHit(core, address) {

@@ -467,3 +467,16 @@ test('UC8151: BUSY low through PON and a refresh as long as its LUT, gate-ordere
   gcmd(0x04);
   assert.match(g.error, /0x1 cut short: 2 of its 5/);
 });
+
+test('an access past the XIP windows, below the SRAM (where an overflowing stack goes), stops the board as a bus fault', () => {
+  const board = new SiliconBoard({ dualCore: false });
+  const bus = board.buses[0];
+  bus.readUint32(0x10000100); // flash, through the cache
+  bus.writeUint32(0x15000000, 7); // XIP SRAM
+  assert.equal(board.stop, null, 'the XIP windows answer');
+  bus.writeUint32(0x1ffffffc, 1); // a push one word below the SRAM
+  assert.match(board.stop, /core 0 accessed 0x1ffffffc, where nothing answers .*a bus fault: just below the SRAM/);
+  const reads = new SiliconBoard({ dualCore: false });
+  reads.buses[0].readUint8(0x19000000);
+  assert.match(reads.stop, /0x19000000, where nothing answers/);
+});

@@ -245,6 +245,9 @@ enum Event {
     Refresh(u64, usize),
     /// An e-paper refresh: its start and end, and when its frame's bytes began.
     Epaper(epaper::Refresh),
+    /// What the panel showed at a moment (`--look-at`): when, and its pixels (none when it
+    /// showed no picture).
+    Look(f64, Option<Vec<u8>>),
     End(RunEnd),
 }
 
@@ -271,6 +274,9 @@ impl Event {
                 v["image"].as_u64().context("a refresh without its picture")? as usize,
             ),
             Some("epaper") => Event::Epaper(serde_json::from_value(v)?),
+            Some("look") => {
+                Event::Look(v["ms"].as_f64().context("a look without its moment")?, v["pixels"].as_str().map(hex_bytes))
+            }
             _ => bail!("emulator printed an unknown event: {line}"),
         };
         Ok(event)
@@ -317,6 +323,8 @@ struct BoardRun {
     refreshes: u64,
     /// An e-paper's refreshes, in order.
     epaper: Vec<epaper::Refresh>,
+    /// What the panel showed at the moments asked for (`--look-at`), in order.
+    looks: Vec<(f64, Option<Vec<u8>>)>,
 }
 
 /// One decoded defmt log line.
@@ -353,6 +361,7 @@ impl BoardRun {
             }
             Event::Refresh(index, id) => run.refresh_changes.push((index, id)),
             Event::Epaper(r) => run.epaper.push(r),
+            Event::Look(ms, pixels) => run.looks.push((ms, pixels)),
             Event::End(e) => {
                 run.ok = e.ok;
                 run.reason = e.reason;

@@ -14,11 +14,12 @@ static CORE1_STACK: hal::multicore::Stack<CORE1_STACK_WORDS> = hal::multicore::S
 /// most (5,984 bytes at 296x128 over the five scenes, as the emulated board found it).
 #[cfg(baked_scenes)]
 const CORE1_STACK_WORDS: usize = 8192;
-/// Core 1's stack in words: 16 KiB where the scenes are parsed on the board (`parse`, `slot`,
+/// Core 1's stack in words: 12 KiB where the scenes are parsed on the board (`parse`, `slot`,
 /// `orbit`), whose storage lives on core 0's stack and needs the rest: with 32 KiB here the
-/// `parse` image of the five scenes overflowed core 0's stack at boot.
+/// `parse` image of the five scenes overflowed core 0's stack at boot, and with 16 KiB it did
+/// once error diffusion dithered rows above the image (core 0 dithers; core 1 only traces).
 #[cfg(not(baked_scenes))]
-const CORE1_STACK_WORDS: usize = 4096;
+const CORE1_STACK_WORDS: usize = 3072;
 
 /// Core 1: runs each job core 0 sends through the SIO FIFO and answers when it is done.
 fn core1_main() {

@@ -57,6 +57,14 @@ pub trait SetUp {
     /// Whether the panel answers a command that changes nothing it shows (normal, not inverted,
     /// display): a probe while the board waits between frames.
     fn answers(&mut self) -> bool;
+    /// Sends the picture shown again, with the set-up that shows it but without turning the
+    /// display off first: a panel that lost power for a moment no transfer saw (it comes back
+    /// dark, its settings lost) shows the picture again, and one that did not changes nothing.
+    /// The modes call it at a steady rate while a picture stands. Panels that keep their
+    /// picture without power have nothing to do.
+    fn refresh(&mut self) -> Result<(), DisplayError> {
+        Ok(())
+    }
     /// Waits until everything drawn is on the panel: the bus's own wait ([`flush`]) unless the
     /// panel has its own.
     fn flush(&mut self) -> Result<(), DisplayError> {
@@ -91,6 +99,10 @@ impl<T: SetUp> SetUp for Bands<T> {
 
     fn answers(&mut self) -> bool {
         self.0.answers()
+    }
+
+    fn refresh(&mut self) -> Result<(), DisplayError> {
+        self.0.refresh()
     }
 
     fn flush(&mut self) -> Result<(), DisplayError> {

@@ -120,7 +120,7 @@ fn main() -> ! {
 
     display::reset(&mut reset, &mut { timer });
     #[cfg(not(any(feature = "sharp", feature = "gray", feature = "uc8151")))]
-    let mut target = display::Bands(display::PageTiles { interface });
+    let mut target = display::Bands(display::PageTiles::new(interface));
     #[cfg(feature = "gray")]
     let mut target = display::gray::Gray::new(interface);
     #[cfg(feature = "sharp")]

@@ -45,14 +45,18 @@ pub const CLOCK: u8 = if cfg!(feature = "gray") { 0xf0 } else { 0x80 };
 /// The SSD1306's pre-charge periods (0xD9): phase 2 in the high nibble, phase 1 in the low, in
 /// display clocks (the `ssd1306` crate's 0x21).
 pub const PRECHARGE: u8 = 0x21;
+/// Display off: every set-up's first command.
+pub const DISPLAY_OFF: &[u8] = &[0xae];
+/// Display on: every set-up's last command.
+pub const DISPLAY_ON: &[u8] = &[0xaf];
 /// Display off and the oscillator at [`CLOCK`]: every set-up's first commands.
-const HEAD: &[&[u8]] = &[&[0xae], &[0xd5, CLOCK]];
+const HEAD: &[&[u8]] = &[DISPLAY_OFF, &[0xd5, CLOCK]];
 /// No offset, start line 0, the SSD1306's charge pump on and horizontal addressing.
 const SSD1306_PUMP: &[&[u8]] = &[&[0xd3, 0], &[0x40], &[0x8d, 0x14], &[0x20, 0x00]];
 /// Segment remap and reversed COM scan (upright), the SSD1306's pre-charge, contrast and VCOMH
 /// (the `ssd1306` crate's), the RAM shown as it is, no scrolling, display on.
 const SSD1306_TAIL: &[&[u8]] =
-    &[&[0xa1], &[0xc8], &[0xd9, PRECHARGE], &[0x81, 0x5f], &[0xdb, 0x40], &[0xa4], &[0xa6], &[0x2e], &[0xaf]];
+    &[&[0xa1], &[0xc8], &[0xd9, PRECHARGE], &[0x81, 0x5f], &[0xdb, 0x40], &[0xa4], &[0xa6], &[0x2e], DISPLAY_ON];
 
 /// The SSD1306, 128x64 (the `ssd1306` crate's set-up: horizontal addressing, charge pump on,
 /// segment remap and reversed COM scan, contrast 0x5F).
@@ -88,7 +92,7 @@ pub const SH1106: Controller = Controller {
     set_up: &[
         HEAD,
         &[&[0xa8, 63], &[0xd3, 0], &[0x40], &[0xad, 0x8b], &[0x32], &[0xda, 0x12], &[0xa1], &[0xc8]],
-        &[&[0xd9, 0x22], &[0x81, 0x80], &[0xdb, 0x35], &[0xa4], &[0xa6], &[0xaf]],
+        &[&[0xd9, 0x22], &[0x81, 0x80], &[0xdb, 0x35], &[0xa4], &[0xa6], DISPLAY_ON],
     ],
     addressing: Addressing::Pages,
     column_offset: 2,
@@ -101,7 +105,7 @@ pub const SSD1309: Controller = Controller {
     set_up: &[
         HEAD,
         &[&[0xa8, 63], &[0xd3, 0], &[0x40], &[0x20, 0x00], &[0xda, 0x12], &[0xa1], &[0xc8]],
-        &[&[0xd9, 0x22], &[0x81, 0x7f], &[0xdb, 0x34], &[0xa4], &[0xa6], &[0x2e], &[0xaf]],
+        &[&[0xd9, 0x22], &[0x81, 0x7f], &[0xdb, 0x34], &[0xa4], &[0xa6], &[0x2e], DISPLAY_ON],
     ],
     addressing: Addressing::Window,
     column_offset: 0,
