@@ -200,10 +200,10 @@ impl Session<'_> {
         for sc in &SCENARIOS {
             let fault = (sc.fault)(&f0.frame, &f1.frame, request).as_sent();
             let mut args = fault.args();
+            eprintln!("fault {}: {}", sc.name, args.join(" "));
             if let Fault::PanelOff(start, len) = fault {
                 args.extend(looks(start + len).flat_map(|ms| ["--look-at".to_string(), format!("{ms:.3}")]));
             }
-            eprintln!("fault {}: {}", sc.name, args.join(" "));
             let run = run_emulator(
                 self.root,
                 &self.elf,
