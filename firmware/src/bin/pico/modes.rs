@@ -212,28 +212,21 @@ impl<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: Outpu
     /// sending the picture again every [`REFRESH_MS`]: ends at once when it stopped answering
     /// and answers again ([`Paused::Lost`]), or when a button is pressed ([`crate::button`]).
     pub fn pause(&mut self) -> Paused {
-        use crate::button::Press;
         let mut lost = false;
         for probe in 1..=PAUSE_MS / PROBE_MS {
             sleep_ms(&mut self.alarm, PROBE_MS);
             crate::guard::feed();
             crate::guard::check_requests();
-            match crate::button::pressed() {
-                Some(Press::Next) => {
-                    defmt::info!("the button: the next scene");
-                    return Paused::Next;
-                }
-                Some(Press::Turn) if firmware::app::CAMERA_TURNS => {
-                    defmt::info!("the button: the camera turned");
-                    return Paused::Turn;
-                }
-                Some(Press::Turn) => {
-                    defmt::warn!("the button: this image bakes its scenes for their own cameras (build with `parse` to turn them)")
-                }
-                None => {}
+            if let Some(p) = button() {
+                return p;
             }
             let refresh = !lost && probe % (REFRESH_MS / PROBE_MS) == 0;
             let answers = if refresh { self.target.refresh().is_ok() } else { self.target.answers() };
+            // A refresh keeps the bus for some 25 ms: a button pressed meanwhile is taken now,
+            // not a probe later.
+            if let Some(p) = button().filter(|_| refresh) {
+                return p;
+            }
             match (answers, lost) {
                 (false, _) => lost = true,
                 (true, true) => {
@@ -244,6 +237,28 @@ impl<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: Outpu
             }
         }
         Paused::Elapsed
+    }
+}
+
+/// How a press of a button ends a pause, if one was pressed since the last look
+/// ([`crate::button`]).
+fn button() -> Option<Paused> {
+    use crate::button::Press;
+    match crate::button::pressed()? {
+        Press::Next => {
+            defmt::info!("the button: the next scene");
+            Some(Paused::Next)
+        }
+        Press::Turn if firmware::app::CAMERA_TURNS => {
+            defmt::info!("the button: the camera turned");
+            Some(Paused::Turn)
+        }
+        Press::Turn => {
+            defmt::warn!(
+                "the button: this image bakes its scenes for their own cameras (build with `parse` to turn them)"
+            );
+            None
+        }
     }
 }
 
