@@ -224,7 +224,7 @@ impl<T: DrawTarget<Color = Shown, Error = DisplayError> + SetUp + Send, L: Outpu
             let answers = if refresh { self.target.refresh().is_ok() } else { self.target.answers() };
             // A refresh keeps the bus for some 25 ms: a button pressed meanwhile is taken now,
             // not a probe later.
-            if let Some(p) = button().filter(|_| refresh) {
+            if let Some(p) = refresh.then(button).flatten() {
                 return p;
             }
             match (answers, lost) {

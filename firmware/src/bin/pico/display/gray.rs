@@ -288,14 +288,23 @@ fn now_us() -> u64 {
 }
 
 /// Arms alarm 1 for `at_ns` (timer time), or for 2 us from now if that has passed (a late
-/// write goes out at once rather than after the timer's 71-minute wrap).
+/// write goes out at once rather than after the timer's 71-minute wrap). The alarm fires only
+/// when the timer's low word equals it, so an alarm written after its moment never fires and
+/// the refresh would stop for good: the timer is read after the target is worked out (its
+/// 64-bit division takes microseconds on a Cortex-M0+), and again after the write, which is
+/// made again while the moment has passed.
 fn schedule(at_ns: u64) {
-    let now = now_us();
-    let at = (at_ns / 1000).max(now + 2);
-    // SAFETY: alarm 1 is the refresh's alone; writing it arms it.
-    #[allow(unsafe_code)]
-    unsafe {
-        (*pac::TIMER::ptr()).alarm1().write(|w| w.bits(at as u32));
+    let want = at_ns / 1000;
+    loop {
+        let at = want.max(now_us() + 2);
+        // SAFETY: alarm 1 is the refresh's alone; writing it arms it.
+        #[allow(unsafe_code)]
+        unsafe {
+            (*pac::TIMER::ptr()).alarm1().write(|w| w.bits(at as u32));
+        }
+        if now_us() < at {
+            return;
+        }
     }
 }
 
