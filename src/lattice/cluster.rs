@@ -17,9 +17,10 @@ use crate::scalar::Real;
 use crate::scene::Scene;
 
 /// World cells counted at a time while looking for dense cells, without a heap (their tallies
-/// live on the stack, 32 KB).
+/// live on the stack, 4 KB: a board that parses its scene keeps the scene's storage on the same
+/// stack, and the 32 KB of 2,048 tallies overflowed the `parse` image's on the Whitted scene).
 #[cfg(not(feature = "alloc"))]
-const CHUNK: usize = 2048;
+const CHUNK: usize = 256;
 /// Most world cells counted at a time with a heap (feature `alloc`): 64 MB of tallies, more
 /// than the largest world lattice the automatic resolution makes (`max_per_axis` 64: 262,144
 /// cells), so that a host's scan passes over the objects once, however many there are.

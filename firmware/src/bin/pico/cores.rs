@@ -14,12 +14,13 @@ static CORE1_STACK: hal::multicore::Stack<CORE1_STACK_WORDS> = hal::multicore::S
 /// most (5,984 bytes at 296x128 over the five scenes, as the emulated board found it).
 #[cfg(baked_scenes)]
 const CORE1_STACK_WORDS: usize = 8192;
-/// Core 1's stack in words: 12 KiB where the scenes are parsed on the board (`parse`, `slot`,
-/// `orbit`), whose storage lives on core 0's stack and needs the rest: with 32 KiB here the
-/// `parse` image of the five scenes overflowed core 0's stack at boot, and with 16 KiB it did
-/// once error diffusion dithered rows above the image (core 0 dithers; core 1 only traces).
+/// Core 1's stack in words: 10 KiB where the scenes are parsed on the board (`parse`, `slot`,
+/// `orbit`), whose storage lives on core 0's stack and needs the rest (flip-link gives core 0
+/// what the statics and the code copied to SRAM leave): with 32 KiB here the `parse` image of
+/// the five scenes overflowed core 0's stack at boot, and with 16 KiB it did again once the
+/// core's code in SRAM grew by 4 KiB (core 0 reaches 31,936 bytes in it; core 1 only traces).
 #[cfg(not(baked_scenes))]
-const CORE1_STACK_WORDS: usize = 3072;
+const CORE1_STACK_WORDS: usize = 2560;
 
 /// Core 1: runs each job core 0 sends through the SIO FIFO and answers when it is done.
 fn core1_main() {
