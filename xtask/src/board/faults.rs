@@ -99,9 +99,9 @@ fn mid(f: &PanelFrame) -> f64 {
 /// The scenarios: a power cut in the middle of a frame (the bus sees it), one inside the pause
 /// after a frame (no transfer sees it: the board's probes do), two short ones that neither a
 /// transfer nor a probe sees (the picture sent again while it stands brings it back), a long
-/// one that spans the start of the next frame (its set-up waits for the panel); a reset in the middle of a frame; core 1
-/// stopping in the middle of a frame; a panic between frames; SDA held low in the middle of a
-/// frame and in the pause; one byte of a frame not acknowledged.
+/// one that spans the start of the next frame (its set-up waits for the panel); a reset in the
+/// middle of a frame; core 1 stopping in the middle of a frame; a panic between frames; SDA
+/// held low in the middle of a frame and in the pause; one byte of a frame not acknowledged.
 const SCENARIOS: [Scenario; 11] = [
     Scenario {
         name: "power cut mid-frame",
@@ -201,8 +201,13 @@ impl Session<'_> {
             let fault = (sc.fault)(&f0.frame, &f1.frame, request).as_sent();
             let mut args = fault.args();
             eprintln!("fault {}: {}", sc.name, args.join(" "));
-            if let Fault::PanelOff(start, len) = fault {
-                args.extend(looks(start + len).flat_map(|ms| ["--look-at".to_string(), format!("{ms:.3}")]));
+            // A power cut: when, and the panel looked at after it.
+            let cut = match fault {
+                Fault::PanelOff(start, len) => Some((start, start + len)),
+                _ => None,
+            };
+            if let Some((_, back)) = cut {
+                args.extend(looks(back).flat_map(|ms| ["--look-at".to_string(), format!("{ms:.3}")]));
             }
             let run = run_emulator(
                 self.root,
@@ -236,10 +241,6 @@ impl Session<'_> {
                 })
                 .collect();
             let mut ok = self.checks.check(run.ok, || format!("{}: the run did not finish: {}", sc.name, run.reason));
-            let cut = match fault {
-                Fault::PanelOff(start, len) => Some((start, start + len)),
-                _ => None,
-            };
             let recovery_ms = self.check_frames(sc.name, &run, &outcomes, (end, cut, panicked.as_deref()), &mut ok)?;
             ok &= self.checks.check(outcomes.len() >= run.frames.len(), || {
                 format!("{}: {} frames on the panel, {} reported", sc.name, run.frames.len(), outcomes.len())
